@@ -1,0 +1,116 @@
+// include/phnn/systems/oscillators.h
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace phnn {
+
+using Vec2 = Eigen::Vector2d;
+using Mat2 = Eigen::Matrix2d;
+
+/// The three controlled oscillators of the paper (tab:PHS-examples-and-formulations,
+/// SPEC.md §1).
+enum class SystemKind { kHarmonic = 0, kDuffing = 1, kSelfSustained = 2 };
+
+/// "harmonic", "duffing", "self-sustained".
+std::string to_string(SystemKind kind);
+/// Parses a system name; throws std::invalid_argument naming the value and
+/// listing the allowed names.
+SystemKind parse_system(const std::string& name);
+/// All systems, in paper order.
+std::vector<SystemKind> all_systems();
+
+/// Physical parameters of one oscillator. Defaults are SPEC.md §1; build them
+/// with OscillatorOptions::defaults(kind).
+struct OscillatorOptions {
+  SystemKind kind = SystemKind::kHarmonic;
+  /// m [kg].
+  double mass = 0.16;
+  /// k = k1 [N/m]; with m = 0.16 this gives f0 = 1 Hz.
+  double stiffness = 1.0 / 0.16;
+  /// k3 [N/m^3] of the Duffing oscillator (ignored by the others).
+  double cubic_stiffness = 100.0 / 0.16;
+  /// c [N s/m] of z(w) = c w (harmonic, Duffing). SPEC.md §1: the text's
+  /// "99 % of the energy dissipated in 5 s" gives c = m ln(100) / 5 = 0.14737;
+  /// the paper's Table 5 prints 0.9 (see sweeps/paper-table-damping.toml).
+  double damping = 0.16 * 4.605170185988091 / 5.0;
+  /// z(w) = z1 w + z2 w^2 + z3 w^3 of the self-sustained oscillator.
+  std::array<double, 3> z_coefficients = {3.0, -4.0, 1.3};
+
+  /// SPEC.md §1 defaults for `kind`.
+  static OscillatorOptions defaults(SystemKind kind);
+  /// Throws std::invalid_argument naming the field, value and constraint.
+  void validate() const;
+};
+
+/// Effort-to-flow map of the PH-DAE (eq:phs_S) for one state:
+///   [x_dot; w; y] = S [gradH; z(w); u],   S = -S^T (4 x 4),
+/// rows (x_q, x_p, w, y), columns (grad_q H, grad_p H, z, u). For all three
+/// systems S_ww = 0, so w = S_wx e + S_wu u is explicit in the effort e.
+struct PortFlows {
+  Vec2 x_dot = Vec2::Zero();
+  double w = 0.0;
+  double z = 0.0;
+  double y = 0.0;
+};
+
+/// One controlled oscillator as a port-Hamiltonian system.
+///
+///   Oscillator duffing(OscillatorOptions::defaults(SystemKind::kDuffing));
+///   const Vec2 f = duffing.vector_field(x, /*u=*/0.3);
+class Oscillator {
+ public:
+  explicit Oscillator(OscillatorOptions options);
+
+  const OscillatorOptions& options() const { return options_; }
+  SystemKind kind() const { return options_.kind; }
+
+  /// H(q, p) = p^2 / 2m + k q^2 / 2 (+ k3 q^4 / 4 for Duffing) [J].
+  double hamiltonian(const Vec2& x) const;
+  Vec2 grad_hamiltonian(const Vec2& x) const;
+  Mat2 hessian(const Vec2& x) const;
+
+  /// Dissipation law z(w) and z'(w).
+  double dissipation(double w) const;
+  double dissipation_derivative(double w) const;
+
+  /// S of eq:phs_S (SPEC.md §1 table).
+  const Eigen::Matrix4d& S() const { return S_; }
+  /// J of eq:phs_JR, rows (x_q, x_p, y), columns (grad_q H, grad_p H, u).
+  Eigen::Matrix3d J() const;
+
+  /// Flows of eq:phs_S for effort e (in place of gradH) and input u.
+  PortFlows flows(const Vec2& effort, double u) const;
+  /// Continuous vector field f(x, u) = flows(gradH(x), u).x_dot.
+  Vec2 vector_field(const Vec2& x, double u) const;
+
+  /// Gonzalez discrete gradient (eq: gonzalez-discrete-gradient) in closed
+  /// form, free of cancellation. For H = p^2/2m + k q^2/2 + k3 q^4/4 and
+  /// a = q + dq/2 (midpoint):
+  ///   H(x + dx) - H(x) - gradH(x + dx/2)^T dx = k3 a dq^3 / 4   (exactly),
+  /// so dg = gradH(x + dx/2) + (k3 a dq^3 / 4) / (dx^T dx) dx, and the
+  /// quotient is O(|dx|) with no 0/0 (dg(x, 0) = gradH(x) exactly).
+  Vec2 discrete_gradient(const Vec2& x, const Vec2& dx) const;
+
+  /// d dg / d dx (2 x 2), used by Newton in the implicit DG step.
+  Mat2 discrete_gradient_jacobian(const Vec2& x, const Vec2& dx) const;
+
+  /// I_w = {w : z'(w) < 0} of Algorithm 4 (self-sustained only): the open
+  /// interval between the roots of z'(w). Throws if it is empty.
+  std::array<double, 2> self_oscillation_interval() const;
+
+  /// Equilibrium state x* for a constant input u (SPEC.md §2, Appendix E):
+  /// harmonic/Duffing: (q*, 0) with k q* + k3 q*^3 = -u;
+  /// self-sustained: (0, m z(-u)).
+  Vec2 equilibrium(double u) const;
+
+ private:
+  OscillatorOptions options_;
+  Eigen::Matrix4d S_;
+};
+
+}  // namespace phnn

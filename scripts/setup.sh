@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs every dependency of phnn-sweep from Debian packages. Idempotent:
+# packages already present are skipped by apt. Needs root (or sudo).
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build ccache pkg-config
+  libtorch-dev                       # LibTorch (CPU)
+  libeigen3-dev                      # Eigen: the double-precision physics core
+  libopenmpi-dev openmpi-bin         # Open MPI
+  libhdf5-openmpi-dev hdf5-tools     # parallel HDF5 + h5dump
+  libboost-mpi-dev                   # Boost.MPI (environment, communicator)
+  libgtest-dev libgmock-dev googletest
+  libopenblas0-pthread               # fast BLAS behind libblas.so.3 (LibTorch uses it)
+  libjemalloc-dev                    # allocator: glibc malloc costs ~16 % of a step
+  python3-h5py python3-numpy python3-matplotlib  # analysis/ only
+)
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "setup: all ${#PACKAGES[@]} packages present"
+fi

@@ -1,0 +1,31 @@
+// tests/integrators/explicit_midpoint_test.cpp
+#include "phnn/integrators/explicit_midpoint.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+namespace phnn {
+namespace {
+
+// One step on x' = a x equals the degree-2 Taylor polynomial exactly:
+// x1 = (1 + a h + (a h)^2 / 2) x0 (the corrected eq: rk2-method, with h).
+TEST(ExplicitMidpointTest, MatchesSecondOrderTaylorOnLinearScalarField) {
+  const double a = -1.7, h = 0.05;
+  const Vec2 x0(0.3, -0.2);
+  const Vec2 x1 = explicit_midpoint_step([&](const Vec2& x) { return Vec2(a * x); }, x0, h);
+  const double factor = 1.0 + a * h + 0.5 * a * a * h * h;
+  EXPECT_NEAR(x1(0), factor * x0(0), 1e-16);
+  EXPECT_NEAR(x1(1), factor * x0(1), 1e-16);
+}
+
+TEST(ExplicitMidpointTest, IsSecondOrderOnDampedHarmonicOscillator) {
+  const double e1 = testing_util::global_error(/*dg=*/false, 1e-2, 2.0);
+  const double e2 = testing_util::global_error(/*dg=*/false, 5e-3, 2.0);
+  EXPECT_NEAR(std::log2(e1 / e2), 2.0, 0.1) << e1 << " " << e2;
+}
+
+}  // namespace
+}  // namespace phnn

@@ -1,0 +1,53 @@
+// tests/test_util.h — shared references for the tests.
+#pragma once
+
+#include <cmath>
+
+#include <algorithm>
+
+#include "phnn/integrators/discrete_gradient.h"
+#include "phnn/integrators/explicit_midpoint.h"
+#include "phnn/systems/oscillators.h"
+
+namespace phnn {
+namespace testing_util {
+
+/// Closed-form solution of the damped, forced harmonic oscillator
+///   m q'' + c q' + k q = -u,  p = m q'   (underdamped: c^2 < 4 k m)
+/// from x0 = (q0, p0): q(t) = q* + e^{-g t} (A cos(wd t) + B sin(wd t)),
+/// q* = -u / k, g = c / 2m, wd = sqrt(k/m - g^2).
+inline Vec2 damped_harmonic_solution(const OscillatorOptions& o, const Vec2& x0,
+                                     double u, double t) {
+  const double m = o.mass, k = o.stiffness, c = o.damping;
+  const double g = c / (2.0 * m);
+  const double wd = std::sqrt(k / m - g * g);
+  const double q_star = -u / k;
+  const double A = x0(0) - q_star;
+  const double v0 = x0(1) / m;
+  const double B = (v0 + g * A) / wd;
+  const double e = std::exp(-g * t), cs = std::cos(wd * t), sn = std::sin(wd * t);
+  const double q = q_star + e * (A * cs + B * sn);
+  const double v = e * ((-g * A + wd * B) * cs + (-g * B - wd * A) * sn);
+  return Vec2(q, m * v);
+}
+
+/// Max-norm global error of DG (dg = true) or RK2 against the closed form,
+/// damped harmonic oscillator with u = 0.4 from (0.2, -0.1) over [0, t_end].
+inline double global_error(bool dg, double h, double t_end) {
+  const OscillatorOptions o = OscillatorOptions::defaults(SystemKind::kHarmonic);
+  const Oscillator osc(o);
+  const Vec2 x0(0.2, -0.1);
+  const double u = 0.4;
+  Vec2 x = x0;
+  double err = 0.0;
+  const int steps = static_cast<int>(std::lround(t_end / h));
+  for (int n = 1; n <= steps; ++n) {
+    x = dg ? discrete_gradient_step(osc, x, u, h).x_next
+           : explicit_midpoint_step(osc, x, u, h);
+    err = std::max(err, (x - damped_harmonic_solution(o, x0, u, n * h)).norm());
+  }
+  return err;
+}
+
+}  // namespace testing_util
+}  // namespace phnn
