@@ -1,0 +1,49 @@
+// include/phnn/models/model_config.h — what a model is, without LibTorch.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace phnn {
+
+/// Model formulation (paper §4.1): NODE baseline, PHNN-S (eq:f_theta-PHS-DAF),
+/// PHNN-JR (eq:f_theta-PHS-JR).
+enum class ModelKind { kNode = 0, kPhnnS = 1, kPhnnJr = 2 };
+/// Discrete-model integrator (Eqs. 26, 28-30): explicit midpoint or the
+/// Gonzalez discrete gradient. NODE supports RK2 only.
+enum class IntegratorKind { kRk2 = 0, kDg = 1 };
+/// Network size (paper Tables 10-12, SPEC.md §3).
+enum class ModelSize { kSmall = 0, kMedium = 1, kLarge = 2 };
+
+/// "node", "phnn-s", "phnn-jr".
+std::string to_string(ModelKind kind);
+/// "rk2", "dg".
+std::string to_string(IntegratorKind kind);
+/// "small", "medium", "large".
+std::string to_string(ModelSize size);
+
+/// Parsers: throw std::invalid_argument naming the value and listing the
+/// allowed values.
+ModelKind parse_model(const std::string& name);
+IntegratorKind parse_integrator(const std::string& name);
+ModelSize parse_size(const std::string& name);
+
+/// Hidden widths of each MLP of a model (SPEC.md §3 table).
+struct NetworkWidths {
+  std::vector<int> node;  // NODE: 3 -> ... -> 2
+  std::vector<int> l_h;   // L_H: 2 -> ... -> 3
+  std::vector<int> l_r;   // L_R: 3 -> ... -> 6
+  std::vector<int> l_z;   // L_z: 1 -> ... -> 1
+};
+NetworkWidths network_widths(ModelSize size);
+
+/// Number of trainable parameters of one member (SPEC.md §3): NODE 746 /
+/// 4022 / 20802; PHNN-JR = L_H + L_R; PHNN-S = L_H + L_z.
+long parameter_count(ModelKind kind, ModelSize size);
+/// Parameters of an MLP with the given input, hidden widths and output.
+long mlp_parameter_count(int in, const std::vector<int>& hidden, int out);
+
+/// Paper's label, e.g. "PHNN-JR-DG", "NODE-RK2".
+std::string model_label(ModelKind kind, IntegratorKind integrator);
+
+}  // namespace phnn

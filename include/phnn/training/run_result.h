@@ -1,0 +1,51 @@
+// include/phnn/training/run_result.h — what one run produces, no LibTorch.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace phnn {
+
+/// Status of a run: a diverged run is a result, not an error (STYLE.md).
+enum class RunStatus { kPending = 0, kDone = 1, kDiverged = 2, kFailed = 3 };
+/// "pending", "done", "diverged", "failed".
+std::string to_string(RunStatus status);
+RunStatus parse_run_status(const std::string& name);
+
+/// One validation point of the training log (paper Figures 10 and 12).
+struct TracePoint {
+  int step = 0;
+  double elapsed_s = 0.0;     // wall time since the cell started training
+  double train_loss = 0.0;    // L_d (+ regularizer) of the last minibatch
+  double validation_loss = 0.0;
+  double kappa = 0.0;         // batch-mean condition number of df/dx
+  double sigma_max = 0.0;     // batch-mean spectral norm
+  double rho = 0.0;           // batch-mean stiffness ratio
+};
+
+/// Everything stored for one run (one seed of one cell).
+struct RunResult {
+  RunStatus status = RunStatus::kPending;
+  std::string message;
+  /// Eq. 31 over the inference set (+inf if any rollout diverged).
+  double mse = 0.0;
+  /// Per-trajectory mean squared error (+inf when that rollout diverged).
+  std::vector<double> trajectory_errors;
+  int diverged_rollouts = 0;
+  std::vector<TracePoint> trace;
+  int best_step = 0;
+  double best_validation_loss = 0.0;
+  double wall_time_s = 0.0;
+  int steps = 0;
+  long parameter_count = 0;
+  /// DG inference steps whose Newton did not converge (0 for RK2).
+  std::int64_t newton_failures = 0;
+  /// Predicted trajectories of paper Figures 7 and 9 ([n][2] each): from
+  /// H(x0) = 0.5 J and 0.75 J, u = 0 (harmonic, Duffing) or a limit-cycle u
+  /// (self-sustained); with the reference trajectories.
+  std::vector<double> figure_prediction_05, figure_prediction_075;
+  std::vector<double> figure_reference_05, figure_reference_075;
+};
+
+}  // namespace phnn

@@ -1,0 +1,48 @@
+// include/phnn/training/trainer_options.h — training settings, no LibTorch.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace phnn {
+
+/// Jacobian regularizer (eq:condition-number-loss, eq:spectral-norm-loss,
+/// eq:stiffness-ratio-loss; SPEC.md §4).
+enum class Regularizer { kNone = 0, kCn = 1, kSn = 2, kSr = 3 };
+/// "none", "cn", "sn", "sr".
+std::string to_string(Regularizer reg);
+/// Throws std::invalid_argument naming the value and the allowed values.
+Regularizer parse_regularizer(const std::string& name);
+
+/// Optimizer and schedule of one run (SPEC.md §4). Defaults are SPEC.md's.
+struct TrainerOptions {
+  /// Adam steps.
+  int steps = 50000;
+  double learning_rate = 1e-3;
+  double adam_beta1 = 0.9;
+  double adam_beta2 = 0.999;
+  double adam_eps = 1e-8;
+  /// Minibatch size; all pairs when N_train <= batch_size, otherwise a
+  /// reshuffle per epoch with a short last batch.
+  int batch_size = 64;
+  /// Validation loss at step 0, every eval_every steps and at the last step.
+  int eval_every = 500;
+  /// Regularizer weights.
+  double lambda_cn = 1e-6;
+  double lambda_sn = 1e-6;
+  double lambda_sr = 1e-4;
+  /// Eps in kappa = s_max / (s_min + eps) and rho = max|Re l| / (min|Re l| + eps).
+  double jacobian_eps = 1e-6;
+  /// DG inference Newton (SPEC.md §4): tolerance on ||delta dx||_inf, cap.
+  double newton_tolerance = 1e-12;
+  int newton_max_iterations = 20;
+  /// DG training fallback threshold tau on ||dx||.
+  double dg_min_dx_norm = 6e-6;
+  /// Divergence: a rollout state with ||x|| > divergence_norm (or non-finite).
+  double divergence_norm = 1e6;
+
+  /// Throws std::invalid_argument naming the field, value and constraint.
+  void validate() const;
+};
+
+}  // namespace phnn

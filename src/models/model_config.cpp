@@ -1,0 +1,88 @@
+// src/models/model_config.cpp
+#include "phnn/models/model_config.h"
+
+#include <stdexcept>
+
+namespace phnn {
+
+std::string to_string(ModelKind kind) {
+  switch (kind) {
+    case ModelKind::kNode: return "node";
+    case ModelKind::kPhnnS: return "phnn-s";
+    case ModelKind::kPhnnJr: return "phnn-jr";
+  }
+  return "unknown";
+}
+
+std::string to_string(IntegratorKind kind) {
+  return kind == IntegratorKind::kRk2 ? "rk2" : "dg";
+}
+
+std::string to_string(ModelSize size) {
+  switch (size) {
+    case ModelSize::kSmall: return "small";
+    case ModelSize::kMedium: return "medium";
+    case ModelSize::kLarge: return "large";
+  }
+  return "unknown";
+}
+
+ModelKind parse_model(const std::string& name) {
+  for (ModelKind k : {ModelKind::kNode, ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
+    if (name == to_string(k)) return k;
+  }
+  throw std::invalid_argument("unknown model \"" + name +
+                              "\"; expected one of: node, phnn-s, phnn-jr");
+}
+
+IntegratorKind parse_integrator(const std::string& name) {
+  if (name == "rk2") return IntegratorKind::kRk2;
+  if (name == "dg") return IntegratorKind::kDg;
+  throw std::invalid_argument("unknown integrator \"" + name + "\"; expected one of: rk2, dg");
+}
+
+ModelSize parse_size(const std::string& name) {
+  for (ModelSize s : {ModelSize::kSmall, ModelSize::kMedium, ModelSize::kLarge}) {
+    if (name == to_string(s)) return s;
+  }
+  throw std::invalid_argument("unknown size \"" + name +
+                              "\"; expected one of: small, medium, large");
+}
+
+NetworkWidths network_widths(ModelSize size) {
+  switch (size) {
+    case ModelSize::kSmall: return {{24, 24}, {16, 16}, {16, 16}, {20, 20}};
+    case ModelSize::kMedium: return {{60, 60}, {42, 42}, {42, 42}, {42, 42}};
+    case ModelSize::kLarge: return {{100, 100, 100}, {100, 100}, {100, 100}, {100, 100}};
+  }
+  return {};
+}
+
+long mlp_parameter_count(int in, const std::vector<int>& hidden, int out) {
+  long count = 0;
+  int prev = in;
+  for (int w : hidden) {
+    count += static_cast<long>(prev) * w + w;
+    prev = w;
+  }
+  return count + static_cast<long>(prev) * out + out;
+}
+
+long parameter_count(ModelKind kind, ModelSize size) {
+  const NetworkWidths w = network_widths(size);
+  switch (kind) {
+    case ModelKind::kNode: return mlp_parameter_count(3, w.node, 2);
+    case ModelKind::kPhnnJr:
+      return mlp_parameter_count(2, w.l_h, 3) + mlp_parameter_count(3, w.l_r, 6);
+    case ModelKind::kPhnnS:
+      return mlp_parameter_count(2, w.l_h, 3) + mlp_parameter_count(1, w.l_z, 1);
+  }
+  return 0;
+}
+
+std::string model_label(ModelKind kind, IntegratorKind integrator) {
+  std::string m = kind == ModelKind::kNode ? "NODE" : kind == ModelKind::kPhnnS ? "PHNN-S" : "PHNN-JR";
+  return m + "-" + (integrator == IntegratorKind::kRk2 ? "RK2" : "DG");
+}
+
+}  // namespace phnn

@@ -1,0 +1,75 @@
+// src/sweep/run_config.cpp
+#include "phnn/sweep/run_config.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace phnn {
+
+std::uint64_t fnv1a64(const std::string& text) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+std::string hex64(std::uint64_t value) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(value));
+  return buf;
+}
+
+namespace {
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+}  // namespace
+
+std::string RunConfig::cell_key() const {
+  std::ostringstream s;
+  s << "system=" << to_string(system) << ";model=" << to_string(model)
+    << ";integrator=" << to_string(integrator) << ";size=" << to_string(size)
+    << ";n_train=" << n_train << ";regularizer=" << to_string(regularizer);
+  // Physics: only the parameters the system uses.
+  s << ";mass=" << num(physics.mass) << ";stiffness=" << num(physics.stiffness);
+  if (system == SystemKind::kDuffing) s << ";cubic_stiffness=" << num(physics.cubic_stiffness);
+  if (system == SystemKind::kSelfSustained) {
+    s << ";z=" << num(physics.z_coefficients[0]) << "," << num(physics.z_coefficients[1]) << ","
+      << num(physics.z_coefficients[2]);
+  } else {
+    s << ";damping=" << num(physics.damping);
+  }
+  s << ";data_seed=" << data.data_seed << ";h_gen=" << num(data.generation_step)
+    << ";period=" << num(data.period) << ";alpha=" << num(data.alpha) << ";beta=" << num(data.beta)
+    << ";sample_rate=" << num(data.sample_rate) << ";e0=" << num(data.energy_min) << ","
+    << num(data.energy_max) << ";eeq=" << num(data.equilibrium_energy_min) << ","
+    << num(data.equilibrium_energy_max) << ";n_traj=" << data.num_trajectories
+    << ";splits=" << data.num_train_max << "," << data.num_validation << ","
+    << data.num_inference << ";gen_tol=" << num(data.newton.newton_tolerance);
+  const TrainerOptions& t = training;
+  s << ";steps=" << t.steps << ";lr=" << num(t.learning_rate) << ";adam=" << num(t.adam_beta1)
+    << "," << num(t.adam_beta2) << "," << num(t.adam_eps) << ";batch=" << t.batch_size
+    << ";eval_every=" << t.eval_every;
+  if (regularizer == Regularizer::kCn) s << ";lambda=" << num(t.lambda_cn);
+  if (regularizer == Regularizer::kSn) s << ";lambda=" << num(t.lambda_sn);
+  if (regularizer == Regularizer::kSr) s << ";lambda=" << num(t.lambda_sr);
+  s << ";jac_eps=" << num(t.jacobian_eps);
+  if (integrator == IntegratorKind::kDg) {
+    s << ";newton=" << num(t.newton_tolerance) << "," << t.newton_max_iterations
+      << ";tau=" << num(t.dg_min_dx_norm);
+  }
+  s << ";divergence=" << num(t.divergence_norm);
+  return s.str();
+}
+
+std::string RunConfig::canonical() const {
+  return cell_key() + ";seed=" + std::to_string(seed);
+}
+
+std::string RunConfig::id() const { return hex64(fnv1a64(canonical())); }
+
+}  // namespace phnn

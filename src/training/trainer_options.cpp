@@ -1,0 +1,73 @@
+// src/training/trainer_options.cpp
+#include "phnn/training/trainer_options.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "phnn/common/check.h"
+#include "phnn/training/run_result.h"
+
+namespace phnn {
+
+std::string to_string(Regularizer reg) {
+  switch (reg) {
+    case Regularizer::kNone: return "none";
+    case Regularizer::kCn: return "cn";
+    case Regularizer::kSn: return "sn";
+    case Regularizer::kSr: return "sr";
+  }
+  return "unknown";
+}
+
+Regularizer parse_regularizer(const std::string& name) {
+  for (Regularizer r : {Regularizer::kNone, Regularizer::kCn, Regularizer::kSn, Regularizer::kSr}) {
+    if (name == to_string(r)) return r;
+  }
+  throw std::invalid_argument("unknown regularizer \"" + name +
+                              "\"; expected one of: none, cn, sn, sr");
+}
+
+std::string to_string(RunStatus status) {
+  switch (status) {
+    case RunStatus::kPending: return "pending";
+    case RunStatus::kDone: return "done";
+    case RunStatus::kDiverged: return "diverged";
+    case RunStatus::kFailed: return "failed";
+  }
+  return "unknown";
+}
+
+RunStatus parse_run_status(const std::string& name) {
+  for (RunStatus s : {RunStatus::kPending, RunStatus::kDone, RunStatus::kDiverged, RunStatus::kFailed}) {
+    if (name == to_string(s)) return s;
+  }
+  throw std::invalid_argument("unknown run status \"" + name +
+                              "\"; expected one of: pending, done, diverged, failed");
+}
+
+void TrainerOptions::validate() const {
+  auto fail = [](const char* field, double value, const char* constraint) {
+    PHNN_REQUIRE(false, "Invalid TrainerOptions: " << field << " = " << value
+                                                   << "; violated constraint: " << constraint
+                                                   << ".");
+  };
+  if (steps < 0) fail("steps", steps, "steps >= 0");
+  if (!(learning_rate > 0.0) || !std::isfinite(learning_rate))
+    fail("learning_rate", learning_rate, "learning_rate > 0");
+  if (!(adam_beta1 >= 0.0 && adam_beta1 < 1.0)) fail("adam_beta1", adam_beta1, "0 <= beta1 < 1");
+  if (!(adam_beta2 >= 0.0 && adam_beta2 < 1.0)) fail("adam_beta2", adam_beta2, "0 <= beta2 < 1");
+  if (!(adam_eps > 0.0)) fail("adam_eps", adam_eps, "adam_eps > 0");
+  if (batch_size < 1) fail("batch_size", batch_size, "batch_size >= 1");
+  if (eval_every < 1) fail("eval_every", eval_every, "eval_every >= 1");
+  if (!(lambda_cn >= 0.0)) fail("lambda_cn", lambda_cn, "lambda_cn >= 0");
+  if (!(lambda_sn >= 0.0)) fail("lambda_sn", lambda_sn, "lambda_sn >= 0");
+  if (!(lambda_sr >= 0.0)) fail("lambda_sr", lambda_sr, "lambda_sr >= 0");
+  if (!(jacobian_eps > 0.0)) fail("jacobian_eps", jacobian_eps, "jacobian_eps > 0");
+  if (!(newton_tolerance > 0.0)) fail("newton_tolerance", newton_tolerance, "newton_tolerance > 0");
+  if (newton_max_iterations < 1)
+    fail("newton_max_iterations", newton_max_iterations, "newton_max_iterations >= 1");
+  if (!(dg_min_dx_norm >= 0.0)) fail("dg_min_dx_norm", dg_min_dx_norm, "dg_min_dx_norm >= 0");
+  if (!(divergence_norm > 0.0)) fail("divergence_norm", divergence_norm, "divergence_norm > 0");
+}
+
+}  // namespace phnn
