@@ -1,0 +1,73 @@
+// include/phnn/models/dynamics_model.h — the learned vector field f_theta of
+// a stack of E independent models (one per seed).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <torch/torch.h>
+
+#include "phnn/models/model_config.h"
+#include "phnn/models/stacked_mlp.h"
+#include "phnn/systems/oscillators.h"
+
+namespace phnn {
+
+/// Shapes: x, dx [E, B, 2]; u [E, B, 1]; f [E, B, 2]; df/dx [E, B, 2, 2]
+/// (row = component of f, column = component of x).
+struct FieldEval {
+  torch::Tensor f;
+  torch::Tensor dfdx;  // undefined unless asked for
+};
+
+/// Options of a model stack.
+struct ModelOptions {
+  ModelKind kind = ModelKind::kPhnnJr;
+  ModelSize size = ModelSize::kSmall;
+  /// Supplies S (PHNN-S) or J (PHNN-JR): the known interconnection structure.
+  SystemKind structure = SystemKind::kHarmonic;
+};
+
+/// Base of NODE, PHNN-S and PHNN-JR. Every method is batched over members.
+class DynamicsModel {
+ public:
+  virtual ~DynamicsModel() = default;
+
+  /// Continuous f_theta(x, u); df/dx by forward-mode jets when asked.
+  virtual FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
+                          bool with_jacobian) const = 0;
+  /// True for PHNN-S and PHNN-JR (they have H_theta and support DG).
+  virtual bool is_port_hamiltonian() const { return false; }
+  /// Inverse-explicit DG field (SPEC.md §4): gradH replaced by the Gonzalez
+  /// discrete gradient dg_theta(x, dx); R_theta at x + dx/2.
+  virtual torch::Tensor discrete_gradient_field(const torch::Tensor& x, const torch::Tensor& dx,
+                                                const torch::Tensor& u,
+                                                double min_dx_norm) const;
+  /// H_theta(x) [E, B] and gradH_theta(x) [E, B, 2] (PH models only).
+  virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
+  virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;
+
+  std::vector<torch::Tensor> parameters() const;
+  int64_t members() const { return members_; }
+  /// Trainable parameters of one member.
+  long parameter_count() const;
+  const ModelOptions& options() const { return options_; }
+  /// The networks, for per-component parameter counts and tests.
+  const std::vector<const StackedMlp*> networks() const;
+
+  /// Builds the model stack, member e initialized from seeds[e].
+  static std::unique_ptr<DynamicsModel> create(const ModelOptions& options,
+                                               const std::vector<std::uint64_t>& seeds);
+
+ protected:
+  DynamicsModel(ModelOptions options, int64_t members)
+      : options_(options), members_(members) {}
+  std::vector<std::unique_ptr<StackedMlp>> nets_;
+
+ private:
+  ModelOptions options_;
+  int64_t members_;
+};
+
+}  // namespace phnn

@@ -1,0 +1,87 @@
+// include/phnn/models/port_hamiltonian.h — PHNN-S and PHNN-JR (paper §4).
+#pragma once
+
+#include <array>
+
+#include "phnn/models/dynamics_model.h"
+
+namespace phnn {
+
+/// H_theta(x) = 1/2 x^T L_H(x)^T L_H(x) x (eq:quadratic_H,
+/// eq:physical_constraints_H) with L_H = [[softplus(o0), 0], [o1, softplus(o2)]]
+/// from a 2 -> 3 MLP: Q = L^T L is positive definite by construction.
+/// Returns the jet of H ([E, B, 1]): g = gradH, h = Hessian, up to `order`.
+Jet hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order);
+
+/// Jet whose value is gradH [E, B, 2] and whose g is the Hessian, from the
+/// order-(k+1) jet of H.
+Jet gradient_jet(const Jet& h);
+
+/// Shared by PHNN-S and PHNN-JR: H_theta, gradH_theta, the Gonzalez DG.
+class PortHamiltonianModel : public DynamicsModel {
+ public:
+  bool is_port_hamiltonian() const override { return true; }
+  torch::Tensor hamiltonian(const torch::Tensor& x) const override;
+  torch::Tensor grad_hamiltonian(const torch::Tensor& x) const override;
+  FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
+                  bool with_jacobian) const override;
+  torch::Tensor discrete_gradient_field(const torch::Tensor& x, const torch::Tensor& dx,
+                                        const torch::Tensor& u,
+                                        double min_dx_norm) const override;
+
+  /// Gonzalez discrete gradient of H_theta (eq: gonzalez-discrete-gradient):
+  ///   dg = gradH(x + dx/2) + (H(x+dx) - H(x) - gradH(x+dx/2)^T dx) / |dx|^2 dx,
+  /// = gradH(x + dx/2) where |dx| < min_dx_norm (SPEC.md §4).
+  torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
+                                  double min_dx_norm) const;
+
+ protected:
+  PortHamiltonianModel(ModelOptions options, int64_t members)
+      : DynamicsModel(options, members) {}
+  /// f from an effort jet e ([E,B,2], directions x) evaluated with the
+  /// dissipation network at `x_dissipation` (PHNN-JR: R(x, u)).
+  virtual Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
+                                const torch::Tensor& u, int order) const = 0;
+  const StackedMlp& l_h() const { return *nets_[0]; }
+};
+
+/// PHNN-S (eq:f_theta-PHS-DAF): w = S_wx gradH + S_wu u,
+/// z_theta(w) = Gamma(w) w with Gamma = L_z(w)^T L_z(w) (n_w = 1: K omitted),
+/// f = S_xx gradH + S_xw z_theta(w) + S_xu u.
+class PhnnS : public PortHamiltonianModel {
+ public:
+  PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+
+ protected:
+  Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
+                        const torch::Tensor& u, int order) const override;
+
+ private:
+  std::array<std::array<double, 4>, 4> S_;
+};
+
+/// PHNN-JR (eq:f_theta-PHS-JR): f = [(J - R_theta(x, u)) [gradH; u]]_{1:2},
+/// R = L_R^T L_R with L_R lower triangular 3 x 3 from a 3 -> 6 MLP.
+class PhnnJr : public PortHamiltonianModel {
+ public:
+  PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  /// R_theta(x, u) [E, B, 3, 3] (for tests: symmetric PSD).
+  torch::Tensor dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const;
+
+ protected:
+  Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
+                        const torch::Tensor& u, int order) const override;
+
+ private:
+  std::array<std::array<double, 3>, 3> J_;
+};
+
+/// NODE baseline (eq: neural-ode): f = MLP([x; u]), 3 -> 2.
+class Node : public DynamicsModel {
+ public:
+  Node(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
+                  bool with_jacobian) const override;
+};
+
+}  // namespace phnn

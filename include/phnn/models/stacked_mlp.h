@@ -1,0 +1,75 @@
+// include/phnn/models/stacked_mlp.h — E independent tanh MLPs evaluated as one
+// stack, with forward-mode derivatives (jets) w.r.t. a few input directions.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <torch/torch.h>
+
+namespace phnn {
+
+/// A batch of vector values with their first and (optionally) second
+/// derivatives w.r.t. d input directions ("jet", truncated Taylor series):
+///   v [E, B, n],  g [E, B, d, n] = dv/dx_i,  h [E, B, d, d, n] = d2v/dx_i dx_j.
+/// Undefined g / h mean "not propagated" (order 0 / 1). Forward-mode
+/// propagation needs only a first-order backward to train through gradH and
+/// df/dx (issue 3: half the ops of a create_graph double backward).
+struct Jet {
+  torch::Tensor v, g, h;
+
+  int order() const { return h.defined() ? 2 : g.defined() ? 1 : 0; }
+  /// Jet of the input coordinates: x [E, B, n]; directions are the first d
+  /// coordinates (d <= n), g = [I_d | 0], h = 0 (omitted when order < 2).
+  static Jet input(const torch::Tensor& x, int directions, int order);
+  /// Jet of a value that does not depend on the directions.
+  static Jet constant(const torch::Tensor& v, int directions, int order);
+  /// Component slice [..., k:k+1] (n = 1 afterwards).
+  Jet component(int64_t k) const;
+  /// Concatenation along the value dimension.
+  static Jet cat(const std::vector<Jet>& parts);
+};
+
+/// Elementwise and arithmetic jet operations (chain and product rules).
+Jet jet_add(const Jet& a, const Jet& b);
+Jet jet_sub(const Jet& a, const Jet& b);
+Jet jet_mul(const Jet& a, const Jet& b);
+Jet jet_scale(const Jet& a, double s);
+Jet jet_tanh(const Jet& a);
+Jet jet_softplus(const Jet& a);
+
+/// Options of a stack of MLPs with identical shapes.
+struct StackedMlpOptions {
+  int input = 2;
+  std::vector<int> hidden = {16, 16};
+  int output = 3;
+};
+
+/// E tanh MLPs as weights [E, in, out] and biases [E, 1, out]:
+///   a_{k+1} = tanh(a_k W_k + b_k),  output = a_L W_L + b_L (linear last layer).
+/// Member e is initialized from its own seed with PyTorch's Linear default,
+/// W, b ~ U(-1/sqrt(fan_in), 1/sqrt(fan_in)), so a member's weights do not
+/// depend on which other members share the stack.
+class StackedMlp {
+ public:
+  StackedMlp(StackedMlpOptions options, const std::vector<std::uint64_t>& seeds,
+             std::uint64_t stream);
+
+  /// Plain forward: x [E, B, in] -> [E, B, out].
+  torch::Tensor forward(const torch::Tensor& x) const;
+  /// Forward with derivatives: the input jet's directions are propagated.
+  Jet forward(const Jet& x) const;
+
+  std::vector<torch::Tensor> parameters() const;
+  int64_t members() const { return members_; }
+  /// Trainable parameters of one member.
+  long parameter_count() const;
+  const StackedMlpOptions& options() const { return options_; }
+
+ private:
+  StackedMlpOptions options_;
+  int64_t members_;
+  std::vector<torch::Tensor> weights_, biases_;
+};
+
+}  // namespace phnn

@@ -1,0 +1,67 @@
+// include/phnn/training/trainer.h — trains one cell: all seeds of one
+// configuration as one stacked model (issue 3), then evaluates it.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "phnn/data/dataset_file.h"
+#include "phnn/models/model_config.h"
+#include "phnn/training/run_result.h"
+#include "phnn/training/trainer_options.h"
+
+namespace phnn {
+
+class DynamicsModel;  // phnn/models/dynamics_model.h
+
+/// One cell: runs that differ only by the model seed.
+struct CellSpec {
+  ModelKind model = ModelKind::kPhnnJr;
+  IntegratorKind integrator = IntegratorKind::kRk2;
+  ModelSize size = ModelSize::kSmall;
+  int n_train = 25;
+  Regularizer regularizer = Regularizer::kNone;
+  std::vector<int> seeds = {0};
+  TrainerOptions training;
+
+  /// Throws std::invalid_argument naming the field (e.g. NODE with DG).
+  void validate(const SystemData& data) const;
+};
+
+/// Called at every validation point and at the end of evaluation.
+struct TrainProgress {
+  int step = 0;
+  int total_steps = 0;
+  double elapsed_s = 0.0;
+  double best_validation_loss = 0.0;  // median over live members
+};
+using ProgressCallback = std::function<void(const TrainProgress&)>;
+
+/// Trains the cell on `data` (the first n_train training pairs, the
+/// validation pairs), keeps each member's best-validation weights, rolls all
+/// members out over the inference set (SPEC.md §5) and the two figure
+/// trajectories. Result e belongs to seeds[e] and depends on nothing but the
+/// cell, the data and that seed. A member whose loss turns non-finite is
+/// frozen and reported as diverged; the others go on.
+/// If `trained` is given it receives the model stack with the best weights.
+std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
+                                  const ProgressCallback& progress = {},
+                                  std::unique_ptr<DynamicsModel>* trained = nullptr);
+
+/// Initial states of the figure trajectories (paper Figures 7 and 9):
+/// (q0, 0) with H(q0, 0) = energy, q0 > 0; and their input: u = 0 for
+/// harmonic / Duffing, u = -(center of I_w) for self-sustained.
+struct FigureSetup {
+  Vec2 x0_05, x0_075;
+  double u = 0.0;
+};
+FigureSetup figure_setup(const OscillatorOptions& system);
+
+/// Reference trajectory of the true system from x0 under u: DG at the data
+/// set's generation step, sub-sampled to sr_infer, num_inference_steps + 1
+/// states flattened [n][2].
+std::vector<double> reference_trajectory(const OscillatorOptions& system,
+                                         const DatasetOptions& options, const Vec2& x0, double u);
+
+}  // namespace phnn

@@ -1,0 +1,122 @@
+// src/apps/cmd_train.cpp — `phnn train`: one cell, all its seeds stacked.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include <torch/torch.h>
+
+#include "apps/cli.h"
+#include "apps/commands.h"
+#include "phnn/data/dataset_file.h"
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+namespace apps {
+namespace {
+
+double quantile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, v.size() - 1);
+  const double frac = pos - static_cast<double>(lo);
+  if (frac == 0.0) return v[lo];
+  return v[lo] + frac * (v[hi] - v[lo]);
+}
+
+}  // namespace
+
+int run_train(int argc, char** argv, int first) {
+  cli::Parser parser("train",
+                     "Trains one cell (all seeds of one configuration) as one stacked model,\n"
+                     "then rolls every member out over the inference set (SPEC.md §3-§5).");
+  parser.option("system", "harmonic | duffing | self-sustained", "", true);
+  parser.option("model", "node | phnn-s | phnn-jr", "", true);
+  parser.option("integrator", "rk2 | dg (node: rk2 only)", "rk2");
+  parser.option("size", "small | medium | large", "small");
+  parser.option("n-train", "training pairs (1..400)", "25");
+  parser.option("reg", "none | cn | sn | sr", "none");
+  parser.option("seeds", "model seeds, e.g. 0-9 or 0,3,5", "0-9");
+  parser.option("steps", "Adam steps", "50000");
+  parser.option("lr", "learning rate", "1e-3");
+  parser.option("batch", "minibatch size", "64");
+  parser.option("eval-every", "validation cadence in steps", "500");
+  parser.option("data", "read the data set from this file (`phnn data`) instead of generating it");
+  parser.option("data-seed", "data-set seed when generating", "0");
+  parser.option("damping", "c of z(w) = c w [N s/m] when generating", "0.14737");
+  parser.option("threads", "LibTorch intra-op threads", "1");
+  parser.flag("quiet", "no progress line");
+  if (!parser.parse(argc, argv, first)) return 0;
+
+  CellSpec cell;
+  const SystemKind system = parse_system(parser.get("system"));
+  cell.model = parse_model(parser.get("model"));
+  cell.integrator = parse_integrator(parser.get("integrator"));
+  cell.size = parse_size(parser.get("size"));
+  cell.regularizer = parse_regularizer(parser.get("reg"));
+  cell.n_train = static_cast<int>(parser.get_int("n-train"));
+  for (auto s : cli::parse_int_list("seeds", parser.get("seeds"))) cell.seeds.push_back(static_cast<int>(s));
+  cell.seeds.erase(cell.seeds.begin());  // drop the default {0}
+  const auto steps = parser.get_int("steps");
+  if (steps < 0) throw cli::UsageError{"phnn train: --steps = " + std::to_string(steps) + " must be >= 0"};
+  cell.training.steps = static_cast<int>(steps);
+  cell.training.learning_rate = parser.get_double("lr");
+  cell.training.batch_size = static_cast<int>(parser.get_int("batch"));
+  cell.training.eval_every = static_cast<int>(parser.get_int("eval-every"));
+  const auto threads = parser.get_int("threads");
+  if (threads < 1) throw cli::UsageError{"phnn train: --threads must be >= 1"};
+  torch::set_num_threads(static_cast<int>(threads));
+
+  SystemData data;
+  if (parser.has("data")) {
+    data = read_dataset_file(parser.get("data"));
+    if (data.system.kind != system) {
+      throw cli::UsageError{"phnn train: --data " + parser.get("data") + " holds system " +
+                            to_string(data.system.kind) + ", not " + to_string(system)};
+    }
+  } else {
+    OscillatorOptions physics = OscillatorOptions::defaults(system);
+    if (parser.has("damping")) physics.damping = parser.get_double("damping");
+    DatasetOptions options;
+    const auto ds = parser.get_int("data-seed");
+    if (ds < 0) throw cli::UsageError{"phnn train: --data-seed must be >= 0"};
+    options.data_seed = static_cast<std::uint64_t>(ds);
+    if (cell.n_train < 1 || cell.n_train > options.num_train_max) {
+      throw cli::UsageError{"phnn train: --n-train = " + std::to_string(cell.n_train) +
+                            " outside [1, " + std::to_string(options.num_train_max) + "]"};
+    }
+    data = make_system_data(physics, options, cell.n_train);
+  }
+  cell.validate(data);
+  std::cout << "phnn train: " << to_string(system) << " " << model_label(cell.model, cell.integrator)
+            << " size=" << to_string(cell.size) << " n_train=" << cell.n_train
+            << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
+            << " steps=" << cell.training.steps << "\n";
+  const bool quiet = parser.flag_set("quiet");
+  const auto results = train_cell(cell, data, [&](const TrainProgress& p) {
+    if (quiet) return;
+    const double eta = p.step > 0 ? p.elapsed_s / p.step * (p.total_steps - p.step) : 0.0;
+    std::fprintf(stderr, "\r  step %d/%d  best val %.3e  elapsed %.0f s  ETA %.0f s   ", p.step,
+                 p.total_steps, p.best_validation_loss, p.elapsed_s, eta);
+    if (p.step == p.total_steps) std::fprintf(stderr, "\n");
+  });
+  std::vector<double> mses;
+  double wall = 0.0;
+  std::printf("%6s  %12s  %10s  %s\n", "seed", "MSE", "best step", "status");
+  for (std::size_t e = 0; e < results.size(); ++e) {
+    const RunResult& r = results[e];
+    std::printf("%6d  %12.4e  %10d  %s %s\n", cell.seeds[e], r.mse, r.best_step,
+                to_string(r.status).c_str(), r.message.c_str());
+    mses.push_back(r.mse);
+    wall += r.wall_time_s;
+  }
+  const double q25 = quantile(mses, 0.25), q50 = quantile(mses, 0.5), q75 = quantile(mses, 0.75);
+  std::printf("median [IQR]: %.2e [%.2e]   parameters/member: %ld   wall time: %.1f s\n", q50,
+              q75 - q25, results.empty() ? 0L : results[0].parameter_count, wall);
+  return 0;
+}
+
+}  // namespace apps
+}  // namespace phnn

@@ -1,0 +1,58 @@
+// src/models/dynamics_model.cpp
+#include "phnn/models/dynamics_model.h"
+
+#include "phnn/common/check.h"
+#include "phnn/models/port_hamiltonian.h"
+
+namespace phnn {
+
+torch::Tensor DynamicsModel::discrete_gradient_field(const torch::Tensor&, const torch::Tensor&,
+                                                     const torch::Tensor&, double) const {
+  PHNN_REQUIRE(false, "discrete_gradient_field: " << to_string(options_.kind)
+                                                  << " has no Hamiltonian; the DG integrator "
+                                                     "needs phnn-s or phnn-jr");
+  return {};
+}
+
+torch::Tensor DynamicsModel::hamiltonian(const torch::Tensor&) const {
+  PHNN_REQUIRE(false, "hamiltonian: " << to_string(options_.kind) << " has no Hamiltonian");
+  return {};
+}
+
+torch::Tensor DynamicsModel::grad_hamiltonian(const torch::Tensor&) const {
+  PHNN_REQUIRE(false, "grad_hamiltonian: " << to_string(options_.kind) << " has no Hamiltonian");
+  return {};
+}
+
+std::vector<torch::Tensor> DynamicsModel::parameters() const {
+  std::vector<torch::Tensor> out;
+  for (const auto& net : nets_) {
+    for (const auto& p : net->parameters()) out.push_back(p);
+  }
+  return out;
+}
+
+long DynamicsModel::parameter_count() const {
+  long n = 0;
+  for (const auto& net : nets_) n += net->parameter_count();
+  return n;
+}
+
+const std::vector<const StackedMlp*> DynamicsModel::networks() const {
+  std::vector<const StackedMlp*> out;
+  for (const auto& net : nets_) out.push_back(net.get());
+  return out;
+}
+
+std::unique_ptr<DynamicsModel> DynamicsModel::create(const ModelOptions& options,
+                                                     const std::vector<std::uint64_t>& seeds) {
+  switch (options.kind) {
+    case ModelKind::kNode: return std::make_unique<Node>(options, seeds);
+    case ModelKind::kPhnnS: return std::make_unique<PhnnS>(options, seeds);
+    case ModelKind::kPhnnJr: return std::make_unique<PhnnJr>(options, seeds);
+  }
+  PHNN_CHECK(false, "unknown model kind");
+  return nullptr;
+}
+
+}  // namespace phnn

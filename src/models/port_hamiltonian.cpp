@@ -1,0 +1,192 @@
+// src/models/port_hamiltonian.cpp
+#include "phnn/models/port_hamiltonian.h"
+
+#include <utility>
+
+#include "phnn/common/check.h"
+
+namespace phnn {
+namespace {
+
+// Network streams: distinct initializations for the networks of one member.
+constexpr std::uint64_t kStreamLH = 1, kStreamLR = 2, kStreamLz = 3, kStreamNode = 4;
+
+// sum_k c_k a_k over the non-zero coefficients (the structure matrices are
+// sparse {-1, 0, 1}).
+Jet lincomb(const std::vector<std::pair<double, const Jet*>>& terms, const Jet& zero_like) {
+  Jet out;
+  bool first = true;
+  for (const auto& [c, jet] : terms) {
+    if (c == 0.0) continue;
+    const Jet term = c == 1.0 ? *jet : jet_scale(*jet, c);
+    out = first ? term : jet_add(out, term);
+    first = false;
+  }
+  return first ? jet_scale(zero_like, 0.0) : out;
+}
+
+}  // namespace
+
+Jet hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order) {
+  const Jet X = Jet::input(x, /*directions=*/2, order);
+  const Jet o = l_h.forward(X);
+  const Jet l00 = jet_softplus(o.component(0));
+  const Jet l10 = o.component(1);
+  const Jet l11 = jet_softplus(o.component(2));
+  const Jet x0 = X.component(0), x1 = X.component(1);
+  // v = L_H x, H = |v|^2 / 2.
+  const Jet v0 = jet_mul(l00, x0);
+  const Jet v1 = jet_add(jet_mul(l10, x0), jet_mul(l11, x1));
+  return jet_scale(jet_add(jet_mul(v0, v0), jet_mul(v1, v1)), 0.5);
+}
+
+Jet gradient_jet(const Jet& h) {
+  PHNN_CHECK(h.g.defined(), "gradient_jet needs an order >= 1 jet of H");
+  Jet g;
+  g.v = h.g.squeeze(-1);                      // [E, B, 2]
+  if (h.h.defined()) g.g = h.h.squeeze(-1);  // [E, B, d, 2], symmetric
+  return g;
+}
+
+torch::Tensor PortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
+  return hamiltonian_jet(l_h(), x, 0).v.squeeze(-1);
+}
+
+torch::Tensor PortHamiltonianModel::grad_hamiltonian(const torch::Tensor& x) const {
+  return hamiltonian_jet(l_h(), x, 1).g.squeeze(-1);
+}
+
+FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tensor& u,
+                                      bool with_jacobian) const {
+  const int order = with_jacobian ? 1 : 0;
+  const Jet grad = gradient_jet(hamiltonian_jet(l_h(), x, order + 1));
+  const Jet f = field_from_effort(grad, x, u, order);
+  FieldEval out;
+  out.f = f.v;
+  if (with_jacobian) out.dfdx = f.g.transpose(-1, -2);
+  return out;
+}
+
+torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
+                                                      const torch::Tensor& dx,
+                                                      double min_dx_norm) const {
+  const int64_t B = x.size(1);
+  // One network call for H(x), H(x + dx) and gradH(x + dx/2).
+  const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
+  const Jet h = hamiltonian_jet(l_h(), points, /*order=*/1);
+  const auto h_x = h.v.narrow(1, 0, B);
+  const auto h_xdx = h.v.narrow(1, B, B);
+  const auto grad_mid = h.g.narrow(1, 2 * B, B).squeeze(-1);  // [E, B, 2]
+  const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);
+  const auto defect = h_xdx - h_x - (grad_mid * dx).sum(-1, /*keepdim=*/true);
+  const auto small = n2 < min_dx_norm * min_dx_norm;
+  const auto coef = torch::where(small, torch::zeros_like(defect),
+                                 defect / torch::where(small, torch::ones_like(n2), n2));
+  return grad_mid + coef * dx;
+}
+
+torch::Tensor PortHamiltonianModel::discrete_gradient_field(const torch::Tensor& x,
+                                                            const torch::Tensor& dx,
+                                                            const torch::Tensor& u,
+                                                            double min_dx_norm) const {
+  Jet effort;
+  effort.v = discrete_gradient(x, dx, min_dx_norm);
+  return field_from_effort(effort, x + 0.5 * dx, u, /*order=*/0).v;
+}
+
+// ---------------------------------------------------------------- PHNN-S
+PhnnS::PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds)
+    : PortHamiltonianModel(options, static_cast<int64_t>(seeds.size())) {
+  PHNN_REQUIRE(options.kind == ModelKind::kPhnnS, "PhnnS: options.kind must be phnn-s");
+  const NetworkWidths w = network_widths(options.size);
+  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{2, w.l_h, 3}, seeds, kStreamLH));
+  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{1, w.l_z, 1}, seeds, kStreamLz));
+  const Oscillator structure(OscillatorOptions::defaults(options.structure));
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) S_[r][c] = structure.S()(r, c);
+}
+
+Jet PhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_dissipation*/,
+                             const torch::Tensor& u, int order) const {
+  const Jet eq = effort.component(0), ep = effort.component(1);
+  const Jet U = Jet::constant(u, /*directions=*/2, order);
+  // w = S_wx e + S_wu u (S_ww = 0 for the three systems).
+  const Jet w = lincomb({{S_[2][0], &eq}, {S_[2][1], &ep}, {S_[2][3], &U}}, U);
+  // z(w) = Gamma(w) w, Gamma = L_z^T L_z >= 0 (eq:physical_constraints_Gamma).
+  const Jet l = nets_[1]->forward(w);
+  const Jet z = jet_mul(jet_mul(l, l), w);
+  const Jet f0 = lincomb({{S_[0][0], &eq}, {S_[0][1], &ep}, {S_[0][2], &z}, {S_[0][3], &U}}, U);
+  const Jet f1 = lincomb({{S_[1][0], &eq}, {S_[1][1], &ep}, {S_[1][2], &z}, {S_[1][3], &U}}, U);
+  return Jet::cat({f0, f1});
+}
+
+// --------------------------------------------------------------- PHNN-JR
+PhnnJr::PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds)
+    : PortHamiltonianModel(options, static_cast<int64_t>(seeds.size())) {
+  PHNN_REQUIRE(options.kind == ModelKind::kPhnnJr, "PhnnJr: options.kind must be phnn-jr");
+  const NetworkWidths w = network_widths(options.size);
+  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{2, w.l_h, 3}, seeds, kStreamLH));
+  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{3, w.l_r, 6}, seeds, kStreamLR));
+  const Oscillator structure(OscillatorOptions::defaults(options.structure));
+  const Eigen::Matrix3d J = structure.J();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) J_[r][c] = J(r, c);
+}
+
+torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const {
+  const auto o = nets_[1]->forward(torch::cat({x, u}, -1));  // [E, B, 6]
+  auto L = torch::zeros({x.size(0), x.size(1), 3, 3}, x.options());
+  int idx = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j <= k; ++j) L.select(-2, k).select(-1, j).copy_(o.select(-1, idx++));
+  return torch::matmul(L.transpose(-1, -2), L);
+}
+
+Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
+                              const torch::Tensor& u, int order) const {
+  // L_R(x, u): lower triangular 3 x 3 from 6 outputs, row by row.
+  const Jet o = nets_[1]->forward(Jet::input(torch::cat({x_dissipation, u}, -1), 2, order));
+  Jet L[3][3];
+  int idx = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j <= k; ++j) L[k][j] = o.component(idx++);
+  const Jet U = Jet::constant(u, 2, order);
+  const Jet e[3] = {effort.component(0), effort.component(1), U};
+  // v = L_R e;  R e = L_R^T v.
+  Jet v[3];
+  for (int k = 0; k < 3; ++k) {
+    v[k] = jet_mul(L[k][0], e[0]);
+    for (int j = 1; j <= k; ++j) v[k] = jet_add(v[k], jet_mul(L[k][j], e[j]));
+  }
+  Jet f[2];
+  for (int i = 0; i < 2; ++i) {
+    Jet re = jet_mul(L[i][i], v[i]);
+    for (int k = i + 1; k < 3; ++k) re = jet_add(re, jet_mul(L[k][i], v[k]));
+    const Jet je = lincomb({{J_[i][0], &e[0]}, {J_[i][1], &e[1]}, {J_[i][2], &e[2]}}, U);
+    f[i] = jet_sub(je, re);
+  }
+  return Jet::cat({f[0], f[1]});
+}
+
+// ------------------------------------------------------------------ NODE
+Node::Node(ModelOptions options, const std::vector<std::uint64_t>& seeds)
+    : DynamicsModel(options, static_cast<int64_t>(seeds.size())) {
+  PHNN_REQUIRE(options.kind == ModelKind::kNode, "Node: options.kind must be node");
+  nets_.push_back(std::make_unique<StackedMlp>(
+      StackedMlpOptions{3, network_widths(options.size).node, 2}, seeds, kStreamNode));
+}
+
+FieldEval Node::field(const torch::Tensor& x, const torch::Tensor& u, bool with_jacobian) const {
+  FieldEval out;
+  const auto input = torch::cat({x, u}, -1);
+  if (!with_jacobian) {
+    out.f = nets_[0]->forward(input);
+    return out;
+  }
+  const Jet f = nets_[0]->forward(Jet::input(input, /*directions=*/2, /*order=*/1));
+  out.f = f.v;
+  out.dfdx = f.g.transpose(-1, -2);
+  return out;
+}
+
+}  // namespace phnn

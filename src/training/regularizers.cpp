@@ -1,0 +1,43 @@
+// src/training/regularizers.cpp
+#include "phnn/training/regularizers.h"
+
+namespace phnn {
+namespace {
+// sqrt with a finite derivative at 0 (the clamped branch has zero slope).
+torch::Tensor safe_sqrt(const torch::Tensor& s) { return torch::sqrt(s.clamp_min(1e-300)); }
+}  // namespace
+
+JacobianStats jacobian_stats(const torch::Tensor& jacobian, double eps) {
+  const auto a = jacobian.select(-2, 0).select(-1, 0);
+  const auto b = jacobian.select(-2, 0).select(-1, 1);
+  const auto c = jacobian.select(-2, 1).select(-1, 0);
+  const auto d = jacobian.select(-2, 1).select(-1, 1);
+  const auto s1 = safe_sqrt((a + d) * (a + d) + (c - b) * (c - b));
+  const auto s2 = safe_sqrt((a - d) * (a - d) + (c + b) * (c + b));
+  JacobianStats out;
+  out.sigma_max = 0.5 * (s1 + s2);
+  out.sigma_min = 0.5 * (s1 - s2).abs();
+  out.kappa = out.sigma_max / (out.sigma_min + eps);
+  const auto half_trace = 0.5 * (a + d);
+  const auto disc = half_trace * half_trace - (a * d - b * c);
+  const auto root = torch::where(disc > 0, safe_sqrt(disc), torch::zeros_like(disc));
+  const auto re1 = (half_trace + root).abs(), re2 = (half_trace - root).abs();
+  out.rho = torch::maximum(re1, re2) / (torch::minimum(re1, re2) + eps);
+  return out;
+}
+
+torch::Tensor regularizer_penalty(Regularizer reg, const JacobianStats& stats,
+                                  const TrainerOptions& options) {
+  switch (reg) {
+    case Regularizer::kCn: return options.lambda_cn * (stats.kappa * stats.kappa).mean(-1);
+    case Regularizer::kSn: return options.lambda_sn * stats.sigma_max.mean(-1);
+    case Regularizer::kSr: {
+      const auto r = stats.rho - 1.0;
+      return options.lambda_sr * (r * r).mean(-1);
+    }
+    case Regularizer::kNone: break;
+  }
+  return torch::zeros({stats.kappa.size(0)}, stats.kappa.options());
+}
+
+}  // namespace phnn
