@@ -104,11 +104,13 @@ int run_train(int argc, char** argv, int first) {
   });
   std::vector<double> mses;
   double wall = 0.0;
-  std::printf("%6s  %12s  %10s  %s\n", "seed", "MSE", "best step", "status");
+  std::printf("%6s  %12s  %11s  %11s  %9s  %s\n", "seed", "MSE", "val(step 0)", "best val",
+              "best step", "status");
   for (std::size_t e = 0; e < results.size(); ++e) {
     const RunResult& r = results[e];
-    std::printf("%6d  %12.4e  %10d  %s %s\n", cell.seeds[e], r.mse, r.best_step,
-                to_string(r.status).c_str(), r.message.c_str());
+    std::printf("%6d  %12.4e  %11.3e  %11.3e  %9d  %s %s\n", cell.seeds[e], r.mse,
+                r.trace.empty() ? NAN : r.trace.front().validation_loss, r.best_validation_loss,
+                r.best_step, to_string(r.status).c_str(), r.message.c_str());
     mses.push_back(r.mse);
     wall += r.wall_time_s;
   }

@@ -1,0 +1,52 @@
+// include/phnn/sweep/scheduler.h — shares the cells of a sweep out over MPI
+// ranks.
+#pragma once
+
+#include <mpi.h>
+
+#include <string>
+
+namespace phnn {
+
+/// Dynamic: a shared counter on rank 0 read-and-incremented with MPI-3
+/// one-sided MPI_Fetch_and_op, so a free rank takes the next item (items are
+/// sorted largest cost first: longest-processing-time-first). Static: item i
+/// goes to rank i % size, no communication at all.
+enum class ScheduleMode { kDynamic, kStatic };
+std::string to_string(ScheduleMode mode);
+
+/// A work queue of items 0..n-1 shared by the ranks of `comm`.
+///
+///   WorkQueue queue(comm, cells.size(), ScheduleMode::kDynamic);
+///   for (int i = queue.next(); i >= 0; i = queue.next()) { run(i); queue.mark_done(); }
+///   queue.close();  // collective
+class WorkQueue {
+ public:
+  /// Collective. If the window cannot be created (MPI_Win_allocate fails)
+  /// the queue falls back to kStatic; mode() tells which one is in use.
+  WorkQueue(MPI_Comm comm, int num_items, ScheduleMode mode);
+  ~WorkQueue();
+  WorkQueue(const WorkQueue&) = delete;
+  WorkQueue& operator=(const WorkQueue&) = delete;
+
+  /// Next item for this rank, -1 when the queue is exhausted.
+  int next();
+  /// Counts one finished item (for progress on rank 0).
+  void mark_done();
+  /// Items finished by all ranks so far (exact on rank 0 in dynamic mode;
+  /// this rank's own count in static mode).
+  int done() const;
+  ScheduleMode mode() const { return mode_; }
+  /// Collective: frees the window. Called by the destructor if needed.
+  void close();
+
+ private:
+  MPI_Comm comm_;
+  int rank_ = 0, size_ = 1, num_items_ = 0;
+  ScheduleMode mode_;
+  MPI_Win window_ = MPI_WIN_NULL;
+  long* counters_ = nullptr;  // [0] = next item, [1] = items done (rank 0)
+  int static_next_ = 0, local_done_ = 0;
+};
+
+}  // namespace phnn

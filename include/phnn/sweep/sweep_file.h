@@ -1,0 +1,102 @@
+// include/phnn/sweep/sweep_file.h — sweep files: what a sweep trains.
+#pragma once
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "phnn/data/dataset.h"
+#include "phnn/models/model_config.h"
+#include "phnn/systems/oscillators.h"
+#include "phnn/training/trainer_options.h"
+
+namespace phnn {
+
+/// A sweep file that cannot be used. what() is "FILE:LINE: message" (line 1
+/// for problems of the whole file, such as a missing `name`), or
+/// "FILE: message" when the file cannot be read at all. The message names the
+/// offending key or value and, where there is a finite set, the allowed ones:
+///
+///   sweeps/x.toml:14: unknown integrator "rk4" in models value "phnn-s-rk4";
+///   expected one of: node-rk2, phnn-jr-dg, phnn-jr-rk2, phnn-s-dg, phnn-s-rk2
+class SweepFileError : public std::invalid_argument {
+ public:
+  /// line <= 0: the error concerns the file as a whole and has no line.
+  SweepFileError(const std::string& file, int line, const std::string& message);
+
+  const std::string& file() const { return file_; }
+  int line() const { return line_; }
+  /// The message without the "FILE:LINE: " prefix.
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string file_;
+  int line_;
+  std::string message_;
+};
+
+/// One study: the axes a grid is built from (the [grid] table, overridden by
+/// the study's own [study.NAME] table). Every axis is non-empty and free of
+/// duplicates; values keep the order of the file.
+struct StudySpec {
+  /// NAME of [study.NAME], or "grid" when the file has no [study.*] table.
+  std::string name;
+  /// Optional human-readable title (paper's study caption).
+  std::string title;
+  std::vector<SystemKind> systems;
+  /// Formulation-integrator pairs, e.g. {kPhnnJr, kDg} for "phnn-jr-dg".
+  std::vector<std::pair<ModelKind, IntegratorKind>> models;
+  std::vector<ModelSize> sizes;
+  /// N_train values, each in [1, DatasetOptions::num_train_max].
+  std::vector<int> n_train;
+  std::vector<Regularizer> regularizers;
+  /// Model-initialization seeds, each >= 0.
+  std::vector<int> seeds;
+};
+
+/// A parsed and validated sweep file: SPEC.md defaults overridden by the file.
+///
+///   const SweepSpec spec = parse_sweep_file("sweeps/paper.toml");
+///   const Grid grid = expand_grid(spec);  // phnn/sweep/grid.h
+struct SweepSpec {
+  /// `name` (required).
+  std::string name;
+  /// `output`: default results-file path (the CLI may override it);
+  /// "results/<name>.h5" when the file does not set it.
+  std::string output;
+  /// Path the file was read from (the display name for parse_sweep_text).
+  std::string source_path;
+  /// The file's full text, stored verbatim in the results file.
+  std::string text;
+  /// hex64(fnv1a64(text)): identifies the exact file a results file came from.
+  std::string text_hash;
+  /// Physical parameters of every system (all three are present, whether or
+  /// not a study uses them): OscillatorOptions::defaults(kind) overridden by
+  /// [physics.<system>].
+  std::map<SystemKind, OscillatorOptions> physics;
+  /// DatasetOptions{} overridden by [data].
+  DatasetOptions data;
+  /// TrainerOptions{} overridden by [training].
+  TrainerOptions training;
+  /// The studies in file order (at least one).
+  std::vector<StudySpec> studies;
+};
+
+/// Reads and parses a sweep file (format: sweeps/FORMAT.md). Throws
+/// SweepFileError naming the path if the file cannot be read, or the line of
+/// the first problem otherwise.
+SweepSpec parse_sweep_file(const std::string& path);
+
+/// Parses sweep-file text; `display_name` is used in error messages and as
+/// SweepSpec::source_path. Throws SweepFileError.
+SweepSpec parse_sweep_text(const std::string& text, const std::string& display_name);
+
+/// "node-rk2", "phnn-jr-dg", ...: the sweep-file spelling of a model.
+std::string model_key(ModelKind kind, IntegratorKind integrator);
+/// The five valid pairs in the order node-rk2, phnn-jr-dg, phnn-jr-rk2,
+/// phnn-s-dg, phnn-s-rk2 (NODE has RK2 only, SPEC.md §3).
+std::vector<std::pair<ModelKind, IntegratorKind>> all_model_pairs();
+
+}  // namespace phnn

@@ -1,0 +1,249 @@
+// tests/sweep/grid_test.cpp
+#include "phnn/sweep/grid.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <sstream>
+#include <string>
+
+namespace phnn {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+const std::string kSweeps = std::string(PHNN_SOURCE_DIR) + "/sweeps/";
+
+// Cost-model results are sums of a few products of exact binary fractions.
+constexpr double kCostTolerance = 1e-9;
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+Grid paper_grid() { return expand_grid(parse_sweep_file(kSweeps + "paper.toml")); }
+
+TEST(GridTest, PaperSweepIs1200RunsIn120Cells) {
+  const Grid grid = paper_grid();
+  EXPECT_EQ(first_line(dry_run_summary(grid, /*ranks=*/64)), "1200 runs in 120 cells");
+  ASSERT_EQ(grid.runs.size(), 1200u);
+  ASSERT_EQ(grid.cells.size(), 120u);
+  ASSERT_EQ(grid.run_studies.size(), 1200u);
+  std::set<int> covered;
+  for (const Cell& cell : grid.cells) {
+    ASSERT_EQ(cell.runs.size(), 10u) << cell.key;
+    for (std::size_t i = 0; i < cell.runs.size(); ++i) {
+      EXPECT_EQ(grid.runs[cell.runs[i]].seed, static_cast<int>(i)) << "seeds sorted 0..9";
+      EXPECT_EQ(grid.runs[cell.runs[i]].cell_key(), cell.key);
+      covered.insert(cell.runs[i]);
+    }
+  }
+  EXPECT_EQ(covered.size(), 1200u) << "every run is in exactly one cell";
+}
+
+TEST(GridTest, PaperRunIdsAreUnique) {
+  const Grid grid = paper_grid();
+  std::set<std::string> ids, canonicals;
+  for (const RunConfig& run : grid.runs) {
+    ids.insert(run.id());
+    canonicals.insert(run.canonical());
+  }
+  EXPECT_EQ(ids.size(), 1200u);
+  EXPECT_EQ(canonicals.size(), 1200u);
+}
+
+TEST(GridTest, PaperStudiesHaveTheSpecRunCounts) {
+  const Grid grid = paper_grid();
+  ASSERT_EQ(grid.studies.size(), 3u);
+  EXPECT_EQ(grid.studies[0].runs.size(), 450u);  // 3 systems x 5 models x 3 n_train x 10
+  EXPECT_EQ(grid.studies[1].runs.size(), 450u);  // 3 x 5 x 3 sizes x 10
+  EXPECT_EQ(grid.studies[2].runs.size(), 600u);  // 3 x 5 x 4 regularizers x 10
+  std::set<int> all;
+  for (const StudyTable& study : grid.studies) {
+    EXPECT_EQ(std::set<int>(study.runs.begin(), study.runs.end()).size(), study.runs.size());
+    all.insert(study.runs.begin(), study.runs.end());
+  }
+  EXPECT_EQ(all.size(), 1200u);
+  const std::string summary = dry_run_summary(grid, /*ranks=*/8);
+  EXPECT_THAT(summary, HasSubstr("study I: 450 runs in 45 cells"));
+  EXPECT_THAT(summary, HasSubstr("study II: 450 runs in 45 cells"));
+  EXPECT_THAT(summary, HasSubstr("study III: 600 runs in 60 cells"));
+}
+
+TEST(GridTest, SharedRunIsTrainedOnceAndListsEveryStudy) {
+  const Grid grid = paper_grid();
+  // small, n_train 25, no regularizer: in Studies I, II and III.
+  int shared = 0;
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+    const RunConfig& run = grid.runs[i];
+    const bool in_all =
+        run.size == ModelSize::kSmall && run.n_train == 25 && run.regularizer == Regularizer::kNone;
+    if (in_all) {
+      EXPECT_THAT(grid.run_studies[i], ElementsAre("I", "II", "III"));
+      ++shared;
+    } else {
+      EXPECT_EQ(grid.run_studies[i].size(), 1u);
+    }
+  }
+  EXPECT_EQ(shared, 150);  // 3 systems x 5 models x 10 seeds
+  // The first run is the first of Study I, nested system, model, ..., seed.
+  EXPECT_EQ(grid.runs[0].system, SystemKind::kHarmonic);
+  EXPECT_EQ(grid.runs[0].model, ModelKind::kNode);
+  EXPECT_EQ(grid.runs[0].seed, 0);
+  EXPECT_EQ(grid.runs[1].seed, 1);
+  EXPECT_EQ(grid.runs[10].n_train, 100);
+}
+
+TEST(GridTest, StudyTablesHaveTheVariedAxisAsColumns) {
+  const Grid grid = paper_grid();
+  const std::vector<std::string> models = {"NODE-RK2", "PHNN-JR-DG", "PHNN-JR-RK2", "PHNN-S-DG",
+                                           "PHNN-S-RK2"};
+  EXPECT_EQ(grid.studies[0].varied_axis, "n_train");
+  EXPECT_THAT(grid.studies[0].columns, ElementsAre("25", "100", "400"));
+  EXPECT_EQ(grid.studies[1].varied_axis, "size");
+  EXPECT_THAT(grid.studies[1].columns, ElementsAre("small", "medium", "large"));
+  EXPECT_EQ(grid.studies[2].varied_axis, "regularizer");
+  EXPECT_THAT(grid.studies[2].columns, ElementsAre("none", "cn", "sn", "sr"));
+  for (const StudyTable& study : grid.studies) {
+    EXPECT_EQ(study.rows, models);
+    EXPECT_EQ(study.systems.size(), 3u);
+    ASSERT_EQ(study.run_columns.size(), study.runs.size());
+  }
+  EXPECT_EQ(grid.studies[0].title, "Impact of the number of training points");
+  // Column of a run follows its varied value.
+  const StudyTable& study_i = grid.studies[0];
+  for (std::size_t i = 0; i < study_i.runs.size(); ++i) {
+    EXPECT_EQ(study_i.run_columns[i], std::to_string(grid.runs[study_i.runs[i]].n_train));
+  }
+}
+
+TEST(GridTest, ExpansionIsDeterministic) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + "paper.toml");
+  const Grid a = expand_grid(spec), b = expand_grid(spec);
+  ASSERT_EQ(a.runs.size(), b.runs.size());
+  for (std::size_t i = 0; i < a.runs.size(); ++i) {
+    EXPECT_EQ(a.runs[i].canonical(), b.runs[i].canonical());
+  }
+  ASSERT_EQ(a.cells.size(), b.cells.size());
+  for (std::size_t c = 0; c < a.cells.size(); ++c) {
+    EXPECT_EQ(a.cells[c].key, b.cells[c].key);
+    EXPECT_EQ(a.cells[c].runs, b.cells[c].runs);
+  }
+  EXPECT_EQ(dry_run_summary(a, 16), dry_run_summary(b, 16));
+  // And from a fresh parse.
+  const Grid c = paper_grid();
+  EXPECT_EQ(c.runs.back().canonical(), a.runs.back().canonical());
+}
+
+TEST(GridTest, RunIdIsStableForAFixedConfig) {
+  const Grid grid = paper_grid();
+  const RunConfig& run = grid.runs[0];
+  // Written by hand from SPEC.md's defaults: changing the canonical form
+  // changes every run id and orphans existing results files.
+  EXPECT_THAT(run.canonical(),
+              StartsWith("system=harmonic;model=node;integrator=rk2;size=small;n_train=25;"
+                         "regularizer=none;mass=0.16;stiffness=6.25;damping=0.14736"));
+  EXPECT_THAT(run.canonical(), HasSubstr(";steps=50000;lr=0.001;"));
+  EXPECT_THAT(run.canonical(), testing::EndsWith(";seed=0"));
+  EXPECT_EQ(run.id(), hex64(fnv1a64(run.canonical())));
+  // Published FNV-1a 64 test vector (Fowler, Noll, Vo): "a" -> af63dc4c8601ec8c.
+  EXPECT_EQ(hex64(fnv1a64("a")), "af63dc4c8601ec8c");
+}
+
+TEST(GridTest, CellsAreOrderedByCostLargestFirstThenKey) {
+  const Grid grid = paper_grid();
+  for (std::size_t c = 1; c < grid.cells.size(); ++c) {
+    const Cell& prev = grid.cells[c - 1];
+    const Cell& cell = grid.cells[c];
+    EXPECT_TRUE(prev.estimated_cost_s > cell.estimated_cost_s ||
+                (prev.estimated_cost_s == cell.estimated_cost_s && prev.key < cell.key))
+        << c;
+  }
+  // Large models cost most: the first cell is a large PHNN-JR-RK2.
+  const RunConfig& first = grid.runs[grid.cells.front().runs.front()];
+  EXPECT_EQ(first.size, ModelSize::kLarge);
+  EXPECT_EQ(model_label(first.model, first.integrator), "PHNN-JR-RK2");
+  double total = 0.0;
+  for (const Cell& cell : grid.cells) total += cell.estimated_cost_s;
+  EXPECT_NEAR(grid.estimated_cost_s, total, kCostTolerance * total);
+}
+
+TEST(GridTest, RunCostFollowsTheDocumentedModel) {
+  RunConfig run;  // SPEC.md defaults: 50000 steps, eval every 500, 2500 / 100 x 500
+  run.model = ModelKind::kPhnnJr;
+  run.integrator = IntegratorKind::kDg;
+  // 600 us x (50000 + 101 x 2500/64 + 100 x 500 / 64 / 20 x 4) batch-steps
+  //   = 600e-6 x (50000 + 3945.3125 + 156.25) = 32.4609375 s.
+  EXPECT_NEAR(estimate_run_cost_s(run), 32.4609375, kCostTolerance);
+  run.model = ModelKind::kNode;
+  run.integrator = IntegratorKind::kRk2;
+  run.size = ModelSize::kLarge;
+  run.regularizer = Regularizer::kCn;
+  // 350 x 10 x 1.6 = 5600 us x (50000 + 3945.3125 + 39.0625) = 302.3125 s.
+  EXPECT_NEAR(estimate_run_cost_s(run), 302.3125, kCostTolerance);
+  run.training.steps = 1050;  // evaluations at 0, 500, 1000 and 1050
+  // 5600e-6 x (1050 + 4 x 2500/64 + 39.0625) = 5600e-6 x 1245.3125 = 6.97375 s.
+  EXPECT_NEAR(estimate_run_cost_s(run), 6.97375, kCostTolerance);
+}
+
+TEST(GridTest, GreedyMakespanGivesLargestFirstToTheFirstFreeRank) {
+  // 5 -> r0, 4 -> r1, 3 -> r1 (7), 3 -> r0 (8), 3 -> r1 (10).
+  EXPECT_DOUBLE_EQ(greedy_makespan_s({3, 5, 3, 4, 3}, /*ranks=*/2), 10.0);
+  EXPECT_DOUBLE_EQ(greedy_makespan_s({3, 5, 3, 4, 3}, /*ranks=*/1), 18.0);
+  EXPECT_DOUBLE_EQ(greedy_makespan_s({3, 5, 3, 4, 3}, /*ranks=*/10), 5.0);
+  EXPECT_THROW(greedy_makespan_s({1.0}, 0), std::invalid_argument);
+}
+
+TEST(GridTest, DryRunSummaryReportsCostAndWallTime) {
+  const Grid grid = paper_grid();
+  const std::string summary = dry_run_summary(grid, /*ranks=*/32);
+  EXPECT_THAT(summary, HasSubstr("core-hours"));
+  EXPECT_THAT(summary, HasSubstr("wall time on 32 ranks"));
+  EXPECT_THAT(summary, HasSubstr("Impact of the model size"));
+  EXPECT_THROW(dry_run_summary(grid, 0), std::invalid_argument);
+}
+
+TEST(GridTest, TableDampingPresetChangesOnlyTheDampedSystems) {
+  const Grid paper = paper_grid();
+  const Grid table = expand_grid(parse_sweep_file(kSweeps + "paper-table-damping.toml"));
+  ASSERT_EQ(table.runs.size(), 1200u);
+  ASSERT_EQ(table.cells.size(), 120u);
+  for (std::size_t i = 0; i < paper.runs.size(); ++i) {
+    const bool damped = paper.runs[i].system != SystemKind::kSelfSustained;
+    EXPECT_EQ(paper.runs[i].id() != table.runs[i].id(), damped) << i;
+  }
+}
+
+TEST(GridTest, DemoAndTinySweepsAreSmall) {
+  const Grid demo = expand_grid(parse_sweep_file(kSweeps + "demo.toml"));
+  EXPECT_EQ(first_line(dry_run_summary(demo, 2)), "40 runs in 20 cells");
+  ASSERT_EQ(demo.studies.size(), 2u);
+  EXPECT_EQ(demo.studies[0].varied_axis, "");
+  EXPECT_THAT(demo.studies[0].columns, ElementsAre("MSE"));
+  EXPECT_EQ(demo.studies[1].varied_axis, "regularizer");
+  EXPECT_THAT(demo.studies[1].systems, ElementsAre(SystemKind::kHarmonic));
+  const Grid tiny = expand_grid(parse_sweep_file(kSweeps + "tiny.toml"));
+  EXPECT_EQ(first_line(dry_run_summary(tiny, 1)), "6 runs in 2 cells");
+  EXPECT_THAT(tiny.studies[0].rows, ElementsAre("PHNN-JR-RK2", "NODE-RK2"));
+}
+
+TEST(GridTest, SeveralVariedAxesGiveProductColumns) {
+  const Grid grid = expand_grid(parse_sweep_text(R"(name = "two"
+[grid]
+systems = ["duffing"]
+models = ["phnn-s-dg"]
+sizes = ["small", "medium"]
+n_train = [25, 50]
+seeds = [0]
+)",
+                                                 "two.toml"));
+  EXPECT_EQ(grid.studies[0].varied_axis, "size/n_train");
+  EXPECT_THAT(grid.studies[0].columns,
+              ElementsAre("small/25", "small/50", "medium/25", "medium/50"));
+  EXPECT_EQ(grid.runs.size(), 4u);
+}
+
+}  // namespace
+}  // namespace phnn

@@ -1,0 +1,399 @@
+// tests/sweep/sweep_file_test.cpp
+#include "phnn/sweep/sweep_file.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "phnn/sweep/run_config.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+const std::string kSweeps = std::string(PHNN_SOURCE_DIR) + "/sweeps/";
+
+// The SweepFileError a text raises; fails the test if it parses.
+SweepFileError error_of(const std::string& text) {
+  try {
+    parse_sweep_text(text, "x.toml");
+  } catch (const SweepFileError& error) {
+    return error;
+  }
+  ADD_FAILURE() << "expected a SweepFileError for:\n" << text;
+  return SweepFileError("x.toml", 0, "no error");
+}
+
+using Pair = std::pair<ModelKind, IntegratorKind>;
+
+TEST(SweepFileTest, PaperSweepHasThreeStudiesOnSpecDefaults) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + "paper.toml");
+  EXPECT_EQ(spec.name, "paper");
+  EXPECT_EQ(spec.output, "results/paper.h5");
+  ASSERT_EQ(spec.studies.size(), 3u);
+  EXPECT_EQ(spec.studies[0].name, "I");
+  EXPECT_EQ(spec.studies[1].name, "II");
+  EXPECT_EQ(spec.studies[2].name, "III");
+  EXPECT_EQ(spec.studies[0].title, "Impact of the number of training points");
+  EXPECT_THAT(spec.studies[0].n_train, ElementsAre(25, 100, 400));
+  EXPECT_THAT(spec.studies[0].sizes, ElementsAre(ModelSize::kSmall));
+  EXPECT_THAT(spec.studies[1].sizes,
+              ElementsAre(ModelSize::kSmall, ModelSize::kMedium, ModelSize::kLarge));
+  EXPECT_THAT(spec.studies[1].n_train, ElementsAre(25));
+  EXPECT_THAT(spec.studies[2].regularizers, ElementsAre(Regularizer::kNone, Regularizer::kCn,
+                                                        Regularizer::kSn, Regularizer::kSr));
+  EXPECT_THAT(spec.studies[2].seeds, ElementsAre(0, 1, 2, 3, 4, 5, 6, 7, 8, 9));
+  EXPECT_THAT(spec.studies[2].models, ElementsAre(Pair(ModelKind::kNode, IntegratorKind::kRk2),
+                                                  Pair(ModelKind::kPhnnJr, IntegratorKind::kDg),
+                                                  Pair(ModelKind::kPhnnJr, IntegratorKind::kRk2),
+                                                  Pair(ModelKind::kPhnnS, IntegratorKind::kDg),
+                                                  Pair(ModelKind::kPhnnS, IntegratorKind::kRk2)));
+  EXPECT_THAT(spec.studies[0].systems,
+              ElementsAre(SystemKind::kHarmonic, SystemKind::kDuffing, SystemKind::kSelfSustained));
+  // SPEC.md values, bit for bit (the file restates some, which must not
+  // change them).
+  const TrainerOptions training;
+  EXPECT_EQ(spec.training.steps, 50000);
+  EXPECT_EQ(spec.training.learning_rate, training.learning_rate);
+  EXPECT_EQ(spec.training.eval_every, 500);
+  EXPECT_EQ(spec.data.num_validation, 2500);
+  EXPECT_EQ(spec.data.generation_step, DatasetOptions().generation_step);
+  for (SystemKind kind : all_systems()) {
+    const OscillatorOptions defaults = OscillatorOptions::defaults(kind);
+    EXPECT_EQ(spec.physics.at(kind).kind, kind);
+    EXPECT_EQ(spec.physics.at(kind).damping, defaults.damping);
+    EXPECT_EQ(spec.physics.at(kind).mass, defaults.mass);
+  }
+}
+
+TEST(SweepFileTest, TableDampingPresetSetsDampingOfHarmonicAndDuffingOnly) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + "paper-table-damping.toml");
+  EXPECT_EQ(spec.output, "results/paper-table-damping.h5");
+  EXPECT_EQ(spec.physics.at(SystemKind::kHarmonic).damping, 0.9);
+  EXPECT_EQ(spec.physics.at(SystemKind::kDuffing).damping, 0.9);
+  EXPECT_EQ(spec.physics.at(SystemKind::kSelfSustained).z_coefficients,
+            OscillatorOptions::defaults(SystemKind::kSelfSustained).z_coefficients);
+  EXPECT_EQ(spec.studies.size(), 3u);
+}
+
+TEST(SweepFileTest, DemoAndTinySweepsParse) {
+  const SweepSpec demo = parse_sweep_file(kSweeps + "demo.toml");
+  EXPECT_EQ(demo.training.steps, 300);
+  EXPECT_EQ(demo.training.eval_every, 100);
+  EXPECT_EQ(demo.output, "results/demo.h5");
+  const SweepSpec tiny = parse_sweep_file(kSweeps + "tiny.toml");
+  EXPECT_EQ(tiny.training.steps, 20);
+  EXPECT_EQ(tiny.data.num_validation, 50);
+  EXPECT_EQ(tiny.data.num_inference, 5);
+  ASSERT_EQ(tiny.studies.size(), 1u);
+  EXPECT_EQ(tiny.studies[0].name, "grid");
+  EXPECT_THAT(tiny.studies[0].models, ElementsAre(Pair(ModelKind::kPhnnJr, IntegratorKind::kRk2),
+                                                  Pair(ModelKind::kNode, IntegratorKind::kRk2)));
+}
+
+TEST(SweepFileTest, ReadsEveryValueKindCommentsAndMultiLineArrays) {
+  const SweepSpec spec = parse_sweep_text(R"(# leading comment
+name = "kinds"   # trailing comment
+[data]
+seed = 7
+alpha = 0.25
+energy_min = 1e-1
+num_trajectories = 12_500
+newton_tolerance = 1E-13
+
+[training]
+learning_rate = 5e-4
+adam_eps = 1
+batch_size = 32
+
+[physics.self-sustained]
+z_coefficients = [3, -4.0, 1.3]
+
+[physics.duffing]
+cubic_stiffness = 500.0
+
+[grid]
+n_train = [
+  25,   # first
+  50,
+]
+seeds = "3-5"
+models = ["phnn-s-dg"]
+)",
+                                          "kinds.toml");
+  EXPECT_EQ(spec.name, "kinds");
+  EXPECT_EQ(spec.output, "results/kinds.h5");
+  EXPECT_EQ(spec.source_path, "kinds.toml");
+  EXPECT_EQ(spec.data.data_seed, 7u);
+  EXPECT_EQ(spec.data.alpha, 0.25);
+  EXPECT_EQ(spec.data.energy_min, 0.1);
+  EXPECT_EQ(spec.data.num_trajectories, 12500);
+  EXPECT_EQ(spec.data.newton.newton_tolerance, 1e-13);
+  EXPECT_EQ(spec.training.learning_rate, 5e-4);
+  EXPECT_EQ(spec.training.adam_eps, 1.0);  // an integer is a valid float
+  EXPECT_EQ(spec.training.batch_size, 32);
+  EXPECT_EQ(spec.physics.at(SystemKind::kSelfSustained).z_coefficients[1], -4.0);
+  EXPECT_EQ(spec.physics.at(SystemKind::kDuffing).cubic_stiffness, 500.0);
+  ASSERT_EQ(spec.studies.size(), 1u);
+  EXPECT_THAT(spec.studies[0].n_train, ElementsAre(25, 50));
+  EXPECT_THAT(spec.studies[0].seeds, ElementsAre(3, 4, 5));
+  EXPECT_EQ(spec.studies[0].systems.size(), 3u);  // default: all systems
+  EXPECT_THAT(spec.studies[0].regularizers, ElementsAre(Regularizer::kNone));
+}
+
+TEST(SweepFileTest, TextHashIsFnv1aOfTheText) {
+  const std::string text = "name = \"h\"\n";
+  const SweepSpec spec = parse_sweep_text(text, "h.toml");
+  EXPECT_EQ(spec.text, text);
+  EXPECT_EQ(spec.text_hash, hex64(fnv1a64(text)));
+  EXPECT_EQ(spec.text_hash.size(), 16u);
+}
+
+TEST(SweepFileTest, StudiesKeepFileOrderAndInheritTheGrid) {
+  const SweepSpec spec = parse_sweep_text(R"(name = "order"
+[study.b]
+n_train = [100]
+[grid]
+systems = ["duffing"]
+[study.a]
+systems = ["harmonic", "self-sustained"]
+)",
+                                          "order.toml");
+  ASSERT_EQ(spec.studies.size(), 2u);
+  EXPECT_EQ(spec.studies[0].name, "b");
+  EXPECT_THAT(spec.studies[0].systems, ElementsAre(SystemKind::kDuffing));
+  EXPECT_THAT(spec.studies[0].n_train, ElementsAre(100));
+  EXPECT_EQ(spec.studies[1].name, "a");
+  EXPECT_THAT(spec.studies[1].systems,
+              ElementsAre(SystemKind::kHarmonic, SystemKind::kSelfSustained));
+  EXPECT_THAT(spec.studies[1].n_train, ElementsAre(25));
+}
+
+// --- errors: FILE:LINE, the offending key or value, the allowed values ---
+
+TEST(SweepFileErrorTest, MisspelledKeyListsTheKeysOfItsTable) {
+  const SweepFileError e = error_of(R"(name = "t"
+[training]
+learning_rate = 1e-3
+stpes = 5000
+)");
+  EXPECT_EQ(e.line(), 4);
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:4: unknown key \"stpes\" in [training]"),
+                              HasSubstr("did you mean \"steps\"?"),
+                              HasSubstr("expected one of: steps, learning_rate, adam_beta1"),
+                              HasSubstr("divergence_norm")));
+}
+
+TEST(SweepFileErrorTest, UnknownTableListsTheTables) {
+  const SweepFileError e = error_of("name = \"t\"\n\n[trainng]\nsteps = 5\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: unknown table [trainng]"),
+                              HasSubstr("did you mean \"training\"?"),
+                              HasSubstr("expected one of: [data], [training], [grid]")));
+}
+
+TEST(SweepFileErrorTest, UnknownPhysicsSystemListsTheSystems) {
+  const SweepFileError e = error_of("name = \"t\"\n[physics.duffin]\ndamping = 0.9\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:2: unknown system \"duffin\""),
+                              HasSubstr("[physics.harmonic], [physics.duffing], "
+                                        "[physics.self-sustained]")));
+}
+
+TEST(SweepFileErrorTest, PhysicsKeyTheSystemDoesNotUseIsUnknown) {
+  const SweepFileError e = error_of("name = \"t\"\n[physics.harmonic]\ncubic_stiffness = 1.0\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: unknown key \"cubic_stiffness\" in "
+                                         "[physics.harmonic]"),
+                              HasSubstr("expected one of: mass, stiffness, damping")));
+}
+
+TEST(SweepFileErrorTest, UnknownKeyAtTopLevelIsReported) {
+  const SweepFileError e = error_of("name = \"t\"\nouput = \"a.h5\"\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:2: unknown key \"ouput\""),
+                              HasSubstr("expected one of: name, output")));
+}
+
+TEST(SweepFileErrorTest, UnknownIntegratorInModelsListsTheModels) {
+  const SweepFileError e = error_of(R"(name = "t"
+[grid]
+models = [
+  "node-rk2",
+  "phnn-s-rk4",
+]
+)");
+  EXPECT_STREQ(e.what(),
+               "x.toml:5: unknown integrator \"rk4\" in models value \"phnn-s-rk4\"; expected "
+               "one of: node-rk2, phnn-jr-dg, phnn-jr-rk2, phnn-s-dg, phnn-s-rk2");
+}
+
+TEST(SweepFileErrorTest, NodeWithDiscreteGradientIsRejected) {
+  const SweepFileError e = error_of("name = \"t\"\n[grid]\nmodels = [\"node-dg\"]\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: models value \"node-dg\""),
+                              HasSubstr("RK2 only"), HasSubstr("expected one of: node-rk2")));
+}
+
+TEST(SweepFileErrorTest, UnknownAxisValuesListTheAllowedValues) {
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nsystems = [\"harmonic\", \"duffng\"]\n").what(),
+              AllOf(StartsWith("x.toml:3: unknown systems value \"duffng\""),
+                    HasSubstr("expected one of: harmonic, duffing, self-sustained")));
+  EXPECT_THAT(error_of("name = \"t\"\n[study.a]\nsizes = [\"huge\"]\n").what(),
+              AllOf(StartsWith("x.toml:3: unknown sizes value \"huge\""),
+                    HasSubstr("expected one of: small, medium, large")));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nregularizers = [\"CN\"]\n").what(),
+              AllOf(StartsWith("x.toml:3: unknown regularizers value \"CN\""),
+                    HasSubstr("expected one of: none, cn, sn, sr")));
+}
+
+TEST(SweepFileErrorTest, StringWhereIntegerExpectedIsATypeError) {
+  const SweepFileError e = error_of("name = \"t\"\n[training]\nsteps = \"5000\"\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: steps expects an integer >= 1"),
+                              HasSubstr("got the string \"5000\"")));
+}
+
+TEST(SweepFileErrorTest, FloatWhereIntegerExpectedIsATypeError) {
+  const SweepFileError e = error_of("name = \"t\"\n[training]\nbatch_size = 64.0\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: batch_size expects an integer >= 1"),
+                              HasSubstr("got the float 64.0")));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nn_train = [25, 1e2]\n").what(),
+              AllOf(StartsWith("x.toml:3: n_train expects an array of integers >= 1"),
+                    HasSubstr("got the float 1e2")));
+}
+
+TEST(SweepFileErrorTest, StringWhereNumberExpectedIsATypeError) {
+  EXPECT_THAT(
+      error_of("name = \"t\"\n[data]\nalpha = \"0.31\"\n").what(),
+      AllOf(StartsWith("x.toml:3: alpha expects a number"), HasSubstr("got the string \"0.31\"")));
+}
+
+TEST(SweepFileErrorTest, EmptyAxisIsRejected) {
+  const SweepFileError e = error_of("name = \"t\"\n[study.I]\nn_train = []\n");
+  EXPECT_THAT(e.what(),
+              AllOf(StartsWith("x.toml:3: n_train is empty"), HasSubstr("at least one value")));
+}
+
+TEST(SweepFileErrorTest, NegativeOrZeroStepCountIsRejected) {
+  EXPECT_THAT(error_of("name = \"t\"\n[training]\nsteps = -5\n").what(),
+              StartsWith("x.toml:3: steps = -5 is out of range; expected an integer >= 1"));
+  EXPECT_THAT(error_of("name = \"t\"\n[training]\n\nsteps = 0\n").what(),
+              StartsWith("x.toml:4: steps = 0 is out of range; expected an integer >= 1"));
+}
+
+TEST(SweepFileErrorTest, DuplicateKeyNamesBothLines) {
+  const SweepFileError e = error_of(R"(name = "t"
+[training]
+steps = 100
+eval_every = 10
+steps = 200
+)");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:5: duplicate key \"steps\" in [training]"),
+                              HasSubstr("first set on line 3")));
+}
+
+TEST(SweepFileErrorTest, DuplicateTableNamesBothLines) {
+  const SweepFileError e = error_of("name = \"t\"\n[study.I]\n[grid]\n[study.I]\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:4: duplicate table [study.I]"),
+                              HasSubstr("first defined on line 2")));
+}
+
+TEST(SweepFileErrorTest, NTrainAboveNumTrainMaxPointsAtTheValue) {
+  const SweepFileError e = error_of(R"(name = "t"
+[data]
+num_train_max = 100
+[study.I]
+n_train = [
+  25,
+  400,
+]
+)");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:7: n_train value 400 of study \"I\" is outside "
+                                         "[1, num_train_max = 100]"),
+                              HasSubstr("raise num_train_max in [data]")));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nn_train = [0]\n").what(),
+              StartsWith("x.toml:3: n_train value 0 is out of range; expected an array of "
+                         "integers >= 1"));
+}
+
+TEST(SweepFileErrorTest, UnterminatedStringPointsAtItsLine) {
+  const SweepFileError e = error_of("name = \"t\"\n[grid]\nsystems = [\"harmonic]\n");
+  EXPECT_THAT(e.what(),
+              AllOf(StartsWith("x.toml:3: unterminated string"), HasSubstr("\"systems\"")));
+  EXPECT_THAT(error_of("name = \"t").what(), StartsWith("x.toml:1: unterminated string"));
+}
+
+TEST(SweepFileErrorTest, UnterminatedArrayPointsAtTheLineThatOpensIt) {
+  const SweepFileError e = error_of(R"(name = "t"
+[grid]
+seeds = [0, 1, 2
+n_train = [25]
+)");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: unterminated array in the value of "
+                                         "\"seeds\""),
+                              HasSubstr("on line 4")));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nseeds = [0, 1,\n").what(),
+              AllOf(StartsWith("x.toml:3: unterminated array"), HasSubstr("end of the file")));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nseeds = [0, 1,\n[study.a]\n").what(),
+              StartsWith("x.toml:3: unterminated array"));
+}
+
+TEST(SweepFileErrorTest, SyntaxErrorsNameTheLine) {
+  EXPECT_THAT(error_of("name = \"t\"\n[training]\nsteps 5000\n").what(),
+              StartsWith("x.toml:3: expected \"=\" after key \"steps\""));
+  EXPECT_THAT(error_of("name = \"t\"\n[training]\nsteps =\n").what(),
+              StartsWith("x.toml:3: missing value for key \"steps\""));
+  EXPECT_THAT(error_of("name = \"t\"\n[training]\nsteps = 5 6\n").what(),
+              StartsWith("x.toml:3: unexpected \"6\" after the value of \"steps\""));
+  EXPECT_THAT(error_of("name = paper\n").what(),
+              AllOf(StartsWith("x.toml:1: invalid value \"paper\" for key \"name\""),
+                    HasSubstr("double quotes")));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid\n").what(),
+              StartsWith("x.toml:2: expected \"]\" to close the table header [grid"));
+  EXPECT_THAT(error_of("name = \"t\"\n[training]\nsteps = 007\n").what(),
+              StartsWith("x.toml:3: invalid value \"007\""));
+}
+
+TEST(SweepFileErrorTest, BadSeedRangeIsRejected) {
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nseeds = \"9-0\"\n").what(),
+              AllOf(StartsWith("x.toml:3: seeds range \"9-0\""), HasSubstr("\"0-9\"")));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nseeds = [-1]\n").what(),
+              StartsWith("x.toml:3: seeds value -1 is out of range"));
+}
+
+TEST(SweepFileErrorTest, ValidateFailuresPointAtTheKeyTheyName) {
+  const SweepFileError e = error_of(R"(name = "t"
+[data]
+energy_min = 0.5
+energy_max = 0.2
+)");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:4: in [data]: Invalid DatasetOptions: "
+                                         "energy_max = 0.2"),
+                              HasSubstr("energy_min = 0.5")));
+  EXPECT_THAT(error_of("name = \"t\"\n[physics.duffing]\n\nmass = -1\n").what(),
+              StartsWith("x.toml:4: in [physics.duffing]: Invalid OscillatorOptions: mass = -1"));
+  EXPECT_THAT(error_of("name = \"t\"\n[training]\nlearning_rate = 0\n").what(),
+              StartsWith("x.toml:3: in [training]: Invalid TrainerOptions: learning_rate = 0"));
+}
+
+TEST(SweepFileErrorTest, MissingNameIsReportedAtLineOne) {
+  EXPECT_THAT(error_of("# no name\n[grid]\n").what(),
+              StartsWith("x.toml:1: missing required key \"name\""));
+}
+
+TEST(SweepFileErrorTest, MissingFileNamesThePath) {
+  try {
+    parse_sweep_file("/nonexistent/dir/sweep.toml");
+    FAIL() << "expected a SweepFileError";
+  } catch (const SweepFileError& e) {
+    EXPECT_THAT(e.what(), StartsWith("/nonexistent/dir/sweep.toml: cannot open the sweep file"));
+    EXPECT_EQ(e.line(), 0);
+  }
+}
+
+TEST(SweepFileErrorTest, IsAnInvalidArgument) {
+  EXPECT_THROW(parse_sweep_text("name = 1\n", "x.toml"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace phnn
