@@ -174,7 +174,7 @@ int run_sweep(int argc, char** argv, int first) {
             action = 2;
           }
         } catch (const std::exception& e) {
-          refusal = std::string(e.what()) + "; pass a new --out path or delete the file";
+          refusal = e.what();
           action = 2;
         }
       }
@@ -233,8 +233,11 @@ int run_sweep(int argc, char** argv, int first) {
       }
     }
     if (recovered || skipped) {
-      std::cout << "phnn sweep: recovered " << recovered << " finished runs from the journals"
-                << (skipped ? " (" + std::to_string(skipped) + " torn records skipped)" : "") << "\n";
+      std::cout << "phnn sweep: recovered " << recovered << " finished runs from the journals in "
+                << journal_directory(out)
+                << (skipped ? " (" + std::to_string(skipped) + " torn records skipped)" : "")
+                << (action == 0 ? "; delete that directory with the file to start afresh" : "")
+                << "\n";
     }
     for (RunStatus s : statuses) status_codes.push_back(static_cast<int>(s));
   }

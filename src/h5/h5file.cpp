@@ -261,7 +261,7 @@ Handle string_type(std::size_t length) {
 
 void File::create_dataset(const std::string& path, Type type,
                           const std::vector<std::uint64_t>& dims,
-                          std::size_t string_length) {
+                          std::size_t string_length, double fill_value) {
   const auto slash = path.rfind('/');
   if (slash != std::string::npos && slash > 0) create_group(path.substr(0, slash));
   std::vector<hsize_t> hdims(dims.begin(), dims.end());
@@ -277,8 +277,7 @@ void File::create_dataset(const std::string& path, Type type,
   if (type == Type::kInt64) h5type = H5T_NATIVE_INT64;
   if (type == Type::kString) h5type = stype.get();
   if (type == Type::kFloat64) {
-    const double fill = 0.0;
-    H5Pset_fill_value(dcpl.get(), H5T_NATIVE_DOUBLE, &fill);
+    H5Pset_fill_value(dcpl.get(), H5T_NATIVE_DOUBLE, &fill_value);
   }
   Handle dset(H5Dcreate2(id_, path.c_str(), h5type, space.get(), H5P_DEFAULT,
                          dcpl.get(), H5P_DEFAULT),
@@ -394,17 +393,27 @@ std::vector<std::int64_t> File::read_ints(const std::string& path, std::uint64_t
   return out;
 }
 
-std::vector<std::string> File::read_strings(const std::string& path) const {
+std::vector<std::string> File::read_strings(const std::string& path, std::uint64_t row,
+                                            std::uint64_t count) const {
   Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
   if (!dset.ok()) fail(path_, "no dataset " + path);
   Handle type(H5Dget_type(dset.get()), H5Tclose);
   const std::size_t length = H5Tget_size(type.get());
   const auto d = dataset_dims(dset.get());
-  const std::size_t n = d.empty() ? 1 : d[0];
-  std::vector<char> buffer(n * length, '\0');
-  if (n > 0 && H5Dread(dset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                       buffer.data()) < 0) {
-    fail(path_, "cannot read " + path);
+  std::size_t n = d.empty() ? 1 : d[0];
+  std::vector<char> buffer;
+  if (row == 0 && count == 0) {  // the whole dataset (scalar ones too)
+    buffer.assign(n * length, '\0');
+    if (n > 0 && H5Dread(dset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                         buffer.data()) < 0) {
+      fail(path_, "cannot read " + path);
+    }
+  } else {
+    std::uint64_t rows = 0;
+    rows_io(id_, path_, path, row, count, type.get(), nullptr, false, &rows);
+    n = rows;
+    buffer.assign(n * length, '\0');
+    rows_io(id_, path_, path, row, n, type.get(), buffer.data(), false);
   }
   std::vector<std::string> out(n);
   for (std::size_t i = 0; i < n; ++i) {

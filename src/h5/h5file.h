@@ -66,10 +66,12 @@ class File {
                              const std::string& name) const;
 
   /// Creates a contiguous dataset of `dims` (strings: fixed `string_length`
-  /// bytes, NUL-padded). Collective in parallel.
+  /// bytes, NUL-padded), allocated and filled at creation: float64 elements
+  /// with `fill_value` (e.g. NaN for "not written yet"), others with zeros.
+  /// Collective in parallel.
   void create_dataset(const std::string& path, Type type,
                       const std::vector<std::uint64_t>& dims,
-                      std::size_t string_length = 0);
+                      std::size_t string_length = 0, double fill_value = 0.0);
   std::vector<std::uint64_t> dims(const std::string& path) const;
 
   /// Writes rows [row, row + count) of a dataset (all trailing dimensions),
@@ -95,7 +97,10 @@ class File {
   std::vector<std::int64_t> read_ints(const std::string& path,
                                       std::uint64_t row = 0,
                                       std::uint64_t count = 0) const;
-  std::vector<std::string> read_strings(const std::string& path) const;
+  /// Fixed-length strings without their NUL padding; rows as above.
+  std::vector<std::string> read_strings(const std::string& path,
+                                        std::uint64_t row = 0,
+                                        std::uint64_t count = 0) const;
 
  private:
   File(std::int64_t id, std::string path, MPI_Comm comm);

@@ -79,19 +79,23 @@ std::string to_string(TableFormat format) {
 
 CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_seeds) {
   CellSummary s;
+  // SPEC.md §5: a diverged run's error is +inf and counted, so it enters the
+  // statistics (as numpy's median over the seeds' MSEs would); a cell with no
+  // converged run shows no numbers.
   std::vector<double> values;
   for (const TableEntry& e : entries) {
     if (e.status == RunStatus::kDiverged ||
         (e.status == RunStatus::kDone && !std::isfinite(e.mse))) {
       ++s.diverged;
+      values.push_back(std::isnan(e.mse) ? std::numeric_limits<double>::infinity() : e.mse);
     } else if (e.status == RunStatus::kDone) {
+      ++s.done;
       values.push_back(e.mse);
     }
   }
-  s.done = static_cast<int>(values.size());
   s.expected = std::max(expected_seeds, static_cast<int>(entries.size()));
   s.missing = std::max(0, s.expected - s.done - s.diverged);
-  if (values.empty()) {
+  if (s.done == 0) {
     s.median = s.q25 = s.q75 = std::numeric_limits<double>::quiet_NaN();
   } else {
     s.median = quantile_linear(values, 0.5);

@@ -99,7 +99,7 @@ class TableTest : public ::testing::Test {
 
 TEST_F(TableTest, MarkdownShowsMedianIqrBestDivergedAndMissing) {
   // NODE-RK2/25: median 3e-3, q25 2e-3, q75 4e-3, IQR 2e-3.
-  // PHNN-JR-DG/25: {1, 2, 3}e-4 -> median 2e-4, IQR 2.5e-4 - 1.5e-4 = 1e-4; best.
+  // PHNN-JR-DG/25: {1, 2, 3}e-4 + 2 x inf -> median 3e-4, q25 2e-4, q75 inf: best.
   // NODE-RK2/100: {5, 6, 7}e-3 -> 6e-3 [1e-3], 3 of 5 finished; best (alone).
   EXPECT_EQ(render(TableFormat::kMarkdown),
             "### Study I — harmonic (columns: n_train)\n"
@@ -109,7 +109,7 @@ TEST_F(TableTest, MarkdownShowsMedianIqrBestDivergedAndMissing) {
             "| model | 25 | 100 |\n"
             "|---|---|---|\n"
             "| NODE-RK2 | 3.00e-03 [2.00e-03] | **6.00e-03 [1.00e-03]** (n=3/5) |\n"
-            "| PHNN-JR-DG | **2.00e-04 [1.00e-04]** (d=2) | — |\n"
+            "| PHNN-JR-DG | **3.00e-04 [inf]** (d=2) | — |\n"
             "\n");
 }
 
@@ -120,7 +120,7 @@ TEST_F(TableTest, LatexBoldsTheBestAndEscapesLabels) {
   EXPECT_THAT(latex, HasSubstr("Model & 25 & 100 \\\\"));
   EXPECT_THAT(latex, HasSubstr("NODE-RK2 & 3.00e-03 [2.00e-03] & \\textbf{6.00e-03 [1.00e-03]} "
                                "(n=3/5) \\\\"));
-  EXPECT_THAT(latex, HasSubstr("PHNN-JR-DG & \\textbf{2.00e-04 [1.00e-04]} (d=2) & -- \\\\"));
+  EXPECT_THAT(latex, HasSubstr("PHNN-JR-DG & \\textbf{3.00e-04 [inf]} (d=2) & -- \\\\"));
   EXPECT_THAT(latex, Not(HasSubstr("—")));
   EXPECT_THAT(latex, HasSubstr("\\end{table}"));
 }
@@ -131,8 +131,8 @@ TEST_F(TableTest, CsvHasOneLinePerCellWithABestColumn) {
                               "missing,expected,best\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,25,3.000000e-03,2.000000e-03,"
                              "4.000000e-03,2.000000e-03,5,0,0,5,0\n"));
-  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,25,2.000000e-04,1.500000e-04,"
-                             "2.500000e-04,1.000000e-04,3,2,0,5,1\n"));
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,25,3.000000e-04,2.000000e-04,"
+                             "inf,inf,3,2,0,5,1\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,100,6.000000e-03,5.500000e-03,"
                              "6.500000e-03,1.000000e-03,3,0,2,5,1\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,100,,,,,0,0,5,5,0\n"));
@@ -170,8 +170,9 @@ TEST(CellSummaryTest, CountsDoneDivergedAndMissing) {
   EXPECT_EQ(s.diverged, 2);
   EXPECT_EQ(s.missing, 7);
   EXPECT_EQ(s.expected, 10);
-  EXPECT_EQ(s.median, 1.0);
-  EXPECT_EQ(s.iqr(), 0.0);
+  // Diverged runs count as +inf (SPEC.md §5): {1, inf, inf} has median inf.
+  EXPECT_EQ(s.median, kInf);
+  EXPECT_EQ(s.q25, kInf);  // numpy: 1 + 0.5 (inf - 1)
 }
 
 TEST(TableEntriesTest, OneEntryPerRunAndStudyFromTheGrid) {

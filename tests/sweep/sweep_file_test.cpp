@@ -83,8 +83,8 @@ TEST(SweepFileTest, TableDampingPresetSetsDampingOfHarmonicAndDuffingOnly) {
 
 TEST(SweepFileTest, DemoAndTinySweepsParse) {
   const SweepSpec demo = parse_sweep_file(kSweeps + "demo.toml");
-  EXPECT_EQ(demo.training.steps, 300);
-  EXPECT_EQ(demo.training.eval_every, 100);
+  EXPECT_EQ(demo.training.steps, 4000);
+  EXPECT_EQ(demo.training.eval_every, 250);
   EXPECT_EQ(demo.output, "results/demo.h5");
   const SweepSpec tiny = parse_sweep_file(kSweeps + "tiny.toml");
   EXPECT_EQ(tiny.training.steps, 20);

@@ -128,7 +128,9 @@ TEST(TrainerTest, DivergedMemberIsFrozenWhileOthersTrain) {
   alone.seeds = {0};
   const auto a = train_cell(alone, small_data(SystemKind::kHarmonic));
   EXPECT_EQ(a[0].status, r[0].status);
-  if (std::isfinite(a[0].mse)) EXPECT_LE(rel(r[0].mse, a[0].mse), 1e-9);
+  if (std::isfinite(a[0].mse)) {
+    EXPECT_LE(rel(r[0].mse, a[0].mse), 1e-9);
+  }
 }
 
 TEST(CellSpecTest, RejectsNodeWithDgAndBadCounts) {

@@ -47,10 +47,10 @@ std::string to_string(TableFormat format);
 
 /// Statistics of one table cell.
 struct CellSummary {
-  /// Runs with status done (and a finite MSE): the median and IQR are over these.
+  /// Runs with status done (and a finite MSE).
   int done = 0;
-  /// Runs with status diverged (or done with a non-finite MSE): excluded
-  /// from the statistics, counted.
+  /// Runs with status diverged (or done with a non-finite MSE): counted, and
+  /// their MSE (+inf for a diverged rollout) enters median and IQR.
   int diverged = 0;
   /// expected - done - diverged (pending, failed or absent runs), >= 0.
   int missing = 0;
@@ -78,7 +78,9 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
 /// appended in this order:
 ///   " (n=7/10)"  fewer than `expected` runs finished (n = done + diverged;
 ///                pending, failed or absent runs are missing);
-///   " (d=2)"     diverged runs (mse = +inf), excluded from median and IQR.
+///   " (d=2)"     diverged runs; their MSE (+inf for a diverged rollout) is
+///                included in median and IQR (SPEC.md §5: "its error is +inf
+///                and counted"), so IQR or median may print as inf.
 /// A cell without any finished run shows just "—" (Markdown) or "--"
 /// (LaTeX); one whose runs all diverged shows "— (d=10)".
 /// expected = max(expected_seeds, entries of the cell).

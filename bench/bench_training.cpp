@@ -1,0 +1,203 @@
+// bench/bench_training.cpp — training cost per member-step (not a test).
+//
+//   bench_training stacked [repeats]   µs per member-step, every model x
+//                                      integrator, +-CN, E = 1 and E = 10
+//   bench_training baseline [repeats]  one small PHNN-JR-RK2 per step, plain
+//                                      torch::nn + autograd create_graph for gradH
+//   bench_training cell                one full cell: small PHNN-JR-RK2,
+//                                      E = 10, 50 000 steps (+ inference)
+//
+// Cost per member-step of the stacked trainer is measured as
+//   (T(steps = 1200) - T(steps = 200)) / (1000 E)
+// with train_cell itself, so evaluation and inference cancel out and what
+// remains is the minibatch step (forward, regularizer, backward, Adam).
+// bench/run_benchmarks.sh runs it under OpenBLAS + jemalloc and under
+// Debian's defaults (reference BLAS, glibc malloc), side by side.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <torch/torch.h>
+
+#include "phnn/data/dataset_file.h"
+#include "phnn/training/trainer.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using phnn::CellSpec;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+const phnn::SystemData& bench_data() {
+  static const phnn::SystemData data = [] {
+    phnn::DatasetOptions options;
+    options.num_validation = 64;
+    options.num_inference = 1;
+    return phnn::make_system_data(phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing),
+                                  options, 100);
+  }();
+  return data;
+}
+
+double time_cell(CellSpec cell, int steps) {
+  cell.training.steps = steps;
+  cell.training.eval_every = 1000000;
+  const auto t0 = Clock::now();
+  phnn::train_cell(cell, bench_data());
+  return seconds_since(t0);
+}
+
+int stacked(int repeats) {
+  const std::pair<phnn::ModelKind, phnn::IntegratorKind> models[] = {
+      {phnn::ModelKind::kNode, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kDg},
+      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kDg}};
+  std::printf("| model | regularizer | E = 1 [µs/member-step] | E = 10 [µs/member-step] |\n");
+  std::printf("|---|---|---|---|\n");
+  for (const auto& [model, integrator] : models) {
+    for (phnn::Regularizer reg : {phnn::Regularizer::kNone, phnn::Regularizer::kCn}) {
+      double us[2];
+      int k = 0;
+      for (int members : {1, 10}) {
+        CellSpec cell;
+        cell.model = model;
+        cell.integrator = integrator;
+        cell.n_train = 64;  // batch 64
+        cell.regularizer = reg;
+        cell.seeds.clear();
+        for (int s = 0; s < members; ++s) cell.seeds.push_back(s);
+        std::vector<double> samples;
+        for (int r = 0; r < repeats; ++r) {
+          const double t_short = time_cell(cell, 200), t_long = time_cell(cell, 1200);
+          samples.push_back((t_long - t_short) / (1000.0 * members) * 1e6);
+        }
+        us[k++] = median(samples);
+      }
+      std::printf("| %s | %s | %.0f | %.0f |\n", phnn::model_label(model, integrator).c_str(),
+                  phnn::to_string(reg).c_str(), us[0], us[1]);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
+// ----------------------------------------------------------------- baseline
+// One small PHNN-JR (L_H 2-16-16-3, L_R 3-16-16-6) as plain torch::nn
+// modules, gradH by autograd with create_graph, RK2, L1 loss, Adam, batch 64.
+struct Mlp : torch::nn::Module {
+  Mlp(int in, int out) {
+    l1 = register_module("l1", torch::nn::Linear(in, 16));
+    l2 = register_module("l2", torch::nn::Linear(16, 16));
+    l3 = register_module("l3", torch::nn::Linear(16, out));
+  }
+  torch::Tensor forward(const torch::Tensor& x) {
+    return l3(torch::tanh(l2(torch::tanh(l1(x)))));
+  }
+  torch::nn::Linear l1{nullptr}, l2{nullptr}, l3{nullptr};
+};
+
+struct BaselinePhnnJr {
+  std::shared_ptr<Mlp> lh = std::make_shared<Mlp>(2, 3), lr = std::make_shared<Mlp>(3, 6);
+  torch::Tensor field(torch::Tensor x, const torch::Tensor& u) {
+    if (!x.requires_grad()) x = x.detach().requires_grad_(true);
+    const auto o = lh->forward(x);
+    const auto q = x.select(-1, 0), p = x.select(-1, 1);
+    const auto v0 = torch::softplus(o.select(-1, 0)) * q;
+    const auto v1 = o.select(-1, 1) * q + torch::softplus(o.select(-1, 2)) * p;
+    const auto H = 0.5 * (v0 * v0 + v1 * v1);
+    const auto grad = torch::autograd::grad({H.sum()}, {x}, {}, true, true)[0];
+    const auto l = lr->forward(torch::cat({x, u}, -1));
+    auto L = torch::zeros({x.size(0), 3, 3}, x.options());
+    L.select(1, 0).select(1, 0).copy_(l.select(-1, 0));
+    L.select(1, 1).select(1, 0).copy_(l.select(-1, 1));
+    L.select(1, 1).select(1, 1).copy_(l.select(-1, 2));
+    L.select(1, 2).select(1, 0).copy_(l.select(-1, 3));
+    L.select(1, 2).select(1, 1).copy_(l.select(-1, 4));
+    L.select(1, 2).select(1, 2).copy_(l.select(-1, 5));
+    const auto R = torch::matmul(L.transpose(1, 2), L);
+    const auto e = torch::cat({grad, u}, -1).unsqueeze(-1);
+    auto J = torch::tensor({0.0, 1.0, 0.0, -1.0, 0.0, -1.0, 0.0, 1.0, 0.0}, x.options()).reshape({3, 3});
+    return torch::matmul(J - R, e).squeeze(-1).narrow(-1, 0, 2);
+  }
+};
+
+int baseline(int repeats) {
+  torch::manual_seed(0);
+  const auto& data = bench_data();
+  auto X = torch::empty({64, 2}, torch::kFloat64), Xn = torch::empty({64, 2}, torch::kFloat64),
+       U = torch::empty({64, 1}, torch::kFloat64);
+  for (int i = 0; i < 64; ++i) {
+    X[i][0] = data.train.x[i](0); X[i][1] = data.train.x[i](1);
+    Xn[i][0] = data.train.x_next[i](0); Xn[i][1] = data.train.x_next[i](1);
+    U[i][0] = data.train.u[i];
+  }
+  std::vector<double> samples;
+  for (int r = 0; r < repeats; ++r) {
+    BaselinePhnnJr model;
+    model.lh->to(torch::kFloat64);
+    model.lr->to(torch::kFloat64);
+    std::vector<torch::Tensor> params = model.lh->parameters();
+    for (auto& p : model.lr->parameters()) params.push_back(p);
+    torch::optim::Adam adam(params, torch::optim::AdamOptions(1e-3));
+    const double h = 0.01;
+    auto step = [&] {
+      const auto k1 = model.field(X, U);
+      const auto x_hat = X + h * model.field(X + 0.5 * h * k1, U);
+      const auto loss = ((Xn - x_hat).abs() / h).mean();
+      adam.zero_grad();
+      loss.backward();
+      adam.step();
+    };
+    for (int i = 0; i < 100; ++i) step();  // warm-up
+    const auto t0 = Clock::now();
+    for (int i = 0; i < 1000; ++i) step();
+    samples.push_back(seconds_since(t0) / 1000 * 1e6);
+  }
+  std::printf("baseline one-model-per-step small PHNN-JR-RK2 (autograd create_graph): %.0f µs/step\n",
+              median(samples));
+  return 0;
+}
+
+int full_cell() {
+  phnn::DatasetOptions options;
+  const auto data = phnn::make_system_data(
+      phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing), options, 25);
+  CellSpec cell;
+  cell.model = phnn::ModelKind::kPhnnJr;
+  cell.integrator = phnn::IntegratorKind::kRk2;
+  cell.n_train = 25;
+  cell.training.steps = 50000;
+  cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+  const auto t0 = Clock::now();
+  const auto results = phnn::train_cell(cell, data);
+  std::printf("full cell (Duffing, small PHNN-JR-RK2, N_train 25, E = 10, 50 000 steps, "
+              "101 validations, inference): %.1f s\n", seconds_since(t0));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  torch::set_num_threads(1);
+  const std::string mode = argc > 1 ? argv[1] : "stacked";
+  const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
+  if (mode == "stacked") return stacked(repeats);
+  if (mode == "baseline") return baseline(repeats);
+  if (mode == "cell") return full_cell();
+  std::fprintf(stderr, "usage: bench_training stacked|baseline|cell [repeats]\n");
+  return 2;
+}

@@ -1,0 +1,178 @@
+// include/phnn/sweep/results_file.h — the one parallel-HDF5 file that holds
+// every run of a sweep (layout: docs/RESULTS_FORMAT.md).
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "phnn/data/dataset_file.h"
+#include "phnn/sweep/run_config.h"
+#include "phnn/training/run_result.h"
+
+namespace phnn {
+
+/// Fixed per-row sizes of the array columns, chosen when the file is created.
+/// Shorter results are padded with NaN (their true lengths are stored too).
+struct ResultsLayout {
+  /// Columns of /runs/trajectory_errors (inference trajectories per run).
+  int num_inference = 100;
+  /// Rows of /runs/trace per run: the max over runs of steps / eval_every + 2
+  /// (step 0, every eval_every steps, the last step).
+  int trace_points = 102;
+  /// Points of each /runs/figure/* trajectory (x_0 ... x_500).
+  int figure_points = 501;
+
+  /// The smallest layout that holds every run of `runs`: max num_inference,
+  /// max steps / eval_every + 2, max num_inference_steps() + 1.
+  static ResultsLayout for_runs(const std::vector<RunConfig>& runs);
+
+  /// Throws std::invalid_argument naming the field and value unless all > 0.
+  void validate() const;
+};
+
+/// Largest stored strings; create() refuses longer canonical configs and
+/// studies, write_run() truncates longer messages (ending them in "...").
+constexpr std::size_t kCanonicalLength = 1024;
+constexpr std::size_t kStudiesLength = 64;
+constexpr std::size_t kMessageLength = 256;
+
+/// The sweep's results file: one row per run (rows = the run list given to
+/// create(), in order), every dataset allocated when the file is created so
+/// that writing a row never changes HDF5 metadata and ranks write their rows
+/// independently. Each row's status is written last, so a crash mid-row
+/// leaves it pending; the Journal, not this file, is the source of truth for
+/// recovery.
+///
+/// Collective calls (every rank of `comm`, same arguments): create, open,
+/// store_system_data, flush, close (also the destructor). In a parallel file
+/// an exception inside one of them is printed with the rank prefix and ends
+/// the job with MPI_Abort (STYLE.md policy 4); bad arguments and a wrong
+/// file are found before the first collective HDF5 call and throw on every
+/// rank (policy 1). Independent calls: write_run and every read_*; their
+/// errors throw std::runtime_error (h5::Error inside phnn) whose message
+/// starts with "[rank r/n] " in a parallel file.
+/// A file made with comm == MPI_COMM_NULL (or open_read_only) is serial and
+/// needs no MPI_Init.
+///
+/// Usage:
+///
+///   ResultsFile out = ResultsFile::create(path, MPI_COMM_WORLD, runs, studies,
+///       sweep.name, sweep.text, sweep.hash, program_version(), layout);
+///   out.store_system_data("duffing", data);            // collective
+///   for (int row : my_rows) out.write_run(row, train(runs[row]));
+///   out.close();                                       // collective
+class ResultsFile {
+ public:
+  /// Value of the file attribute "format" and of "format_version".
+  static constexpr const char* kFormat = "phnn-results";
+  static constexpr std::int64_t kFormatVersion = 1;
+
+  /// Collective over comm: creates (truncates) `path`, creates every dataset
+  /// for `runs`, writes the config columns, the file attributes
+  /// (format, format_version, sweep_name, sweep_text, sweep_hash,
+  /// program_version, units, created) and status = pending for every row.
+  /// `run_studies[i]` lists the studies of run i, e.g. "I,II,III". Throws
+  /// std::invalid_argument (every rank alike) for mismatched sizes, duplicate
+  /// run ids, a canonical() or studies string over its fixed length, a
+  /// sweep_text over 60000 bytes, or an invalid layout; std::runtime_error if
+  /// the directory of `path` is not writable. The journal of `path` is left
+  /// alone (it may be what the new file is rebuilt from); a fresh start that
+  /// must not replay old records calls remove_journals(path) first.
+  static ResultsFile create(const std::string& path, MPI_Comm comm,
+                            const std::vector<RunConfig>& runs,
+                            const std::vector<std::string>& run_studies,
+                            const std::string& sweep_name,
+                            const std::string& sweep_text,
+                            const std::string& sweep_hash,
+                            const std::string& program_version,
+                            const ResultsLayout& layout);
+
+  /// Collective: opens an existing results file read-write, to resume. Throws
+  /// std::runtime_error on every rank if `path` is missing, not HDF5, not a
+  /// phnn results file, of another format version, or was written by a
+  /// different sweep (sweep_hash != expected_sweep_hash), e.g.
+  ///   results/paper.h5 was written by sweep 'demo' (hash 1a2b...), not by
+  ///   this sweep file (hash 3c4d...); pass a new --out path or delete the file
+  static ResultsFile open(const std::string& path, MPI_Comm comm,
+                          const std::string& expected_sweep_hash);
+
+  /// Serial, read-only (the reducer): the same checks as open() but the sweep
+  /// hash.
+  static ResultsFile open_read_only(const std::string& path);
+
+  ResultsFile(ResultsFile&& other) noexcept;
+  ResultsFile& operator=(ResultsFile&& other) noexcept;
+  ResultsFile(const ResultsFile&) = delete;
+  ResultsFile& operator=(const ResultsFile&) = delete;
+  /// Closes the file: collective in parallel, like close().
+  ~ResultsFile();
+
+  const std::string& path() const;
+  int num_runs() const;
+  /// Read from the dataset shapes.
+  const ResultsLayout& layout() const;
+
+  /// File attributes.
+  std::string sweep_name() const;
+  std::string sweep_text() const;
+  std::string sweep_hash() const;
+  std::string program_version() const;
+  /// UTC creation time, ISO 8601 ("2024-05-01T12:00:00Z").
+  std::string created() const;
+
+  /// Independent: writes every column of row `row`, the status last. Throws
+  /// std::invalid_argument if the row is out of range or an array of
+  /// `result` is longer than the layout allows (trajectory_errors >
+  /// num_inference, trace > trace_points, a figure > figure_points points or
+  /// of odd length); h5::Error if HDF5 fails. Messages over kMessageLength
+  /// bytes are truncated.
+  void write_run(int row, const RunResult& result);
+
+  /// Independent reads.
+  std::vector<RunStatus> read_statuses() const;
+  /// Row `row` as written by write_run (bit-exact, except a truncated
+  /// message); a pending row reads as a default RunResult with NaN scalars.
+  RunResult read_run(int row) const;
+
+  /// Config columns, one entry per row.
+  std::vector<std::string> read_run_ids() const;
+  std::vector<std::string> read_canonical() const;
+  std::vector<std::string> read_systems() const;       // "harmonic", ...
+  std::vector<std::string> read_models() const;        // "node", "phnn-s", ...
+  std::vector<std::string> read_integrators() const;   // "rk2", "dg"
+  std::vector<std::string> read_sizes() const;         // "small", ...
+  std::vector<std::string> read_regularizers() const;  // "none", "cn", ...
+  std::vector<std::string> read_studies() const;       // "I,II"
+  std::vector<std::int64_t> read_n_train() const;
+  std::vector<std::int64_t> read_seeds() const;
+
+  /// Any column of /runs by name ("mse", "wall_time_s", "figure/length",
+  /// ...), flattened row-major over all rows.
+  std::vector<double> read_double_column(const std::string& column) const;
+  std::vector<std::int64_t> read_int_column(const std::string& column) const;
+  std::vector<std::string> read_string_column(const std::string& column) const;
+
+  /// Collective: stores one system's data set once under /data/<system_name>
+  /// (every rank passes identical data) and flushes the file.
+  void store_system_data(const std::string& system_name, const SystemData& data);
+  /// True once store_system_data(system_name, ...) has completed.
+  bool has_system_data(const std::string& system_name) const;
+  /// Reads a data set stored by store_system_data.
+  SystemData read_system_data(const std::string& system_name) const;
+
+  /// Collective: flushes HDF5's buffers to the file.
+  void flush();
+  /// Collective: closes the file; later calls throw. Idempotent.
+  void close();
+
+ private:
+  struct Impl;
+  explicit ResultsFile(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace phnn

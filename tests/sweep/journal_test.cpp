@@ -1,0 +1,142 @@
+// tests/sweep/journal_test.cpp
+#include "phnn/sweep/journal.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "sweep/sample_results.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+using testing_util::expect_bit_equal;
+using testing_util::sample_layout;
+using testing_util::sample_result;
+using testing_util::sample_runs;
+using testing_util::tagged_nan;
+
+class JournalTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    results_path_ = ::testing::TempDir() + "phnn_journal_" + std::to_string(::getpid()) + "_" +
+                    ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".h5";
+    remove_journals(results_path_);
+  }
+  void TearDown() override { remove_journals(results_path_); }
+
+  static std::string id(int row) { return sample_runs(row + 1)[row].id(); }
+
+  std::string results_path_;
+};
+
+TEST_F(JournalTest, ReplayRoundTripsEveryFieldBitExactly) {
+  {
+    Journal journal(results_path_, 0);
+    for (int row = 0; row < 8; ++row) journal.append(id(row), sample_result(row, sample_layout()));
+  }
+  int skipped = -1;
+  const auto replayed = replay_journals(results_path_, &skipped);
+  EXPECT_EQ(skipped, 0);
+  ASSERT_EQ(replayed.size(), 8u);
+  for (int row = 0; row < 8; ++row) {
+    SCOPED_TRACE("row " + std::to_string(row));
+    ASSERT_EQ(replayed.count(id(row)), 1u);
+    expect_bit_equal(sample_result(row, sample_layout()), replayed.at(id(row)));
+  }
+}
+
+TEST_F(JournalTest, WritesOneLineWithHexFloatsEscapedStringsAndAChecksum) {
+  RunResult r;
+  r.status = RunStatus::kFailed;
+  r.mse = 1.5;
+  r.best_validation_loss = tagged_nan(0x123);
+  r.message = "100% bad\nnews";
+  const std::string line = internal::encode_journal_record("00ff", r, /*time_ns=*/42);
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+  EXPECT_THAT(line, ::testing::StartsWith("run 00ff v=1 time=42 status=failed "));
+  EXPECT_THAT(line, HasSubstr(" mse=0x1.8p+0 "));
+  EXPECT_THAT(line, HasSubstr(" best_validation_loss=nan_7ff8000000000123 "));
+  EXPECT_THAT(line, HasSubstr(" message=100%25%20bad%0Anews "));
+  EXPECT_THAT(line, ::testing::MatchesRegex(".* fnv1a64=[0-9a-f]{16}"));
+  std::string id;
+  RunResult back;
+  std::int64_t time_ns = 0;
+  ASSERT_TRUE(internal::decode_journal_record(line, &id, &back, &time_ns));
+  EXPECT_EQ(id, "00ff");
+  EXPECT_EQ(time_ns, 42);
+  expect_bit_equal(r, back);
+  // One changed character fails the checksum.
+  std::string corrupt = line;
+  corrupt[corrupt.find("0x1.8p+0")] = '1';
+  EXPECT_FALSE(internal::decode_journal_record(corrupt, &id, &back, &time_ns));
+}
+
+TEST_F(JournalTest, SkipsAndCountsATornLastLine) {
+  Journal(results_path_, 0).append(id(0), sample_result(0, sample_layout()));
+  Journal(results_path_, 0).append(id(1), sample_result(1, sample_layout()));
+  const std::string log = journal_directory(results_path_) + "/rank-0.log";
+  std::ifstream in(log);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Kill mid-record: the second line loses its tail.
+  ASSERT_EQ(::truncate(log.c_str(), static_cast<off_t>(text.size() - 30)), 0);
+  int skipped = 0;
+  auto replayed = replay_journals(results_path_, &skipped);
+  EXPECT_EQ(skipped, 1);
+  ASSERT_EQ(replayed.size(), 1u);
+  expect_bit_equal(sample_result(0, sample_layout()), replayed.at(id(0)));
+
+  // The restarted rank appends after the torn fragment, not onto it.
+  Journal(results_path_, 0).append(id(2), sample_result(2, sample_layout()));
+  replayed = replay_journals(results_path_, &skipped);
+  EXPECT_EQ(skipped, 1);
+  ASSERT_EQ(replayed.size(), 2u);
+  expect_bit_equal(sample_result(2, sample_layout()), replayed.at(id(2)));
+}
+
+TEST_F(JournalTest, MergesRecordsOfEveryRankAndRankCount) {
+  // An earlier job with 3 ranks, then a resumed job with 2.
+  Journal(results_path_, 0).append(id(0), sample_result(0, sample_layout()));
+  Journal(results_path_, 2).append(id(2), sample_result(2, sample_layout()));
+  Journal(results_path_, 1).append(id(1), sample_result(1, sample_layout()));
+  Journal(results_path_, 1).append(id(3), sample_result(3, sample_layout()));
+  Journal(results_path_, 10).append(id(4), sample_result(4, sample_layout()));
+  int skipped = -1;
+  const auto replayed = replay_journals(results_path_, &skipped);
+  EXPECT_EQ(skipped, 0);
+  ASSERT_EQ(replayed.size(), 5u);
+  for (int row = 0; row < 5; ++row) {
+    expect_bit_equal(sample_result(row, sample_layout()), replayed.at(id(row)));
+  }
+}
+
+TEST_F(JournalTest, LaterRecordsOfARunWin) {
+  Journal(results_path_, 1).append(id(0), sample_result(1, sample_layout()));
+  Journal(results_path_, 0).append(id(0), sample_result(2, sample_layout()));
+  Journal(results_path_, 1).append(id(0), sample_result(3, sample_layout()));
+  const auto replayed = replay_journals(results_path_);
+  ASSERT_EQ(replayed.size(), 1u);
+  expect_bit_equal(sample_result(3, sample_layout()), replayed.at(id(0)));
+}
+
+TEST_F(JournalTest, MissingJournalIsEmpty) {
+  int skipped = -1;
+  EXPECT_TRUE(replay_journals(results_path_, &skipped).empty());
+  EXPECT_EQ(skipped, 0);
+}
+
+TEST_F(JournalTest, ReportsAnUnwritableDirectoryWithRankAndPath) {
+  EXPECT_THAT([] { Journal("/nonexistent/dir/r.h5", 3); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  HasSubstr("[rank 3] /nonexistent/dir/r.h5.journal/rank-3.log")));
+}
+
+}  // namespace
+}  // namespace phnn

@@ -1,0 +1,298 @@
+// tests/sweep/results_file_test.cpp — the serial path (MPI_COMM_NULL, no
+// MPI_Init); tests/mpi/results_file_mpi_test.cpp covers the parallel one.
+#include "phnn/sweep/results_file.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "h5/h5file.h"
+#include "phnn/sweep/journal.h"
+#include "sweep/sample_results.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::EndsWith;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
+using testing_util::bits;
+using testing_util::expect_bit_equal;
+using testing_util::sample_layout;
+using testing_util::sample_result;
+using testing_util::sample_runs;
+using testing_util::sample_studies;
+
+constexpr int kNumRuns = 7;
+constexpr char kSweepHash[] = "1a2b3c4d5e6f7081";
+
+class ResultsFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = ::testing::TempDir() + "phnn_results_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".h5";
+  }
+  void TearDown() override {
+    std::remove(path_.c_str());
+    remove_journals(path_);
+  }
+
+  ResultsFile create(int num_runs = kNumRuns) const {
+    return ResultsFile::create(path_, MPI_COMM_NULL, sample_runs(num_runs),
+                               sample_studies(num_runs), "demo", "name = demo\nseeds = 0..6\n",
+                               kSweepHash, "phnn-sweep 0.1.0", sample_layout());
+  }
+
+  std::string path_;
+};
+
+TEST_F(ResultsFileTest, RoundTripsEveryFieldBitExactly) {
+  const ResultsLayout layout = sample_layout();
+  {
+    ResultsFile file = create();
+    // Row 6 stays pending.
+    for (int row = 0; row < kNumRuns - 1; ++row) file.write_run(row, sample_result(row, layout));
+    file.close();
+  }
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  ASSERT_EQ(file.num_runs(), kNumRuns);
+  EXPECT_EQ(file.layout().num_inference, layout.num_inference);
+  EXPECT_EQ(file.layout().trace_points, layout.trace_points);
+  EXPECT_EQ(file.layout().figure_points, layout.figure_points);
+  for (int row = 0; row < kNumRuns - 1; ++row) {
+    SCOPED_TRACE("row " + std::to_string(row));
+    expect_bit_equal(sample_result(row, layout), file.read_run(row));
+  }
+  const RunResult pending = file.read_run(kNumRuns - 1);
+  EXPECT_EQ(pending.status, RunStatus::kPending);
+  EXPECT_TRUE(std::isnan(pending.mse));
+  EXPECT_TRUE(pending.trace.empty());
+  EXPECT_TRUE(pending.trajectory_errors.empty());
+  EXPECT_TRUE(pending.figure_prediction_05.empty());
+  // The padding really is NaN in the file.
+  const std::vector<double> trace = file.read_double_column("trace");
+  EXPECT_TRUE(std::isnan(trace[(1 * layout.trace_points + 2) * 7]));  // row 1 has 2 points
+  EXPECT_EQ(bits(file.read_double_column("mse")[1]),
+            bits(std::numeric_limits<double>::infinity()));
+}
+
+TEST_F(ResultsFileTest, StoresConfigColumnsAndFileAttributes) {
+  create().close();
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  const std::vector<RunConfig> runs = sample_runs(kNumRuns);
+  const std::vector<std::string> ids = file.read_run_ids();
+  const std::vector<std::string> canonical = file.read_canonical();
+  ASSERT_EQ(ids.size(), runs.size());
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    EXPECT_EQ(ids[i], runs[i].id());
+    EXPECT_EQ(canonical[i], runs[i].canonical());
+    EXPECT_EQ(file.read_systems()[i], to_string(runs[i].system));
+    EXPECT_EQ(file.read_models()[i], to_string(runs[i].model));
+    EXPECT_EQ(file.read_integrators()[i], to_string(runs[i].integrator));
+    EXPECT_EQ(file.read_sizes()[i], to_string(runs[i].size));
+    EXPECT_EQ(file.read_regularizers()[i], to_string(runs[i].regularizer));
+    EXPECT_EQ(file.read_n_train()[i], runs[i].n_train);
+    EXPECT_EQ(file.read_seeds()[i], runs[i].seed);
+    EXPECT_EQ(file.read_studies()[i], sample_studies(kNumRuns)[i]);
+  }
+  EXPECT_EQ(file.sweep_name(), "demo");
+  EXPECT_EQ(file.sweep_text(), "name = demo\nseeds = 0..6\n");
+  EXPECT_EQ(file.sweep_hash(), kSweepHash);
+  EXPECT_EQ(file.program_version(), "phnn-sweep 0.1.0");
+  EXPECT_THAT(file.created(), ::testing::MatchesRegex("[0-9]{4}-[0-9]{2}-[0-9]{2}T.*Z"));
+  const h5::File raw = h5::File::open(path_, h5::Access::kReadOnly);
+  EXPECT_EQ(raw.string_attribute("/", "format"), "phnn-results");
+  EXPECT_EQ(raw.int_attribute("/", "format_version"), 1);
+  EXPECT_THAT(raw.string_attribute("/", "units"), HasSubstr("q [m], p [kg m/s]"));
+  EXPECT_THAT(raw.string_attribute("/runs/mse", "units"), HasSubstr("m^2 and (kg m/s)^2"));
+  EXPECT_EQ(raw.string_attribute("/runs/wall_time_s", "units"), "s");
+}
+
+TEST_F(ResultsFileTest, StatusesDefaultToPendingUntilWritten) {
+  ResultsFile file = create();
+  EXPECT_EQ(file.read_statuses(), std::vector<RunStatus>(kNumRuns, RunStatus::kPending));
+  file.write_run(2, sample_result(/*row=*/1, sample_layout()));
+  std::vector<RunStatus> expected(kNumRuns, RunStatus::kPending);
+  expected[2] = RunStatus::kDiverged;
+  EXPECT_EQ(file.read_statuses(), expected);
+}
+
+TEST_F(ResultsFileTest, TruncatesLongMessagesWithoutSplittingACharacter) {
+  ResultsFile file = create();
+  RunResult r = sample_result(0, sample_layout());
+  r.message = std::string(252, 'a') + "\xc3\xbc" + std::string(100, 'b');  // u-umlaut at 252
+  file.write_run(0, r);
+  const std::string back = file.read_run(0).message;
+  EXPECT_EQ(back, std::string(252, 'a') + "...");
+  EXPECT_LE(back.size(), kMessageLength);
+}
+
+TEST_F(ResultsFileTest, RejectsArraysLongerThanTheLayout) {
+  ResultsFile file = create();
+  RunResult r = sample_result(0, sample_layout());
+  r.trace.resize(sample_layout().trace_points + 1);
+  EXPECT_THAT([&] { file.write_run(0, r); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("trace has 7 points, the file holds 6")));
+  r = sample_result(0, sample_layout());
+  r.figure_reference_05.push_back(1.0);
+  EXPECT_THAT([&] { file.write_run(0, r); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("figure_reference_05 has 19 values")));
+  EXPECT_THAT([&] { file.write_run(kNumRuns, sample_result(0, sample_layout())); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("row outside [0, 7)")));
+}
+
+TEST_F(ResultsFileTest, ReopensForResumeKeepingEveryRow) {
+  const ResultsLayout layout = sample_layout();
+  {
+    ResultsFile file = create();
+    file.write_run(0, sample_result(0, layout));
+  }  // the destructor closes
+  {
+    ResultsFile file = ResultsFile::open(path_, MPI_COMM_NULL, kSweepHash);
+    EXPECT_EQ(file.num_runs(), kNumRuns);
+    file.write_run(3, sample_result(3, layout));
+  }
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  expect_bit_equal(sample_result(0, layout), file.read_run(0));
+  expect_bit_equal(sample_result(3, layout), file.read_run(3));
+  EXPECT_EQ(file.read_statuses()[1], RunStatus::kPending);
+}
+
+TEST_F(ResultsFileTest, RefusesAFileWrittenByAnotherSweep) {
+  create().close();
+  EXPECT_THAT([&] { ResultsFile::open(path_, MPI_COMM_NULL, "3c4d000000000000"); },
+              ThrowsMessage<std::runtime_error>(::testing::AllOf(
+                  HasSubstr(path_ + " was written by sweep 'demo' (hash 1a2b3c4d5e6f7081)"),
+                  HasSubstr("not by this sweep file (hash 3c4d000000000000)"),
+                  HasSubstr("pass a new --out path or delete the file"))));
+}
+
+TEST_F(ResultsFileTest, RefusesMissingNonHdf5AndForeignFiles) {
+  EXPECT_THAT([] { ResultsFile::open("/nonexistent/dir/r.h5", MPI_COMM_NULL, kSweepHash); },
+              ThrowsMessage<std::runtime_error>(
+                  HasSubstr("/nonexistent/dir/r.h5: no such results file")));
+  std::ofstream(path_) << "not hdf5 at all";
+  EXPECT_THAT([&] { ResultsFile::open(path_, MPI_COMM_NULL, kSweepHash); },
+              ThrowsMessage<std::runtime_error>(HasSubstr(path_ + ": not an HDF5 file")));
+  {
+    h5::File foreign = h5::File::create(path_);
+    foreign.write("/something", {2}, std::vector<double>{1, 2});
+  }
+  EXPECT_THAT([&] { ResultsFile::open_read_only(path_); },
+              ThrowsMessage<std::runtime_error>(HasSubstr("not a phnn results file")));
+}
+
+TEST_F(ResultsFileTest, RefusesBadRunListsBeforeTouchingTheFile) {
+  std::vector<RunConfig> runs = sample_runs(3);
+  runs[2] = runs[0];
+  EXPECT_THAT(
+      [&] {
+        ResultsFile::create(path_, MPI_COMM_NULL, runs, sample_studies(3), "demo", "", kSweepHash,
+                            "v", sample_layout());
+      },
+      ThrowsMessage<std::invalid_argument>(HasSubstr("runs 0 and 2 are the same run")));
+  EXPECT_THAT(
+      [&] {
+        ResultsFile::create(path_, MPI_COMM_NULL, sample_runs(3), sample_studies(2), "demo", "",
+                            kSweepHash, "v", sample_layout());
+      },
+      ThrowsMessage<std::invalid_argument>(HasSubstr("got 2 study lists for 3 runs")));
+  EXPECT_THAT(
+      [&] {
+        ResultsFile::create("/nonexistent/dir/r.h5", MPI_COMM_NULL, sample_runs(3),
+                            sample_studies(3), "demo", "", kSweepHash, "v", sample_layout());
+      },
+      ThrowsMessage<std::runtime_error>(HasSubstr("directory /nonexistent/dir does not exist")));
+  EXPECT_FALSE(h5::File::is_hdf5(path_));
+}
+
+// A file lost mid-creation is rebuilt from the journal, so create() keeps it.
+TEST_F(ResultsFileTest, CreateKeepsTheJournal) {
+  Journal(path_, 0).append("0123456789abcdef", sample_result(0, sample_layout()));
+  create().close();
+  EXPECT_EQ(replay_journals(path_).size(), 1u);
+  remove_journals(path_);
+  EXPECT_TRUE(replay_journals(path_).empty());
+}
+
+TEST_F(ResultsFileTest, StoresEachSystemsDataOnce) {
+  DatasetOptions options;
+  options.num_validation = 20;
+  options.num_inference = 2;
+  const SystemData data =
+      make_system_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 25);
+  ResultsFile file = create();
+  EXPECT_FALSE(file.has_system_data("duffing"));
+  file.store_system_data("duffing", data);
+  EXPECT_TRUE(file.has_system_data("duffing"));
+  EXPECT_THAT([&] { file.store_system_data("duffing", data); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("/data/duffing is already stored")));
+  file.close();
+  const SystemData back = ResultsFile::open_read_only(path_).read_system_data("duffing");
+  EXPECT_EQ(back.system.kind, SystemKind::kDuffing);
+  ASSERT_EQ(back.train.size(), 25u);
+  EXPECT_EQ(back.train.x[24], data.train.x[24]);
+  EXPECT_EQ(back.inference.states[1][500], data.inference.states[1][500]);
+}
+
+// All metadata is written by create(), so a writer killed without closing
+// (kill -9 mid-sweep) leaves a readable file with its finished rows.
+TEST_F(ResultsFileTest, SurvivesAWriterKilledWithoutClosing) {
+  const ResultsLayout layout = sample_layout();
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ResultsFile file = create();
+    file.write_run(0, sample_result(0, layout));
+    file.write_run(1, sample_result(1, layout));
+    std::raise(SIGKILL);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  expect_bit_equal(sample_result(0, layout), file.read_run(0));
+  expect_bit_equal(sample_result(1, layout), file.read_run(1));
+  EXPECT_EQ(file.read_statuses()[2], RunStatus::kPending);
+}
+
+TEST_F(ResultsFileTest, IsReadableByH5dump) {
+  {
+    ResultsFile file = create();
+    file.write_run(0, sample_result(0, sample_layout()));
+  }
+  const std::string command = "h5dump -H " + path_ + " > /dev/null 2>&1";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+}
+
+TEST(ResultsLayoutTest, ForRunsIsTheSmallestLayoutThatHoldsEveryRun) {
+  std::vector<RunConfig> runs = sample_runs(2);
+  runs[0].training.steps = 50000;
+  runs[0].training.eval_every = 500;
+  runs[1].training.steps = 1000;
+  runs[1].training.eval_every = 3;
+  const ResultsLayout layout = ResultsLayout::for_runs(runs);
+  EXPECT_EQ(layout.trace_points, 1000 / 3 + 2);
+  EXPECT_EQ(layout.num_inference, 100);
+  EXPECT_EQ(layout.figure_points, 501);
+}
+
+TEST(ResultsLayoutTest, RejectsNonPositiveSizes) {
+  ResultsLayout layout;
+  layout.trace_points = 0;
+  EXPECT_THAT([&] { layout.validate(); },
+              ThrowsMessage<std::invalid_argument>(HasSubstr("trace_points = 0")));
+}
+
+}  // namespace
+}  // namespace phnn

@@ -1,0 +1,198 @@
+// tests/sweep/sweep_command_test.cpp — `phnn sweep` end to end under mpiexec:
+// rank-count independence, kill-and-resume, rejection of bad sweep files.
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/journal.h"
+#include "phnn/sweep/results_file.h"
+#include "phnn/sweep/sweep_file.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string temp_dir(const std::string& name) {
+  const std::string dir = ::testing::TempDir() + "phnn_sweep_" + name + "_" + std::to_string(::getpid());
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  return dir;
+}
+
+std::string mpiexec(int ranks) {
+  return std::string(PHNN_MPIEXEC) + " -n " + std::to_string(ranks) + " " + PHNN_MPIEXEC_PREFLAGS +
+         " " + PHNN_BINARY;
+}
+
+int shell(const std::string& command, std::string* output = nullptr) {
+  const std::string log = ::testing::TempDir() + "phnn_sweep_cmd_" + std::to_string(::getpid()) + ".log";
+  const int status = std::system((command + " > " + log + " 2>&1").c_str());
+  if (output) {
+    std::ifstream in(log);
+    output->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Three cells, one with the DG integrator (Newton at inference), N_train >
+// batch so per-member reshuffling is exercised.
+const char* kSweep = R"(name = "rank-test"
+[data]
+num_validation = 40
+num_inference = 3
+[training]
+steps = 30
+eval_every = 10
+batch_size = 16
+[grid]
+systems = ["duffing"]
+models = ["phnn-s-dg", "phnn-jr-rk2", "node-rk2"]
+n_train = [25]
+seeds = [0, 1, 2]
+)";
+
+std::string write_sweep(const std::string& dir, const std::string& text) {
+  const std::string path = dir + "/sweep.toml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+void expect_same_run(const RunResult& a, const RunResult& b, int row) {
+  SCOPED_TRACE("row " + std::to_string(row));
+  EXPECT_EQ(a.status, b.status);
+  EXPECT_EQ(a.message, b.message);
+  EXPECT_EQ(a.mse, b.mse);  // bitwise: == on doubles
+  EXPECT_EQ(a.trajectory_errors, b.trajectory_errors);
+  EXPECT_EQ(a.best_step, b.best_step);
+  EXPECT_EQ(a.best_validation_loss, b.best_validation_loss);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(a.parameter_count, b.parameter_count);
+  EXPECT_EQ(a.newton_failures, b.newton_failures);
+  EXPECT_EQ(a.figure_prediction_05, b.figure_prediction_05);
+  EXPECT_EQ(a.figure_prediction_075, b.figure_prediction_075);
+  ASSERT_EQ(a.trace.size(), b.trace.size());
+  for (std::size_t k = 0; k < a.trace.size(); ++k) {  // every column but the time
+    EXPECT_EQ(a.trace[k].step, b.trace[k].step);
+    EXPECT_EQ(a.trace[k].train_loss, b.trace[k].train_loss);
+    EXPECT_EQ(a.trace[k].validation_loss, b.trace[k].validation_loss);
+    EXPECT_EQ(a.trace[k].kappa, b.trace[k].kappa);
+    EXPECT_EQ(a.trace[k].sigma_max, b.trace[k].sigma_max);
+    EXPECT_EQ(a.trace[k].rho, b.trace[k].rho);
+  }
+}
+
+TEST(SweepCommandTest, ResultsDoNotDependOnTheNumberOfRanksOrScheduling) {
+  const std::string dir = temp_dir("ranks");
+  const std::string sweep = write_sweep(dir, kSweep);
+  const std::string runs[] = {"1 dynamic", "2 dynamic", "3 dynamic", "2 static"};
+  std::vector<ResultsFile> files;
+  for (const std::string& r : runs) {
+    const int ranks = r[0] - '0';
+    const bool is_static = r.find("static") != std::string::npos;
+    const std::string out = dir + "/np" + r.substr(0, 1) + (is_static ? "s" : "d") + ".h5";
+    std::string log;
+    ASSERT_EQ(shell(mpiexec(ranks) + " sweep " + sweep + " --quiet --out " + out +
+                        (is_static ? " --static" : ""),
+                    &log),
+              0)
+        << log;
+    EXPECT_THAT(log, HasSubstr(is_static ? "static scheduling" : "dynamic scheduling"));
+    files.push_back(ResultsFile::open_read_only(out));
+  }
+  const auto statuses = files[0].read_statuses();
+  ASSERT_EQ(statuses.size(), 9u);
+  for (RunStatus s : statuses) EXPECT_EQ(s, RunStatus::kDone);
+  for (std::size_t f = 1; f < files.size(); ++f) {
+    EXPECT_EQ(files[f].read_run_ids(), files[0].read_run_ids());
+    for (int row = 0; row < files[0].num_runs(); ++row) {
+      expect_same_run(files[f].read_run(row), files[0].read_run(row), row);
+    }
+  }
+}
+
+TEST(SweepCommandTest, KilledRankThenRerunCompletesEveryRunOnce) {
+  const std::string dir = temp_dir("kill");
+  std::string text = kSweep;
+  text.replace(text.find("steps = 30"), 10, "steps = 1500");
+  text.replace(text.find("seeds = [0, 1, 2]"), 17, "seeds = [0, 1]\nn_train = [25, 26, 27]");
+  text.replace(text.find("n_train = [25]\n"), 15, "");
+  const std::string sweep = write_sweep(dir, text);
+  const std::string out = dir + "/killed.h5";
+  const std::string command = mpiexec(2) + " sweep " + sweep + " --quiet --out " + out;
+  // Start in the background; kill one rank once a first run is journaled.
+  ASSERT_EQ(std::system((command + " > " + dir + "/first.log 2>&1 & echo $! > " + dir + "/pid").c_str()), 0);
+  const auto start = std::chrono::steady_clock::now();
+  bool journaled = false;
+  while (std::chrono::steady_clock::now() - start < std::chrono::seconds(240)) {
+    if (!replay_journals(out).empty()) {
+      journaled = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(journaled) << "no run finished within 240 s";
+  ASSERT_EQ(shell("pkill -KILL -n -f '[p]hnn sweep " + sweep + "'"), 0);
+  std::ifstream pid_file(dir + "/pid");
+  pid_t pid = 0;
+  pid_file >> pid;
+  while (::kill(pid, 0) == 0 && std::chrono::steady_clock::now() - start < std::chrono::seconds(300)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const auto finished_before = replay_journals(out).size();
+  ASSERT_LT(finished_before, 18u) << "the sweep finished before the kill";
+  std::string log;
+  ASSERT_EQ(shell(command, &log), 0) << log;
+  const ResultsFile file = ResultsFile::open_read_only(out);
+  const auto ids = file.read_run_ids();
+  EXPECT_EQ(std::set<std::string>(ids.begin(), ids.end()).size(), 18u);
+  const Grid grid = expand_grid(parse_sweep_file(sweep));
+  ASSERT_EQ(ids.size(), grid.runs.size());
+  for (RunStatus s : file.read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
+  // Each run recorded once in the journals, before or after the kill.
+  EXPECT_EQ(replay_journals(out).size(), 18u);
+  EXPECT_EQ(shell("h5dump -H " + out), 0);
+  RecordProperty("runs_finished_before_kill", static_cast<int>(finished_before));
+}
+
+TEST(SweepCommandTest, BadSweepFilesExitTwoBeforeWritingAnything) {
+  const std::string dir = temp_dir("bad");
+  const std::pair<const char*, const char*> cases[] = {
+      {"name = \"x\"\n[training]\nstpes = 5\n", ":3: unknown key \"stpes\""},
+      {"name = \"x\"\n[training]\nsteps = -5\n", ":3:"},
+      {"name = \"x\"\n[grid]\nn_train = []\n", ":3:"},
+      {"name = \"x\"\n[training]\nsteps = \"many\"\n", ":3:"},
+      {"name = \"x\"\n[grid]\nmodels = [\"phnn-s-rk4\"]\n", ":3:"},
+  };
+  for (const auto& [text, expected] : cases) {
+    const std::string sweep = write_sweep(dir, text);
+    const std::string out = dir + "/never.h5";
+    std::string log;
+    EXPECT_EQ(shell(mpiexec(2) + " sweep " + sweep + " --out " + out, &log), 2) << log;
+    EXPECT_THAT(log, HasSubstr(sweep + expected));
+    struct stat st;
+    EXPECT_NE(::stat(out.c_str(), &st), 0) << "a results file was written";
+    EXPECT_NE(::stat(journal_directory(out).c_str(), &st), 0) << "a journal was written";
+  }
+}
+
+TEST(SweepCommandTest, DryRunPrintsRunsAndCellsOfThePaper) {
+  std::string log;
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + PHNN_SOURCE_DIR + "/sweeps/paper.toml --dry-run", &log), 0);
+  EXPECT_EQ(log.substr(0, log.find('\n')), "1200 runs in 120 cells");
+}
+
+}  // namespace
+}  // namespace phnn
