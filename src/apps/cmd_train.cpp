@@ -3,13 +3,20 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include <torch/torch.h>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "phnn/common/check.h"
 #include "phnn/data/dataset_file.h"
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/results_file.h"
+#include "phnn/sweep/sweep_file.h"
+#include "phnn/sweep/version.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {
@@ -24,6 +31,64 @@ double quantile(std::vector<double> v, double q) {
   const double frac = pos - static_cast<double>(lo);
   if (frac == 0.0) return v[lo];
   return v[lo] + frac * (v[hi] - v[lo]);
+}
+
+std::string g17(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// The cell as a one-study sweep file, so that `phnn train --out` writes a
+// results file that `phnn reduce` and analysis/ read like any sweep's.
+std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
+  std::ostringstream s;
+  const std::string system = to_string(data.system.kind);
+  s << "# written by `phnn train --out`\n"
+    << "name = \"train-" << system << "-" << to_string(cell.model) << "-"
+    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed
+    << "\n\n[training]\nsteps = " << cell.training.steps
+    << "\nlearning_rate = " << g17(cell.training.learning_rate)
+    << "\nbatch_size = " << cell.training.batch_size
+    << "\neval_every = " << cell.training.eval_every << "\n\n[physics." << system << "]\n"
+    << "mass = " << g17(data.system.mass) << "\nstiffness = " << g17(data.system.stiffness) << "\n";
+  if (data.system.kind == SystemKind::kDuffing) {
+    s << "cubic_stiffness = " << g17(data.system.cubic_stiffness) << "\n";
+  }
+  if (data.system.kind == SystemKind::kSelfSustained) {
+    s << "z_coefficients = [" << g17(data.system.z_coefficients[0]) << ", "
+      << g17(data.system.z_coefficients[1]) << ", " << g17(data.system.z_coefficients[2]) << "]\n";
+  } else {
+    s << "damping = " << g17(data.system.damping) << "\n";
+  }
+  s << "\n[grid]\nsystems = [\"" << system << "\"]\nmodels = [\"" << to_string(cell.model) << "-"
+    << to_string(cell.integrator) << "\"]\nsizes = [\"" << to_string(cell.size)
+    << "\"]\nn_train = [" << cell.n_train << "]\nregularizers = [\"" << to_string(cell.regularizer)
+    << "\"]\nseeds = [";
+  for (std::size_t i = 0; i < cell.seeds.size(); ++i) s << (i ? ", " : "") << cell.seeds[i];
+  s << "]\n";
+  return s.str();
+}
+
+void write_cell_file(const std::string& path, const CellSpec& cell, const SystemData& data,
+                     const std::vector<RunResult>& results) {
+  const std::string text = cell_sweep_text(cell, data);
+  const SweepSpec spec = parse_sweep_text(text, path + "@sweep_text");
+  const Grid grid = expand_grid(spec);
+  PHNN_CHECK(grid.runs.size() == results.size(), "cell sweep text expands to "
+                                                     << grid.runs.size() << " runs, not "
+                                                     << results.size());
+  std::vector<std::string> studies(grid.runs.size(), "grid");
+  ResultsFile file = ResultsFile::create(path, MPI_COMM_NULL, grid.runs, studies, spec.name, text,
+                                         spec.text_hash, program_version(),
+                                         ResultsLayout::for_runs(grid.runs));
+  file.store_system_data(to_string(data.system.kind), data);
+  // Grid rows are ordered by seed, like the cell's members.
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+    const auto it = std::find(cell.seeds.begin(), cell.seeds.end(), grid.runs[i].seed);
+    file.write_run(static_cast<int>(i), results[static_cast<std::size_t>(it - cell.seeds.begin())]);
+  }
+  file.close();
 }
 
 }  // namespace
@@ -47,6 +112,7 @@ int run_train(int argc, char** argv, int first) {
   parser.option("data-seed", "data-set seed when generating", "0");
   parser.option("damping", "c of z(w) = c w [N s/m] when generating", "0.14737");
   parser.option("threads", "LibTorch intra-op threads", "1");
+  parser.option("out", "also write the runs to this results file (readable by `phnn reduce`)");
   parser.flag("quiet", "no progress line");
   if (!parser.parse(argc, argv, first)) return 0;
 
@@ -57,8 +123,8 @@ int run_train(int argc, char** argv, int first) {
   cell.size = parse_size(parser.get("size"));
   cell.regularizer = parse_regularizer(parser.get("reg"));
   cell.n_train = static_cast<int>(parser.get_int("n-train"));
+  cell.seeds.clear();
   for (auto s : cli::parse_int_list("seeds", parser.get("seeds"))) cell.seeds.push_back(static_cast<int>(s));
-  cell.seeds.erase(cell.seeds.begin());  // drop the default {0}
   const auto steps = parser.get_int("steps");
   if (steps < 0) throw cli::UsageError{"phnn train: --steps = " + std::to_string(steps) + " must be >= 0"};
   cell.training.steps = static_cast<int>(steps);
@@ -95,6 +161,10 @@ int run_train(int argc, char** argv, int first) {
             << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
             << " steps=" << cell.training.steps << "\n";
   const bool quiet = parser.flag_set("quiet");
+  if (parser.has("out") && std::ifstream(parser.get("out")).good()) {
+    throw cli::UsageError{"phnn train: --out " + parser.get("out") +
+                          " exists; choose a new path (train never overwrites results)"};
+  }
   const auto results = train_cell(cell, data, [&](const TrainProgress& p) {
     if (quiet) return;
     const double eta = p.step > 0 ? p.elapsed_s / p.step * (p.total_steps - p.step) : 0.0;
@@ -117,6 +187,10 @@ int run_train(int argc, char** argv, int first) {
   const double q25 = quantile(mses, 0.25), q50 = quantile(mses, 0.5), q75 = quantile(mses, 0.75);
   std::printf("median [IQR]: %.2e [%.2e]   parameters/member: %ld   wall time: %.1f s\n", q50,
               q75 - q25, results.empty() ? 0L : results[0].parameter_count, wall);
+  if (parser.has("out")) {
+    write_cell_file(parser.get("out"), cell, data, results);
+    std::printf("runs written to %s\n", parser.get("out").c_str());
+  }
   return 0;
 }
 

@@ -27,7 +27,12 @@ void CellSpec::validate(const SystemData& data) const {
                "Invalid CellSpec: n_train = " << n_train << "; the data set has "
                                               << data.train.size() << " training pairs");
   PHNN_REQUIRE(!seeds.empty(), "Invalid CellSpec: no seeds");
-  for (int s : seeds) PHNN_REQUIRE(s >= 0, "Invalid CellSpec: seed = " << s << " must be >= 0");
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    PHNN_REQUIRE(seeds[i] >= 0, "Invalid CellSpec: seed = " << seeds[i] << " must be >= 0");
+    for (std::size_t j = 0; j < i; ++j) {
+      PHNN_REQUIRE(seeds[i] != seeds[j], "Invalid CellSpec: seed " << seeds[i] << " listed twice");
+    }
+  }
   PHNN_REQUIRE(!data.validation.x.empty(), "Invalid CellSpec: the data set has no validation pairs");
 }
 

@@ -51,9 +51,10 @@ TEST(TrainerTest, StackingIsExact) {
 }
 
 // Learning smoke test: every model x integrator on every system reduces the
-// validation loss >= 5x within 5 000 steps at N_train = 100, median over
-// seeds 0-2 (single seeds can stall on a plateau: Duffing PHNN-S seeds 0 and
-// 4 sit at ~4x after 5 000 steps while the other 8 of 10 reach 12-50x).
+// validation loss >= 5x within 5 000 steps at N_train = 100, median over the
+// paper's 10 seeds. Single seeds can stall on a plateau: for Duffing
+// PHNN-S-DG seeds 0, 1 and 4 sit at 3.6-4.9x after 5 000 steps while the
+// other 7 reach 21-49x (measured; PHNN-S-RK2 behaves alike).
 TEST(TrainerTest, EveryModelLearnsEverySystem) {
   const std::pair<ModelKind, IntegratorKind> models[] = {
       {ModelKind::kNode, IntegratorKind::kRk2},  {ModelKind::kPhnnJr, IntegratorKind::kDg},
@@ -66,7 +67,7 @@ TEST(TrainerTest, EveryModelLearnsEverySystem) {
       cell.integrator = integrator;
       cell.n_train = 100;
       cell.training.steps = 5000;
-      cell.seeds = {0, 1, 2};
+      cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
       const auto r = train_cell(cell, small_data(sys));
       std::vector<double> reductions;
       for (const auto& run : r) {
@@ -74,10 +75,11 @@ TEST(TrainerTest, EveryModelLearnsEverySystem) {
         EXPECT_TRUE(std::isfinite(run.mse));
       }
       std::sort(reductions.begin(), reductions.end());
-      EXPECT_GE(reductions[1], 5.0) << to_string(sys) << " " << model_label(model, integrator);
+      const double median = 0.5 * (reductions[4] + reductions[5]);
+      EXPECT_GE(median, 5.0) << to_string(sys) << " " << model_label(model, integrator);
       RecordProperty(to_string(sys) + "_" + model_label(model, integrator),
-                     std::to_string(reductions[0]) + "," + std::to_string(reductions[1]) + "," +
-                         std::to_string(reductions[2]));
+                     "min " + std::to_string(reductions.front()) + " median " +
+                         std::to_string(median) + " max " + std::to_string(reductions.back()));
     }
   }
 }

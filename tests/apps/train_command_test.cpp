@@ -1,0 +1,64 @@
+// tests/apps/train_command_test.cpp — `phnn train` end to end.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/sweep/results_file.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+
+int run(const std::string& args, std::string* output) {
+  const std::string log = ::testing::TempDir() + "phnn_train_" + std::to_string(::getpid()) + ".log";
+  const int status = std::system((std::string(PHNN_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
+  std::ifstream in(log);
+  output->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(TrainCommandTest, TrainsACellAndWritesAFileTheReducerReads) {
+  const std::string out = ::testing::TempDir() + "phnn_train_cell_" + std::to_string(::getpid()) + ".h5";
+  std::remove(out.c_str());
+  std::string log;
+  ASSERT_EQ(run("train --system harmonic --model phnn-s --integrator dg --n-train 25 --seeds 0-2 "
+                "--steps 40 --eval-every 20 --quiet --out " + out, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("median [IQR]:"));
+  EXPECT_THAT(log, HasSubstr("parameters/member: 852"));
+  const ResultsFile file = ResultsFile::open_read_only(out);
+  ASSERT_EQ(file.num_runs(), 3);
+  for (RunStatus s : file.read_statuses()) EXPECT_NE(s, RunStatus::kPending);
+  EXPECT_EQ(file.read_seeds(), (std::vector<std::int64_t>{0, 1, 2}));
+  EXPECT_TRUE(file.has_system_data("harmonic"));
+  ASSERT_EQ(run("reduce " + out, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("| PHNN-S-DG |"));
+  // Never overwrites.
+  EXPECT_EQ(run("train --system harmonic --model phnn-s --steps 1 --out " + out, &log), 2);
+  EXPECT_THAT(log, HasSubstr("exists"));
+  std::remove(out.c_str());
+}
+
+TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
+  std::string log;
+  EXPECT_EQ(run("train --system harmonic --model node --integrator dg --steps 1", &log), 2);
+  EXPECT_THAT(log, HasSubstr("integrator = dg with model = node"));
+  EXPECT_EQ(run("train --system harmonic --model phnn-jr --steps -4", &log), 2);
+  EXPECT_THAT(log, HasSubstr("--steps = -4"));
+  EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 3-1", &log), 2);
+  EXPECT_THAT(log, HasSubstr("--seeds"));
+  EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 1,1 --steps 1", &log), 2);
+  EXPECT_THAT(log, HasSubstr("seed 1 listed twice"));
+  EXPECT_EQ(run("train --system harmonic --model mlp", &log), 2);
+  EXPECT_THAT(log, HasSubstr("unknown model \"mlp\""));
+}
+
+}  // namespace
+}  // namespace phnn
