@@ -12,6 +12,7 @@ PACKAGES=(
   libboost-mpi-dev                   # Boost.MPI (environment, communicator)
   libgtest-dev libgmock-dev googletest
   libopenblas0-pthread               # fast BLAS behind libblas.so.3 (LibTorch uses it)
+  libblas-dev                        # libblas.so to link dgemm_ (src/models/stacked_matmul.cpp)
   libjemalloc-dev                    # allocator: glibc malloc costs ~16 % of a step
   python3-h5py python3-numpy python3-matplotlib  # analysis/ only
 )

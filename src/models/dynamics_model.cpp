@@ -32,6 +32,34 @@ std::vector<torch::Tensor> DynamicsModel::parameters() const {
   return out;
 }
 
+DynamicsModel::FlatParameters DynamicsModel::flatten_parameters() {
+  const std::vector<torch::Tensor> params = parameters();
+  int64_t total = 0;
+  for (const auto& p : params) total += p.numel();
+  FlatParameters flat{torch::empty({total}, torch::kFloat64), torch::zeros({total}, torch::kFloat64)};
+  {
+    torch::NoGradGuard no_grad;
+    int64_t offset = 0;
+    for (const auto& p : params) {
+      flat.values.narrow(0, offset, p.numel()).copy_(p.detach().reshape({-1}));
+      offset += p.numel();
+    }
+  }
+  int64_t offset = 0;
+  for (auto& net : nets_) net->bind_to(flat.values, flat.gradients, &offset);
+  return flat;
+}
+
+std::vector<torch::Tensor> DynamicsModel::unflatten(const torch::Tensor& flat_like) const {
+  std::vector<torch::Tensor> out;
+  int64_t offset = 0;
+  for (const auto& p : parameters()) {
+    out.push_back(flat_like.narrow(0, offset, p.numel()).view(p.sizes()));
+    offset += p.numel();
+  }
+  return out;
+}
+
 long DynamicsModel::parameter_count() const {
   long n = 0;
   for (const auto& net : nets_) n += net->parameter_count();

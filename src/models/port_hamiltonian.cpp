@@ -29,7 +29,7 @@ Jet lincomb(const std::vector<std::pair<double, const Jet*>>& terms, const Jet& 
 
 Jet hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order) {
   const Jet X = Jet::input(x, /*directions=*/2, order);
-  const Jet o = l_h.forward(X);
+  const Jet o = l_h.forward_input(x, /*directions=*/2, order);
   const Jet l00 = jet_softplus(o.component(0));
   const Jet l10 = o.component(1);
   const Jet l11 = jet_softplus(o.component(2));
@@ -48,20 +48,42 @@ Jet gradient_jet(const Jet& h) {
   return g;
 }
 
+HamiltonianAndGradient hamiltonian_and_gradient(const StackedMlp& l_h, const torch::Tensor& x) {
+  const Jet o = l_h.forward_input(x, /*directions=*/2, /*order=*/1);
+  const auto q = x.narrow(-1, 0, 1), p = x.narrow(-1, 1, 1);
+  const auto o0 = o.v.narrow(-1, 0, 1), l10 = o.v.narrow(-1, 1, 1), o2 = o.v.narrow(-1, 2, 1);
+  const auto l00 = torch::softplus(o0), l11 = torch::softplus(o2);
+  const auto v0 = l00 * q, v1 = l10 * q + l11 * p;
+  HamiltonianAndGradient out;
+  out.h = 0.5 * (v0 * v0 + v1 * v1);
+  // L^T v = (l00 v0 + l10 v1, l11 v1).
+  const auto lt_v = torch::cat({l00 * v0 + l10 * v1, l11 * v1}, -1);
+  const auto c = torch::cat({v0 * torch::sigmoid(o0) * q, v1 * q, v1 * torch::sigmoid(o2) * p}, -1);
+  // (do/dx) c: o.g is [E, B, 2 (directions), 3 (outputs)].
+  out.grad = lt_v + (o.g * c.unsqueeze(-2)).sum(-1);
+  return out;
+}
+
 torch::Tensor PortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
   return hamiltonian_jet(l_h(), x, 0).v.squeeze(-1);
 }
 
 torch::Tensor PortHamiltonianModel::grad_hamiltonian(const torch::Tensor& x) const {
-  return hamiltonian_jet(l_h(), x, 1).g.squeeze(-1);
+  return hamiltonian_and_gradient(l_h(), x).grad;
 }
 
 FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tensor& u,
                                       bool with_jacobian) const {
-  const int order = with_jacobian ? 1 : 0;
+  FieldEval out;
+  if (!with_jacobian) {
+    Jet effort;
+    effort.v = hamiltonian_and_gradient(l_h(), x).grad;
+    out.f = field_from_effort(effort, x, u, /*order=*/0).v;
+    return out;
+  }
+  const int order = 1;
   const Jet grad = gradient_jet(hamiltonian_jet(l_h(), x, order + 1));
   const Jet f = field_from_effort(grad, x, u, order);
-  FieldEval out;
   out.f = f.v;
   if (with_jacobian) out.dfdx = f.g.transpose(-1, -2);
   return out;
@@ -73,10 +95,10 @@ torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
   const int64_t B = x.size(1);
   // One network call for H(x), H(x + dx) and gradH(x + dx/2).
   const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
-  const Jet h = hamiltonian_jet(l_h(), points, /*order=*/1);
-  const auto h_x = h.v.narrow(1, 0, B);
-  const auto h_xdx = h.v.narrow(1, B, B);
-  const auto grad_mid = h.g.narrow(1, 2 * B, B).squeeze(-1);  // [E, B, 2]
+  const HamiltonianAndGradient h = hamiltonian_and_gradient(l_h(), points);
+  const auto h_x = h.h.narrow(1, 0, B);
+  const auto h_xdx = h.h.narrow(1, B, B);
+  const auto grad_mid = h.grad.narrow(1, 2 * B, B);  // [E, B, 2]
   const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);
   const auto defect = h_xdx - h_x - (grad_mid * dx).sum(-1, /*keepdim=*/true);
   const auto small = n2 < min_dx_norm * min_dx_norm;
@@ -131,6 +153,14 @@ PhnnJr::PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds)
   const Eigen::Matrix3d J = structure.J();
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) J_[r][c] = J(r, c);
+  j_matrix_ = torch::zeros({3, 3}, torch::kFloat64);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) j_matrix_[r][c] = J_[r][c];
+  // Output k of L_R goes to row-major lower-triangle entry (row, col).
+  placement_ = torch::zeros({6, 9}, torch::kFloat64);
+  int k = 0;
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col <= row; ++col) placement_[k++][3 * row + col] = 1.0;
 }
 
 torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const {
@@ -144,8 +174,18 @@ torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x, const torch::Te
 
 Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
                               const torch::Tensor& u, int order) const {
+  if (order == 0) {
+    // Matrix form: L_R from its 6 outputs by one placement matmul, then
+    // f = [J e - L^T (L e)]_{1:2} with e = (gradH, u).
+    const auto o = nets_[1]->forward(torch::cat({x_dissipation, u}, -1));  // [E, B, 6]
+    const auto L = torch::matmul(o, placement_).unflatten(-1, {3, 3});    // [E, B, 3, 3]
+    const auto e = torch::cat({effort.v, u}, -1).unsqueeze(-1);            // [E, B, 3, 1]
+    const auto re = torch::matmul(L.transpose(-1, -2), torch::matmul(L, e));
+    const auto je = torch::matmul(j_matrix_, e);
+    return Jet{(je - re).squeeze(-1).narrow(-1, 0, 2), {}, {}};
+  }
   // L_R(x, u): lower triangular 3 x 3 from 6 outputs, row by row.
-  const Jet o = nets_[1]->forward(Jet::input(torch::cat({x_dissipation, u}, -1), 2, order));
+  const Jet o = nets_[1]->forward_input(torch::cat({x_dissipation, u}, -1), 2, order);
   Jet L[3][3];
   int idx = 0;
   for (int k = 0; k < 3; ++k)
@@ -183,7 +223,7 @@ FieldEval Node::field(const torch::Tensor& x, const torch::Tensor& u, bool with_
     out.f = nets_[0]->forward(input);
     return out;
   }
-  const Jet f = nets_[0]->forward(Jet::input(input, /*directions=*/2, /*order=*/1));
+  const Jet f = nets_[0]->forward_input(input, /*directions=*/2, /*order=*/1);
   out.f = f.v;
   out.dfdx = f.g.transpose(-1, -2);
   return out;

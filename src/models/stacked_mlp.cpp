@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "models/stacked_matmul.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
 
@@ -162,7 +163,7 @@ torch::Tensor StackedMlp::forward(const torch::Tensor& x) const {
   torch::Tensor a = x;
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
-    a = torch::baddbmm(biases_[l], a, weights_[l]);
+    a = internal::stacked_matmul(a, weights_[l]) + biases_[l];
     if (l < last) a = torch::tanh(a);
   }
   return a;
@@ -173,7 +174,7 @@ namespace {
 torch::Tensor batched_linear(const torch::Tensor& t, const torch::Tensor& w) {
   const auto sizes = t.sizes();
   auto flat = t.reshape({sizes[0], -1, sizes.back()});
-  auto out = torch::bmm(flat, w);
+  auto out = internal::stacked_matmul(flat, w);
   std::vector<int64_t> shape(sizes.begin(), sizes.end());
   shape.back() = w.size(2);
   return out.reshape(shape);
@@ -185,12 +186,52 @@ Jet StackedMlp::forward(const Jet& x) const {
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
     Jet z;
-    z.v = torch::baddbmm(biases_[l], a.v, weights_[l]);
+    z.v = internal::stacked_matmul(a.v, weights_[l]) + biases_[l];
     if (a.g.defined()) z.g = batched_linear(a.g, weights_[l]);
     if (a.h.defined()) z.h = batched_linear(a.h, weights_[l]);
     a = l < last ? jet_tanh(z) : z;
   }
   return a;
+}
+
+Jet StackedMlp::forward_input(const torch::Tensor& x, int directions, int order) const {
+  if (order == 0) return Jet{forward(x), {}, {}};
+  const int64_t E = x.size(0), B = x.size(1);
+  // Layer 0: z = x W + b, dz/dx_i = W[i, :], d2z = 0.
+  Jet z;
+  z.v = internal::stacked_matmul(x, weights_[0]) + biases_[0];
+  z.g = weights_[0].narrow(1, 0, directions).unsqueeze(1).expand({E, B, directions, weights_[0].size(2)});
+  Jet a;
+  if (weights_.size() == 1) return z;
+  const auto t = torch::tanh(z.v);
+  const auto d1 = 1.0 - t * t;
+  a.v = t;
+  a.g = d1.unsqueeze(-2) * z.g;
+  if (order >= 2) {
+    a.h = (-2.0 * t * d1).unsqueeze(-2).unsqueeze(-2) * direction_outer(z.g, z.g);
+  }
+  const std::size_t last = weights_.size() - 1;
+  for (std::size_t l = 1; l < weights_.size(); ++l) {
+    Jet y;
+    y.v = internal::stacked_matmul(a.v, weights_[l]) + biases_[l];
+    y.g = batched_linear(a.g, weights_[l]);
+    if (a.h.defined()) y.h = batched_linear(a.h, weights_[l]);
+    a = l < last ? jet_tanh(y) : y;
+  }
+  return a;
+}
+
+void StackedMlp::bind_to(const torch::Tensor& values, const torch::Tensor& gradients,
+                         int64_t* offset) {
+  for (std::size_t l = 0; l < weights_.size(); ++l) {
+    for (torch::Tensor* p : {&weights_[l], &biases_[l]}) {
+      const int64_t n = p->numel();
+      const auto shape = p->sizes().vec();
+      *p = values.narrow(0, *offset, n).view(shape).detach().requires_grad_(true);
+      p->mutable_grad() = gradients.narrow(0, *offset, n).view(shape);
+      *offset += n;
+    }
+  }
 }
 
 std::vector<torch::Tensor> StackedMlp::parameters() const {

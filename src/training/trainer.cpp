@@ -14,6 +14,7 @@
 #include "phnn/integrators/discrete_gradient.h"
 #include "phnn/models/dynamics_model.h"
 #include "phnn/training/discrete_step.h"
+#include "phnn/training/flat_adam.h"
 #include "phnn/training/regularizers.h"
 
 namespace phnn {
@@ -150,10 +151,11 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   std::unique_ptr<DynamicsModel> model =
       DynamicsModel::create(ModelOptions{cell.model, cell.size, data.system.kind}, seeds);
-  std::vector<torch::Tensor> params = model->parameters();
-  torch::optim::Adam adam(params, torch::optim::AdamOptions(opt.learning_rate)
-                                      .betas(std::make_tuple(opt.adam_beta1, opt.adam_beta2))
-                                      .eps(opt.adam_eps));
+  // One contiguous leaf for the whole stack: Adam in a handful of ops.
+  const DynamicsModel::FlatParameters flat = model->flatten_parameters();
+  const std::vector<torch::Tensor> params = model->parameters();  // alias flat.values
+  const std::vector<torch::Tensor> grads = model->unflatten(flat.gradients);
+  FlatAdam adam(flat.values, flat.gradients, opt);
 
   const int N = cell.n_train;
   const double h = data.train.step;
@@ -261,9 +263,7 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
     }
     const auto dead_idx = torch::tensor(dead, torch::kLong);
     if (!dead.empty()) {
-      for (auto& p : params) {
-        if (p.grad().defined()) p.mutable_grad().index_fill_(0, dead_idx, 0.0);
-      }
+      for (const auto& g : grads) g.index_fill_(0, dead_idx, 0.0);
     }
     adam.step();
     if (!dead.empty()) {

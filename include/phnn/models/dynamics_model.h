@@ -49,6 +49,17 @@ class DynamicsModel {
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;
 
   std::vector<torch::Tensor> parameters() const;
+  /// Moves every parameter into one contiguous buffer: the parameters stay
+  /// separate leaves but alias slices of it, and their gradients alias
+  /// slices of a second buffer, so an optimizer can update the whole stack
+  /// in a handful of ops on {values, gradients}. (Views of one flat leaf
+  /// would instead cost a full-size zero fill per parameter in backward.)
+  struct FlatParameters {
+    torch::Tensor values, gradients;
+  };
+  FlatParameters flatten_parameters();
+  /// Views of a tensor laid out like the flat buffers, shaped like parameters().
+  std::vector<torch::Tensor> unflatten(const torch::Tensor& flat_like) const;
   int64_t members() const { return members_; }
   /// Trainable parameters of one member.
   long parameter_count() const;

@@ -17,6 +17,15 @@ Jet hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order);
 /// order-(k+1) jet of H.
 Jet gradient_jet(const Jet& h);
 
+/// H [E, B, 1] and gradH [E, B, 2] in closed form from the order-1 jet of
+/// the L_H outputs o (fewer ops than hamiltonian_jet(.., 1), same values to
+/// round-off). With v = L_H x, s_k = sigmoid(o_k):
+///   gradH = L_H^T v + (do/dx) c,  c = (v0 s0 q, v1 q, v1 s2 p).
+struct HamiltonianAndGradient {
+  torch::Tensor h, grad;
+};
+HamiltonianAndGradient hamiltonian_and_gradient(const StackedMlp& l_h, const torch::Tensor& x);
+
 /// Shared by PHNN-S and PHNN-JR: H_theta, gradH_theta, the Gonzalez DG.
 class PortHamiltonianModel : public DynamicsModel {
  public:
@@ -74,6 +83,8 @@ class PhnnJr : public PortHamiltonianModel {
 
  private:
   std::array<std::array<double, 3>, 3> J_;
+  torch::Tensor j_matrix_;   // J [3, 3]
+  torch::Tensor placement_;  // [6, 9]: L_R outputs -> row-major 3 x 3 lower triangle
 };
 
 /// NODE baseline (eq: neural-ode): f = MLP([x; u]), 3 -> 2.

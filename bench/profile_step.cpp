@@ -1,0 +1,32 @@
+// bench/profile_step.cpp — per-operator profile of training steps (chrome
+// trace JSON from the LibTorch autograd profiler), for finding hot spots.
+//   profile_step MODEL INTEGRATOR MEMBERS STEPS OUT.json
+#include <cstdlib>
+#include <string>
+
+#include <torch/csrc/autograd/profiler_legacy.h>
+#include <torch/torch.h>
+
+#include "phnn/data/dataset_file.h"
+#include "phnn/training/trainer.h"
+
+int main(int argc, char** argv) {
+  if (argc < 6) return 2;
+  torch::set_num_threads(1);
+  phnn::DatasetOptions options;
+  options.num_validation = 64;
+  options.num_inference = 1;
+  const auto data = phnn::make_system_data(
+      phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing), options, 64);
+  phnn::CellSpec cell;
+  cell.model = phnn::parse_model(argv[1]);
+  cell.integrator = phnn::parse_integrator(argv[2]);
+  cell.n_train = 64;
+  cell.seeds.clear();
+  for (int s = 0; s < std::atoi(argv[3]); ++s) cell.seeds.push_back(s);
+  cell.training.steps = std::atoi(argv[4]);
+  cell.training.eval_every = 1000000;
+  torch::autograd::profiler::RecordProfile guard(argv[5]);
+  phnn::train_cell(cell, data);
+  return 0;
+}

@@ -1,0 +1,31 @@
+// include/phnn/training/flat_adam.h — Adam on one contiguous parameter tensor.
+#pragma once
+
+#include <torch/torch.h>
+
+#include "phnn/training/trainer_options.h"
+
+namespace phnn {
+
+/// Adam (Kingma & Ba; the update of torch::optim::Adam 1.13, no weight
+/// decay, no AMSGrad) on a single flat leaf tensor: the same arithmetic in
+/// the same order, so it matches torch::optim::Adam on the separate tensors
+/// bit for bit (tested), in ~8 ops per step instead of ~8 per tensor.
+///   m = b1 m + (1 - b1) g;  v = b2 v + (1 - b2) g^2
+///   p -= lr / (1 - b1^t) * m / (sqrt(v) / sqrt(1 - b2^t) + eps)
+class FlatAdam {
+ public:
+  /// `values` and `gradients`: contiguous buffers that the parameters and
+  /// their .grad() alias (DynamicsModel::flatten_parameters()).
+  FlatAdam(torch::Tensor values, torch::Tensor gradients, const TrainerOptions& options);
+  void zero_grad();
+  void step();
+  int64_t steps_taken() const { return t_; }
+
+ private:
+  torch::Tensor p_, g_, m_, v_;
+  double lr_, b1_, b2_, eps_;
+  int64_t t_ = 0;
+};
+
+}  // namespace phnn
