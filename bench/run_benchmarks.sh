@@ -15,7 +15,7 @@ LD_PRELOAD=$JEMALLOC $BENCH baseline "$REPEATS"
 LD_PRELOAD=$JEMALLOC $BENCH stacked "$REPEATS"
 echo "## Debian defaults: reference BLAS + glibc malloc"
 LD_LIBRARY_PATH=$REFBLAS $BENCH baseline "$REPEATS"
-LD_LIBRARY_PATH=$REFBLAS $BENCH stacked "$REPEATS"
+LD_LIBRARY_PATH=$REFBLAS $BENCH stacked "${REPEATS_DEFAULTS:-1}"
 if [[ ${FULL_CELL:-0} == 1 ]]; then
   LD_PRELOAD=$JEMALLOC $BENCH cell
 fi

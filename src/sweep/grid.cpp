@@ -205,8 +205,8 @@ std::string dry_run_summary(const Grid& grid, int ranks) {
   out << "estimated cost: " << buf << " core-hours (" << format_duration(grid.estimated_cost_s)
       << " on one core); wall time on " << ranks << (ranks == 1 ? " rank: " : " ranks: ")
       << format_duration(wall)
-      << " (largest cell first to the first free rank; placeholder cost model, see "
-         "include/phnn/sweep/grid.h)\n";
+      << " (largest cell first to the first free rank; cost model fit on one "
+         "development machine, see include/phnn/sweep/grid.h)\n";
   if (!grid.cells.empty()) {
     out << "largest cell: " << format_duration(grid.cells.front().estimated_cost_s)
         << ", smallest: " << format_duration(grid.cells.back().estimated_cost_s) << "\n";

@@ -9,8 +9,9 @@
 
 namespace phnn {
 
-/// Cost model of one run, in seconds on one core. The numbers are
-/// placeholders, to be re-fit from the benchmark; all of them live here.
+/// Cost model of one run, in seconds on one core. The constants were fit to
+/// bench/bench_training and `phnn train` timings on the 2-core development
+/// machine (docs/BENCHMARKS.md); all of them live here.
 ///
 ///   member_step_us = base_us[model][integrator] * size_factor[size]
 ///                    * (regularizer != none ? regularizer_factor : 1)
@@ -33,22 +34,28 @@ namespace phnn {
 /// training cost does not depend on n_train (the batch is <= 64 pairs).
 struct CostModel {
   /// Microseconds per member per training step, small size, no regularizer,
-  /// indexed [ModelKind][IntegratorKind] (NODE-DG does not exist).
+  /// indexed [ModelKind][IntegratorKind] (NODE-DG does not exist). Measured
+  /// with bench/bench_training (docs/BENCHMARKS.md): one thread, float64,
+  /// batch 64, 10 members stacked (a paper cell), OpenBLAS + jemalloc.
   double base_us[3][2] = {
-      /*kNode=*/{/*kRk2=*/350.0, /*kDg=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/650.0, /*kDg=*/550.0},
-      /*kPhnnJr=*/{/*kRk2=*/700.0, /*kDg=*/600.0},
+      /*kNode=*/{/*kRk2=*/80.0, /*kDg=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/275.0, /*kDg=*/295.0},
+      /*kPhnnJr=*/{/*kRk2=*/319.0, /*kDg=*/319.0},
   };
-  /// Indexed by ModelSize: small, medium, large.
-  double size_factor[3] = {1.0, 2.5, 10.0};
-  /// Jacobian and its SVD / eigenvalues in every step (CN, SN, SR).
-  double regularizer_factor = 1.6;
+  /// Indexed by ModelSize: small, medium, large (PHNN-JR-RK2, E = 10,
+  /// measured with `phnn train`: 272, 660 and 4186 us per member-step).
+  double size_factor[3] = {1.0, 2.4, 15.0};
+  /// Jacobian, closed-form SVD / eigenvalues and their backward in every
+  /// step (CN, SN, SR): measured 2.6-2.7x.
+  double regularizer_factor = 2.7;
   /// Pairs per batch-step in the validation and inference terms.
   double reference_batch = 64.0;
-  /// A rollout state-step costs 1 / rollout_speedup of a training pair-step.
-  double rollout_speedup = 20.0;
-  /// DG rollouts solve a Newton system per step.
-  double dg_newton_factor = 4.0;
+  /// A rollout state-step costs 1 / rollout_speedup of a training pair-step
+  /// (forward only, no backward; measured ~0.08 s per small RK2 run).
+  double rollout_speedup = 3.0;
+  /// DG rollouts solve a Newton system per step (3-5 batched residual
+  /// evaluations; measured ~0.85 s per small DG run).
+  double dg_newton_factor = 10.0;
 };
 
 /// Estimated wall time of one run on one core [s] (CostModel above).
