@@ -167,6 +167,56 @@ TEST(SweepCommandTest, KilledRankThenRerunCompletesEveryRunOnce) {
   RecordProperty("runs_finished_before_kill", static_cast<int>(finished_before));
 }
 
+// Slurm's --signal=USR1@T: every rank finishes its cell, takes no new one,
+// the file is closed, exit status 75; the same command then completes.
+TEST(SweepCommandTest, StopsCleanlyOnSignalThenResumes) {
+  const std::string dir = temp_dir("signal");
+  std::string text = kSweep;
+  text.replace(text.find("steps = 30"), 10, "steps = 4000");
+  text.replace(text.find("seeds = [0, 1, 2]"), 17, "seeds = [0, 1]\nn_train = [25, 26, 27]");
+  text.replace(text.find("n_train = [25]\n"), 15, "");
+  const std::string sweep = write_sweep(dir, text);
+  const std::string out = dir + "/stopped.h5";
+  const std::string command = mpiexec(2) + " sweep " + sweep + " --out " + out;
+  ASSERT_EQ(std::system(("(" + command + " > " + dir + "/first.log 2>&1; echo $? > " + dir +
+                         "/status) &").c_str()),
+            0);
+  const auto start = std::chrono::steady_clock::now();
+  while (replay_journals(out).empty() &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(240)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_FALSE(replay_journals(out).empty()) << "no run finished within 240 s";
+  // The ranks only (mpirun would forward it to them anyway).
+  std::string ps;
+  shell("ps -eo args | grep '[p]hnn sweep'", &ps);
+  ASSERT_EQ(shell("pkill -USR1 -f '^" + std::string(PHNN_BINARY) + " sweep " + sweep + "'"), 0)
+      << ps;
+  int status = -1;
+  while (std::chrono::steady_clock::now() - start < std::chrono::seconds(300)) {
+    std::ifstream in(dir + "/status");
+    if (in >> status) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  std::ifstream first_log(dir + "/first.log");
+  const std::string log((std::istreambuf_iterator<char>(first_log)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(status, 75) << log;
+  EXPECT_THAT(log, HasSubstr("stopped on a signal"));
+  const auto finished = replay_journals(out).size();
+  EXPECT_LT(finished, 18u);
+  {
+    const ResultsFile file = ResultsFile::open_read_only(out);  // closed cleanly
+    int done = 0;
+    for (RunStatus s : file.read_statuses()) done += s == RunStatus::kDone;
+    EXPECT_EQ(static_cast<std::size_t>(done), finished);
+  }
+  std::string rerun;
+  ASSERT_EQ(shell(command + " --quiet", &rerun), 0) << rerun;
+  EXPECT_THAT(rerun, HasSubstr(std::to_string(finished) + " finished before"));
+  const ResultsFile file = ResultsFile::open_read_only(out);
+  for (RunStatus s : file.read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
+}
+
 TEST(SweepCommandTest, BadSweepFilesExitTwoBeforeWritingAnything) {
   const std::string dir = temp_dir("bad");
   const std::pair<const char*, const char*> cases[] = {
