@@ -116,13 +116,25 @@ torch::Tensor PortHamiltonianModel::discrete_gradient_field(const torch::Tensor&
   return field_from_effort(effort, x + 0.5 * dx, u, /*order=*/0).v;
 }
 
+namespace {
+// The L_H network shared by both formulations, then the dissipation network.
+void add_networks(std::vector<std::unique_ptr<StackedMlp>>* nets, const ModelOptions& options,
+                  const std::vector<std::uint64_t>& seeds, int dissipation_in,
+                  const std::vector<int>& dissipation_hidden, int dissipation_out,
+                  std::uint64_t dissipation_stream) {
+  nets->push_back(std::make_unique<StackedMlp>(
+      StackedMlpOptions{2, network_widths(options.size).l_h, 3}, seeds, kStreamLH));
+  nets->push_back(std::make_unique<StackedMlp>(
+      StackedMlpOptions{dissipation_in, dissipation_hidden, dissipation_out}, seeds,
+      dissipation_stream));
+}
+}  // namespace
+
 // ---------------------------------------------------------------- PHNN-S
 PhnnS::PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds)
     : PortHamiltonianModel(options, static_cast<int64_t>(seeds.size())) {
   PHNN_REQUIRE(options.kind == ModelKind::kPhnnS, "PhnnS: options.kind must be phnn-s");
-  const NetworkWidths w = network_widths(options.size);
-  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{2, w.l_h, 3}, seeds, kStreamLH));
-  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{1, w.l_z, 1}, seeds, kStreamLz));
+  add_networks(&nets_, options, seeds, 1, network_widths(options.size).l_z, 1, kStreamLz);
   const Oscillator structure(OscillatorOptions::defaults(options.structure));
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) S_[r][c] = structure.S()(r, c);
@@ -146,9 +158,7 @@ Jet PhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_dissipa
 PhnnJr::PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds)
     : PortHamiltonianModel(options, static_cast<int64_t>(seeds.size())) {
   PHNN_REQUIRE(options.kind == ModelKind::kPhnnJr, "PhnnJr: options.kind must be phnn-jr");
-  const NetworkWidths w = network_widths(options.size);
-  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{2, w.l_h, 3}, seeds, kStreamLH));
-  nets_.push_back(std::make_unique<StackedMlp>(StackedMlpOptions{3, w.l_r, 6}, seeds, kStreamLR));
+  add_networks(&nets_, options, seeds, 3, network_widths(options.size).l_r, 6, kStreamLR);
   const Oscillator structure(OscillatorOptions::defaults(options.structure));
   const Eigen::Matrix3d J = structure.J();
   for (int r = 0; r < 3; ++r)

@@ -70,6 +70,25 @@ std::string write_sweep(const std::string& dir, const std::string& text) {
   return path;
 }
 
+// kSweep with 18 runs in 9 cells of `steps` steps: long enough to interrupt.
+std::string write_long_sweep(const std::string& dir, int steps) {
+  std::string text = kSweep;
+  text.replace(text.find("steps = 30"), 10, "steps = " + std::to_string(steps));
+  text.replace(text.find("seeds = [0, 1, 2]"), 17, "seeds = [0, 1]\nn_train = [25, 26, 27]");
+  text.replace(text.find("n_train = [25]\n"), 15, "");
+  return write_sweep(dir, text);
+}
+
+// Waits until a first run is journaled (true) or `limit` passes (false).
+bool wait_for_first_journal(const std::string& out, std::chrono::seconds limit) {
+  const auto start = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - start < limit) {
+    if (!replay_journals(out).empty()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
 void expect_same_run(const RunResult& a, const RunResult& b, int row) {
   SCOPED_TRACE("row " + std::to_string(row));
   EXPECT_EQ(a.status, b.status);
@@ -125,25 +144,14 @@ TEST(SweepCommandTest, ResultsDoNotDependOnTheNumberOfRanksOrScheduling) {
 
 TEST(SweepCommandTest, KilledRankThenRerunCompletesEveryRunOnce) {
   const std::string dir = temp_dir("kill");
-  std::string text = kSweep;
-  text.replace(text.find("steps = 30"), 10, "steps = 1500");
-  text.replace(text.find("seeds = [0, 1, 2]"), 17, "seeds = [0, 1]\nn_train = [25, 26, 27]");
-  text.replace(text.find("n_train = [25]\n"), 15, "");
-  const std::string sweep = write_sweep(dir, text);
+  const std::string sweep = write_long_sweep(dir, 1500);
   const std::string out = dir + "/killed.h5";
   const std::string command = mpiexec(2) + " sweep " + sweep + " --quiet --out " + out;
   // Start in the background; kill one rank once a first run is journaled.
   ASSERT_EQ(std::system((command + " > " + dir + "/first.log 2>&1 & echo $! > " + dir + "/pid").c_str()), 0);
   const auto start = std::chrono::steady_clock::now();
-  bool journaled = false;
-  while (std::chrono::steady_clock::now() - start < std::chrono::seconds(240)) {
-    if (!replay_journals(out).empty()) {
-      journaled = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  ASSERT_TRUE(journaled) << "no run finished within 240 s";
+  ASSERT_TRUE(wait_for_first_journal(out, std::chrono::seconds(240)))
+      << "no run finished within 240 s";
   ASSERT_EQ(shell("pkill -KILL -n -f '[p]hnn sweep " + sweep + "'"), 0);
   std::ifstream pid_file(dir + "/pid");
   pid_t pid = 0;
@@ -171,22 +179,15 @@ TEST(SweepCommandTest, KilledRankThenRerunCompletesEveryRunOnce) {
 // the file is closed, exit status 75; the same command then completes.
 TEST(SweepCommandTest, StopsCleanlyOnSignalThenResumes) {
   const std::string dir = temp_dir("signal");
-  std::string text = kSweep;
-  text.replace(text.find("steps = 30"), 10, "steps = 4000");
-  text.replace(text.find("seeds = [0, 1, 2]"), 17, "seeds = [0, 1]\nn_train = [25, 26, 27]");
-  text.replace(text.find("n_train = [25]\n"), 15, "");
-  const std::string sweep = write_sweep(dir, text);
+  const std::string sweep = write_long_sweep(dir, 4000);
   const std::string out = dir + "/stopped.h5";
   const std::string command = mpiexec(2) + " sweep " + sweep + " --out " + out;
   ASSERT_EQ(std::system(("(" + command + " > " + dir + "/first.log 2>&1; echo $? > " + dir +
                          "/status) &").c_str()),
             0);
   const auto start = std::chrono::steady_clock::now();
-  while (replay_journals(out).empty() &&
-         std::chrono::steady_clock::now() - start < std::chrono::seconds(240)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  ASSERT_FALSE(replay_journals(out).empty()) << "no run finished within 240 s";
+  ASSERT_TRUE(wait_for_first_journal(out, std::chrono::seconds(240)))
+      << "no run finished within 240 s";
   // The ranks only (mpirun would forward it to them anyway).
   std::string ps;
   shell("ps -eo args | grep '[p]hnn sweep'", &ps);
