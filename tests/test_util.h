@@ -3,7 +3,14 @@
 
 #include <cmath>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 #include "phnn/integrators/discrete_gradient.h"
 #include "phnn/integrators/explicit_midpoint.h"
@@ -47,6 +54,19 @@ inline double global_error(bool dg, double h, double t_end) {
     err = std::max(err, (x - damped_harmonic_solution(o, x0, u, n * h)).norm());
   }
   return err;
+}
+
+/// Runs `command` through the shell with stdout and stderr captured into
+/// *output (if given); returns its exit status (-1 if it did not exit).
+inline int run_shell(const std::string& command, std::string* output = nullptr) {
+  const std::string log =
+      std::string(P_tmpdir) + "/phnn_test_cmd_" + std::to_string(::getpid()) + ".log";
+  const int status = std::system((command + " > " + log + " 2>&1").c_str());
+  if (output) {
+    std::ifstream in(log);
+    output->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace testing_util

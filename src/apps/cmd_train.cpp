@@ -13,6 +13,7 @@
 #include "apps/commands.h"
 #include "phnn/common/check.h"
 #include "phnn/data/dataset_file.h"
+#include "phnn/report/tables.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
@@ -22,16 +23,6 @@
 namespace phnn {
 namespace apps {
 namespace {
-
-double quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const std::size_t hi = std::min(lo + 1, v.size() - 1);
-  const double frac = pos - static_cast<double>(lo);
-  if (frac == 0.0) return v[lo];
-  return v[lo] + frac * (v[hi] - v[lo]);
-}
 
 std::string g17(double v) {
   char buf[40];
@@ -184,7 +175,9 @@ int run_train(int argc, char** argv, int first) {
     mses.push_back(r.mse);
     wall += r.wall_time_s;
   }
-  const double q25 = quantile(mses, 0.25), q50 = quantile(mses, 0.5), q75 = quantile(mses, 0.75);
+  // The reducer's statistics (numpy linear quartiles), so both print the same.
+  const double q25 = quantile_linear(mses, 0.25), q50 = quantile_linear(mses, 0.5),
+               q75 = quantile_linear(mses, 0.75);
   std::printf("median [IQR]: %.2e [%.2e]   parameters/member: %ld   wall time: %.1f s\n", q50,
               q75 - q25, results.empty() ? 0L : results[0].parameter_count, wall);
   if (parser.has("out")) {

@@ -10,6 +10,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 #include "phnn/sweep/results_file.h"
 
 namespace phnn {
@@ -18,11 +20,7 @@ namespace {
 using ::testing::HasSubstr;
 
 int run(const std::string& args, std::string* output) {
-  const std::string log = ::testing::TempDir() + "phnn_train_" + std::to_string(::getpid()) + ".log";
-  const int status = std::system((std::string(PHNN_BINARY) + " " + args + " > " + log + " 2>&1").c_str());
-  std::ifstream in(log);
-  output->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return testing_util::run_shell(std::string(PHNN_BINARY) + " " + args, output);
 }
 
 TEST(TrainCommandTest, TrainsACellAndWritesAFileTheReducerReads) {

@@ -9,6 +9,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 #include "h5/h5file.h"
 
 namespace phnn {
@@ -65,11 +67,7 @@ TEST(DatasetFileTest, RefusesMissingAndForeignFiles) {
 
 // The CLI: bad options exit with status 2 and name the option.
 int run(const std::string& args, std::string* output) {
-  const std::string out = temp_path("cli_out.txt");
-  const int status = std::system((std::string(PHNN_BINARY) + " " + args + " > " + out + " 2>&1").c_str());
-  std::ifstream in(out);
-  output->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return testing_util::run_shell(std::string(PHNN_BINARY) + " " + args, output);
 }
 
 TEST(DataCommandTest, RejectsUnknownSystemAndBadNumbers) {

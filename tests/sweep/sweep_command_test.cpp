@@ -20,6 +20,7 @@
 #include "phnn/sweep/journal.h"
 #include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -38,13 +39,7 @@ std::string mpiexec(int ranks) {
 }
 
 int shell(const std::string& command, std::string* output = nullptr) {
-  const std::string log = ::testing::TempDir() + "phnn_sweep_cmd_" + std::to_string(::getpid()) + ".log";
-  const int status = std::system((command + " > " + log + " 2>&1").c_str());
-  if (output) {
-    std::ifstream in(log);
-    output->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return testing_util::run_shell(command, output);
 }
 
 // Three cells, one with the DG integrator (Newton at inference), N_train >
