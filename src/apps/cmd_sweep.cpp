@@ -1,6 +1,7 @@
-// src/apps/cmd_sweep.cpp — `phnn sweep FILE`: every rank trains cells taken
-// from a shared queue; every result lands in one parallel HDF5 file, each run
-// first in this rank's journal (fsync), then in its row of the file.
+// src/apps/cmd_sweep.cpp — `phnn sweep FILE`: every rank trains work items
+// (cells, or member groups of a cell) taken from a shared queue; every result
+// lands in one parallel HDF5 file, each run first in this rank's journal
+// (fsync), then in its row of the file.
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -29,6 +30,7 @@
 #include "phnn/sweep/scheduler.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/sweep/version.h"
+#include "phnn/sweep/work_plan.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {
@@ -39,7 +41,7 @@ namespace mpi = boost::mpi;
 using Clock = std::chrono::steady_clock;
 
 // Set by SIGTERM / SIGUSR1 (Slurm's --signal before the time limit, or
-// scancel): finish the cell in hand, take no new one, close the file cleanly.
+// scancel): finish the item in hand, take no new one, close the file cleanly.
 volatile std::sig_atomic_t g_stop_signal = 0;
 extern "C" void request_stop(int signal) { g_stop_signal = signal; }
 
@@ -72,11 +74,47 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
-// A cell of the grid with the runs that still need work.
-struct WorkItem {
-  int cell = 0;
-  std::vector<int> runs;
-};
+// --split and --max-group-size; throws cli::UsageError.
+SplitOptions split_options(const cli::Parser& parser) {
+  SplitOptions options;
+  try {
+    options.mode = parse_split_mode(parser.get("split"));
+    options.max_group_size = static_cast<int>(parser.get_int("max-group-size"));
+    options.validate();
+  } catch (const std::invalid_argument& e) {
+    throw cli::UsageError{"phnn sweep: --split/--max-group-size: " + std::string(e.what())};
+  }
+  return options;
+}
+
+// --ranks for --dry-run: "128" or "2,16,128"; this run's size by default.
+std::vector<int> dry_run_ranks(const cli::Parser& parser, int size) {
+  if (!parser.has("ranks")) return {size};
+  std::vector<int> ranks;
+  for (std::int64_t r : cli::parse_int_list("ranks", parser.get("ranks"))) {
+    if (r < 1) throw cli::UsageError{"phnn sweep: --ranks: every rank count must be >= 1"};
+    ranks.push_back(static_cast<int>(r));
+  }
+  return ranks;
+}
+
+// Runs of each cell still to train (pending, or failed with --retry-failed),
+// in the cell's seed order; *done counts the others.
+std::vector<std::vector<int>> pending_runs(const Grid& grid, const std::vector<int>& status_codes,
+                                           bool retry_failed, int* done) {
+  std::vector<std::vector<int>> pending(grid.cells.size());
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    for (int row : grid.cells[c].runs) {
+      const auto s = static_cast<RunStatus>(status_codes[static_cast<std::size_t>(row)]);
+      if (s == RunStatus::kPending || (retry_failed && s == RunStatus::kFailed)) {
+        pending[c].push_back(row);
+      } else {
+        ++*done;
+      }
+    }
+  }
+  return pending;
+}
 
 std::string describe(const RunConfig& run) {
   std::ostringstream s;
@@ -96,25 +134,42 @@ int run_sweep(int argc, char** argv, int first) {
 
   cli::Parser parser("sweep",
                      "Runs a sweep file over the MPI ranks (mpirun -np N phnn sweep FILE):\n"
-                     "cells largest first from a shared counter, one parallel HDF5 results file,\n"
-                     "resume by running the same command again.");
+                     "work items (cells, or member groups of a cell) largest first from a shared\n"
+                     "counter, one parallel HDF5 results file, resume by running the same command\n"
+                     "again.");
   parser.positional("FILE", "sweep file (sweeps/*.toml; format: sweeps/FORMAT.md)");
   parser.option("out", "results file (default: the sweep file's `output`)");
-  parser.flag("dry-run", "print `N runs in M cells` and the estimated cost; train nothing");
-  parser.option("ranks", "ranks assumed by --dry-run's wall-time estimate (default: this run's)");
+  parser.flag("dry-run",
+              "print `N runs in M cells`, the estimated cost and the simulated schedule "
+              "(items, makespan, core-hours, efficiency); train nothing");
+  parser.option("ranks",
+                "rank counts for --dry-run's schedule, one line each, e.g. 2,16,128 "
+                "(default: this run's)");
+  parser.option("split",
+                "auto: split cells into contiguous member groups where the cost model's simulated "
+                "schedule on this run's ranks is >1 % shorter (results are identical either way); "
+                "off: one item per cell",
+                "auto");
+  parser.option("max-group-size",
+                "at most K runs per work item (forces splitting, with --split auto); 0 = no cap",
+                "0");
   parser.flag("static", "static round-robin scheduling instead of the MPI-3 shared counter");
   parser.flag("retry-failed", "re-run runs whose status is failed (done/diverged are kept)");
   parser.option("threads", "LibTorch intra-op threads per rank", "1");
-  parser.flag("quiet", "no per-cell log lines");
+  parser.flag("quiet", "no per-item log lines");
   // Bad configuration fails on every rank alike, before any collective call;
   // only rank 0 speaks.
   SweepSpec spec;
   Grid grid;
+  SplitOptions split;
+  std::vector<int> ranks;
   try {
     if (!parser.parse(argc, argv, first)) return 0;
     spec = parse_sweep_file(parser.get("FILE"));
     grid = expand_grid(spec);
     if (parser.get_int("threads") < 1) throw cli::UsageError{"phnn sweep: --threads must be >= 1"};
+    split = split_options(parser);
+    ranks = dry_run_ranks(parser, size);
   } catch (const cli::UsageError& e) {
     if (root) std::cerr << e.message << "\n";
     return cli::kUsageError;
@@ -136,10 +191,7 @@ int run_sweep(int argc, char** argv, int first) {
   }
 
   if (parser.flag_set("dry-run")) {
-    if (root) {
-      const int ranks = parser.has("ranks") ? static_cast<int>(parser.get_int("ranks")) : size;
-      std::cout << dry_run_summary(grid, std::max(1, ranks));
-    }
+    if (root) std::cout << dry_run_summary(grid, ranks, split);
     return 0;
   }
 
@@ -242,28 +294,20 @@ int run_sweep(int argc, char** argv, int first) {
     for (RunStatus s : statuses) status_codes.push_back(static_cast<int>(s));
   }
   mpi::broadcast(world, status_codes, 0);
-  const bool retry_failed = parser.flag_set("retry-failed");
-  std::vector<WorkItem> work;
-  int runs_to_do = 0, runs_done_before = 0;
-  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
-    WorkItem item;
-    item.cell = static_cast<int>(c);
-    for (int row : grid.cells[c].runs) {
-      const auto s = static_cast<RunStatus>(status_codes[static_cast<std::size_t>(row)]);
-      if (s == RunStatus::kPending || (retry_failed && s == RunStatus::kFailed)) item.runs.push_back(row);
-      else ++runs_done_before;
-    }
-    if (!item.runs.empty()) {
-      runs_to_do += static_cast<int>(item.runs.size());
-      work.push_back(item);
-    }
-  }
+  // The same statuses on every rank give the same plan on every rank.
+  int runs_done_before = 0;
+  const WorkPlan plan = plan_work(
+      grid, pending_runs(grid, status_codes, parser.flag_set("retry-failed"), &runs_done_before),
+      size, split);
+  const std::vector<WorkItem>& work = plan.items;
+  const int runs_to_do = static_cast<int>(grid.runs.size()) - runs_done_before;
   ScheduleMode mode = parser.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
   WorkQueue queue(MPI_COMM_WORLD, static_cast<int>(work.size()), mode);
   if (root) {
     std::cout << "phnn sweep: " << spec.name << ": " << grid.runs.size() << " runs in "
               << grid.cells.size() << " cells; " << runs_done_before << " finished before, "
-              << runs_to_do << " to run in " << work.size() << " cells on " << size << " rank"
+              << runs_to_do << " to run in " << work.size() << " items (" << plan.cells
+              << " cells, " << plan.split_cells << " split) on " << size << " rank"
               << (size > 1 ? "s" : "") << " (" << to_string(queue.mode()) << " scheduling) -> "
               << out << std::endl;
   }
@@ -273,21 +317,21 @@ int run_sweep(int argc, char** argv, int first) {
   // --- train ----------------------------------------------------------------
   Journal journal(out, rank);
   const bool quiet = parser.flag_set("quiet");
-  int my_runs = 0, my_cells = 0;
+  int my_runs = 0;
   double last_progress = -1e9;
   auto report_progress = [&](bool force) {
     if (!root || (!force && elapsed() - last_progress < 10.0)) return;
     last_progress = elapsed();
-    const int cells_done = queue.done();
+    const int items_done = queue.done();
     const double minutes = elapsed() / 60.0;
-    const double rate = minutes > 0 ? cells_done / minutes : 0.0;
-    const double runs_per_cell = work.empty() ? 0.0 : static_cast<double>(runs_to_do) / work.size();
+    const double rate = minutes > 0 ? items_done / minutes : 0.0;
+    const double runs_per_item = work.empty() ? 0.0 : static_cast<double>(runs_to_do) / work.size();
     std::string eta = "--";
-    if (cells_done > 0 && cells_done < static_cast<int>(work.size())) {
-      eta = format_duration((work.size() - cells_done) / rate * 60.0);
+    if (items_done > 0 && items_done < static_cast<int>(work.size())) {
+      eta = format_duration((work.size() - items_done) / rate * 60.0);
     }
-    std::printf("[progress] cells %d/%zu  %.1f runs/min  elapsed %s  ETA %s\n", cells_done,
-                work.size(), rate * runs_per_cell, format_duration(elapsed()).c_str(), eta.c_str());
+    std::printf("[progress] items %d/%zu  %.1f runs/min  elapsed %s  ETA %s\n", items_done,
+                work.size(), rate * runs_per_item, format_duration(elapsed()).c_str(), eta.c_str());
     std::fflush(stdout);
   };
   for (int i = g_stop_signal ? -1 : queue.next(); i >= 0; i = g_stop_signal ? -1 : queue.next()) {
@@ -303,7 +347,7 @@ int run_sweep(int argc, char** argv, int first) {
     cell.seeds.clear();
     for (int row : item.runs) cell.seeds.push_back(grid.runs[static_cast<std::size_t>(row)].seed);
     if (!quiet) {
-      std::printf("%scell %d/%zu: %s, %zu seed%s\n", prefix.c_str(), i + 1, work.size(),
+      std::printf("%sitem %d/%zu: %s, %zu seed%s\n", prefix.c_str(), i + 1, work.size(),
                   describe(head).c_str(), cell.seeds.size(), cell.seeds.size() > 1 ? "s" : "");
       std::fflush(stdout);
     }
@@ -320,7 +364,7 @@ int run_sweep(int argc, char** argv, int first) {
         r.status = RunStatus::kFailed;
         r.message = e.what();
       }
-      std::fprintf(stderr, "%scell %d failed: %s\n", prefix.c_str(), i + 1, e.what());
+      std::fprintf(stderr, "%sitem %d failed: %s\n", prefix.c_str(), i + 1, e.what());
     }
     for (std::size_t k = 0; k < item.runs.size(); ++k) {
       const int row = item.runs[k];
@@ -328,10 +372,9 @@ int run_sweep(int argc, char** argv, int first) {
       results.write_run(row, cell_results[k]);
     }
     my_runs += static_cast<int>(item.runs.size());
-    ++my_cells;
     queue.mark_done();
     if (!quiet) {
-      std::printf("%scell %d/%zu done in %s\n", prefix.c_str(), i + 1, work.size(),
+      std::printf("%sitem %d/%zu done in %s\n", prefix.c_str(), i + 1, work.size(),
                   format_duration(std::chrono::duration<double>(Clock::now() - cell_start).count()).c_str());
       std::fflush(stdout);
     }

@@ -2,29 +2,48 @@
 #include "phnn/sweep/grid.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <functional>
 #include <map>
 #include <queue>
-#include <set>
-#include <sstream>
 #include <stdexcept>
 
 namespace phnn {
 
-double estimate_run_cost_s(const RunConfig& run, const CostModel& c) {
-  const double member_step_us =
-      c.base_us[static_cast<int>(run.model)][static_cast<int>(run.integrator)] *
-      c.size_factor[static_cast<int>(run.size)] *
-      (run.regularizer != Regularizer::kNone ? c.regularizer_factor : 1.0);
+namespace {
+
+// The cost of a stack of E runs like `run` is fixed_s + E * member_s.
+struct CostParts {
+  double fixed_s = 0.0, member_s = 0.0;
+};
+
+// CostModel's formula (include/phnn/sweep/grid.h), split into its two parts.
+CostParts cost_parts(const RunConfig& run, const CostModel& c) {
+  const int m = static_cast<int>(run.model), i = static_cast<int>(run.integrator);
+  const int s = static_cast<int>(run.size);
+  const double reg = run.regularizer != Regularizer::kNone ? c.regularizer_factor : 1.0;
+  const double fixed_us = c.fixed_us[m][i] * c.fixed_size_factor[s] * reg;
+  const double member_us = c.member_us[m][i] * c.member_size_factor[s] * reg;
   const TrainerOptions& t = run.training;
   const int evaluations = 1 + t.steps / t.eval_every + (t.steps % t.eval_every != 0 ? 1 : 0);
   const double validation = evaluations * run.data.num_validation / c.reference_batch;
   const double inference = static_cast<double>(run.data.num_inference) *
                            run.data.num_inference_steps() / c.reference_batch / c.rollout_speedup *
                            (run.integrator == IntegratorKind::kDg ? c.dg_newton_factor : 1.0);
-  const double batch_steps = t.steps + validation + inference;
-  return batch_steps * member_step_us * 1e-6;
+  CostParts parts;
+  parts.fixed_s = t.steps * fixed_us * 1e-6;
+  parts.member_s = (t.steps + validation + inference) * member_us * 1e-6;
+  return parts;
+}
+
+}  // namespace
+
+double estimate_group_cost_s(const RunConfig& run, int members, const CostModel& cost_model) {
+  if (members < 1) {
+    throw std::invalid_argument("estimate_group_cost_s: members = " + std::to_string(members) +
+                                "; need at least 1");
+  }
+  const CostParts parts = cost_parts(run, cost_model);
+  return parts.fixed_s + members * parts.member_s;
 }
 
 namespace {
@@ -131,13 +150,15 @@ Grid expand_grid(const SweepSpec& spec, const CostModel& cost_model) {
       grid.cells.emplace_back();
       grid.cells.back().key = key;
     }
-    Cell& cell = grid.cells[it->second];
-    cell.runs.push_back(i);
-    cell.estimated_cost_s += estimate_run_cost_s(grid.runs[i], cost_model);
+    grid.cells[it->second].runs.push_back(i);
   }
   for (Cell& cell : grid.cells) {
     std::sort(cell.runs.begin(), cell.runs.end(),
               [&](int a, int b) { return grid.runs[a].seed < grid.runs[b].seed; });
+    const CostParts parts = cost_parts(grid.runs[cell.runs.front()], cost_model);
+    cell.fixed_cost_s = parts.fixed_s;
+    cell.member_cost_s = parts.member_s;
+    cell.estimated_cost_s = cell.cost_s(static_cast<int>(cell.runs.size()));
   }
   std::sort(grid.cells.begin(), grid.cells.end(), [](const Cell& a, const Cell& b) {
     if (a.estimated_cost_s != b.estimated_cost_s) return a.estimated_cost_s > b.estimated_cost_s;
@@ -147,90 +168,23 @@ Grid expand_grid(const SweepSpec& spec, const CostModel& cost_model) {
   return grid;
 }
 
-double greedy_makespan_s(std::vector<double> cell_costs_s, int ranks) {
+double greedy_makespan_s(std::vector<double> item_costs_s, int ranks) {
   if (ranks < 1) {
     throw std::invalid_argument("greedy_makespan_s: ranks = " + std::to_string(ranks) +
                                 "; need at least 1 rank");
   }
-  std::sort(cell_costs_s.begin(), cell_costs_s.end(), std::greater<double>());
-  // Min-heap of rank loads: each cell goes to the rank that is free first.
+  std::sort(item_costs_s.begin(), item_costs_s.end(), std::greater<double>());
+  // Min-heap of rank loads: each item goes to the rank that is free first.
   std::priority_queue<double, std::vector<double>, std::greater<double>> loads;
   for (int r = 0; r < ranks; ++r) loads.push(0.0);
   double makespan = 0.0;
-  for (double cost : cell_costs_s) {
+  for (double cost : item_costs_s) {
     const double load = loads.top() + cost;
     loads.pop();
     loads.push(load);
     makespan = std::max(makespan, load);
   }
   return makespan;
-}
-
-namespace {
-
-std::string format_duration(double seconds) {
-  char buf[64];
-  if (seconds < 10.0) {
-    std::snprintf(buf, sizeof buf, "%.1f s", seconds);
-  } else if (seconds < 120.0) {
-    std::snprintf(buf, sizeof buf, "%.0f s", seconds);
-  } else if (seconds < 7200.0) {
-    std::snprintf(buf, sizeof buf, "%.1f min", seconds / 60.0);
-  } else {
-    std::snprintf(buf, sizeof buf, "%.1f h", seconds / 3600.0);
-  }
-  return buf;
-}
-
-// "1 system", "3 systems".
-std::string count(std::size_t n, const std::string& noun) {
-  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
-}
-
-}  // namespace
-
-std::string dry_run_summary(const Grid& grid, int ranks) {
-  if (ranks < 1) {
-    throw std::invalid_argument("dry_run_summary: ranks = " + std::to_string(ranks) +
-                                "; need at least 1 rank");
-  }
-  std::vector<double> costs;
-  for (const Cell& cell : grid.cells) costs.push_back(cell.estimated_cost_s);
-  const double wall = greedy_makespan_s(costs, ranks);
-
-  std::ostringstream out;
-  out << grid.runs.size() << " runs in " << grid.cells.size() << " cells\n";
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "%.3g", grid.estimated_cost_s / 3600.0);
-  out << "estimated cost: " << buf << " core-hours (" << format_duration(grid.estimated_cost_s)
-      << " on one core); wall time on " << ranks << (ranks == 1 ? " rank: " : " ranks: ")
-      << format_duration(wall)
-      << " (largest cell first to the first free rank; cost model fit on one "
-         "development machine, see include/phnn/sweep/grid.h)\n";
-  if (!grid.cells.empty()) {
-    out << "largest cell: " << format_duration(grid.cells.front().estimated_cost_s)
-        << ", smallest: " << format_duration(grid.cells.back().estimated_cost_s) << "\n";
-  }
-
-  std::map<std::string, int> cell_index;  // cell_key -> index in grid.cells
-  for (int c = 0; c < static_cast<int>(grid.cells.size()); ++c) cell_index[grid.cells[c].key] = c;
-  for (const StudyTable& study : grid.studies) {
-    std::set<int> runs(study.runs.begin(), study.runs.end());
-    std::set<int> cells;
-    int shared = 0;
-    for (int r : runs) {
-      cells.insert(cell_index[grid.runs[r].cell_key()]);
-      if (grid.run_studies[r].size() > 1) ++shared;
-    }
-    out << "study " << study.name << ": " << runs.size() << " runs in " << cells.size()
-        << " cells (" << count(study.systems.size(), "system") << " x "
-        << count(study.rows.size(), "model") << " x " << count(study.columns.size(), "column");
-    if (!study.varied_axis.empty()) out << " of " << study.varied_axis;
-    out << "), " << shared << " shared with other studies";
-    if (!study.title.empty()) out << " — " << study.title;
-    out << "\n";
-  }
-  return out.str();
 }
 
 }  // namespace phnn

@@ -1,5 +1,6 @@
 // tests/sweep/grid_test.cpp
 #include "phnn/sweep/grid.h"
+#include "phnn/sweep/work_plan.h"  // dry_run_summary
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -27,7 +28,7 @@ Grid paper_grid() { return expand_grid(parse_sweep_file(kSweeps + "paper.toml"))
 
 TEST(GridTest, PaperSweepIs1200RunsIn120Cells) {
   const Grid grid = paper_grid();
-  EXPECT_EQ(first_line(dry_run_summary(grid, /*ranks=*/64)), "1200 runs in 120 cells");
+  EXPECT_EQ(first_line(dry_run_summary(grid, /*ranks=*/{64})), "1200 runs in 120 cells");
   ASSERT_EQ(grid.runs.size(), 1200u);
   ASSERT_EQ(grid.cells.size(), 120u);
   ASSERT_EQ(grid.run_studies.size(), 1200u);
@@ -66,7 +67,7 @@ TEST(GridTest, PaperStudiesHaveTheSpecRunCounts) {
     all.insert(study.runs.begin(), study.runs.end());
   }
   EXPECT_EQ(all.size(), 1200u);
-  const std::string summary = dry_run_summary(grid, /*ranks=*/8);
+  const std::string summary = dry_run_summary(grid, /*ranks=*/{8});
   EXPECT_THAT(summary, HasSubstr("study I: 450 runs in 45 cells"));
   EXPECT_THAT(summary, HasSubstr("study II: 450 runs in 45 cells"));
   EXPECT_THAT(summary, HasSubstr("study III: 600 runs in 60 cells"));
@@ -131,7 +132,7 @@ TEST(GridTest, ExpansionIsDeterministic) {
     EXPECT_EQ(a.cells[c].key, b.cells[c].key);
     EXPECT_EQ(a.cells[c].runs, b.cells[c].runs);
   }
-  EXPECT_EQ(dry_run_summary(a, 16), dry_run_summary(b, 16));
+  EXPECT_EQ(dry_run_summary(a, {16}), dry_run_summary(b, {16}));
   // And from a fresh parse.
   const Grid c = paper_grid();
   EXPECT_EQ(c.runs.back().canonical(), a.runs.back().canonical());
@@ -171,30 +172,51 @@ TEST(GridTest, CellsAreOrderedByCostLargestFirstThenKey) {
   EXPECT_NEAR(grid.estimated_cost_s, total, kCostTolerance * total);
 }
 
-TEST(GridTest, RunCostFollowsTheDocumentedModel) {
-  // The formula, with fixed constants (the defaults are re-fit from bench/).
+TEST(GridTest, GroupCostFollowsTheDocumentedModel) {
+  // The formula, with fixed constants (the defaults are placeholders to refit).
+  const int jr = static_cast<int>(ModelKind::kPhnnJr), node = static_cast<int>(ModelKind::kNode);
+  const int dg = static_cast<int>(IntegratorKind::kDg), rk2 = static_cast<int>(IntegratorKind::kRk2);
   CostModel model;
-  model.base_us[static_cast<int>(ModelKind::kPhnnJr)][static_cast<int>(IntegratorKind::kDg)] = 600.0;
-  model.base_us[static_cast<int>(ModelKind::kNode)][static_cast<int>(IntegratorKind::kRk2)] = 350.0;
-  model.size_factor[static_cast<int>(ModelSize::kLarge)] = 10.0;
+  model.fixed_us[jr][dg] = 500.0;
+  model.member_us[jr][dg] = 100.0;
+  model.fixed_us[node][rk2] = 40.0;
+  model.member_us[node][rk2] = 30.0;
+  model.fixed_size_factor[static_cast<int>(ModelSize::kLarge)] = 2.0;
+  model.member_size_factor[static_cast<int>(ModelSize::kLarge)] = 10.0;
   model.regularizer_factor = 1.6;
   model.rollout_speedup = 20.0;
   model.dg_newton_factor = 4.0;
   RunConfig run;  // SPEC.md defaults: 50000 steps, eval every 500, 2500 / 100 x 500
   run.model = ModelKind::kPhnnJr;
   run.integrator = IntegratorKind::kDg;
-  // 600 us x (50000 + 101 x 2500/64 + 100 x 500 / 64 / 20 x 4) batch-steps
-  //   = 600e-6 x (50000 + 3945.3125 + 156.25) = 32.4609375 s.
-  EXPECT_NEAR(estimate_run_cost_s(run, model), 32.4609375, kCostTolerance);
+  // fixed  = 50000 x 500e-6 = 25 s;
+  // member = (50000 + 101 x 2500/64 + 100 x 500 / 64 / 20 x 4) x 100e-6
+  //        = (50000 + 3945.3125 + 156.25) x 100e-6 = 5.41015625 s.
+  EXPECT_NEAR(estimate_group_cost_s(run, 1, model), 30.41015625, kCostTolerance);
+  EXPECT_NEAR(estimate_group_cost_s(run, 3, model), 41.23046875, kCostTolerance);
   run.model = ModelKind::kNode;
   run.integrator = IntegratorKind::kRk2;
   run.size = ModelSize::kLarge;
   run.regularizer = Regularizer::kCn;
-  // 350 x 10 x 1.6 = 5600 us x (50000 + 3945.3125 + 39.0625) = 302.3125 s.
-  EXPECT_NEAR(estimate_run_cost_s(run, model), 302.3125, kCostTolerance);
+  // fixed  = 50000 x 40 x 2 x 1.6e-6 = 6.4 s;
+  // member = (50000 + 3945.3125 + 39.0625) x 30 x 10 x 1.6e-6 = 25.9125 s.
+  EXPECT_NEAR(estimate_group_cost_s(run, 10, model), 6.4 + 259.125, kCostTolerance);
   run.training.steps = 1050;  // evaluations at 0, 500, 1000 and 1050
-  // 5600e-6 x (1050 + 4 x 2500/64 + 39.0625) = 5600e-6 x 1245.3125 = 6.97375 s.
-  EXPECT_NEAR(estimate_run_cost_s(run, model), 6.97375, kCostTolerance);
+  // 1050 x 128e-6 + 2 x (1050 + 4 x 2500/64 + 39.0625) x 480e-6 = 0.1344 + 1.1955 s.
+  EXPECT_NEAR(estimate_group_cost_s(run, 2, model), 1.3299, kCostTolerance);
+  EXPECT_THROW(estimate_group_cost_s(run, 0, model), std::invalid_argument);
+}
+
+TEST(GridTest, CellCostIsOneStackOfItsRunsAndStacksAreCheaperPerMember) {
+  const Grid grid = paper_grid();
+  for (const Cell& cell : grid.cells) {
+    const RunConfig& head = grid.runs[cell.runs.front()];
+    EXPECT_NEAR(cell.estimated_cost_s, estimate_group_cost_s(head, 10),
+                kCostTolerance * cell.estimated_cost_s);
+    EXPECT_NEAR(cell.cost_s(3), estimate_group_cost_s(head, 3), kCostTolerance * cell.cost_s(3));
+    // The fixed per-step cost: ten single runs cost more than one stack.
+    EXPECT_GT(10 * cell.cost_s(1), cell.cost_s(10)) << cell.key;
+  }
 }
 
 TEST(GridTest, GreedyMakespanGivesLargestFirstToTheFirstFreeRank) {
@@ -203,15 +225,6 @@ TEST(GridTest, GreedyMakespanGivesLargestFirstToTheFirstFreeRank) {
   EXPECT_DOUBLE_EQ(greedy_makespan_s({3, 5, 3, 4, 3}, /*ranks=*/1), 18.0);
   EXPECT_DOUBLE_EQ(greedy_makespan_s({3, 5, 3, 4, 3}, /*ranks=*/10), 5.0);
   EXPECT_THROW(greedy_makespan_s({1.0}, 0), std::invalid_argument);
-}
-
-TEST(GridTest, DryRunSummaryReportsCostAndWallTime) {
-  const Grid grid = paper_grid();
-  const std::string summary = dry_run_summary(grid, /*ranks=*/32);
-  EXPECT_THAT(summary, HasSubstr("core-hours"));
-  EXPECT_THAT(summary, HasSubstr("wall time on 32 ranks"));
-  EXPECT_THAT(summary, HasSubstr("Impact of the model size"));
-  EXPECT_THROW(dry_run_summary(grid, 0), std::invalid_argument);
 }
 
 TEST(GridTest, TableDampingPresetChangesOnlyTheDampedSystems) {
@@ -227,14 +240,14 @@ TEST(GridTest, TableDampingPresetChangesOnlyTheDampedSystems) {
 
 TEST(GridTest, DemoAndTinySweepsAreSmall) {
   const Grid demo = expand_grid(parse_sweep_file(kSweeps + "demo.toml"));
-  EXPECT_EQ(first_line(dry_run_summary(demo, 2)), "40 runs in 20 cells");
+  EXPECT_EQ(first_line(dry_run_summary(demo, {2})), "40 runs in 20 cells");
   ASSERT_EQ(demo.studies.size(), 2u);
   EXPECT_EQ(demo.studies[0].varied_axis, "");
   EXPECT_THAT(demo.studies[0].columns, ElementsAre("MSE"));
   EXPECT_EQ(demo.studies[1].varied_axis, "regularizer");
   EXPECT_THAT(demo.studies[1].systems, ElementsAre(SystemKind::kHarmonic));
   const Grid tiny = expand_grid(parse_sweep_file(kSweeps + "tiny.toml"));
-  EXPECT_EQ(first_line(dry_run_summary(tiny, 1)), "6 runs in 2 cells");
+  EXPECT_EQ(first_line(dry_run_summary(tiny, {1})), "6 runs in 2 cells");
   EXPECT_THAT(tiny.studies[0].rows, ElementsAre("PHNN-JR-RK2", "NODE-RK2"));
 }
 

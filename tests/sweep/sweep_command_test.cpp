@@ -213,6 +213,65 @@ TEST(SweepCommandTest, StopsCleanlyOnSignalThenResumes) {
   for (RunStatus s : file.read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
 }
 
+// Runs `phnn sweep` of `sweep` into `out` on `ranks` ranks with extra flags;
+// returns the log (the test fails if the exit status is not 0).
+std::string run_sweep(const std::string& sweep, const std::string& out, int ranks,
+                      const std::string& flags) {
+  std::string log;
+  EXPECT_EQ(shell(mpiexec(ranks) + " sweep " + sweep + " --quiet --out " + out + " " + flags, &log),
+            0)
+      << log;
+  return log;
+}
+
+void expect_same_file(const ResultsFile& a, const ResultsFile& b) {
+  ASSERT_EQ(a.read_run_ids(), b.read_run_ids());
+  for (int row = 0; row < a.num_runs(); ++row) expect_same_run(a.read_run(row), b.read_run(row), row);
+}
+
+// Stacking is exact: member groups of 1 or 2 seeds give bitwise the results
+// of whole cells, on 1 and 2 ranks.
+TEST(SweepCommandTest, SplitCellsGiveBitwiseTheResultsOfWholeCells) {
+  const std::string dir = temp_dir("split");
+  const std::string sweep = write_sweep(dir, kSweep);
+  const std::string whole = dir + "/whole.h5";
+  EXPECT_THAT(run_sweep(sweep, whole, 1, "--split off"), HasSubstr("to run in 3 items (3 cells, 0 split)"));
+  const ResultsFile reference = ResultsFile::open_read_only(whole);
+  for (RunStatus s : reference.read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
+  const std::pair<int, int> cases[] = {{1, 1}, {2, 2}, {2, 1}};  // ranks, max group size
+  for (const auto& [ranks, group] : cases) {
+    SCOPED_TRACE(std::to_string(ranks) + " ranks, groups of " + std::to_string(group));
+    const std::string out = dir + "/split" + std::to_string(ranks) + std::to_string(group) + ".h5";
+    const std::string log = run_sweep(sweep, out, ranks, "--max-group-size " + std::to_string(group));
+    // Groups of at most 2 of 3 seeds: 6 items, or 9 if auto splits further.
+    EXPECT_THAT(log, HasSubstr(group == 1 ? "to run in 9 items (3 cells, 3 split)" : "(3 cells, 3 split)"));
+    expect_same_file(ResultsFile::open_read_only(out), reference);
+  }
+}
+
+// A split sweep missing runs of two cells (rows reset to pending, journals
+// gone): the rerun trains only those, split, and completes the file.
+TEST(SweepCommandTest, ResumeOfAPartiallyFinishedSplitSweepCompletesIt) {
+  const std::string dir = temp_dir("split_resume");
+  const std::string sweep = write_sweep(dir, kSweep);
+  const std::string whole = dir + "/whole.h5", out = dir + "/split.h5";
+  run_sweep(sweep, whole, 1, "--split off");
+  run_sweep(sweep, out, 2, "--max-group-size 2");
+  const Grid grid = expand_grid(parse_sweep_file(sweep));
+  std::vector<int> reset = {grid.cells[0].runs[1], grid.cells[0].runs[2], grid.cells[1].runs[0]};
+  {
+    ResultsFile file = ResultsFile::open(out, MPI_COMM_NULL, parse_sweep_file(sweep).text_hash);
+    for (int row : reset) file.write_run(row, RunResult{});  // status pending
+    file.close();
+  }
+  ASSERT_EQ(shell("rm -rf " + journal_directory(out)), 0);
+  const std::string log = run_sweep(sweep, out, 2, "--max-group-size 1");
+  EXPECT_THAT(log, HasSubstr("6 finished before, 3 to run in 3 items (2 cells, 1 split)"));
+  const ResultsFile resumed = ResultsFile::open_read_only(out);
+  for (RunStatus s : resumed.read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
+  expect_same_file(resumed, ResultsFile::open_read_only(whole));
+}
+
 TEST(SweepCommandTest, BadSweepFilesExitTwoBeforeWritingAnything) {
   const std::string dir = temp_dir("bad");
   const std::pair<const char*, const char*> cases[] = {
@@ -238,6 +297,23 @@ TEST(SweepCommandTest, DryRunPrintsRunsAndCellsOfThePaper) {
   std::string log;
   ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + PHNN_SOURCE_DIR + "/sweeps/paper.toml --dry-run", &log), 0);
   EXPECT_EQ(log.substr(0, log.find('\n')), "1200 runs in 120 cells");
+}
+
+TEST(SweepCommandTest, DryRunPrintsTheScheduleForSeveralRankCounts) {
+  const std::string paper = std::string(PHNN_SOURCE_DIR) + "/sweeps/paper.toml";
+  std::string log;
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --ranks 2,16,128", &log), 0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("\n  2 ranks: 120 items (120 whole cells), makespan"));
+  EXPECT_THAT(log, HasSubstr("\n  16 ranks: "));
+  EXPECT_THAT(log, HasSubstr("\n  128 ranks: "));
+  EXPECT_THAT(log, HasSubstr("split auto"));
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --ranks 128 --split off", &log), 0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("\n  128 ranks: 120 items (120 whole cells)"));
+  EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --ranks 0", &log), 2);
+  EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --split off --max-group-size 2", &log), 2);
+  EXPECT_THAT(log, HasSubstr("needs mode auto"));
 }
 
 }  // namespace

@@ -9,44 +9,62 @@
 
 namespace phnn {
 
-/// Cost model of one run, in seconds on one core. The constants were fit to
-/// bench/bench_training and `phnn train` timings on the 2-core development
-/// machine (docs/BENCHMARKS.md); all of them live here.
+/// Cost model of a stack of E runs of one cell (a work item), in seconds on
+/// one core. Every constant of the model lives in this struct: to refit it,
+/// time `train_cell` at E = 1 and E = 10 per model-integrator (small, no
+/// regularizer) and per size, and solve the line below for fixed and member.
 ///
-///   member_step_us = base_us[model][integrator] * size_factor[size]
+///   step_us(E)     = (fixed_us[model][integrator] * fixed_size_factor[size]
+///                     + E * member_us[model][integrator] * member_size_factor[size])
+///                    * (regularizer != none ? regularizer_factor : 1)
+///   member_us_all  = member_us[model][integrator] * member_size_factor[size]
 ///                    * (regularizer != none ? regularizer_factor : 1)
 ///
-///   batch_steps    = steps                                      (training)
-///                  + evaluations * num_validation / reference_batch
+///   cost_s(E)      = steps * step_us(E) * 1e-6                       (training)
+///                  + E * eval_steps * member_us_all * 1e-6   (validation, inference)
+///
+///   eval_steps     = evaluations * num_validation / reference_batch
 ///                  + num_inference * num_inference_steps
 ///                      / reference_batch / rollout_speedup
 ///                      * (integrator == DG ? dg_newton_factor : 1)
 ///
-///   cost_s         = batch_steps * member_step_us * 1e-6
-///
 /// with evaluations = 1 + floor(steps / eval_every) (+ 1 when steps is not a
 /// multiple of eval_every): step 0, every eval_every steps and the last step
-/// (SPEC.md §4). A validation pass over num_validation pairs costs
-/// num_validation / reference_batch batch-steps (2500 / 64 by default); an
-/// inference rollout of num_inference trajectories x num_inference_steps
-/// steps (100 x 500) costs 1 / rollout_speedup of a training batch-step per
-/// reference_batch state-steps, x dg_newton_factor for DG (Newton). The
-/// training cost does not depend on n_train (the batch is <= 64 pairs).
+/// (SPEC.md §4). The fixed part is the per-step cost that does not shrink
+/// with fewer members (operator dispatch, autograd bookkeeping, Adam's calls):
+/// it is why a stack of E members is cheaper than E single runs, and why
+/// splitting a cell into groups costs core-hours. Validation (2500 pairs) and
+/// inference (100 trajectories) run on large batches, where that overhead is
+/// amortized, so they are charged per member only. The training cost does
+/// not depend on n_train (the batch is <= 64 pairs).
 struct CostModel {
-  /// Microseconds per member per training step, small size, no regularizer,
-  /// indexed [ModelKind][IntegratorKind] (NODE-DG does not exist). Measured
-  /// with bench/bench_training (docs/BENCHMARKS.md): one thread, float64,
-  /// batch 64, 10 members stacked (a paper cell), OpenBLAS + jemalloc.
-  double base_us[3][2] = {
-      /*kNode=*/{/*kRk2=*/80.0, /*kDg=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/275.0, /*kDg=*/295.0},
-      /*kPhnnJr=*/{/*kRk2=*/319.0, /*kDg=*/319.0},
+  /// Per-step cost of a stack that does not depend on its size E [us], small
+  /// size, no regularizer, indexed [ModelKind][IntegratorKind] (NODE-DG does
+  /// not exist). Placeholders from docs/BENCHMARKS.md's E = 1 and E = 10
+  /// timings: small PHNN-JR-RK2 1114 and 3190 us per step give fixed 883 and
+  /// member 231; NODE-RK2 198 and 800 give 131 and 67; the PHNN-S rows and
+  /// PHNN-JR-DG are PHNN-JR-RK2's split scaled to their E = 10 cost (275,
+  /// 295, 319 us per member-step). To be refit after the kernel rework.
+  double fixed_us[3][2] = {
+      /*kNode=*/{/*kRk2=*/131.0, /*kDg=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/761.0, /*kDg=*/817.0},
+      /*kPhnnJr=*/{/*kRk2=*/883.0, /*kDg=*/883.0},
   };
-  /// Indexed by ModelSize: small, medium, large (PHNN-JR-RK2, E = 10,
-  /// measured with `phnn train`: 272, 660 and 4186 us per member-step).
-  double size_factor[3] = {1.0, 2.4, 15.0};
+  /// Per-step cost of each member of a stack [us], same indexing.
+  double member_us[3][2] = {
+      /*kNode=*/{/*kRk2=*/67.0, /*kDg=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/199.0, /*kDg=*/214.0},
+      /*kPhnnJr=*/{/*kRk2=*/231.0, /*kDg=*/231.0},
+  };
+  /// Indexed by ModelSize: small, medium, large. Assumed independent of the
+  /// width (the fixed part is per-operator overhead); not measured yet.
+  double fixed_size_factor[3] = {1.0, 1.0, 1.0};
+  /// Indexed by ModelSize. Chosen so that PHNN-JR-RK2 at E = 10 keeps its
+  /// measured 2.4x and 15x (`phnn train`: 272, 660 and 4186 us per
+  /// member-step) with fixed_size_factor = 1: (10 x 231 x f + 883) / 3193.
+  double member_size_factor[3] = {1.0, 2.9, 20.4};
   /// Jacobian, closed-form SVD / eigenvalues and their backward in every
-  /// step (CN, SN, SR): measured 2.6-2.7x.
+  /// step (CN, SN, SR): measured 2.6-3.0x, on both parts.
   double regularizer_factor = 2.7;
   /// Pairs per batch-step in the validation and inference terms.
   double reference_batch = 64.0;
@@ -58,18 +76,28 @@ struct CostModel {
   double dg_newton_factor = 10.0;
 };
 
-/// Estimated wall time of one run on one core [s] (CostModel above).
-double estimate_run_cost_s(const RunConfig& run, const CostModel& cost_model = CostModel());
+/// Estimated cost of a work item: `members` runs of run's cell trained as one
+/// stack, on one core [s] (CostModel above). Throws std::invalid_argument if
+/// members < 1.
+double estimate_group_cost_s(const RunConfig& run, int members,
+                             const CostModel& cost_model = CostModel());
 
 /// Runs of one cell: the same configuration but the seed (equal
-/// RunConfig::cell_key()); the unit of work handed to a rank.
+/// RunConfig::cell_key()). Its runs are trained as one stack, or split into
+/// member groups (phnn/sweep/work_plan.h).
 struct Cell {
   /// RunConfig::cell_key() of its runs.
   std::string key;
   /// Indices into Grid::runs, sorted by seed.
   std::vector<int> runs;
-  /// Sum of estimate_run_cost_s() over the runs.
+  /// estimate_group_cost_s(E) = fixed_cost_s + E * member_cost_s: a stack of
+  /// E of its runs [s].
+  double fixed_cost_s = 0.0, member_cost_s = 0.0;
+  /// Cost of all its runs as one stack: cost_s(runs.size()).
   double estimated_cost_s = 0.0;
+
+  /// Cost of a stack of `members` of its runs [s].
+  double cost_s(int members) const { return fixed_cost_s + members * member_cost_s; }
 };
 
 /// What one study's tables are made of (paper Appendix F; SPEC.md §6): one
@@ -99,7 +127,7 @@ struct StudyTable {
 /// A sweep expanded into distinct runs.
 ///
 ///   const Grid grid = expand_grid(parse_sweep_file("sweeps/paper.toml"));
-///   std::cout << dry_run_summary(grid, /*ranks=*/64);  // "1200 runs in 120 cells" ...
+///   std::cout << grid.runs.size() << " runs in " << grid.cells.size() << " cells\n";
 struct Grid {
   /// Distinct runs (by RunConfig::canonical()), in order of first appearance:
   /// studies in file order, then axes nested system, model, size, n_train,
@@ -112,7 +140,7 @@ struct Grid {
   std::vector<Cell> cells;
   /// One per study, in file order.
   std::vector<StudyTable> studies;
-  /// Sum over cells [core-seconds].
+  /// Sum of Cell::estimated_cost_s (every cell unsplit) [core-seconds].
   double estimated_cost_s = 0.0;
 };
 
@@ -120,14 +148,10 @@ struct Grid {
 /// the same spec gives the same runs, ids and cell order.
 Grid expand_grid(const SweepSpec& spec, const CostModel& cost_model = CostModel());
 
-/// Makespan of cells with the given costs on `ranks` ranks when each cell
-/// goes, largest first, to the rank that becomes free first (LPT greedy) [s].
-double greedy_makespan_s(std::vector<double> cell_costs_s, int ranks);
-
-/// The plan of a sweep, for `--dry-run`. First line exactly
-/// "N runs in M cells"; then the estimated cost (core-hours, and wall time
-/// on `ranks` ranks with the largest-first greedy schedule of cells), and
-/// runs/cells per study. Throws std::invalid_argument if ranks < 1.
-std::string dry_run_summary(const Grid& grid, int ranks);
+/// Makespan of items with the given costs on `ranks` ranks when each item
+/// goes, largest first, to the rank that becomes free first (LPT list
+/// scheduling, what the dynamic WorkQueue does) [s]. Throws
+/// std::invalid_argument if ranks < 1.
+double greedy_makespan_s(std::vector<double> item_costs_s, int ranks);
 
 }  // namespace phnn

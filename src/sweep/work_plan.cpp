@@ -1,0 +1,277 @@
+// src/sweep/work_plan.cpp — cells split into member groups by the cost model;
+// the LPT schedule simulation behind `--dry-run`.
+#include "phnn/sweep/work_plan.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace phnn {
+
+void SplitOptions::validate() const {
+  auto fail = [](const std::string& what) {
+    throw std::invalid_argument("Invalid SplitOptions: " + what);
+  };
+  if (max_group_size < 0) {
+    fail("max_group_size = " + std::to_string(max_group_size) +
+         "; violated constraint: max_group_size >= 0 (0 = no cap).");
+  }
+  if (mode == Mode::kOff && max_group_size > 0) {
+    fail("max_group_size = " + std::to_string(max_group_size) +
+         " with mode off; a cap splits cells, so it needs mode auto.");
+  }
+  if (!(min_gain >= 0.0)) {
+    fail("min_gain = " + std::to_string(min_gain) + "; violated constraint: min_gain >= 0.");
+  }
+}
+
+std::string to_string(SplitOptions::Mode mode) {
+  return mode == SplitOptions::Mode::kAuto ? "auto" : "off";
+}
+
+SplitOptions::Mode parse_split_mode(const std::string& text) {
+  if (text == "auto") return SplitOptions::Mode::kAuto;
+  if (text == "off") return SplitOptions::Mode::kOff;
+  throw std::invalid_argument("unknown split mode \"" + text + "\"; expected one of: auto, off");
+}
+
+double WorkPlan::efficiency() const {
+  return makespan_s > 0.0 ? unsplit_cost_s / (ranks * makespan_s) : 1.0;
+}
+
+namespace {
+
+using Pending = std::vector<std::vector<int>>;
+
+void check_pending(const Grid& grid, const Pending& pending) {
+  if (pending.size() != grid.cells.size()) {
+    throw std::invalid_argument("plan_work: pending has " + std::to_string(pending.size()) +
+                                " entries for " + std::to_string(grid.cells.size()) +
+                                " cells; give one (possibly empty) list per cell");
+  }
+  for (std::size_t c = 0; c < pending.size(); ++c) {
+    const std::set<int> runs(grid.cells[c].runs.begin(), grid.cells[c].runs.end());
+    for (int run : pending[c]) {
+      if (runs.count(run) == 0) {
+        throw std::invalid_argument("plan_work: run " + std::to_string(run) +
+                                    " is not a run of cell " + std::to_string(c));
+      }
+    }
+  }
+}
+
+// Size of the largest of g near-equal groups of n runs.
+int largest_group(int n, int g) { return (n + g - 1) / g; }
+
+// Fewest groups for n runs of `cell` with every group's cost <= target and
+// at most `cap` runs (0 = no cap); n groups (single runs) if none fits.
+int group_count(const Cell& cell, int n, double target, int cap) {
+  const int first = cap > 0 ? largest_group(n, cap) : 1;
+  for (int g = first; g < n; ++g) {
+    if (cell.cost_s(largest_group(n, g)) <= target) return g;
+  }
+  return std::max(1, n);
+}
+
+std::vector<int> group_counts(const Grid& grid, const Pending& pending, double target, int cap) {
+  std::vector<int> counts(pending.size(), 0);
+  for (std::size_t c = 0; c < pending.size(); ++c) {
+    const int n = static_cast<int>(pending[c].size());
+    if (n > 0) counts[c] = group_count(grid.cells[c], n, target, cap);
+  }
+  return counts;
+}
+
+// Items of cell c: its pending runs in counts near-equal contiguous groups,
+// the larger groups first.
+void append_items(const Grid& grid, int c, const std::vector<int>& runs, int count,
+                  std::vector<WorkItem>* items) {
+  const int n = static_cast<int>(runs.size());
+  int begin = 0;
+  for (int g = 0; g < count; ++g) {
+    const int size = n / count + (g < n % count ? 1 : 0);
+    WorkItem item;
+    item.cell = c;
+    item.runs.assign(runs.begin() + begin, runs.begin() + begin + size);
+    item.estimated_cost_s = grid.cells[c].cost_s(size);
+    items->push_back(std::move(item));
+    begin += size;
+  }
+}
+
+WorkPlan make_plan(const Grid& grid, const Pending& pending, const std::vector<int>& counts,
+                   int ranks) {
+  WorkPlan plan;
+  plan.ranks = ranks;
+  for (std::size_t c = 0; c < pending.size(); ++c) {
+    if (pending[c].empty()) continue;
+    ++plan.cells;
+    if (counts[c] > 1) ++plan.split_cells;
+    plan.unsplit_cost_s += grid.cells[c].cost_s(static_cast<int>(pending[c].size()));
+    append_items(grid, static_cast<int>(c), pending[c], counts[c], &plan.items);
+  }
+  std::stable_sort(plan.items.begin(), plan.items.end(), [](const WorkItem& a, const WorkItem& b) {
+    return a.estimated_cost_s > b.estimated_cost_s;
+  });
+  std::vector<double> costs;
+  for (const WorkItem& item : plan.items) {
+    costs.push_back(item.estimated_cost_s);
+    plan.cost_s += item.estimated_cost_s;
+  }
+  plan.makespan_s = greedy_makespan_s(costs, ranks);
+  return plan;
+}
+
+// Every target at which group_counts() changes, largest first: the cost of
+// a group of k runs of each cell, from the largest cell (or capped group)
+// down to the largest single run, below which nothing changes.
+std::vector<double> candidate_targets(const Grid& grid, const Pending& pending, int cap) {
+  double floor = 0.0;
+  for (std::size_t c = 0; c < pending.size(); ++c) {
+    if (!pending[c].empty()) floor = std::max(floor, grid.cells[c].cost_s(1));
+  }
+  std::set<double, std::greater<double>> targets;
+  for (std::size_t c = 0; c < pending.size(); ++c) {
+    const int n = static_cast<int>(pending[c].size());
+    const int largest = cap > 0 ? std::min(n, cap) : n;
+    for (int k = 1; k <= largest; ++k) {
+      const double cost = grid.cells[c].cost_s(k);
+      if (cost >= floor) targets.insert(cost);
+    }
+  }
+  return std::vector<double>(targets.begin(), targets.end());
+}
+
+}  // namespace
+
+WorkPlan plan_work(const Grid& grid, const Pending& pending, int ranks,
+                   const SplitOptions& options) {
+  options.validate();
+  check_pending(grid, pending);
+  if (ranks < 1) {
+    throw std::invalid_argument("plan_work: ranks = " + std::to_string(ranks) +
+                                "; need at least 1 rank");
+  }
+  const int cap = options.max_group_size;
+  const std::vector<double> targets = candidate_targets(grid, pending, cap);
+  if (options.mode == SplitOptions::Mode::kOff || targets.empty()) {
+    return make_plan(grid, pending, group_counts(grid, pending, /*target=*/1e300, cap), ranks);
+  }
+  // Simulate every candidate, then take the least split (largest target)
+  // within (1 + min_gain) of the shortest makespan.
+  std::vector<double> makespans;
+  for (double target : targets) {
+    makespans.push_back(make_plan(grid, pending, group_counts(grid, pending, target, cap), ranks)
+                            .makespan_s);
+  }
+  const double best = *std::min_element(makespans.begin(), makespans.end());
+  std::size_t chosen = 0;
+  while (makespans[chosen] > best * (1.0 + options.min_gain)) ++chosen;
+  return make_plan(grid, pending, group_counts(grid, pending, targets[chosen], cap), ranks);
+}
+
+WorkPlan plan_work(const Grid& grid, int ranks, const SplitOptions& options) {
+  Pending pending;
+  for (const Cell& cell : grid.cells) pending.push_back(cell.runs);
+  return plan_work(grid, pending, ranks, options);
+}
+
+namespace {
+
+std::string format_duration(double seconds) {
+  char buf[64];
+  if (seconds < 10.0) {
+    std::snprintf(buf, sizeof buf, "%.1f s", seconds);
+  } else if (seconds < 120.0) {
+    std::snprintf(buf, sizeof buf, "%.0f s", seconds);
+  } else if (seconds < 7200.0) {
+    std::snprintf(buf, sizeof buf, "%.1f min", seconds / 60.0);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.1f h", seconds / 3600.0);
+  }
+  return buf;
+}
+
+// "1 system", "3 systems".
+std::string count(std::size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
+std::string core_hours(double seconds) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3g core-hours", seconds / 3600.0);
+  return buf;
+}
+
+}  // namespace
+
+std::string schedule_line(const WorkPlan& plan) {
+  const std::size_t groups =
+      plan.items.size() - static_cast<std::size_t>(plan.cells - plan.split_cells);
+  char efficiency[32];
+  std::snprintf(efficiency, sizeof efficiency, "%.1f %%", 100.0 * plan.efficiency());
+  std::ostringstream out;
+  out << plan.ranks << (plan.ranks == 1 ? " rank: " : " ranks: ") << count(plan.items.size(), "item")
+      << " (" << count(static_cast<std::size_t>(plan.cells - plan.split_cells), "whole cell");
+  if (plan.split_cells > 0) out << " + " << groups << " groups of " << count(plan.split_cells, "cell");
+  out << "), makespan " << format_duration(plan.makespan_s) << ", " << core_hours(plan.cost_s)
+      << ", efficiency " << efficiency;
+  return out.str();
+}
+
+namespace {
+
+// "study I: 450 runs in 45 cells (3 systems x ...), 150 shared ... — title".
+std::string study_lines(const Grid& grid) {
+  std::map<std::string, int> cell_index;  // cell_key -> index in grid.cells
+  for (int c = 0; c < static_cast<int>(grid.cells.size()); ++c) cell_index[grid.cells[c].key] = c;
+  std::ostringstream out;
+  for (const StudyTable& study : grid.studies) {
+    std::set<int> runs(study.runs.begin(), study.runs.end());
+    std::set<int> cells;
+    int shared = 0;
+    for (int r : runs) {
+      cells.insert(cell_index[grid.runs[r].cell_key()]);
+      if (grid.run_studies[r].size() > 1) ++shared;
+    }
+    out << "study " << study.name << ": " << runs.size() << " runs in " << cells.size()
+        << " cells (" << count(study.systems.size(), "system") << " x "
+        << count(study.rows.size(), "model") << " x " << count(study.columns.size(), "column");
+    if (!study.varied_axis.empty()) out << " of " << study.varied_axis;
+    out << "), " << shared << " shared with other studies";
+    if (!study.title.empty()) out << " — " << study.title;
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+std::string dry_run_summary(const Grid& grid, const std::vector<int>& ranks,
+                            const SplitOptions& options) {
+  if (ranks.empty()) throw std::invalid_argument("dry_run_summary: no rank count given");
+  std::vector<WorkPlan> plans;
+  for (int r : ranks) plans.push_back(plan_work(grid, r, options));  // throws if r < 1
+  std::ostringstream out;
+  out << grid.runs.size() << " runs in " << grid.cells.size() << " cells\n";
+  out << "estimated cost: " << core_hours(grid.estimated_cost_s) << " unsplit ("
+      << format_duration(grid.estimated_cost_s)
+      << " on one core; cost model fit on one development machine, see "
+         "include/phnn/sweep/grid.h)\n";
+  if (!grid.cells.empty()) {
+    out << "largest cell: " << format_duration(grid.cells.front().estimated_cost_s)
+        << ", smallest: " << format_duration(grid.cells.back().estimated_cost_s) << "\n";
+  }
+  out << "schedule (split " << to_string(options.mode)
+      << "; items largest first to the first free rank; efficiency = unsplit cost / (ranks x "
+         "makespan)):\n";
+  for (const WorkPlan& plan : plans) out << "  " << schedule_line(plan) << "\n";
+  out << study_lines(grid);
+  return out.str();
+}
+
+}  // namespace phnn

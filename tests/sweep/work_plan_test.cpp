@@ -1,0 +1,214 @@
+// tests/sweep/work_plan_test.cpp
+#include "phnn/sweep/work_plan.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+
+namespace phnn {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+const std::string kSweeps = std::string(PHNN_SOURCE_DIR) + "/sweeps/";
+
+// Plan costs are sums of at most 1200 cell costs: relative rounding ~1e-13.
+constexpr double kCostTolerance = 1e-9;
+
+Grid paper_grid() { return expand_grid(parse_sweep_file(kSweeps + "paper.toml")); }
+
+// A grid of cells with hand-set costs cost_s(E) = fixed + E * member, each
+// with `runs` runs (configurations do not matter to the planner).
+struct CellCost {
+  double fixed, member;
+  int runs;
+};
+Grid hand_grid(const std::vector<CellCost>& costs) {
+  Grid grid;
+  for (const CellCost& c : costs) {
+    Cell cell;
+    cell.key = "cell" + std::to_string(grid.cells.size());
+    cell.fixed_cost_s = c.fixed;
+    cell.member_cost_s = c.member;
+    for (int r = 0; r < c.runs; ++r) {
+      cell.runs.push_back(static_cast<int>(grid.runs.size()));
+      grid.runs.emplace_back();
+    }
+    cell.estimated_cost_s = cell.cost_s(c.runs);
+    grid.cells.push_back(cell);
+  }
+  return grid;
+}
+
+// Every run of `pending` is in exactly one item, items are contiguous pieces
+// of their cell's pending list, costs match the cell's, largest first.
+void expect_partition(const Grid& grid, const std::vector<std::vector<int>>& pending,
+                      const WorkPlan& plan) {
+  std::map<int, int> seen;  // run -> items containing it
+  for (std::size_t i = 0; i < plan.items.size(); ++i) {
+    const WorkItem& item = plan.items[i];
+    ASSERT_FALSE(item.runs.empty());
+    const std::vector<int>& cell = pending[static_cast<std::size_t>(item.cell)];
+    const auto start = std::find(cell.begin(), cell.end(), item.runs.front());
+    ASSERT_NE(start, cell.end());
+    EXPECT_TRUE(std::equal(item.runs.begin(), item.runs.end(), start)) << "item " << i;
+    for (int run : item.runs) ++seen[run];
+    EXPECT_DOUBLE_EQ(item.estimated_cost_s,
+                     grid.cells[item.cell].cost_s(static_cast<int>(item.runs.size())));
+    if (i > 0) {
+      EXPECT_GE(plan.items[i - 1].estimated_cost_s, item.estimated_cost_s);
+    }
+  }
+  std::size_t expected = 0;
+  for (const auto& runs : pending) {
+    expected += runs.size();
+    for (int run : runs) EXPECT_EQ(seen[run], 1) << "run " << run;
+  }
+  EXPECT_EQ(seen.size(), expected);
+}
+
+std::vector<std::vector<int>> all_runs(const Grid& grid) {
+  std::vector<std::vector<int>> pending;
+  for (const Cell& cell : grid.cells) pending.push_back(cell.runs);
+  return pending;
+}
+
+// Closed form: 2 ranks, cell A = 1 + 2E with 4 runs (9 s), cell B = 1 + E
+// with 2 runs (3 s). Whole: A | B, makespan 9. Split A in two (5 s each):
+// LPT puts 5 | 5, then B on either: makespan 8 (the best; A in four 3-s
+// pieces gives 3,3,3,3,3 -> 9). Efficiency = 12 / (2 x 8).
+TEST(WorkPlanTest, SimulatedScheduleMatchesAHandCheckedExample) {
+  const Grid grid = hand_grid({{1.0, 2.0, 4}, {1.0, 1.0, 2}});
+  const WorkPlan plan = plan_work(grid, /*ranks=*/2);
+  ASSERT_EQ(plan.items.size(), 3u);
+  EXPECT_THAT(plan.items[0].runs, ElementsAre(0, 1));
+  EXPECT_THAT(plan.items[1].runs, ElementsAre(2, 3));
+  EXPECT_THAT(plan.items[2].runs, ElementsAre(4, 5));
+  EXPECT_DOUBLE_EQ(plan.makespan_s, 8.0);
+  EXPECT_DOUBLE_EQ(plan.unsplit_cost_s, 12.0);
+  EXPECT_DOUBLE_EQ(plan.cost_s, 13.0);  // one extra group: + 1 s fixed cost
+  EXPECT_DOUBLE_EQ(plan.efficiency(), 0.75);
+  EXPECT_EQ(plan.split_cells, 1);
+  SplitOptions off;
+  off.mode = SplitOptions::Mode::kOff;
+  EXPECT_DOUBLE_EQ(plan_work(grid, 2, off).makespan_s, 9.0);
+}
+
+// Closed form: one cell of n = 12 runs, cost f + E m, on N = 4 ranks. The
+// shortest LPT schedule is 4 groups of 3: makespan f + 3m = 7 (3 groups of
+// 4: 9; 6 groups of 2 take two rounds: 10; 12 single runs: 3 rounds, 9),
+// efficiency (f + 12m) / (4 (f + 3m)).
+TEST(WorkPlanTest, OneCellOnFourRanksIsSplitIntoFourEqualGroups) {
+  const double f = 1.0, m = 2.0;
+  const Grid grid = hand_grid({{f, m, 12}});
+  const WorkPlan plan = plan_work(grid, /*ranks=*/4);
+  ASSERT_EQ(plan.items.size(), 4u);
+  for (const WorkItem& item : plan.items) EXPECT_EQ(item.runs.size(), 3u);
+  EXPECT_DOUBLE_EQ(plan.makespan_s, f + 3 * m);
+  EXPECT_DOUBLE_EQ(plan.efficiency(), (f + 12 * m) / (4 * (f + 3 * m)));
+  expect_partition(grid, all_runs(grid), plan);
+}
+
+TEST(WorkPlanTest, PlanIsDeterministicAndCoversEverySeedOnce) {
+  const Grid grid = paper_grid();
+  for (int ranks : {1, 2, 16, 64, 128, 1200}) {
+    SCOPED_TRACE(std::to_string(ranks) + " ranks");
+    const WorkPlan a = plan_work(grid, ranks), b = plan_work(grid, ranks);
+    ASSERT_EQ(a.items.size(), b.items.size());
+    for (std::size_t i = 0; i < a.items.size(); ++i) {
+      EXPECT_EQ(a.items[i].cell, b.items[i].cell);
+      EXPECT_EQ(a.items[i].runs, b.items[i].runs);
+    }
+    EXPECT_EQ(a.makespan_s, b.makespan_s);
+    expect_partition(grid, all_runs(grid), a);
+    EXPECT_NEAR(a.unsplit_cost_s, grid.estimated_cost_s, kCostTolerance * grid.estimated_cost_s);
+    EXPECT_GE(a.cost_s, a.unsplit_cost_s * (1 - kCostTolerance));
+  }
+}
+
+TEST(WorkPlanTest, PaperGridIsNotSplitOnFewRanks) {
+  const Grid grid = paper_grid();
+  for (int ranks : {1, 2}) {
+    const WorkPlan plan = plan_work(grid, ranks);
+    EXPECT_EQ(plan.items.size(), 120u) << ranks;
+    EXPECT_EQ(plan.split_cells, 0) << ranks;
+    EXPECT_EQ(plan.cost_s, plan.unsplit_cost_s) << "no core-hours wasted";
+  }
+}
+
+// Efficiency of the simulated schedule (the cost model's placeholders;
+// docs/DECISIONS.md "Member groups" gives the numbers and the ceiling).
+TEST(WorkPlanTest, PaperGridEfficiencyBySimulation) {
+  const Grid grid = paper_grid();
+  SplitOptions off;
+  off.mode = SplitOptions::Mode::kOff;
+  EXPECT_GE(plan_work(grid, 16).efficiency(), 0.95);
+  EXPECT_GE(plan_work(grid, 64).efficiency(), 0.9);
+  // 128 ranks: 0.90 looks out of reach under the placeholder constants (a
+  // search over 30 000 split vectors found about 0.89 at best): each extra group
+  // pays 44-119 s of fixed cost and a large PHNN-JR seed alone takes 310 s
+  // of a ~470-s ideal makespan. Whole cells reach 0.18.
+  const WorkPlan plan = plan_work(grid, 128);
+  EXPECT_GE(plan.efficiency(), 0.8);
+  EXPECT_LT(plan_work(grid, 128, off).efficiency(), 0.2);
+}
+
+TEST(WorkPlanTest, PartiallyFinishedCellsPlanOnlyTheirMissingRuns) {
+  const Grid grid = hand_grid({{1.0, 2.0, 10}, {1.0, 1.0, 4}, {5.0, 1.0, 3}});
+  // Cell 0 misses seeds 1, 2, 5, 9; cell 1 is done; cell 2 misses all.
+  const std::vector<std::vector<int>> pending = {{1, 2, 5, 9}, {}, {14, 15, 16}};
+  for (int ranks : {1, 2, 3, 8}) {
+    const WorkPlan plan = plan_work(grid, pending, ranks);
+    expect_partition(grid, pending, plan);
+    EXPECT_EQ(plan.cells, 2);
+    EXPECT_DOUBLE_EQ(plan.unsplit_cost_s, (1.0 + 4 * 2.0) + (5.0 + 3 * 1.0));
+  }
+  EXPECT_THROW(plan_work(grid, {{0}}, 2), std::invalid_argument);           // one list per cell
+  EXPECT_THROW(plan_work(grid, {{0}, {0}, {}}, 2), std::invalid_argument);  // 0 is not in cell 1
+}
+
+TEST(WorkPlanTest, MaxGroupSizeCapsEveryItem) {
+  const Grid grid = paper_grid();
+  SplitOptions options;
+  options.max_group_size = 3;
+  const WorkPlan plan = plan_work(grid, /*ranks=*/2, options);
+  for (const WorkItem& item : plan.items) EXPECT_LE(item.runs.size(), 3u);
+  EXPECT_EQ(plan.items.size(), 480u);  // 10 seeds -> 4 groups (3, 3, 2, 2), 120 cells
+  expect_partition(grid, all_runs(grid), plan);
+}
+
+TEST(WorkPlanTest, SplitOptionsRejectContradictionsAndNamesTheField) {
+  SplitOptions options;
+  options.max_group_size = -1;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<std::invalid_argument>(HasSubstr("max_group_size = -1")));
+  options.max_group_size = 2;
+  options.mode = SplitOptions::Mode::kOff;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<std::invalid_argument>(HasSubstr("needs mode auto")));
+  EXPECT_EQ(parse_split_mode("off"), SplitOptions::Mode::kOff);
+  EXPECT_EQ(to_string(parse_split_mode("auto")), "auto");
+  EXPECT_THROW(parse_split_mode("sometimes"), std::invalid_argument);
+  EXPECT_THROW(plan_work(paper_grid(), 0), std::invalid_argument);
+}
+
+TEST(WorkPlanTest, DryRunSummaryPrintsOneScheduleLinePerRankCount) {
+  const Grid grid = paper_grid();
+  const std::string summary = dry_run_summary(grid, {2, 128});
+  EXPECT_THAT(summary, HasSubstr("core-hours unsplit"));
+  EXPECT_THAT(summary, HasSubstr("\n  2 ranks: 120 items (120 whole cells), makespan "));
+  EXPECT_THAT(summary, HasSubstr("\n  128 ranks: "));
+  EXPECT_THAT(summary, HasSubstr("efficiency"));
+  EXPECT_THAT(summary, HasSubstr("Impact of the model size"));
+  EXPECT_EQ(summary.find("\n  128 ranks: 120 items"), std::string::npos) << "split at 128 ranks";
+  EXPECT_THROW(dry_run_summary(grid, {0}), std::invalid_argument);
+  EXPECT_THROW(dry_run_summary(grid, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace phnn
