@@ -4,6 +4,11 @@
 //                                      integrator, +-CN, E = 1 and E = 10
 //   bench_training baseline [repeats]  one small PHNN-JR-RK2 per step, plain
 //                                      torch::nn + autograd create_graph for gradH
+//   bench_training compare [repeats] [size]  fused vs reference networks,
+//                                      interleaved, E = 10
+//   bench_training run MODEL INTEGRATOR REG STEPS [SIZE]   one cell, E = 10
+//                                      (for perf; PHNN_REFERENCE_NETWORKS=1
+//                                      selects the reference networks)
 //   bench_training cell                one full cell: small PHNN-JR-RK2,
 //                                      E = 10, 50 000 steps (+ inference)
 //
@@ -57,6 +62,47 @@ double time_cell(CellSpec cell, int steps) {
   const auto t0 = Clock::now();
   phnn::train_cell(cell, bench_data());
   return seconds_since(t0);
+}
+
+// Fused networks against the op-by-op reference path, interleaved run by
+// run in one process (E = 10, batch 64): the before/after of the fused node.
+int compare(int repeats, phnn::ModelSize size) {
+  const std::pair<phnn::ModelKind, phnn::IntegratorKind> models[] = {
+      {phnn::ModelKind::kNode, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kDg},
+      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kDg}};
+  std::printf("size %s, E = 10, µs per member-step, median of %d interleaved runs\n",
+              phnn::to_string(size).c_str(), repeats);
+  std::printf("| model | regularizer | reference | fused | speed-up |\n|---|---|---|---|---|\n");
+  for (const auto& [model, integrator] : models) {
+    for (phnn::Regularizer reg : {phnn::Regularizer::kNone, phnn::Regularizer::kCn}) {
+      CellSpec cell;
+      cell.model = model;
+      cell.integrator = integrator;
+      cell.size = size;
+      cell.n_train = 64;
+      cell.regularizer = reg;
+      cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+      const int short_steps = size == phnn::ModelSize::kSmall ? 200 : 50;
+      const int long_steps = size == phnn::ModelSize::kSmall ? 1200 : 300;
+      std::vector<double> samples[2];
+      for (int r = 0; r < repeats; ++r) {
+        for (int fused : {0, 1}) {
+          cell.fused_networks = fused;
+          const double t_short = time_cell(cell, short_steps), t_long = time_cell(cell, long_steps);
+          samples[fused].push_back((t_long - t_short) / ((long_steps - short_steps) * 10.0) * 1e6);
+        }
+      }
+      const double ref = median(samples[0]), fused = median(samples[1]);
+      std::printf("| %s | %s | %.0f | %.0f | %.2fx |\n",
+                  phnn::model_label(model, integrator).c_str(), phnn::to_string(reg).c_str(), ref,
+                  fused, ref / fused);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
 }
 
 int stacked(int repeats) {
@@ -196,6 +242,21 @@ int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "stacked";
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
   if (mode == "stacked") return stacked(repeats);
+  if (mode == "run" && argc > 5) {  // for perf: run MODEL INTEGRATOR REG STEPS [SIZE]
+    CellSpec cell;
+    cell.model = phnn::parse_model(argv[2]);
+    cell.integrator = phnn::parse_integrator(argv[3]);
+    cell.regularizer = phnn::parse_regularizer(argv[4]);
+    cell.size = phnn::parse_size(argc > 6 ? argv[6] : "small");
+    cell.n_train = 64;
+    cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+    cell.fused_networks = std::getenv("PHNN_REFERENCE_NETWORKS") == nullptr;
+    std::printf("%.3f s\n", time_cell(cell, std::atoi(argv[5])));
+    return 0;
+  }
+  if (mode == "compare") {
+    return compare(repeats, phnn::parse_size(argc > 3 ? argv[3] : "small"));
+  }
   if (mode == "baseline") return baseline(repeats);
   if (mode == "cell") return full_cell();
   std::fprintf(stderr, "usage: bench_training stacked|baseline|cell [repeats]\n");

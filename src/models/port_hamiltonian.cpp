@@ -3,6 +3,7 @@
 
 #include <utility>
 
+#include "models/fused_heads.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -50,6 +51,10 @@ Jet gradient_jet(const Jet& h) {
 
 HamiltonianAndGradient hamiltonian_and_gradient(const StackedMlp& l_h, const torch::Tensor& x) {
   const Jet o = l_h.forward_input(x, /*directions=*/2, /*order=*/1);
+  if (l_h.options().fused) {
+    const auto head = internal::hamiltonian_head(o.v, o.g, x);
+    return {head.h, head.grad};
+  }
   const auto q = x.narrow(-1, 0, 1), p = x.narrow(-1, 1, 1);
   const auto o0 = o.v.narrow(-1, 0, 1), l10 = o.v.narrow(-1, 1, 1), o2 = o.v.narrow(-1, 2, 1);
   const auto l00 = torch::softplus(o0), l11 = torch::softplus(o2);
@@ -65,6 +70,9 @@ HamiltonianAndGradient hamiltonian_and_gradient(const StackedMlp& l_h, const tor
 }
 
 torch::Tensor PortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
+  if (l_h().options().fused) {
+    return internal::hamiltonian_head(l_h().forward(x), {}, x).h.squeeze(-1);
+  }
   return hamiltonian_jet(l_h(), x, 0).v.squeeze(-1);
 }
 
@@ -93,6 +101,15 @@ torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
                                                       const torch::Tensor& dx,
                                                       double min_dx_norm) const {
   const int64_t B = x.size(1);
+  if (l_h().options().fused) {
+    // H at x and x + dx needs no derivative: one order-0 network call for
+    // both, one order-1 call at the midpoint.
+    const auto ends = torch::cat({x, x + dx}, /*dim=*/1);
+    const auto h_ends = internal::hamiltonian_head(l_h().forward(ends), {}, ends).h;
+    const auto grad_mid = hamiltonian_and_gradient(l_h(), x + 0.5 * dx).grad;
+    return internal::gonzalez_head(h_ends.narrow(1, 0, B), h_ends.narrow(1, B, B), grad_mid, dx,
+                                   min_dx_norm);
+  }
   // One network call for H(x), H(x + dx) and gradH(x + dx/2).
   const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
   const HamiltonianAndGradient h = hamiltonian_and_gradient(l_h(), points);
@@ -123,9 +140,10 @@ void add_networks(std::vector<std::unique_ptr<StackedMlp>>* nets, const ModelOpt
                   const std::vector<int>& dissipation_hidden, int dissipation_out,
                   std::uint64_t dissipation_stream) {
   nets->push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{2, network_widths(options.size).l_h, 3}, seeds, kStreamLH));
+      StackedMlpOptions{2, network_widths(options.size).l_h, 3, options.fused_networks}, seeds, kStreamLH));
   nets->push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{dissipation_in, dissipation_hidden, dissipation_out}, seeds,
+      StackedMlpOptions{dissipation_in, dissipation_hidden, dissipation_out,
+                        options.fused_networks}, seeds,
       dissipation_stream));
 }
 }  // namespace
@@ -184,6 +202,10 @@ torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x, const torch::Te
 
 Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
                               const torch::Tensor& u, int order) const {
+  if (order == 0 && nets_[1]->options().fused) {
+    const auto o = nets_[1]->forward(torch::cat({x_dissipation, u}, -1));  // [E, B, 6]
+    return Jet{internal::jr_field_head(effort.v, o, u, J_), {}, {}};
+  }
   if (order == 0) {
     // Matrix form: L_R from its 6 outputs by one placement matmul, then
     // f = [J e - L^T (L e)]_{1:2} with e = (gradH, u).
@@ -223,7 +245,7 @@ Node::Node(ModelOptions options, const std::vector<std::uint64_t>& seeds)
     : DynamicsModel(options, static_cast<int64_t>(seeds.size())) {
   PHNN_REQUIRE(options.kind == ModelKind::kNode, "Node: options.kind must be node");
   nets_.push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{3, network_widths(options.size).node, 2}, seeds, kStreamNode));
+      StackedMlpOptions{3, network_widths(options.size).node, 2, options.fused_networks}, seeds, kStreamNode));
 }
 
 FieldEval Node::field(const torch::Tensor& x, const torch::Tensor& u, bool with_jacobian) const {

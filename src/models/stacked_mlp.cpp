@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "models/fused_mlp.h"
 #include "models/stacked_matmul.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
@@ -160,6 +161,27 @@ StackedMlp::StackedMlp(StackedMlpOptions options, const std::vector<std::uint64_
 }
 
 torch::Tensor StackedMlp::forward(const torch::Tensor& x) const {
+  if (!options_.fused) return reference_forward(x);
+  return internal::fused_mlp(weights_, biases_, x, {}, {}, internal::FusedMlpOptions{}).v;
+}
+
+Jet StackedMlp::forward(const Jet& x) const {
+  if (!options_.fused) return reference_forward(x);
+  const int order = x.order();
+  const int directions = order >= 1 ? static_cast<int>(x.g.size(-2)) : 0;
+  const auto out = internal::fused_mlp(weights_, biases_, x.v, x.g, x.h,
+                                       internal::FusedMlpOptions{directions, order});
+  return Jet{out.v, out.g, out.h};
+}
+
+Jet StackedMlp::forward_input(const torch::Tensor& x, int directions, int order) const {
+  if (!options_.fused) return reference_forward_input(x, directions, order);
+  const auto out = internal::fused_mlp(weights_, biases_, x, {}, {},
+                                       internal::FusedMlpOptions{order >= 1 ? directions : 0, order});
+  return Jet{out.v, out.g, out.h};
+}
+
+torch::Tensor StackedMlp::reference_forward(const torch::Tensor& x) const {
   torch::Tensor a = x;
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
@@ -181,7 +203,7 @@ torch::Tensor batched_linear(const torch::Tensor& t, const torch::Tensor& w) {
 }
 }  // namespace
 
-Jet StackedMlp::forward(const Jet& x) const {
+Jet StackedMlp::reference_forward(const Jet& x) const {
   Jet a = x;
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
@@ -194,8 +216,9 @@ Jet StackedMlp::forward(const Jet& x) const {
   return a;
 }
 
-Jet StackedMlp::forward_input(const torch::Tensor& x, int directions, int order) const {
-  if (order == 0) return Jet{forward(x), {}, {}};
+Jet StackedMlp::reference_forward_input(const torch::Tensor& x, int directions,
+                                        int order) const {
+  if (order == 0) return Jet{reference_forward(x), {}, {}};
   const int64_t E = x.size(0), B = x.size(1);
   // Layer 0: z = x W + b, dz/dx_i = W[i, :], d2z = 0.
   Jet z;

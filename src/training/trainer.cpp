@@ -150,7 +150,8 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   const int64_t E = static_cast<int64_t>(cell.seeds.size());
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   std::unique_ptr<DynamicsModel> model =
-      DynamicsModel::create(ModelOptions{cell.model, cell.size, data.system.kind}, seeds);
+      DynamicsModel::create(
+      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks}, seeds);
   // One contiguous leaf for the whole stack: Adam in a handful of ops.
   const DynamicsModel::FlatParameters flat = model->flatten_parameters();
   const std::vector<torch::Tensor> params = model->parameters();  // alias flat.values

@@ -27,6 +27,9 @@ struct ModelOptions {
   ModelSize size = ModelSize::kSmall;
   /// Supplies S (PHNN-S) or J (PHNN-JR): the known interconnection structure.
   SystemKind structure = SystemKind::kHarmonic;
+  /// Networks through the fused autograd node (StackedMlpOptions::fused);
+  /// false selects the op-by-op reference path (tests, benchmarks).
+  bool fused_networks = true;
 };
 
 /// Base of NODE, PHNN-S and PHNN-JR. Every method is batched over members.

@@ -43,6 +43,11 @@ struct StackedMlpOptions {
   int input = 2;
   std::vector<int> hidden = {16, 16};
   int output = 3;
+  /// Evaluate through the fused autograd node (src/models/fused_mlp.h): one
+  /// node per call with a hand-written backward. false: the reference path,
+  /// one LibTorch op per matmul / tanh / jet product (for tests and
+  /// benchmarks; same values to round-off).
+  bool fused = true;
 };
 
 /// E tanh MLPs as weights [E, in, out] and biases [E, 1, out]:
@@ -76,6 +81,10 @@ class StackedMlp {
   const StackedMlpOptions& options() const { return options_; }
 
  private:
+  Jet reference_forward(const Jet& x) const;
+  Jet reference_forward_input(const torch::Tensor& x, int directions, int order) const;
+  torch::Tensor reference_forward(const torch::Tensor& x) const;
+
   StackedMlpOptions options_;
   int64_t members_;
   std::vector<torch::Tensor> weights_, biases_;

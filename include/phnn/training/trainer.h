@@ -24,6 +24,10 @@ struct CellSpec {
   Regularizer regularizer = Regularizer::kNone;
   std::vector<int> seeds = {0};
   TrainerOptions training;
+  /// Networks through the fused autograd node (default) or the op-by-op
+  /// reference path (ModelOptions::fused_networks): same results to
+  /// round-off, for tests and side-by-side benchmarks.
+  bool fused_networks = true;
 
   /// Throws std::invalid_argument naming the field (e.g. NODE with DG).
   void validate(const SystemData& data) const;

@@ -1,0 +1,287 @@
+// src/models/fused_heads.cpp — forward and backward of the closed-form model
+// heads, row by row (a row = one member and one batch element).
+#include "models/fused_heads.h"
+
+#include <cmath>
+
+namespace phnn {
+namespace internal {
+namespace {
+
+using torch::Tensor;
+using torch::autograd::AutogradContext;
+using torch::autograd::variable_list;
+
+// LibTorch's softplus (threshold 20), its slope, and sigmoid.
+inline double softplus(double x) { return x > 20.0 ? x : std::log1p(std::exp(x)); }
+inline double softplus_slope(double x) {
+  if (x > 20.0) return 1.0;
+  const double z = std::exp(x);
+  return z / (z + 1.0);
+}
+inline double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+
+Tensor dense(const Tensor& t) { return t.contiguous(); }
+
+// ------------------------------------------------------------ Hamiltonian
+// Per row, with l00 = softplus(o0), l10 = o1, l11 = softplus(o2), s_k =
+// sigmoid(o_k):  v0 = l00 q, v1 = l10 q + l11 p, H = (v0^2 + v1^2) / 2,
+//   m = L^T v = (l00 v0 + l10 v1, l11 v1),  c = (v0 s0 q, v1 q, v1 s2 p),
+//   gradH_i = m_i + sum_k o_g[i][k] c_k.
+// Backward with adjoints H~, g~ (c~_k = sum_i g~_i o_g[i][k]):
+//   o_g~[i][k] = g~_i c_k
+//   v0~ = H~ v0 + g~0 l00 + c~0 s0 q
+//   v1~ = H~ v1 + g~0 l10 + g~1 l11 + c~1 q + c~2 s2 p
+//   l00~ = g~0 v0 + v0~ q,  l10~ = g~0 v1 + v1~ q,  l11~ = g~1 v1 + v1~ p
+//   q~ = c~0 v0 s0 + c~1 v1 + v0~ l00 + v1~ l10,  p~ = c~2 v1 s2 + v1~ l11
+//   o0~ = l00~ softplus'(o0) + c~0 v0 q s0 (1 - s0),  o1~ = l10~,
+//   o2~ = l11~ softplus'(o2) + c~2 v1 p s2 (1 - s2).
+struct HamiltonianRow {
+  double q, p, l00, l10, l11, s0, s2, v0, v1;
+  HamiltonianRow(const double* o, const double* x)
+      : q(x[0]), p(x[1]), l00(softplus(o[0])), l10(o[1]), l11(softplus(o[2])),
+        s0(sigmoid(o[0])), s2(sigmoid(o[2])), v0(l00 * q), v1(l10 * q + l11 * p) {}
+  double c(int k) const { return k == 0 ? v0 * s0 * q : k == 1 ? v1 * q : v1 * s2 * p; }
+};
+
+class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction> {
+ public:
+  static variable_list forward(AutogradContext* ctx, const Tensor& o_in,
+                               const c10::optional<Tensor>& o_g_in, const Tensor& x_in) {
+    const Tensor o = dense(o_in), x = dense(x_in);
+    const bool with_grad = o_g_in.has_value();
+    const Tensor o_g = with_grad ? dense(*o_g_in) : Tensor();
+    const int64_t rows = o.size(0) * o.size(1);
+    Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
+    Tensor grad = with_grad ? torch::empty({o.size(0), o.size(1), 2}, o.options()) : Tensor();
+    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+    double* ph = h.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const HamiltonianRow row(po + 3 * r, px + 2 * r);
+      ph[r] = 0.5 * (row.v0 * row.v0 + row.v1 * row.v1);
+      if (!with_grad) continue;
+      const double* og = o_g.data_ptr<double>() + 6 * r;
+      double* g = grad.data_ptr<double>() + 2 * r;
+      const double c[3] = {row.c(0), row.c(1), row.c(2)};
+      g[0] = row.l00 * row.v0 + row.l10 * row.v1 + og[0] * c[0] + og[1] * c[1] + og[2] * c[2];
+      g[1] = row.l11 * row.v1 + og[3] * c[0] + og[4] * c[1] + og[5] * c[2];
+    }
+    ctx->save_for_backward({o, with_grad ? o_g : o, x});
+    ctx->saved_data["with_grad"] = with_grad;
+    return with_grad ? variable_list{h, grad} : variable_list{h};
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const Tensor &o = saved[0], &x = saved[2];
+    const bool with_grad = ctx->saved_data["with_grad"].toBool();
+    const int64_t rows = o.size(0) * o.size(1);
+    const Tensor h_bar = grads[0].defined() ? dense(grads[0]) : torch::zeros_like(o.narrow(-1, 0, 1));
+    const Tensor g_bar = with_grad && grads[1].defined() ? dense(grads[1]) : Tensor();
+    Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
+    Tensor o_g_bar = with_grad ? torch::zeros_like(saved[1]) : Tensor();
+    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+    const double* phb = h_bar.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const HamiltonianRow row(po + 3 * r, px + 2 * r);
+      const double hb = phb[r];
+      double gb[2] = {0.0, 0.0}, cb[3] = {0.0, 0.0, 0.0};
+      if (g_bar.defined()) {
+        const double* og = saved[1].data_ptr<double>() + 6 * r;
+        double* ogb = o_g_bar.data_ptr<double>() + 6 * r;
+        gb[0] = g_bar.data_ptr<double>()[2 * r];
+        gb[1] = g_bar.data_ptr<double>()[2 * r + 1];
+        for (int k = 0; k < 3; ++k) {
+          cb[k] = gb[0] * og[k] + gb[1] * og[3 + k];
+          ogb[k] = gb[0] * row.c(k);
+          ogb[3 + k] = gb[1] * row.c(k);
+        }
+      }
+      const double v0b = hb * row.v0 + gb[0] * row.l00 + cb[0] * row.s0 * row.q;
+      const double v1b = hb * row.v1 + gb[0] * row.l10 + gb[1] * row.l11 + cb[1] * row.q +
+                         cb[2] * row.s2 * row.p;
+      const double l00b = gb[0] * row.v0 + v0b * row.q;
+      const double l10b = gb[0] * row.v1 + v1b * row.q;
+      const double l11b = gb[1] * row.v1 + v1b * row.p;
+      double* ob = o_bar.data_ptr<double>() + 3 * r;
+      ob[0] = l00b * softplus_slope(po[3 * r]) + cb[0] * row.v0 * row.q * row.s0 * (1.0 - row.s0);
+      ob[1] = l10b;
+      ob[2] = l11b * softplus_slope(po[3 * r + 2]) +
+              cb[2] * row.v1 * row.p * row.s2 * (1.0 - row.s2);
+      double* xb = x_bar.data_ptr<double>() + 2 * r;
+      xb[0] = cb[0] * row.v0 * row.s0 + cb[1] * row.v1 + v0b * row.l00 + v1b * row.l10;
+      xb[1] = cb[2] * row.v1 * row.s2 + v1b * row.l11;
+    }
+    return {o_bar, o_g_bar, x_bar};
+  }
+};
+
+// ---------------------------------------------------------------- PHNN-JR
+// Per row, eps = (e0, e1, u), L lower triangular from o (row-major):
+//   v = L eps,  f_i = sum_j J_ij eps_j - (L^T v)_i,  i = 0, 1.
+// Backward with f~ (f~_2 = 0), w = L f~:
+//   eps~ = J^T f~ - L^T w          (R = L^T L is symmetric)
+//   L~_ab = -(v_a f~_b + w_a eps_b)  for the lower-triangle entries (a >= b).
+constexpr int kRow[6] = {0, 1, 1, 2, 2, 2}, kCol[6] = {0, 0, 1, 0, 1, 2};
+
+// y = L a and z = L^T a for the row-major lower triangle o.
+inline void lower_times(const double* o, const double* a, double* y) {
+  y[0] = o[0] * a[0];
+  y[1] = o[1] * a[0] + o[2] * a[1];
+  y[2] = o[3] * a[0] + o[4] * a[1] + o[5] * a[2];
+}
+inline void lower_transpose_times(const double* o, const double* a, double* z) {
+  z[0] = o[0] * a[0] + o[1] * a[1] + o[3] * a[2];
+  z[1] = o[2] * a[1] + o[4] * a[2];
+  z[2] = o[5] * a[2];
+}
+
+class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
+ public:
+  static Tensor forward(AutogradContext* ctx, const Tensor& effort_in, const Tensor& o_in,
+                        const Tensor& u_in, std::array<std::array<double, 3>, 3> J) {
+    const Tensor e = dense(effort_in), o = dense(o_in), u = dense(u_in);
+    const int64_t rows = e.size(0) * e.size(1);
+    Tensor f = torch::empty_like(e);
+    const double *pe = e.data_ptr<double>(), *po = o.data_ptr<double>(), *pu = u.data_ptr<double>();
+    double* pf = f.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+      double v[3], rv[3];
+      lower_times(po + 6 * r, eps, v);
+      lower_transpose_times(po + 6 * r, v, rv);
+      for (int i = 0; i < 2; ++i) {
+        pf[2 * r + i] = J[i][0] * eps[0] + J[i][1] * eps[1] + J[i][2] * eps[2] - rv[i];
+      }
+    }
+    ctx->save_for_backward({e, o, u});
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) ctx->saved_data["J" + std::to_string(3 * i + j)] = J[i][j];
+    return f;
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const Tensor &e = saved[0], &o = saved[1], &u = saved[2];
+    double J[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) J[i][j] = ctx->saved_data["J" + std::to_string(3 * i + j)].toDouble();
+    const Tensor fb = dense(grads[0]);
+    const int64_t rows = e.size(0) * e.size(1);
+    Tensor e_bar = torch::empty_like(e), o_bar = torch::empty_like(o), u_bar = torch::empty_like(u);
+    const double *pe = e.data_ptr<double>(), *po = o.data_ptr<double>(), *pu = u.data_ptr<double>();
+    const double* pfb = fb.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+      const double f_bar[3] = {pfb[2 * r], pfb[2 * r + 1], 0.0};
+      double v[3], w[3], ltw[3];
+      lower_times(po + 6 * r, eps, v);
+      lower_times(po + 6 * r, f_bar, w);
+      lower_transpose_times(po + 6 * r, w, ltw);
+      double eps_bar[3];
+      for (int j = 0; j < 3; ++j) eps_bar[j] = J[0][j] * f_bar[0] + J[1][j] * f_bar[1] - ltw[j];
+      e_bar.data_ptr<double>()[2 * r] = eps_bar[0];
+      e_bar.data_ptr<double>()[2 * r + 1] = eps_bar[1];
+      u_bar.data_ptr<double>()[r] = eps_bar[2];
+      double* ob = o_bar.data_ptr<double>() + 6 * r;
+      for (int k = 0; k < 6; ++k) ob[k] = -(v[kRow[k]] * f_bar[kCol[k]] + w[kRow[k]] * eps[kCol[k]]);
+    }
+    return {e_bar, o_bar, u_bar, Tensor()};
+  }
+};
+
+// --------------------------------------------------------------- Gonzalez
+// Per row: n2 = |dx|^2, D = H1 - H0 - g.dx, k = D / n2 (0 if n2 < tau^2),
+// dg = g + k dx. Backward with dg~, s = dg~.dx (small rows: g~ = dg~ only):
+//   H1~ = s / n2,  H0~ = -s / n2,  g~ = dg~ - (s / n2) dx,
+//   dx~ = k dg~ - (s / n2) (g + 2 k dx).
+class GonzalezFunction : public torch::autograd::Function<GonzalezFunction> {
+ public:
+  static Tensor forward(AutogradContext* ctx, const Tensor& h0_in, const Tensor& h1_in,
+                        const Tensor& g_in, const Tensor& dx_in, double min_dx_norm) {
+    const Tensor h0 = dense(h0_in), h1 = dense(h1_in), g = dense(g_in), dx = dense(dx_in);
+    const int64_t rows = g.size(0) * g.size(1);
+    Tensor dg = torch::empty_like(g);
+    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
+    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
+    double* out = dg.data_ptr<double>();
+    const double tau2 = min_dx_norm * min_dx_norm;
+    for (int64_t r = 0; r < rows; ++r) {
+      const double* gr = pg + 2 * r;
+      const double* d = pd + 2 * r;
+      const double n2 = d[0] * d[0] + d[1] * d[1];
+      const double defect = p1[r] - p0[r] - (gr[0] * d[0] + gr[1] * d[1]);
+      const double k = n2 < tau2 ? 0.0 : defect / n2;
+      out[2 * r] = gr[0] + k * d[0];
+      out[2 * r + 1] = gr[1] + k * d[1];
+    }
+    ctx->save_for_backward({h0, h1, g, dx});
+    ctx->saved_data["tau2"] = tau2;
+    return dg;
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const Tensor &h0 = saved[0], &h1 = saved[1], &g = saved[2], &dx = saved[3];
+    const double tau2 = ctx->saved_data["tau2"].toDouble();
+    const Tensor db = dense(grads[0]);
+    const int64_t rows = g.size(0) * g.size(1);
+    Tensor h0_bar = torch::empty_like(h0), h1_bar = torch::empty_like(h1);
+    Tensor g_bar = torch::empty_like(g), dx_bar = torch::empty_like(dx);
+    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
+    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
+    const double* pb = db.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double* gr = pg + 2 * r;
+      const double* d = pd + 2 * r;
+      const double* b = pb + 2 * r;
+      const double n2 = d[0] * d[0] + d[1] * d[1];
+      double* gb = g_bar.data_ptr<double>() + 2 * r;
+      double* xb = dx_bar.data_ptr<double>() + 2 * r;
+      if (n2 < tau2) {
+        h0_bar.data_ptr<double>()[r] = h1_bar.data_ptr<double>()[r] = 0.0;
+        gb[0] = b[0], gb[1] = b[1], xb[0] = xb[1] = 0.0;
+        continue;
+      }
+      const double k = (p1[r] - p0[r] - (gr[0] * d[0] + gr[1] * d[1])) / n2;
+      const double s_n2 = (b[0] * d[0] + b[1] * d[1]) / n2;
+      h1_bar.data_ptr<double>()[r] = s_n2;
+      h0_bar.data_ptr<double>()[r] = -s_n2;
+      for (int i = 0; i < 2; ++i) {
+        gb[i] = b[i] - s_n2 * d[i];
+        xb[i] = k * b[i] - s_n2 * (gr[i] + 2.0 * k * d[i]);
+      }
+    }
+    return {h0_bar, h1_bar, g_bar, dx_bar, Tensor()};
+  }
+};
+
+}  // namespace
+
+HamiltonianHead hamiltonian_head(const torch::Tensor& o, const torch::Tensor& o_g,
+                                 const torch::Tensor& x) {
+  TORCH_CHECK(o.dim() == 3 && o.size(2) == 3 && x.size(2) == 2 &&
+                  o.scalar_type() == torch::kFloat64,
+              "hamiltonian_head: expected float64 o [E, B, 3] and x [E, B, 2], got ", o.sizes(),
+              " and ", x.sizes());
+  const auto out = HamiltonianFunction::apply(
+      o, o_g.defined() ? c10::optional<torch::Tensor>(o_g) : c10::nullopt, x.expand_as(o.narrow(-1, 0, 2)));
+  return {out[0], out.size() > 1 ? out[1] : torch::Tensor()};
+}
+
+torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
+                            const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J) {
+  TORCH_CHECK(effort.dim() == 3 && effort.size(2) == 2 && o.size(2) == 6 && u.size(2) == 1,
+              "jr_field_head: expected e [E, B, 2], o [E, B, 6], u [E, B, 1], got ",
+              effort.sizes(), ", ", o.sizes(), ", ", u.sizes());
+  return JrFieldFunction::apply(effort, o, u.expand({effort.size(0), effort.size(1), 1}), J);
+}
+
+torch::Tensor gonzalez_head(const torch::Tensor& h_x, const torch::Tensor& h_x_dx,
+                            const torch::Tensor& grad_mid, const torch::Tensor& dx,
+                            double min_dx_norm) {
+  return GonzalezFunction::apply(h_x, h_x_dx, grad_mid, dx.expand_as(grad_mid), min_dx_norm);
+}
+
+}  // namespace internal
+}  // namespace phnn

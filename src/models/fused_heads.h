@@ -1,0 +1,40 @@
+// src/models/fused_heads.h — the closed-form parts of the PHNN models that
+// sit on top of the networks, each one autograd node with a hand-written
+// backward (docs/METHOD.md "Fused networks"). Private to src/models; the
+// op-by-op formulas they replace stay in port_hamiltonian.cpp as the
+// reference path, and the tests compare the two.
+#pragma once
+
+#include <array>
+
+#include <torch/torch.h>
+
+namespace phnn {
+namespace internal {
+
+/// H = |L_H(x) x|^2 / 2 and, if `o_g` is defined, gradH (eq:quadratic_H),
+/// from the L_H outputs o [E, B, 3] and their x-derivatives o_g [E, B, 2, 3]:
+///   L_H = [[softplus(o0), 0], [o1, softplus(o2)]],  v = L_H x,
+///   gradH = L_H^T v + o_g c,  c = (v0 sigmoid(o0) q, v1 q, v1 sigmoid(o2) p).
+/// Returns {H [E, B, 1], gradH [E, B, 2] or undefined}.
+struct HamiltonianHead {
+  torch::Tensor h, grad;
+};
+HamiltonianHead hamiltonian_head(const torch::Tensor& o, const torch::Tensor& o_g,
+                                 const torch::Tensor& x);
+
+/// PHNN-JR field (eq:f_theta-PHS-JR) from the effort e [E, B, 2] (gradH or
+/// the discrete gradient), the L_R outputs o [E, B, 6] (row-major lower
+/// triangle of L_R) and u [E, B, 1]:  f = [(J - L_R^T L_R) (e, u)]_{1:2}.
+torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
+                            const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J);
+
+/// Gonzalez discrete gradient (eq: gonzalez-discrete-gradient) from H(x)
+/// [E, B, 1], H(x + dx) [E, B, 1], gradH(x + dx/2) [E, B, 2] and dx:
+///   dg = g + (H(x+dx) - H(x) - g.dx) / |dx|^2 dx,  = g where |dx| < min_dx_norm.
+torch::Tensor gonzalez_head(const torch::Tensor& h_x, const torch::Tensor& h_x_dx,
+                            const torch::Tensor& grad_mid, const torch::Tensor& dx,
+                            double min_dx_norm);
+
+}  // namespace internal
+}  // namespace phnn

@@ -1,0 +1,45 @@
+// src/models/fused_mlp.h — a stack of E tanh MLPs and its forward-mode jets
+// as one autograd node with a hand-written backward (docs/METHOD.md "Fused
+// networks"). Private to src/models: StackedMlp is its only caller.
+#pragma once
+
+#include <vector>
+
+#include <torch/torch.h>
+
+namespace phnn {
+namespace internal {
+
+/// What to propagate through the network.
+struct FusedMlpOptions {
+  /// Input directions d (<= input width): the jet is taken w.r.t. them.
+  int directions = 0;
+  /// 0: value only; 1: + first derivatives; 2: + second derivatives.
+  int order = 0;
+};
+
+/// Outputs of fused_mlp (undefined above the requested order):
+///   v [E, B, out], g [E, B, d, out] = dv/dx_i, h [E, B, d, d, out] = d2v/dx_i dx_j.
+struct FusedMlpJet {
+  torch::Tensor v, g, h;
+};
+
+/// The jet of a_{l+1} = tanh(a_l W_l + b_l) (l < L), output a_L W_L + b_L,
+/// for weights W_l [E, n_l, n_{l+1}] and biases b_l [E, 1, n_{l+1}], from an
+/// input jet (x_v [E, B, n_0], x_g [E, B, d, n_0], x_h [E, B, d, d, n_0]).
+/// An undefined x_g means x_g = [I_d | 0] (the jet of the input coordinates)
+/// and an undefined x_h means 0. x_h must be symmetric in (i, j).
+///
+/// All E members and the whole batch go through one autograd node: per
+/// layer one dgemm per member on the stacked channels (value, d tangents,
+/// d(d+1)/2 second derivatives), tanh once on the value channel, and the
+/// jet's chain rule elementwise. Its backward is written out in
+/// fused_mlp.cpp; it is first-order only (no double backward), which is all
+/// training needs since derivatives w.r.t. x are carried forward as jets.
+FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
+                      const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
+                      const torch::Tensor& x_g, const torch::Tensor& x_h,
+                      const FusedMlpOptions& options);
+
+}  // namespace internal
+}  // namespace phnn

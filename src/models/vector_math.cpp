@@ -1,0 +1,58 @@
+// src/models/vector_math.cpp
+#include "models/vector_math.h"
+
+#include <cmath>
+#include <cstring>
+
+namespace phnn {
+namespace internal {
+namespace {
+
+// exp(x) for 0 <= x <= 44 (the caller clamps), Cephes' exp.c.
+inline double exp_reduced(double x) {
+  constexpr double kLog2e = 1.4426950408889634073599;
+  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
+  constexpr double kShifter = 6755399441055744.0;  // 1.5 * 2^52: t - kShifter = round(t)
+  const double t = x * kLog2e + kShifter;
+  const double k = t - kShifter;
+  const double r = (x - k * kLn2Hi) - k * kLn2Lo;
+  const double rr = r * r;
+  const double p = r * ((1.26177193074810590878e-4 * rr + 3.02994407707441961300e-2) * rr +
+                        9.99999999999999999910e-1);
+  const double q = ((3.00198505138664455042e-6 * rr + 2.52448340349684104192e-3) * rr +
+                    2.27265548208155028766e-1) * rr + 2.00000000000000000009e0;
+  const double e = 1.0 + 2.0 * p / (q - p);
+  // 2^k from its bits: the low mantissa bits of t hold k.
+  int64_t t_bits, shifter_bits;
+  std::memcpy(&t_bits, &t, sizeof t);
+  constexpr double kShifterCopy = kShifter;
+  std::memcpy(&shifter_bits, &kShifterCopy, sizeof shifter_bits);
+  const int64_t scale_bits = ((t_bits - shifter_bits) + 1023) << 52;
+  double scale;
+  std::memcpy(&scale, &scale_bits, sizeof scale);
+  return e * scale;
+}
+
+inline double tanh_one(double x) {
+  const double z = x * x;
+  const double num = (-9.64399179425052238628e-1 * z - 9.92877231001918586564e1) * z -
+                     1.61468768441708447952e3;
+  const double den = ((z + 1.12811678491632931402e2) * z + 2.23548839060100448583e3) * z +
+                     4.84406305325125486048e3;
+  const double small = x + x * z * (num / den);
+  double a = std::fabs(x);
+  a = a < 22.0 ? a : 22.0;
+  const double large = std::copysign(1.0 - 2.0 / (exp_reduced(2.0 * a) + 1.0), x);
+  const double y = std::fabs(x) < 0.625 ? small : large;
+  return x == x ? y : x;  // NaN in, NaN out
+}
+
+}  // namespace
+
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+void tanh_array(const double* x, double* y, int64_t n) {
+  for (int64_t i = 0; i < n; ++i) y[i] = tanh_one(x[i]);
+}
+
+}  // namespace internal
+}  // namespace phnn

@@ -1,0 +1,25 @@
+// src/models/vector_math.h — tanh over arrays, written so the compiler
+// vectorizes it (AVX-512 / AVX2 clones chosen at run time), for the fused
+// networks. LibTorch's tanh on this build goes through Sleef's 1-ulp AVX2
+// kernel at ~5 ns per element, 20 % of a small training step (perf).
+#pragma once
+
+#include <cstdint>
+
+namespace phnn {
+namespace internal {
+
+/// y[i] = tanh(x[i]) for i < n, to within 2 ulp of std::tanh (tested), NaN
+/// and +-inf handled like std::tanh. x and y may alias.
+///
+/// Method (the Cephes library's, S. L. Moshier): for |x| < 0.625 the odd
+/// rational approximation tanh x = x + x^3 P(x^2) / Q(x^2); otherwise
+/// tanh |x| = 1 - 2 / (exp(2|x|) + 1) with |x| clamped at 22 (where tanh
+/// rounds to 1) and exp by the reduction 2|x| = k ln 2 + r, |r| <= ln2/2,
+/// exp r = 1 + 2 r P(r^2) / (Q(r^2) - r P(r^2)) (a Pade form), times 2^k
+/// built from its bits. Both branches are computed and blended, so the loop
+/// has no branch and vectorizes.
+void tanh_array(const double* x, double* y, int64_t n);
+
+}  // namespace internal
+}  // namespace phnn
