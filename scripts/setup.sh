@@ -15,6 +15,7 @@ PACKAGES=(
   libblas-dev                        # libblas.so to link dgemm_ (src/models/stacked_matmul.cpp)
   libjemalloc-dev                    # allocator: glibc malloc costs ~16 % of a step
   python3-h5py python3-numpy python3-matplotlib  # analysis/ only
+  python3-torch                      # bench/pytorch_step.py only
 )
 
 SUDO=""
