@@ -12,14 +12,17 @@ using torch::Tensor;
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
-// LibTorch's softplus (threshold 20), its slope, and sigmoid.
-inline double softplus(double x) { return x > 20.0 ? x : std::log1p(std::exp(x)); }
-inline double softplus_slope(double x) {
-  if (x > 20.0) return 1.0;
-  const double z = std::exp(x);
-  return z / (z + 1.0);
-}
-inline double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+// softplus(x) and sigmoid(x) from one exp(-|x|); above x = 20 softplus is x
+// and its slope 1, as in LibTorch's softplus (threshold 20).
+struct SoftplusSigmoid {
+  double softplus, sigmoid, slope;
+  explicit SoftplusSigmoid(double x) {
+    const double z = std::exp(-std::fabs(x));
+    sigmoid = x >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z);
+    softplus = x > 20.0 ? x : std::fmax(x, 0.0) + std::log1p(z);
+    slope = x > 20.0 ? 1.0 : sigmoid;
+  }
+};
 
 Tensor dense(const Tensor& t) { return t.contiguous(); }
 
@@ -36,11 +39,14 @@ Tensor dense(const Tensor& t) { return t.contiguous(); }
 //   q~ = c~0 v0 s0 + c~1 v1 + v0~ l00 + v1~ l10,  p~ = c~2 v1 s2 + v1~ l11
 //   o0~ = l00~ softplus'(o0) + c~0 v0 q s0 (1 - s0),  o1~ = l10~,
 //   o2~ = l11~ softplus'(o2) + c~2 v1 p s2 (1 - s2).
+// The forward keeps (l00, l11, s0, s2, softplus'(o0), softplus'(o2)) per row
+// for the backward.
+constexpr int kAux = 6;
 struct HamiltonianRow {
   double q, p, l00, l10, l11, s0, s2, v0, v1;
-  HamiltonianRow(const double* o, const double* x)
-      : q(x[0]), p(x[1]), l00(softplus(o[0])), l10(o[1]), l11(softplus(o[2])),
-        s0(sigmoid(o[0])), s2(sigmoid(o[2])), v0(l00 * q), v1(l10 * q + l11 * p) {}
+  HamiltonianRow(const double* o, const double* x, const double* aux)
+      : q(x[0]), p(x[1]), l00(aux[0]), l10(o[1]), l11(aux[1]), s0(aux[2]), s2(aux[3]),
+        v0(l00 * q), v1(l10 * q + l11 * p) {}
   double c(int k) const { return k == 0 ? v0 * s0 * q : k == 1 ? v1 * q : v1 * s2 * p; }
 };
 
@@ -54,26 +60,32 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
     const int64_t rows = o.size(0) * o.size(1);
     Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
     Tensor grad = with_grad ? torch::empty({o.size(0), o.size(1), 2}, o.options()) : Tensor();
+    Tensor aux = torch::empty({rows, kAux}, o.options());
     const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
-    double* ph = h.data_ptr<double>();
+    const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
+    double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
+    double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
     for (int64_t r = 0; r < rows; ++r) {
-      const HamiltonianRow row(po + 3 * r, px + 2 * r);
+      const SoftplusSigmoid f0(po[3 * r]), f2(po[3 * r + 2]);
+      double* a = pa + kAux * r;
+      a[0] = f0.softplus, a[1] = f2.softplus, a[2] = f0.sigmoid, a[3] = f2.sigmoid;
+      a[4] = f0.slope, a[5] = f2.slope;
+      const HamiltonianRow row(po + 3 * r, px + 2 * r, a);
       ph[r] = 0.5 * (row.v0 * row.v0 + row.v1 * row.v1);
       if (!with_grad) continue;
-      const double* og = o_g.data_ptr<double>() + 6 * r;
-      double* g = grad.data_ptr<double>() + 2 * r;
+      const double* og = pog + 6 * r;
       const double c[3] = {row.c(0), row.c(1), row.c(2)};
-      g[0] = row.l00 * row.v0 + row.l10 * row.v1 + og[0] * c[0] + og[1] * c[1] + og[2] * c[2];
-      g[1] = row.l11 * row.v1 + og[3] * c[0] + og[4] * c[1] + og[5] * c[2];
+      pg[2 * r] = row.l00 * row.v0 + row.l10 * row.v1 + og[0] * c[0] + og[1] * c[1] + og[2] * c[2];
+      pg[2 * r + 1] = row.l11 * row.v1 + og[3] * c[0] + og[4] * c[1] + og[5] * c[2];
     }
-    ctx->save_for_backward({o, with_grad ? o_g : o, x});
+    ctx->save_for_backward({o, with_grad ? o_g : o, x, aux});
     ctx->saved_data["with_grad"] = with_grad;
     return with_grad ? variable_list{h, grad} : variable_list{h};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &o = saved[0], &x = saved[2];
+    const Tensor &o = saved[0], &x = saved[2], &aux = saved[3];
     const bool with_grad = ctx->saved_data["with_grad"].toBool();
     const int64_t rows = o.size(0) * o.size(1);
     const Tensor h_bar = grads[0].defined() ? dense(grads[0]) : torch::zeros_like(o.narrow(-1, 0, 1));
@@ -81,16 +93,21 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
     Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
     Tensor o_g_bar = with_grad ? torch::zeros_like(saved[1]) : Tensor();
     const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
-    const double* phb = h_bar.data_ptr<double>();
+    const double *phb = h_bar.data_ptr<double>(), *pa = aux.data_ptr<double>();
+    const double* pog = g_bar.defined() ? saved[1].data_ptr<double>() : nullptr;
+    const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
+    double* pogb = g_bar.defined() ? o_g_bar.data_ptr<double>() : nullptr;
+    double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
     for (int64_t r = 0; r < rows; ++r) {
-      const HamiltonianRow row(po + 3 * r, px + 2 * r);
+      const double* a = pa + kAux * r;
+      const HamiltonianRow row(po + 3 * r, px + 2 * r, a);
       const double hb = phb[r];
       double gb[2] = {0.0, 0.0}, cb[3] = {0.0, 0.0, 0.0};
-      if (g_bar.defined()) {
-        const double* og = saved[1].data_ptr<double>() + 6 * r;
-        double* ogb = o_g_bar.data_ptr<double>() + 6 * r;
-        gb[0] = g_bar.data_ptr<double>()[2 * r];
-        gb[1] = g_bar.data_ptr<double>()[2 * r + 1];
+      if (pgb) {
+        const double* og = pog + 6 * r;
+        double* ogb = pogb + 6 * r;
+        gb[0] = pgb[2 * r];
+        gb[1] = pgb[2 * r + 1];
         for (int k = 0; k < 3; ++k) {
           cb[k] = gb[0] * og[k] + gb[1] * og[3 + k];
           ogb[k] = gb[0] * row.c(k);
@@ -103,12 +120,11 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
       const double l00b = gb[0] * row.v0 + v0b * row.q;
       const double l10b = gb[0] * row.v1 + v1b * row.q;
       const double l11b = gb[1] * row.v1 + v1b * row.p;
-      double* ob = o_bar.data_ptr<double>() + 3 * r;
-      ob[0] = l00b * softplus_slope(po[3 * r]) + cb[0] * row.v0 * row.q * row.s0 * (1.0 - row.s0);
+      double* ob = pob + 3 * r;
+      ob[0] = l00b * a[4] + cb[0] * row.v0 * row.q * row.s0 * (1.0 - row.s0);
       ob[1] = l10b;
-      ob[2] = l11b * softplus_slope(po[3 * r + 2]) +
-              cb[2] * row.v1 * row.p * row.s2 * (1.0 - row.s2);
-      double* xb = x_bar.data_ptr<double>() + 2 * r;
+      ob[2] = l11b * a[5] + cb[2] * row.v1 * row.p * row.s2 * (1.0 - row.s2);
+      double* xb = pxb + 2 * r;
       xb[0] = cb[0] * row.v0 * row.s0 + cb[1] * row.v1 + v0b * row.l00 + v1b * row.l10;
       xb[1] = cb[2] * row.v1 * row.s2 + v1b * row.l11;
     }
@@ -171,6 +187,8 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
     Tensor e_bar = torch::empty_like(e), o_bar = torch::empty_like(o), u_bar = torch::empty_like(u);
     const double *pe = e.data_ptr<double>(), *po = o.data_ptr<double>(), *pu = u.data_ptr<double>();
     const double* pfb = fb.data_ptr<double>();
+    double *peb = e_bar.data_ptr<double>(), *pob = o_bar.data_ptr<double>();
+    double* pub = u_bar.data_ptr<double>();
     for (int64_t r = 0; r < rows; ++r) {
       const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
       const double f_bar[3] = {pfb[2 * r], pfb[2 * r + 1], 0.0};
@@ -180,10 +198,10 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
       lower_transpose_times(po + 6 * r, w, ltw);
       double eps_bar[3];
       for (int j = 0; j < 3; ++j) eps_bar[j] = J[0][j] * f_bar[0] + J[1][j] * f_bar[1] - ltw[j];
-      e_bar.data_ptr<double>()[2 * r] = eps_bar[0];
-      e_bar.data_ptr<double>()[2 * r + 1] = eps_bar[1];
-      u_bar.data_ptr<double>()[r] = eps_bar[2];
-      double* ob = o_bar.data_ptr<double>() + 6 * r;
+      peb[2 * r] = eps_bar[0];
+      peb[2 * r + 1] = eps_bar[1];
+      pub[r] = eps_bar[2];
+      double* ob = pob + 6 * r;
       for (int k = 0; k < 6; ++k) ob[k] = -(v[kRow[k]] * f_bar[kCol[k]] + w[kRow[k]] * eps[kCol[k]]);
     }
     return {e_bar, o_bar, u_bar, Tensor()};
@@ -231,22 +249,24 @@ class GonzalezFunction : public torch::autograd::Function<GonzalezFunction> {
     const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
     const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
     const double* pb = db.data_ptr<double>();
+    double *ph0b = h0_bar.data_ptr<double>(), *ph1b = h1_bar.data_ptr<double>();
+    double *pgb = g_bar.data_ptr<double>(), *pxb = dx_bar.data_ptr<double>();
     for (int64_t r = 0; r < rows; ++r) {
       const double* gr = pg + 2 * r;
       const double* d = pd + 2 * r;
       const double* b = pb + 2 * r;
       const double n2 = d[0] * d[0] + d[1] * d[1];
-      double* gb = g_bar.data_ptr<double>() + 2 * r;
-      double* xb = dx_bar.data_ptr<double>() + 2 * r;
+      double* gb = pgb + 2 * r;
+      double* xb = pxb + 2 * r;
       if (n2 < tau2) {
-        h0_bar.data_ptr<double>()[r] = h1_bar.data_ptr<double>()[r] = 0.0;
+        ph0b[r] = ph1b[r] = 0.0;
         gb[0] = b[0], gb[1] = b[1], xb[0] = xb[1] = 0.0;
         continue;
       }
       const double k = (p1[r] - p0[r] - (gr[0] * d[0] + gr[1] * d[1])) / n2;
       const double s_n2 = (b[0] * d[0] + b[1] * d[1]) / n2;
-      h1_bar.data_ptr<double>()[r] = s_n2;
-      h0_bar.data_ptr<double>()[r] = -s_n2;
+      ph1b[r] = s_n2;
+      ph0b[r] = -s_n2;
       for (int i = 0; i < 2; ++i) {
         gb[i] = b[i] - s_n2 * d[i];
         xb[i] = k * b[i] - s_n2 * (gr[i] + 2.0 * k * d[i]);

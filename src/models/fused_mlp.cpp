@@ -22,7 +22,10 @@
 //   W~ = A^T Z~,   b~ = sum over the batch of channel 0 of Z~,   A~ = Z~ W^T.
 #include "models/fused_mlp.h"
 
+#include <algorithm>
 #include <utility>
+
+#include <torch/csrc/autograd/functions/utils.h>
 
 #include "models/vector_math.h"
 #include "phnn/common/check.h"
@@ -79,33 +82,26 @@ void gemm_tn(int64_t E, int rows, int n_in, int n_out, const double* a, const do
   }
 }
 
-// Copies a strided [E, B, n] view into channel c of a packed [E, C, B, n].
-void pack_channel(const Tensor& src, Tensor* packed, int64_t c) {
-  packed->select(1, c).copy_(src);
+// dst[e][b][k] = src[e][b][k] for a 3-D view with any strides (expanded
+// inputs too); dst is dense [E, B, n] with the given member stride.
+void gather_3d(const Tensor& src, double* dst, int64_t dst_member_stride) {
+  const int64_t E = src.size(0), B = src.size(1), n = src.size(2);
+  const int64_t se = src.stride(0), sb = src.stride(1), sk = src.stride(2);
+  const double* p = src.data_ptr<double>();
+  for (int64_t e = 0; e < E; ++e)
+    for (int64_t b = 0; b < B; ++b)
+      for (int64_t k = 0; k < n; ++k) dst[e * dst_member_stride + b * n + k] = p[e * se + b * sb + k * sk];
 }
 
-// The input jet as packed channels.
-Tensor pack_input(const Tensor& x_v, const Tensor& x_g, const Tensor& x_h, const Channels& ch) {
-  const int64_t E = x_v.size(0), B = x_v.size(1), n = x_v.size(2);
-  Tensor packed = torch::empty({E, ch.count(), B, n}, x_v.options());
-  pack_channel(x_v, &packed, 0);
-  if (ch.order >= 1) {
-    if (x_g.defined()) {
-      for (int64_t i = 0; i < ch.d; ++i) pack_channel(x_g.select(2, i), &packed, ch.tangent(i));
-    } else {  // d x / d x_i = e_i
-      packed.narrow(1, 1, ch.d).zero_();
-      for (int64_t i = 0; i < ch.d; ++i) packed.select(1, ch.tangent(i)).select(-1, i).fill_(1.0);
-    }
-  }
-  for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
-    auto dst = packed.select(1, ch.pair(p));
-    if (x_h.defined()) {
-      dst.copy_(x_h.select(2, ch.pairs[p].first).select(2, ch.pairs[p].second));
-    } else {
-      dst.zero_();
-    }
-  }
-  return packed;
+// The inverse: a dense [B, n] block per member (member stride given) into a
+// 3-D view with any strides.
+void scatter_3d(const double* src, int64_t src_member_stride, Tensor* dst) {
+  const int64_t E = dst->size(0), B = dst->size(1), n = dst->size(2);
+  const int64_t se = dst->stride(0), sb = dst->stride(1), sk = dst->stride(2);
+  double* p = dst->data_ptr<double>();
+  for (int64_t e = 0; e < E; ++e)
+    for (int64_t b = 0; b < B; ++b)
+      for (int64_t k = 0; k < n; ++k) p[e * se + b * sb + k * sk] = src[e * src_member_stride + b * n + k];
 }
 
 // (F): activations a of layer l+1 from its pre-activations z, t = tanh(z_0).
@@ -178,178 +174,219 @@ void tanh_jet_backward(const Channels& ch, int64_t E, int64_t bn, const double* 
   }
 }
 
-// Layer sizes and the jet's channels, fixed for one call.
-struct Shape {
+// Sizes of one call and where each saved buffer lives in the workspace.
+struct Plan {
+  Channels ch{0, 0};
   int64_t E = 0, B = 0;
   std::vector<int64_t> widths;  // n_0 .. n_L
+  std::vector<int64_t> act, pre, tanh;  // offsets: A_l (l < L), Z_l and T_l (l < L - 1)
+  int64_t out = 0, total = 0;           // Z_L, workspace size
+
+  Plan(const Channels& channels, int64_t members, int64_t batch, std::vector<int64_t> sizes)
+      : ch(channels), E(members), B(batch), widths(std::move(sizes)) {
+    const int64_t C = ch.count();
+    for (int64_t l = 0; l < layers(); ++l) {
+      act.push_back(total);
+      total += E * C * B * widths[l];
+      if (l + 1 < layers()) {
+        pre.push_back(total);
+        total += E * C * B * widths[l + 1];
+        tanh.push_back(total);
+        total += E * B * widths[l + 1];
+      }
+    }
+    out = total;
+    total += E * C * B * widths.back();
+  }
   int64_t layers() const { return static_cast<int64_t>(widths.size()) - 1; }
+  int64_t rows() const { return ch.count() * B; }  // rows of a member's GEMM
+  int64_t block(int64_t n) const { return rows() * n; }  // a member's [C, B, n]
 };
 
-// The forward pass; fills the saved activations A_l (l = 0..L-1, packed
-// inputs of each linear layer), pre-activations Z_l and tanh values T_l of
-// the hidden layers, and returns Z_L packed.
-Tensor forward_packed(const std::vector<Tensor>& W, const std::vector<Tensor>& b, Tensor a,
-                      const Channels& ch, const Shape& shape, std::vector<Tensor>* acts,
-                      std::vector<Tensor>* pre, std::vector<Tensor>* tanhs) {
-  const int64_t C = ch.count(), E = shape.E, B = shape.B;
-  for (int64_t l = 0; l < shape.layers(); ++l) {
-    const int64_t n_in = shape.widths[l], n_out = shape.widths[l + 1];
-    Tensor z = torch::empty({E, C, B, n_out}, a.options());
-    const Tensor w = W[l].contiguous(), bias = b[l].contiguous();
-    gemm_nn(E, static_cast<int>(C * B), static_cast<int>(n_in), static_cast<int>(n_out),
-            a.data_ptr<double>(), w.data_ptr<double>(), z.data_ptr<double>(), false, 0.0);
-    z.select(1, 0).add_(bias);  // bias [E, 1, n_out] broadcasts over the batch
-    acts->push_back(a);
-    if (l + 1 == shape.layers()) return z;
-    Tensor t = torch::empty({E, B, n_out}, a.options());  // tanh of the value channel
-    for (int64_t e = 0; e < E; ++e) {
-      tanh_array(z.data_ptr<double>() + e * C * B * n_out, t.data_ptr<double>() + e * B * n_out,
-                 B * n_out);
+// The input jet into the packed A_0 (channels per the file comment).
+void pack_input(const Tensor& x_v, const Tensor& x_g, const Tensor& x_h, const Plan& plan,
+                double* a0) {
+  const int64_t n = plan.widths[0], bn = plan.B * n, stride = plan.block(n);
+  const Channels& ch = plan.ch;
+  gather_3d(x_v, a0, stride);
+  for (int64_t i = 0; i < ch.d && ch.order >= 1; ++i) {
+    double* dst = a0 + ch.tangent(i) * bn;
+    if (x_g.defined()) {
+      gather_3d(x_g.select(2, i), dst, stride);
+      continue;
     }
-    Tensor next = torch::empty_like(z);
-    tanh_jet_forward(ch, E, B * n_out, z.data_ptr<double>(), t.data_ptr<double>(),
-                     next.data_ptr<double>());
-    pre->push_back(z);
-    tanhs->push_back(t);
-    a = next;
+    for (int64_t e = 0; e < plan.E; ++e)  // d x / d x_i = e_i
+      for (int64_t k = 0; k < bn; ++k) dst[e * stride + k] = (k % n == i) ? 1.0 : 0.0;
   }
-  return a;  // not reached: a network has at least one layer
+  for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
+    double* dst = a0 + ch.pair(p) * bn;
+    if (x_h.defined()) {
+      gather_3d(x_h.select(2, ch.pairs[p].first).select(2, ch.pairs[p].second), dst, stride);
+      continue;
+    }
+    for (int64_t e = 0; e < plan.E; ++e) std::fill(dst + e * stride, dst + e * stride + bn, 0.0);
+  }
 }
 
-// Unpacks the output channels into the jet's [E, B, ...] tensors.
-FusedMlpJet unpack_output(const Tensor& z, const Channels& ch) {
+// Z = A W + b (b on channel 0 only), per member.
+void linear_forward(const Plan& plan, int64_t l, const double* a, const Tensor& w, const Tensor& b,
+                    double* z) {
+  const int64_t n_in = plan.widths[l], n_out = plan.widths[l + 1];
+  gemm_nn(plan.E, static_cast<int>(plan.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
+          a, w.data_ptr<double>(), z, /*transpose_b=*/false, 0.0);
+  const double* pb = b.data_ptr<double>();
+  for (int64_t e = 0; e < plan.E; ++e) {
+    double* ze = z + e * plan.block(n_out);
+    const double* be = pb + e * n_out;
+    for (int64_t r = 0; r < plan.B; ++r)
+      for (int64_t k = 0; k < n_out; ++k) ze[r * n_out + k] += be[k];
+  }
+}
+
+// Unpacks Z_L into the jet's [E, B, ...] outputs.
+FusedMlpJet unpack_output(const Plan& plan, const double* z, const torch::TensorOptions& options) {
+  const Channels& ch = plan.ch;
+  const int64_t n = plan.widths.back(), bn = plan.B * n, stride = plan.block(n);
   FusedMlpJet out;
-  out.v = z.select(1, 0).clone();
-  if (ch.order >= 1) out.g = z.narrow(1, 1, ch.d).permute({0, 2, 1, 3}).contiguous();
-  if (ch.order >= 2) {
-    const int64_t E = z.size(0), B = z.size(2), n = z.size(3);
-    out.h = torch::empty({E, B, ch.d, ch.d, n}, z.options());
-    for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
-      const auto [i, j] = ch.pairs[p];
-      const Tensor src = z.select(1, ch.pair(p));
-      out.h.select(2, i).select(2, j).copy_(src);
-      if (i != j) out.h.select(2, j).select(2, i).copy_(src);
+  out.v = torch::empty({plan.E, plan.B, n}, options);
+  scatter_3d(z, stride, &out.v);
+  if (ch.order >= 1) {
+    out.g = torch::empty({plan.E, plan.B, ch.d, n}, options);
+    for (int64_t i = 0; i < ch.d; ++i) {
+      Tensor gi = out.g.select(2, i);
+      scatter_3d(z + ch.tangent(i) * bn, stride, &gi);
     }
+  }
+  for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
+    if (!out.h.defined()) out.h = torch::empty({plan.E, plan.B, ch.d, ch.d, n}, options);
+    const auto [i, j] = ch.pairs[p];
+    Tensor hij = out.h.select(2, i).select(2, j), hji = out.h.select(2, j).select(2, i);
+    scatter_3d(z + ch.pair(p) * bn, stride, &hij);
+    if (i != j) scatter_3d(z + ch.pair(p) * bn, stride, &hji);
   }
   return out;
 }
 
-// Adjoint of unpack_output: the packed Z_L adjoint from the outputs' adjoints
-// (undefined = 0); a symmetric pair gathers both of its copies.
-Tensor pack_output_adjoint(const variable_list& grads, const Channels& ch, const Shape& shape) {
-  const int64_t n = shape.widths.back();
-  Tensor bar = torch::zeros({shape.E, ch.count(), shape.B, n}, torch::kFloat64);
-  if (grads[0].defined()) bar.select(1, 0).copy_(grads[0]);
+// Adjoint of unpack_output: the packed adjoint of Z_L from the outputs'
+// adjoints (undefined = 0); an off-diagonal pair gathers both its copies.
+void pack_output_adjoint(const Plan& plan, const torch::autograd::variable_list& grads, double* bar) {
+  const Channels& ch = plan.ch;
+  const int64_t n = plan.widths.back(), bn = plan.B * n, stride = plan.block(n);
+  std::fill(bar, bar + plan.E * stride, 0.0);
+  if (grads[0].defined()) gather_3d(grads[0], bar, stride);
   if (ch.order >= 1 && grads.size() > 1 && grads[1].defined()) {
-    bar.narrow(1, 1, ch.d).copy_(grads[1].permute({0, 2, 1, 3}));
+    for (int64_t i = 0; i < ch.d; ++i) gather_3d(grads[1].select(2, i), bar + ch.tangent(i) * bn, stride);
   }
-  if (ch.order >= 2 && grads.size() > 2 && grads[2].defined()) {
-    for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
-      const auto [i, j] = ch.pairs[p];
-      auto dst = bar.select(1, ch.pair(p));
-      dst.copy_(grads[2].select(2, i).select(2, j));
-      if (i != j) dst.add_(grads[2].select(2, j).select(2, i));
-    }
+  if (ch.order < 2 || grads.size() < 3 || !grads[2].defined()) return;
+  std::vector<double> tmp(static_cast<std::size_t>(plan.E * stride));
+  for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
+    const auto [i, j] = ch.pairs[p];
+    double* dst = bar + ch.pair(p) * bn;
+    gather_3d(grads[2].select(2, i).select(2, j), dst, stride);
+    if (i == j) continue;
+    gather_3d(grads[2].select(2, j).select(2, i), tmp.data(), stride);
+    for (int64_t e = 0; e < plan.E; ++e)
+      for (int64_t k = 0; k < bn; ++k) dst[e * stride + k] += tmp[static_cast<std::size_t>(e * stride + k)];
   }
-  return bar;
 }
 
-class FusedMlpFunction : public torch::autograd::Function<FusedMlpFunction> {
+// The backward node of one fused call. Holds the forward's workspace (A_l,
+// Z_l, T_l) and the weights; its next edges are, in order, x_v, x_g, x_h,
+// W_0..W_{L-1}, b_0..b_{L-1} (an undefined input has an empty edge).
+class FusedMlpBackward : public torch::autograd::Node {
  public:
-  static variable_list forward(AutogradContext* ctx, const Tensor& x_v,
-                               const c10::optional<Tensor>& x_g, const c10::optional<Tensor>& x_h,
-                               at::TensorList weights, at::TensorList biases, int64_t directions,
-                               int64_t order) {
-    const Channels ch(directions, order);
-    Shape shape{x_v.size(0), x_v.size(1), {x_v.size(2)}};
-    for (const auto& w : weights) shape.widths.push_back(w.size(2));
-    const Tensor g = x_g.has_value() ? *x_g : Tensor(), h = x_h.has_value() ? *x_h : Tensor();
-    std::vector<Tensor> W(weights.begin(), weights.end()), b(biases.begin(), biases.end());
-    std::vector<Tensor> acts, pre, tanhs;
-    const Tensor z = forward_packed(W, b, pack_input(x_v, g, h, ch), ch, shape, &acts, &pre, &tanhs);
-    ctx->saved_data["W"] = W;
-    ctx->saved_data["A"] = acts;
-    ctx->saved_data["Z"] = pre;
-    ctx->saved_data["T"] = tanhs;
-    ctx->saved_data["shape"] = shape.widths;
-    ctx->saved_data["directions"] = directions;
-    ctx->saved_data["order"] = order;
-    ctx->saved_data["has_g"] = g.defined();
-    ctx->saved_data["has_h"] = h.defined();
-    const FusedMlpJet out = unpack_output(z, ch);
-    variable_list result{out.v};
-    if (order >= 1) result.push_back(out.g);
-    if (order >= 2) result.push_back(out.h);
-    return result;
+  FusedMlpBackward(Plan plan, Tensor workspace, std::vector<Tensor> weights)
+      : plan_(std::move(plan)), workspace_(std::move(workspace)), weights_(std::move(weights)) {}
+  std::string name() const override { return "FusedMlpBackward"; }
+  void release_variables() override {
+    workspace_.reset();
+    weights_.clear();
   }
-
-  static variable_list backward(AutogradContext* ctx, variable_list grads) {
-    const Channels ch(ctx->saved_data["directions"].toInt(), ctx->saved_data["order"].toInt());
-    const std::vector<Tensor> W = ctx->saved_data["W"].toTensorVector();
-    const std::vector<Tensor> A = ctx->saved_data["A"].toTensorVector();
-    const std::vector<Tensor> Z = ctx->saved_data["Z"].toTensorVector();
-    const std::vector<Tensor> T = ctx->saved_data["T"].toTensorVector();
-    Shape shape{A[0].size(0), A[0].size(2), ctx->saved_data["shape"].toIntVector()};
-    const int64_t L = shape.layers(), C = ch.count(), E = shape.E, B = shape.B;
-    std::vector<Tensor> w_bar(static_cast<std::size_t>(L)), b_bar(static_cast<std::size_t>(L));
-    // needs_input_grad counts variable inputs only: x_v, then x_g and x_h
-    // where they were given.
-    const bool has_g = ctx->saved_data["has_g"].toBool(), has_h = ctx->saved_data["has_h"].toBool();
-    const bool need_v = ctx->needs_input_grad(0);
-    const bool need_g = has_g && ctx->needs_input_grad(1);
-    const bool need_h = has_h && ctx->needs_input_grad(has_g ? 2 : 1);
-    const bool input_grad = need_v || need_g || need_h;
-    Tensor z_bar = pack_output_adjoint(grads, ch, shape);
-    Tensor a_bar;
-    for (int64_t l = L - 1; l >= 0; --l) {
-      const auto ul = static_cast<std::size_t>(l);
-      const int64_t n_in = shape.widths[ul], n_out = shape.widths[ul + 1];
-      w_bar[ul] = torch::empty({E, n_in, n_out}, torch::kFloat64);
-      gemm_tn(E, static_cast<int>(C * B), static_cast<int>(n_in), static_cast<int>(n_out),
-              A[ul].data_ptr<double>(), z_bar.data_ptr<double>(), w_bar[ul].data_ptr<double>());
-      b_bar[ul] = z_bar.select(1, 0).sum(1, /*keepdim=*/true);
-      if (l == 0 && !input_grad) break;
-      a_bar = torch::empty({E, C, B, n_in}, torch::kFloat64);
-      const Tensor w = W[ul].contiguous();
-      gemm_nn(E, static_cast<int>(C * B), static_cast<int>(n_out), static_cast<int>(n_in),
-              z_bar.data_ptr<double>(), w.data_ptr<double>(), a_bar.data_ptr<double>(),
-              /*transpose_b=*/true, 0.0);
-      if (l == 0) break;
-      z_bar = torch::empty_like(a_bar);
-      tanh_jet_backward(ch, E, B * n_in, Z[ul - 1].data_ptr<double>(),
-                        T[ul - 1].data_ptr<double>(), a_bar.data_ptr<double>(),
-                        z_bar.data_ptr<double>());
-    }
-    variable_list out;
-    out.push_back(need_v ? a_bar.select(1, 0) : Tensor());
-    out.push_back(need_g ? a_bar.narrow(1, 1, ch.d).permute({0, 2, 1, 3}) : Tensor());
-    out.push_back(need_h ? input_curvature_adjoint(a_bar, ch) : Tensor());
-    for (auto& w : w_bar) out.push_back(w);
-    for (auto& b : b_bar) out.push_back(b);
-    out.emplace_back();  // directions
-    out.emplace_back();  // order
-    return out;
-  }
+  variable_list apply(variable_list&& grads) override;
 
  private:
-  // Adjoint of x_h [E, B, d, d, n]: pack_input read x_h[i][j] (i <= j) only;
-  // the adjoint is split evenly over both symmetric copies.
-  static Tensor input_curvature_adjoint(const Tensor& a_bar, const Channels& ch) {
-    const int64_t E = a_bar.size(0), B = a_bar.size(2), n = a_bar.size(3);
-    Tensor out = torch::zeros({E, B, ch.d, ch.d, n}, a_bar.options());
-    for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
-      const auto [i, j] = ch.pairs[p];
-      const Tensor src = a_bar.select(1, ch.pair(p));
-      if (i == j) {
-        out.select(2, i).select(2, j).copy_(src);
-      } else {
-        out.select(2, i).select(2, j).copy_(0.5 * src);
-        out.select(2, j).select(2, i).copy_(0.5 * src);
-      }
-    }
-    return out;
-  }
+  Tensor input_adjoint(const double* a_bar, int64_t channel) const;
+  Tensor input_curvature_adjoint(const double* a_bar) const;
+
+  Plan plan_;
+  Tensor workspace_;
+  std::vector<Tensor> weights_;
 };
+
+variable_list FusedMlpBackward::apply(variable_list&& grads) {
+  TORCH_CHECK(workspace_.defined(), "FusedMlpBackward: backward through the graph a second time");
+  const Plan& p = plan_;
+  const int64_t L = p.layers(), E = p.E;
+  const bool need_v = should_compute_output(0), need_g = should_compute_output(1),
+             need_h = should_compute_output(2);
+  const int64_t widest = *std::max_element(p.widths.begin(), p.widths.end());
+  Tensor scratch = torch::empty({2 * E * p.block(widest)}, torch::kFloat64);
+  double* z_bar = scratch.data_ptr<double>();
+  double* a_bar = z_bar + E * p.block(widest);
+  const double* ws = workspace_.data_ptr<double>();
+  pack_output_adjoint(p, grads, z_bar);
+  variable_list out(static_cast<std::size_t>(3 + 2 * L));
+  for (int64_t l = L - 1; l >= 0; --l) {
+    const int64_t n_in = p.widths[l], n_out = p.widths[l + 1];
+    const auto ul = static_cast<std::size_t>(l);
+    if (should_compute_output(static_cast<std::size_t>(3 + l))) {  // W~ = A^T Z~
+      Tensor w_bar = torch::empty({E, n_in, n_out}, torch::kFloat64);
+      gemm_tn(E, static_cast<int>(p.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
+              ws + p.act[ul], z_bar, w_bar.data_ptr<double>());
+      out[3 + ul] = w_bar;
+    }
+    if (should_compute_output(static_cast<std::size_t>(3 + L + l))) {  // b~ = sum_batch Z~_0
+      Tensor b_bar = torch::zeros({E, 1, n_out}, torch::kFloat64);
+      double* pb = b_bar.data_ptr<double>();
+      for (int64_t e = 0; e < E; ++e)
+        for (int64_t r = 0; r < p.B; ++r)
+          for (int64_t k = 0; k < n_out; ++k) pb[e * n_out + k] += z_bar[e * p.block(n_out) + r * n_out + k];
+      out[3 + L + ul] = b_bar;
+    }
+    if (l == 0 && !(need_v || need_g || need_h)) break;
+    gemm_nn(E, static_cast<int>(p.rows()), static_cast<int>(n_out), static_cast<int>(n_in), z_bar,
+            weights_[ul].data_ptr<double>(), a_bar, /*transpose_b=*/true, 0.0);  // A~ = Z~ W^T
+    if (l == 0) break;
+    tanh_jet_backward(p.ch, E, p.B * n_in, ws + p.pre[ul - 1], ws + p.tanh[ul - 1], a_bar, z_bar);
+  }
+  if (need_v) out[0] = input_adjoint(a_bar, 0);
+  if (need_g) {
+    Tensor g = torch::empty({E, p.B, p.ch.d, p.widths[0]}, torch::kFloat64);
+    for (int64_t i = 0; i < p.ch.d; ++i) {
+      Tensor gi = g.select(2, i);
+      scatter_3d(a_bar + p.ch.tangent(i) * p.B * p.widths[0], p.block(p.widths[0]), &gi);
+    }
+    out[1] = g;
+  }
+  if (need_h) out[2] = input_curvature_adjoint(a_bar);
+  return out;
+}
+
+Tensor FusedMlpBackward::input_adjoint(const double* a_bar, int64_t channel) const {
+  const int64_t n = plan_.widths[0];
+  Tensor t = torch::empty({plan_.E, plan_.B, n}, torch::kFloat64);
+  scatter_3d(a_bar + channel * plan_.B * n, plan_.block(n), &t);
+  return t;
+}
+
+// Adjoint of x_h [E, B, d, d, n]: pack_input read x_h[i][j] (i <= j) only;
+// the adjoint is split evenly over both symmetric copies.
+Tensor FusedMlpBackward::input_curvature_adjoint(const double* a_bar) const {
+  const Channels& ch = plan_.ch;
+  const int64_t n = plan_.widths[0];
+  Tensor out = torch::zeros({plan_.E, plan_.B, ch.d, ch.d, n}, torch::kFloat64);
+  for (std::size_t q = 0; q < ch.pairs.size(); ++q) {
+    const auto [i, j] = ch.pairs[q];
+    const Tensor src = input_adjoint(a_bar, ch.pair(q));
+    if (i == j) {
+      out.select(2, i).select(2, j).copy_(src);
+    } else {
+      out.select(2, i).select(2, j).copy_(0.5 * src);
+      out.select(2, j).select(2, i).copy_(0.5 * src);
+    }
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -365,15 +402,44 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
   TORCH_CHECK(options.order == 0 || options.directions >= 1, "fused_mlp: directions must be >= 1");
   TORCH_CHECK(options.order == 0 || x_g.defined() || options.directions <= x_v.size(2),
               "fused_mlp: the input-coordinate jet has at most ", x_v.size(2), " directions");
-  const c10::optional<Tensor> g = x_g.defined() ? c10::optional<Tensor>(x_g) : c10::nullopt;
-  const c10::optional<Tensor> h = x_h.defined() ? c10::optional<Tensor>(x_h) : c10::nullopt;
-  const variable_list out = FusedMlpFunction::apply(x_v, g, h, at::TensorList(weights),
-                                                    at::TensorList(biases), options.directions,
-                                                    options.order);
-  FusedMlpJet jet;
-  jet.v = out[0];
-  if (options.order >= 1) jet.g = out[1];
-  if (options.order >= 2) jet.h = out[2];
+  std::vector<int64_t> widths{x_v.size(2)};
+  for (std::size_t l = 0; l < weights.size(); ++l) {
+    TORCH_CHECK(weights[l].is_contiguous() && biases[l].is_contiguous() &&
+                    weights[l].size(0) == x_v.size(0) && weights[l].size(1) == widths.back(),
+                "fused_mlp: layer ", l, " weights ", weights[l].sizes(), " do not fit input width ",
+                widths.back(), " and ", x_v.size(0), " members (or are not contiguous)");
+    widths.push_back(weights[l].size(2));
+  }
+  const Channels ch(options.order >= 1 ? options.directions : 0, options.order);
+  const Plan plan(ch, x_v.size(0), x_v.size(1), widths);
+  Tensor workspace = torch::empty({plan.total}, x_v.options());
+  double* ws = workspace.data_ptr<double>();
+  pack_input(x_v, x_g, x_h, plan, ws + plan.act[0]);
+  for (int64_t l = 0; l < plan.layers(); ++l) {
+    const auto ul = static_cast<std::size_t>(l);
+    const bool last = l + 1 == plan.layers();
+    double* z = ws + (last ? plan.out : plan.pre[ul]);
+    linear_forward(plan, l, ws + plan.act[ul], weights[ul], biases[ul], z);
+    if (last) break;
+    const int64_t n = plan.widths[ul + 1];
+    double* t = ws + plan.tanh[ul];
+    for (int64_t e = 0; e < plan.E; ++e) tanh_array(z + e * plan.block(n), t + e * plan.B * n, plan.B * n);
+    tanh_jet_forward(ch, plan.E, plan.B * n, z, t, ws + plan.act[ul + 1]);
+  }
+  FusedMlpJet jet = unpack_output(plan, ws + plan.out, x_v.options());
+  std::vector<Tensor> inputs{x_v, x_g, x_h};
+  inputs.insert(inputs.end(), weights.begin(), weights.end());
+  inputs.insert(inputs.end(), biases.begin(), biases.end());
+  if (!torch::GradMode::is_enabled() ||
+      std::none_of(inputs.begin(), inputs.end(), [](const Tensor& t) { return t.defined() && t.requires_grad(); })) {
+    return jet;
+  }
+  auto node = std::shared_ptr<FusedMlpBackward>(new FusedMlpBackward(plan, workspace, weights),
+                                                torch::autograd::deleteNode);
+  node->set_next_edges(torch::autograd::collect_next_edges(inputs));
+  for (Tensor* t : {&jet.v, &jet.g, &jet.h}) {
+    if (t->defined()) torch::autograd::set_history(*t, node);
+  }
   return jet;
 }
 

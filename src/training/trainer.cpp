@@ -240,8 +240,12 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   BatchSampler sampler(cell.seeds, N, opt.batch_size);
   evaluate(0);
   for (int step = 1; step <= opt.steps; ++step) {
-    const auto idx = sampler.next();
-    const auto x = X.index({idx}), xn = Xn.index({idx}), u = U.index({idx});
+    // Every pair in every step when N <= batch: no gather needed.
+    const bool full_batch = N <= opt.batch_size;
+    const auto idx = full_batch ? torch::Tensor() : sampler.next();
+    const auto x = full_batch ? Xall : X.index({idx});
+    const auto xn = full_batch ? Xnall : Xn.index({idx});
+    const auto u = full_batch ? Uall : U.index({idx});
     auto loss = data_loss(x, xn, u);
     if (cell.regularizer != Regularizer::kNone) {
       const auto stats = jacobian_stats(model->field(x, u, true).dfdx, opt.jacobian_eps);
@@ -250,11 +254,12 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
     adam.zero_grad();
     loss.sum().backward();
     // A member whose loss is non-finite is frozen at its last finite weights.
-    const auto finite = torch::isfinite(loss);
+    const auto finite = torch::isfinite(loss.detach());
+    const auto finite_a = finite.accessor<bool, 1>();
     std::vector<int64_t> dead;
     for (int64_t e = 0; e < E; ++e) {
       const auto ue = static_cast<std::size_t>(e);
-      if (alive[ue] && !finite[e].item<bool>()) {
+      if (alive[ue] && !finite_a[e]) {
         alive[ue] = false;
         diverged_at[ue] = step;
         torch::NoGradGuard no_grad;
