@@ -241,6 +241,22 @@ int main(int argc, char** argv) {
   torch::set_num_threads(1);
   const std::string mode = argc > 1 ? argv[1] : "stacked";
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
+  if (mode == "inference") {  // inference [MODEL] [INTEGRATOR]: a small cell's rollouts
+    phnn::DatasetOptions options;  // 100 inference trajectories x 500 steps (+ 2 figure ones)
+    const auto data = phnn::make_system_data(
+        phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing), options, 25);
+    CellSpec cell;
+    cell.model = phnn::parse_model(argc > 2 ? argv[2] : "phnn-jr");
+    cell.integrator = phnn::parse_integrator(argc > 3 ? argv[3] : "dg");
+    cell.n_train = 25;
+    cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+    cell.training.steps = 1;  // two validations on 2 500 pairs, then inference
+    cell.training.eval_every = 1000000;
+    const auto t0 = Clock::now();
+    phnn::train_cell(cell, data);
+    std::printf("%.3f s\n", seconds_since(t0));
+    return 0;
+  }
   if (mode == "stacked") return stacked(repeats);
   if (mode == "run" && argc > 5) {  // for perf: run MODEL INTEGRATOR REG STEPS [SIZE]
     CellSpec cell;

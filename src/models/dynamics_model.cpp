@@ -14,6 +14,14 @@ torch::Tensor DynamicsModel::discrete_gradient_field(const torch::Tensor&, const
   return {};
 }
 
+FieldEval DynamicsModel::discrete_gradient_field_with_jacobian(const torch::Tensor& x,
+                                                               const torch::Tensor& dx,
+                                                               const torch::Tensor& u,
+                                                               double min_dx_norm) const {
+  discrete_gradient_field(x, dx, u, min_dx_norm);  // throws: no Hamiltonian
+  return {};
+}
+
 torch::Tensor DynamicsModel::hamiltonian(const torch::Tensor&) const {
   PHNN_REQUIRE(false, "hamiltonian: " << to_string(options_.kind) << " has no Hamiltonian");
   return {};

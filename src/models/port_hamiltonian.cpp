@@ -133,6 +133,44 @@ torch::Tensor PortHamiltonianModel::discrete_gradient_field(const torch::Tensor&
   return field_from_effort(effort, x + 0.5 * dx, u, /*order=*/0).v;
 }
 
+// Jacobian of the DG field w.r.t. dx. With m = x + dx/2, g = gradH(m),
+// Hm = Hessian of H at m, g1 = gradH(x + dx), n2 = |dx|^2,
+// D = H(x + dx) - H(x) - g.dx and k = D / n2 (eq: gonzalez-discrete-gradient):
+//   d dg / d dx = Hm / 2 + dx (dk/d dx)^T + k I,
+//   dk / d dx   = (g1 - g - Hm dx / 2) / n2 - 2 k dx / n2,
+// and d dg / d dx = Hm / 2 below the fallback threshold (dg = g). Everything
+// else in f_bar depends on dx through m only (R(m, u), z(w(dg))), so the
+// field is differentiated as a jet in the directions of m with the effort's
+// tangent d dg / d m = 2 d dg / d dx, and d f_bar / d dx = (d f_bar / d m) / 2.
+FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
+    const torch::Tensor& x, const torch::Tensor& dx, const torch::Tensor& u,
+    double min_dx_norm) const {
+  const auto m = x + 0.5 * dx;
+  const Jet grad_m = gradient_jet(hamiltonian_jet(l_h(), m, /*order=*/2));  // v = g, g = Hm
+  const auto hess = grad_m.g;                                                // [E, B, 2, 2]
+  const auto h0 = hamiltonian(x).unsqueeze(-1);
+  const auto end = hamiltonian_and_gradient(l_h(), x + dx);
+  const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);                       // [E, B, 1]
+  const auto small = n2 < min_dx_norm * min_dx_norm;
+  const auto safe_n2 = torch::where(small, torch::ones_like(n2), n2);
+  const auto k = torch::where(small, torch::zeros_like(n2),
+                              (end.h - h0 - (grad_m.v * dx).sum(-1, true)) / safe_n2);
+  const auto hess_dx = torch::matmul(hess, dx.unsqueeze(-1)).squeeze(-1);  // Hm dx
+  const auto dk = torch::where(small, torch::zeros_like(dx),
+                               (end.grad - grad_m.v - 0.5 * hess_dx) / safe_n2 - 2.0 * k * dx / safe_n2);
+  const auto eye = torch::eye(2, x.options());
+  // J_dg[a][b] = d dg_a / d dx_b.
+  const auto j_dg = 0.5 * hess + dx.unsqueeze(-1) * dk.unsqueeze(-2) + k.unsqueeze(-1) * eye;
+  Jet effort;
+  effort.v = grad_m.v + k * dx;
+  effort.g = 2.0 * j_dg.transpose(-1, -2);  // [E, B, i (direction m_i), a]
+  const Jet f = field_from_effort(effort, m, u, /*order=*/1);
+  FieldEval out;
+  out.f = f.v;
+  out.dfdx = 0.5 * f.g.transpose(-1, -2);  // [E, B, component, dx_i]
+  return out;
+}
+
 namespace {
 // The L_H network shared by both formulations, then the dissipation network.
 void add_networks(std::vector<std::unique_ptr<StackedMlp>>* nets, const ModelOptions& options,

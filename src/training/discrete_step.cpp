@@ -19,38 +19,50 @@ torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& 
 
 DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tensor& x,
                                   const torch::Tensor& u, double h,
-                                  const DgInferenceOptions& options) {
+                                  const DgInferenceOptions& options, DgNewtonJacobian* cache) {
   PHNN_REQUIRE(model.is_port_hamiltonian(),
                "dg_inference_step: " << to_string(model.options().kind) << " has no Hamiltonian");
-  const int64_t B = x.size(1);
-  const double eps = options.fd_step;
   auto dx = rk2_step(model, x, u, h) - x;
-  // Row 3 blocks: dx, dx + eps e_q, dx + eps e_p.
-  const auto e_q = torch::tensor({eps, 0.0}, x.options());
-  const auto e_p = torch::tensor({0.0, eps}, x.options());
-  const auto x3 = torch::cat({x, x, x}, 1);
-  const auto u3 = torch::cat({u, u, u}, 1);
   DgInferenceStep out;
-  auto converged = torch::zeros({x.size(0), B}, x.options().dtype(torch::kBool));
-  for (int it = 0; it < options.max_iterations; ++it) {
-    const auto dx3 = torch::cat({dx, dx + e_q, dx + e_p}, 1);
-    const auto r3 = dx3 - h * model.discrete_gradient_field(x3, dx3, u3, options.min_dx_norm);
-    const auto r = r3.narrow(1, 0, B);
-    const auto col_q = (r3.narrow(1, B, B) - r) / eps;  // dr/d dx_q  [E, B, 2]
-    const auto col_p = (r3.narrow(1, 2 * B, B) - r) / eps;
-    // Solve [col_q col_p] delta = -r (Cramer's rule, 2 x 2).
-    const auto a = col_q.select(-1, 0), c = col_q.select(-1, 1);
-    const auto b = col_p.select(-1, 0), d = col_p.select(-1, 1);
-    const auto det = a * d - b * c;
+  const auto row_shape = std::vector<int64_t>{x.size(0), x.size(1)};
+  auto converged = torch::zeros(row_shape, x.options().dtype(torch::kBool));
+  // Simplified Newton, row by row: a row keeps its Jacobian (from the cache,
+  // i.e. the previous step of the rollout, or from the first iteration)
+  // while its residual shrinks at least 10x per iteration, and gets a fresh
+  // one at its current iterate otherwise. Every decision is per row and the
+  // residual always comes from discrete_gradient_field, so a row's result
+  // does not depend on the other rows or members in the batch.
+  const bool have_cache = cache && cache->dfddx.defined() && cache->dfddx.size(0) == x.size(0) &&
+                          cache->dfddx.size(1) == x.size(1);
+  torch::Tensor jacobian = have_cache ? cache->dfddx : torch::zeros({x.size(0), x.size(1), 2, 2}, x.options());
+  auto refresh = torch::full(row_shape, !have_cache, x.options().dtype(torch::kBool));
+  torch::Tensor previous_norm;
+  for (int it = 0;; ++it) {
+    // r(dx) = dx - h f_bar(x, dx, u);  r'(dx) = I - h d f_bar / d dx.
+    const auto r = dx - h * model.discrete_gradient_field(x, dx, u, options.min_dx_norm);
+    const auto norm = std::get<0>(r.abs().max(-1));
+    converged = converged.logical_or(norm <= options.tolerance);
+    if (it == options.max_iterations || converged.all().item<bool>()) break;
+    if (previous_norm.defined()) refresh = refresh | (norm > 0.1 * previous_norm);
+    refresh = refresh & converged.logical_not();
+    if (refresh.any().item<bool>()) {
+      const auto fresh = model.discrete_gradient_field_with_jacobian(x, dx, u, options.min_dx_norm).dfdx;
+      jacobian = torch::where(refresh.unsqueeze(-1).unsqueeze(-1), fresh, jacobian);
+      ++out.jacobian_evaluations;
+    }
+    refresh = torch::zeros_like(refresh);
+    previous_norm = norm;
+    const auto jac = -h * jacobian;  // + I on the diagonal below
+    const auto a = 1.0 + jac.select(-1, 0).select(-1, 0), b = jac.select(-2, 0).select(-1, 1);
+    const auto c = jac.select(-2, 1).select(-1, 0), d = 1.0 + jac.select(-1, 1).select(-1, 1);
     const auto r0 = r.select(-1, 0), r1 = r.select(-1, 1);
-    const auto delta = torch::stack({-(d * r0 - b * r1) / det, -(a * r1 - c * r0) / det}, -1);
+    const auto det = a * d - b * c;  // Cramer's rule, 2 x 2: [a b; c d] delta = -r
+    const auto delta = torch::stack({(b * r1 - d * r0) / det, (c * r0 - a * r1) / det}, -1);
     // Converged rows keep their solution.
-    const auto step = torch::where(converged.unsqueeze(-1), torch::zeros_like(delta), delta);
-    dx = dx + step;
+    dx = dx + torch::where(converged.unsqueeze(-1), torch::zeros_like(delta), delta);
     out.iterations = it + 1;
-    converged = converged.logical_or(std::get<0>(step.abs().max(-1)) <= options.tolerance);
-    if (converged.all().item<bool>()) break;
   }
+  if (cache) cache->dfddx = jacobian;
   out.x_next = x + dx;
   out.converged = converged;
   return out;

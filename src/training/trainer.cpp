@@ -326,10 +326,11 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   dg_options.tolerance = opt.newton_tolerance;
   dg_options.max_iterations = opt.newton_max_iterations;
   dg_options.min_dx_norm = opt.dg_min_dx_norm;
+  DgNewtonJacobian newton_jacobian;  // carried along the rollout
   for (int n = 1; n <= steps; ++n) {
     torch::Tensor next;
     if (use_dg) {
-      const auto s = dg_inference_step(*model, x, u, h_inf, dg_options);
+      const auto s = dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
       next = s.x_next;
       newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);
     } else {

@@ -32,6 +32,53 @@ TEST(DiscreteStepTest, DgTrainingStepEqualsInferenceStepAtNewtonSolution) {
   }
 }
 
+// The analytic d f_bar / d dx used by Newton equals central differences of
+// discrete_gradient_field (an independent computation: no jets). Step 1e-6
+// on |dx| ~ 0.1: truncation ~1e-12 |f'''|, round-off ~1e-16 / 1e-6 = 1e-10.
+TEST(DiscreteStepTest, DgFieldJacobianMatchesCentralDifferences) {
+  for (ModelKind kind : {ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
+    for (SystemKind sys : all_systems()) {
+      const auto model = DynamicsModel::create(ModelOptions{kind, ModelSize::kSmall, sys}, {0, 1});
+      torch::NoGradGuard no_grad;
+      const auto x = 2.0 * states(2, 32, 3);
+      const auto dx = 0.2 * states(2, 32, 4);
+      const auto u = states(2, 32, 5).narrow(-1, 0, 1);
+      const FieldEval fj = model->discrete_gradient_field_with_jacobian(x, dx, u, 6e-6);
+      EXPECT_LE((fj.f - model->discrete_gradient_field(x, dx, u, 6e-6)).abs().max().item<double>(),
+                1e-12);
+      const double eps = 1e-6;
+      for (int i = 0; i < 2; ++i) {
+        auto e = torch::zeros({2}, torch::kFloat64);
+        e[i] = eps;
+        const auto column = (model->discrete_gradient_field(x, dx + e, u, 6e-6) -
+                             model->discrete_gradient_field(x, dx - e, u, 6e-6)) / (2 * eps);
+        const auto analytic = fj.dfdx.select(-1, i);
+        const double scale = std::max(1.0, column.abs().max().item<double>());
+        EXPECT_LE((analytic - column).abs().max().item<double>(), 1e-7 * scale)
+            << model_label(kind, IntegratorKind::kDg) << " " << to_string(sys) << " column " << i;
+      }
+    }
+  }
+}
+
+// Newton stops on the residual: every converged row satisfies
+// max |dx - h f_bar(x, dx, u)| <= 1e-12, recomputed here without jets.
+TEST(DiscreteStepTest, DgInferenceMeetsResidualTolerance) {
+  for (ModelKind kind : {ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
+    const auto model = DynamicsModel::create(
+        ModelOptions{kind, ModelSize::kSmall, SystemKind::kDuffing}, {0, 1, 2});
+    torch::NoGradGuard no_grad;
+    const auto x = 2.0 * states(3, 100, 6);
+    const auto u = states(3, 100, 7).narrow(-1, 0, 1);
+    const auto s = dg_inference_step(*model, x, u, 0.01);
+    ASSERT_TRUE(s.converged.all().item<bool>());
+    EXPECT_GE(s.iterations, 1);
+    const auto dx = s.x_next - x;
+    const auto r = dx - 0.01 * model->discrete_gradient_field(x, dx, u, 6e-6);
+    EXPECT_LE(r.abs().max().item<double>(), 1e-12);
+  }
+}
+
 TEST(DiscreteStepTest, Rk2IsExplicitMidpointOfTheField) {
   const auto model = DynamicsModel::create(ModelOptions{ModelKind::kNode, ModelSize::kSmall, SystemKind::kHarmonic}, {0});
   torch::NoGradGuard no_grad;

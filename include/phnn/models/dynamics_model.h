@@ -47,6 +47,12 @@ class DynamicsModel {
   virtual torch::Tensor discrete_gradient_field(const torch::Tensor& x, const torch::Tensor& dx,
                                                 const torch::Tensor& u,
                                                 double min_dx_norm) const;
+  /// The DG field f_bar(x, dx, u) and its Jacobian d f_bar / d dx [E, B, 2, 2]
+  /// (row = component of f_bar), for Newton at inference (PH models only).
+  virtual FieldEval discrete_gradient_field_with_jacobian(const torch::Tensor& x,
+                                                          const torch::Tensor& dx,
+                                                          const torch::Tensor& u,
+                                                          double min_dx_norm) const;
   /// H_theta(x) [E, B] and gradH_theta(x) [E, B, 2] (PH models only).
   virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;

@@ -38,6 +38,12 @@ class PortHamiltonianModel : public DynamicsModel {
                                         const torch::Tensor& u,
                                         double min_dx_norm) const override;
 
+  /// d f_bar / d dx from jets taken w.r.t. the midpoint m = x + dx/2 (see
+  /// port_hamiltonian.cpp): no finite differences.
+  FieldEval discrete_gradient_field_with_jacobian(const torch::Tensor& x, const torch::Tensor& dx,
+                                                  const torch::Tensor& u,
+                                                  double min_dx_norm) const override;
+
   /// Gonzalez discrete gradient of H_theta (eq: gonzalez-discrete-gradient):
   ///   dg = gradH(x + dx/2) + (H(x+dx) - H(x) - gradH(x+dx/2)^T dx) / |dx|^2 dx,
   /// = gradH(x + dx/2) where |dx| < min_dx_norm (SPEC.md §4).

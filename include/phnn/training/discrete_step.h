@@ -20,26 +20,39 @@ torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& 
 
 /// Options of the implicit DG inference step.
 struct DgInferenceOptions {
-  /// Newton stops when max |delta dx| <= tolerance for every row.
+  /// A row has converged when its residual max |dx - h f_bar| <= tolerance.
   double tolerance = 1e-12;
+  /// Newton updates at most; a row still above tolerance then is reported.
   int max_iterations = 20;
   double min_dx_norm = 6e-6;
-  /// Forward-difference step of the 2 x 2 Newton Jacobian.
-  double fd_step = 1e-7;
+};
+
+/// The Newton Jacobian d f_bar / d dx [E, B, 2, 2] carried from one step of
+/// a rollout to the next (the state moves by O(h) per step, so it stays a
+/// good simplified-Newton matrix; rows where it is not get a fresh one).
+struct DgNewtonJacobian {
+  torch::Tensor dfddx;
 };
 
 struct DgInferenceStep {
   torch::Tensor x_next;     // [E, B, 2]
   torch::Tensor converged;  // [E, B] bool
-  int iterations = 0;
+  int iterations = 0;            // Newton updates of the slowest row
+  int jacobian_evaluations = 0;  // batched Jacobian evaluations
 };
 
 /// DG at inference: solves r(dx) = dx - h f_bar(x, dx, u) = 0 by Newton from
-/// the RK2 step, with the 2 x 2 Jacobian I - h d f_bar / d dx by forward
-/// differences (both columns and the residual in one batched model call).
-/// Rows that do not converge within max_iterations are reported, not thrown.
+/// the RK2 step, all members and rows at once, with the analytic 2 x 2
+/// Jacobian I - h d f_bar / d dx (DynamicsModel::
+/// discrete_gradient_field_with_jacobian, forward-mode jets), kept per row
+/// while that row's residual shrinks at least 10x per iteration and
+/// re-evaluated otherwise (simplified Newton; docs/METHOD.md). With `cache`,
+/// a rollout reuses the previous step's Jacobians as the start. A row stops
+/// (is frozen) once its residual is within tolerance; rows still above it
+/// after max_iterations are reported in `converged`, not thrown.
 DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tensor& x,
                                   const torch::Tensor& u, double h,
-                                  const DgInferenceOptions& options = {});
+                                  const DgInferenceOptions& options = {},
+                                  DgNewtonJacobian* cache = nullptr);
 
 }  // namespace phnn
