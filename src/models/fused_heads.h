@@ -1,6 +1,6 @@
 // src/models/fused_heads.h — the closed-form parts of the PHNN models that
 // sit on top of the networks, each one autograd node with a hand-written
-// backward (docs/METHOD.md "Fused networks"). Private to src/models; the
+// backward (docs/DECISIONS.md "Fused networks"). Private to src/models; the
 // op-by-op formulas they replace stay in port_hamiltonian.cpp as the
 // reference path, and the tests compare the two.
 #pragma once

@@ -1,5 +1,5 @@
 // src/models/fused_mlp.cpp — forward and hand-written backward of a stacked
-// tanh MLP's jet (docs/METHOD.md "Fused networks").
+// tanh MLP's jet (docs/DECISIONS.md "Fused networks").
 //
 // Layout. A jet of a layer's activations is stored per member as C channels
 // of [B, n] row-major blocks, tensor [E, C, B, n]:

@@ -1,5 +1,5 @@
 // src/models/fused_mlp.h — a stack of E tanh MLPs and its forward-mode jets
-// as one autograd node with a hand-written backward (docs/METHOD.md "Fused
+// as one autograd node with a hand-written backward (docs/DECISIONS.md "Fused
 // networks"). Private to src/models: StackedMlp is its only caller.
 #pragma once
 

@@ -46,7 +46,7 @@ struct DgInferenceStep {
 /// Jacobian I - h d f_bar / d dx (DynamicsModel::
 /// discrete_gradient_field_with_jacobian, forward-mode jets), kept per row
 /// while that row's residual shrinks at least 10x per iteration and
-/// re-evaluated otherwise (simplified Newton; docs/METHOD.md). With `cache`,
+/// re-evaluated otherwise (simplified Newton; docs/DECISIONS.md "DG inference"). With `cache`,
 /// a rollout reuses the previous step's Jacobians as the start. A row stops
 /// (is frozen) once its residual is within tolerance; rows still above it
 /// after max_iterations are reported in `converged`, not thrown.
