@@ -6,7 +6,7 @@
 //                                      torch::nn + autograd create_graph for gradH
 //   bench_training compare [repeats] [size]  fused vs reference networks,
 //                                      interleaved, E = 10
-//   bench_training run MODEL INTEGRATOR REG STEPS [SIZE]   one cell, E = 10
+//   bench_training run MODEL INTEGRATOR REG STEPS [SIZE] [N_TRAIN]   one cell, E = 10
 //                                      (for perf; PHNN_REFERENCE_NETWORKS=1
 //                                      selects the reference networks)
 //   bench_training cell                one full cell: small PHNN-JR-RK2,
@@ -264,7 +264,7 @@ int main(int argc, char** argv) {
     cell.integrator = phnn::parse_integrator(argv[3]);
     cell.regularizer = phnn::parse_regularizer(argv[4]);
     cell.size = phnn::parse_size(argc > 6 ? argv[6] : "small");
-    cell.n_train = 64;
+    cell.n_train = argc > 7 ? std::atoi(argv[7]) : 64;  // batch = min(n_train, 64)
     cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
     cell.fused_networks = std::getenv("PHNN_REFERENCE_NETWORKS") == nullptr;
     std::printf("%.3f s\n", time_cell(cell, std::atoi(argv[5])));

@@ -23,6 +23,16 @@ struct HamiltonianHead {
 HamiltonianHead hamiltonian_head(const torch::Tensor& o, const torch::Tensor& o_g,
                                  const torch::Tensor& x);
 
+/// gradH [E, B, 2] and the Hessian of H [E, B, 2, 2] (symmetric; [i][k] =
+/// d2H / dx_i dx_k) from the L_H outputs o [E, B, 3] and their first and
+/// second x-derivatives o_g [E, B, 2, 3], o_h [E, B, 2, 2, 3]: the order-2
+/// jet of H = |L_H x|^2 / 2 in closed form (for the Jacobian regularizers).
+struct HamiltonianCurvature {
+  torch::Tensor grad, hessian;
+};
+HamiltonianCurvature hamiltonian_curvature_head(const torch::Tensor& o, const torch::Tensor& o_g,
+                                                const torch::Tensor& o_h, const torch::Tensor& x);
+
 /// PHNN-JR field (eq:f_theta-PHS-JR) from the effort e [E, B, 2] (gradH or
 /// the discrete gradient), the L_R outputs o [E, B, 6] (row-major lower
 /// triangle of L_R) and u [E, B, 1]:  f = [(J - L_R^T L_R) (e, u)]_{1:2}.

@@ -80,6 +80,14 @@ torch::Tensor PortHamiltonianModel::grad_hamiltonian(const torch::Tensor& x) con
   return hamiltonian_and_gradient(l_h(), x).grad;
 }
 
+Jet PortHamiltonianModel::curvature_jet(const torch::Tensor& x) const {
+  if (!l_h().options().fused) return gradient_jet(hamiltonian_jet(l_h(), x, /*order=*/2));
+  // Closed-form gradH and Hessian from L_H's order-2 jet (one fused head).
+  const Jet o = l_h().forward_input(x, /*directions=*/2, /*order=*/2);
+  const auto curvature = internal::hamiltonian_curvature_head(o.v, o.g, o.h, x);
+  return Jet{curvature.grad, curvature.hessian, {}};
+}
+
 FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tensor& u,
                                       bool with_jacobian) const {
   FieldEval out;
@@ -90,7 +98,7 @@ FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tenso
     return out;
   }
   const int order = 1;
-  const Jet grad = gradient_jet(hamiltonian_jet(l_h(), x, order + 1));
+  const Jet grad = curvature_jet(x);
   const Jet f = field_from_effort(grad, x, u, order);
   out.f = f.v;
   if (with_jacobian) out.dfdx = f.g.transpose(-1, -2);
@@ -146,7 +154,7 @@ FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
     const torch::Tensor& x, const torch::Tensor& dx, const torch::Tensor& u,
     double min_dx_norm) const {
   const auto m = x + 0.5 * dx;
-  const Jet grad_m = gradient_jet(hamiltonian_jet(l_h(), m, /*order=*/2));  // v = g, g = Hm
+  const Jet grad_m = curvature_jet(m);  // v = g, g = Hm
   const auto hess = grad_m.g;                                                // [E, B, 2, 2]
   const auto h0 = hamiltonian(x).unsqueeze(-1);
   const auto end = hamiltonian_and_gradient(l_h(), x + dx);

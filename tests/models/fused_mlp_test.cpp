@@ -136,8 +136,9 @@ TEST(FusedMlpTest, TrainingLossAndGradientsMatchReferenceForEveryModel) {
   }
 }
 
-// Learned H, gradH and the discrete gradient through the fused heads equal
-// the reference formulas, including rows below the DG fallback threshold.
+// Learned H, gradH, the discrete gradient and the Jacobians through the
+// fused heads equal the reference formulas, including rows below the DG
+// fallback threshold.
 TEST(FusedMlpTest, HamiltonianAndDiscreteGradientMatchReference) {
   const auto fused = DynamicsModel::create(
       ModelOptions{ModelKind::kPhnnJr, ModelSize::kSmall, SystemKind::kDuffing, true}, seeds());
@@ -152,6 +153,19 @@ TEST(FusedMlpTest, HamiltonianAndDiscreteGradientMatchReference) {
   const auto& f = dynamic_cast<const PortHamiltonianModel&>(*fused);
   const auto& r = dynamic_cast<const PortHamiltonianModel&>(*reference);
   expect_close(f.discrete_gradient(x, dx, 6e-6), r.discrete_gradient(x, dx, 6e-6), 1e-12, "DG");
+  // df/dx through the closed-form Hessian head (the regularizers' Jacobian).
+  const auto u = 0.5 * torch::randn({3, 40, 1}, torch::kFloat64);
+  expect_close(fused->field(x, u, true).dfdx, reference->field(x, u, true).dfdx, 1e-12, "df/dx");
+  // d f_bar / d dx divides an O(|dx|^2) difference of gradients by |dx|^2,
+  // so round-off differences grow like eps |gradH| / |dx|^2: compare at
+  // |dx| in [0.05, 0.1] (bound ~4e-14 x |gradH| ~ 1e-12) and below tau.
+  const auto angle = 6.283185307179586 * torch::rand({3, 40}, torch::kFloat64);
+  auto dx_mid = (0.05 + 0.05 * torch::rand({3, 40, 1}, torch::kFloat64)) *
+                torch::stack({torch::cos(angle), torch::sin(angle)}, -1);
+  dx_mid.narrow(1, 0, 5).mul_(1e-7);
+  expect_close(fused->discrete_gradient_field_with_jacobian(x, dx_mid, u, 6e-6).dfdx,
+               reference->discrete_gradient_field_with_jacobian(x, dx_mid, u, 6e-6).dfdx, 1e-12,
+               "d f_bar / d dx");
 }
 
 // Within 2 ulp of std::tanh from 1e-20 to 30 (both signs), the branch point

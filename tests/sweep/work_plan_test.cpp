@@ -141,21 +141,20 @@ TEST(WorkPlanTest, PaperGridIsNotSplitOnFewRanks) {
   }
 }
 
-// Efficiency of the simulated schedule (the cost model's placeholders;
-// docs/DECISIONS.md "Member groups" gives the numbers and the ceiling).
+// Efficiency of the simulated schedule under the default cost model (fit
+// to the fused kernels; docs/BENCHMARKS.md gives the numbers). A guard, not
+// the goal: at 128 ranks every extra group pays the per-step fixed cost
+// (~200 us, x6 with a regularizer) for 50 000 steps, which caps the split
+// plans near 0.75; whole cells reach 0.24.
 TEST(WorkPlanTest, PaperGridEfficiencyBySimulation) {
   const Grid grid = paper_grid();
   SplitOptions off;
   off.mode = SplitOptions::Mode::kOff;
   EXPECT_GE(plan_work(grid, 16).efficiency(), 0.95);
-  EXPECT_GE(plan_work(grid, 64).efficiency(), 0.9);
-  // 128 ranks: 0.90 looks out of reach under the placeholder constants (a
-  // search over 30 000 split vectors found about 0.89 at best): each extra group
-  // pays 44-119 s of fixed cost and a large PHNN-JR seed alone takes 310 s
-  // of a ~470-s ideal makespan. Whole cells reach 0.18.
+  EXPECT_GE(plan_work(grid, 64).efficiency(), 0.88);
   const WorkPlan plan = plan_work(grid, 128);
-  EXPECT_GE(plan.efficiency(), 0.8);
-  EXPECT_LT(plan_work(grid, 128, off).efficiency(), 0.2);
+  EXPECT_GE(plan.efficiency(), 0.7);
+  EXPECT_LT(plan_work(grid, 128, off).efficiency(), 0.3);
 }
 
 TEST(WorkPlanTest, PartiallyFinishedCellsPlanOnlyTheirMissingRuns) {

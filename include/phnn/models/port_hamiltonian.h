@@ -58,6 +58,9 @@ class PortHamiltonianModel : public DynamicsModel {
   virtual Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
                                 const torch::Tensor& u, int order) const = 0;
   const StackedMlp& l_h() const { return *nets_[0]; }
+  /// Jet whose value is gradH(x) [E, B, 2] and whose g is the Hessian
+  /// [E, B, 2, 2].
+  Jet curvature_jet(const torch::Tensor& x) const;
 };
 
 /// PHNN-S (eq:f_theta-PHS-DAF): w = S_wx gradH + S_wu u,

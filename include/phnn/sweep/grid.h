@@ -40,40 +40,46 @@ namespace phnn {
 struct CostModel {
   /// Per-step cost of a stack that does not depend on its size E [us], small
   /// size, no regularizer, indexed [ModelKind][IntegratorKind] (NODE-DG does
-  /// not exist). Placeholders from docs/BENCHMARKS.md's E = 1 and E = 10
-  /// timings: small PHNN-JR-RK2 1114 and 3190 us per step give fixed 883 and
-  /// member 231; NODE-RK2 198 and 800 give 131 and 67; the PHNN-S rows and
-  /// PHNN-JR-DG are PHNN-JR-RK2's split scaled to their E = 10 cost (275,
-  /// 295, 319 us per member-step). To be refit after the kernel rework.
+  /// not exist). Fit to bench/bench_training `stacked` (fused networks,
+  /// docs/BENCHMARKS.md): t(E) = fixed + E member per step from the E = 1
+  /// and E = 10 timings, e.g. small PHNN-JR-RK2 292 and 112 us per
+  /// member-step give fixed 200 and member 92.
   double fixed_us[3][2] = {
       /*kNode=*/{/*kRk2=*/131.0, /*kDg=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/761.0, /*kDg=*/817.0},
-      /*kPhnnJr=*/{/*kRk2=*/883.0, /*kDg=*/883.0},
+      /*kPhnnS=*/{/*kRk2=*/268.0, /*kDg=*/172.0},
+      /*kPhnnJr=*/{/*kRk2=*/200.0, /*kDg=*/193.0},
   };
   /// Per-step cost of each member of a stack [us], same indexing.
   double member_us[3][2] = {
-      /*kNode=*/{/*kRk2=*/67.0, /*kDg=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/199.0, /*kDg=*/214.0},
-      /*kPhnnJr=*/{/*kRk2=*/231.0, /*kDg=*/231.0},
+      /*kNode=*/{/*kRk2=*/43.0, /*kDg=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/113.0, /*kDg=*/129.0},
+      /*kPhnnJr=*/{/*kRk2=*/92.0, /*kDg=*/90.0},
   };
   /// Indexed by ModelSize: small, medium, large. Assumed independent of the
-  /// width (the fixed part is per-operator overhead); not measured yet.
+  /// width (the fixed part is per-operator overhead); not measured.
   double fixed_size_factor[3] = {1.0, 1.0, 1.0};
-  /// Indexed by ModelSize. Chosen so that PHNN-JR-RK2 at E = 10 keeps its
-  /// measured 2.4x and 15x (`phnn train`: 272, 660 and 4186 us per
-  /// member-step) with fixed_size_factor = 1: (10 x 231 x f + 883) / 3193.
-  double member_size_factor[3] = {1.0, 2.9, 20.4};
-  /// Jacobian, closed-form SVD / eigenvalues and their backward in every
-  /// step (CN, SN, SR): measured 2.6-3.0x, on both parts.
-  double regularizer_factor = 2.7;
+  /// Indexed by ModelSize. At E = 10 the fused PHNN-JR-RK2 costs 118, 534
+  /// and 1497 us per member-step (small, medium, large; the other models'
+  /// medium/small ratios are 2.2-3.4): 4.0 and 16 with fixed_size_factor 1.
+  double member_size_factor[3] = {1.0, 4.0, 16.0};
+  /// Jacobian (second-order jets for the PHNNs), closed-form SVD /
+  /// eigenvalues and their backward in every step (CN, SN, SR), on both
+  /// parts, indexed by ModelKind: measured 2.5x (NODE), 4.7-5.4x (PHNN-S),
+  /// 5.8-6.2x (PHNN-JR).
+  double regularizer_factor[3] = {2.5, 5.0, 6.0};
+  /// A training step on a batch smaller than reference_batch (N_train < 64)
+  /// costs member_us x (1 - small_batch_saving x (64 - batch) / 64) per
+  /// member (validation and inference are not affected).
+  double small_batch_saving = 0.85;  // PHNN-JR-RK2 E = 10: 64 us at batch 25, 110 at 64
   /// Pairs per batch-step in the validation and inference terms.
   double reference_batch = 64.0;
   /// A rollout state-step costs 1 / rollout_speedup of a training pair-step
-  /// (forward only, no backward; measured ~0.08 s per small RK2 run).
-  double rollout_speedup = 3.0;
-  /// DG rollouts solve a Newton system per step (3-5 batched residual
-  /// evaluations; measured ~0.85 s per small DG run).
-  double dg_newton_factor = 10.0;
+  /// (forward only, no backward; fit to `bench_training inference`: a small
+  /// PHNN-JR-RK2 cell's 2 validations and 102 x 500-step rollouts, 0.57 s).
+  double rollout_speedup = 1.6;
+  /// DG rollouts solve a Newton system per step (simplified Newton, 3-6
+  /// residual evaluations; the same cell with DG: 2.4 s).
+  double dg_newton_factor = 5.0;
 };
 
 /// Estimated cost of a work item: `members` runs of run's cell trained as one
