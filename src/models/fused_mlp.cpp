@@ -27,6 +27,7 @@
 
 #include <torch/csrc/autograd/functions/utils.h>
 
+#include "models/jet_kernels.h"
 #include "models/vector_math.h"
 #include "phnn/common/check.h"
 
@@ -73,8 +74,8 @@ void gemm_nn(int64_t E, int rows, int k, int cols, const double* a, const double
 
 // Per member: W~[e] = A[e]^T Z~[e], A [rows, n_in], Z~ [rows, n_out].
 void gemm_tn(int64_t E, int rows, int n_in, int n_out, const double* a, const double* z,
-             double* w) {
-  const double one = 1.0, zero = 0.0;
+             double* w, double beta) {
+  const double one = 1.0, zero = beta;
   const char tz = 'N', ta = 'T';
   for (int64_t e = 0; e < E; ++e) {
     dgemm_(&tz, &ta, &n_out, &n_in, &rows, &one, z + e * rows * n_out, &n_out,
@@ -102,76 +103,6 @@ void scatter_3d(const double* src, int64_t src_member_stride, Tensor* dst) {
   for (int64_t e = 0; e < E; ++e)
     for (int64_t b = 0; b < B; ++b)
       for (int64_t k = 0; k < n; ++k) p[e * se + b * sb + k * sk] = src[e * src_member_stride + b * n + k];
-}
-
-// (F): activations a of layer l+1 from its pre-activations z, t = tanh(z_0).
-void tanh_jet_forward(const Channels& ch, int64_t E, int64_t bn, const double* z, const double* t,
-                      double* a) {
-  const int64_t C = ch.count();
-  for (int64_t e = 0; e < E; ++e) {
-    const double* ze = z + e * C * bn;
-    const double* te = t + e * bn;
-    double* ae = a + e * C * bn;
-    for (int64_t k = 0; k < bn; ++k) ae[k] = te[k];
-    if (ch.order < 1) continue;
-    for (int64_t i = 0; i < ch.d; ++i) {
-      const double* zi = ze + ch.tangent(i) * bn;
-      double* ai = ae + ch.tangent(i) * bn;
-      for (int64_t k = 0; k < bn; ++k) ai[k] = (1.0 - te[k] * te[k]) * zi[k];
-    }
-    for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
-      const double* zi = ze + ch.tangent(ch.pairs[p].first) * bn;
-      const double* zj = ze + ch.tangent(ch.pairs[p].second) * bn;
-      const double* zp = ze + ch.pair(p) * bn;
-      double* ap = ae + ch.pair(p) * bn;
-      for (int64_t k = 0; k < bn; ++k) {
-        const double s = 1.0 - te[k] * te[k];
-        ap[k] = s * zp[k] - 2.0 * te[k] * s * zi[k] * zj[k];
-      }
-    }
-  }
-}
-
-// (B): adjoint z_bar of the pre-activations from the adjoint a_bar of the
-// activations (separate buffers).
-void tanh_jet_backward(const Channels& ch, int64_t E, int64_t bn, const double* z, const double* t,
-                       const double* a_bar, double* z_bar) {
-  const int64_t C = ch.count();
-  for (int64_t e = 0; e < E; ++e) {
-    const double* ze = z + e * C * bn;
-    const double* te = t + e * bn;
-    const double* ab = a_bar + e * C * bn;
-    double* zb = z_bar + e * C * bn;
-    for (int64_t k = 0; k < bn; ++k) zb[k] = (1.0 - te[k] * te[k]) * ab[k];
-    if (ch.order < 1) continue;
-    for (int64_t i = 0; i < ch.d; ++i) {
-      const double* zi = ze + ch.tangent(i) * bn;
-      const double* abi = ab + ch.tangent(i) * bn;
-      double* zbi = zb + ch.tangent(i) * bn;
-      for (int64_t k = 0; k < bn; ++k) {
-        const double s = 1.0 - te[k] * te[k];
-        zb[k] += -2.0 * te[k] * s * abi[k] * zi[k];
-        zbi[k] = s * abi[k];
-      }
-    }
-    for (std::size_t p = 0; p < ch.pairs.size(); ++p) {
-      const int64_t i = ch.pairs[p].first, j = ch.pairs[p].second;
-      const double* zi = ze + ch.tangent(i) * bn;
-      const double* zj = ze + ch.tangent(j) * bn;
-      const double* zp = ze + ch.pair(p) * bn;
-      const double* abp = ab + ch.pair(p) * bn;
-      double* zbi = zb + ch.tangent(i) * bn;
-      double* zbj = zb + ch.tangent(j) * bn;
-      double* zbp = zb + ch.pair(p) * bn;
-      for (int64_t k = 0; k < bn; ++k) {
-        const double tt = te[k] * te[k], s = 1.0 - tt, s1 = -2.0 * te[k] * s;
-        zb[k] += abp[k] * (s1 * zp[k] + s * (6.0 * tt - 2.0) * zi[k] * zj[k]);
-        zbp[k] = s * abp[k];
-        zbi[k] += s1 * abp[k] * zj[k];  // i == j: this line and the next give 2 s1 a~_ii z_i
-        zbj[k] += s1 * abp[k] * zi[k];
-      }
-    }
-  }
 }
 
 // Sizes of one call and where each saved buffer lives in the workspace.
@@ -295,12 +226,17 @@ void pack_output_adjoint(const Plan& plan, const torch::autograd::variable_list&
 // W_0..W_{L-1}, b_0..b_{L-1} (an undefined input has an empty edge).
 class FusedMlpBackward : public torch::autograd::Node {
  public:
-  FusedMlpBackward(Plan plan, Tensor workspace, std::vector<Tensor> weights)
-      : plan_(std::move(plan)), workspace_(std::move(workspace)), weights_(std::move(weights)) {}
+  FusedMlpBackward(Plan plan, Tensor workspace, std::vector<Tensor> weights,
+                   std::vector<Tensor> sinks)
+      : plan_(std::move(plan)),
+        workspace_(std::move(workspace)),
+        weights_(std::move(weights)),
+        sinks_(std::move(sinks)) {}
   std::string name() const override { return "FusedMlpBackward"; }
   void release_variables() override {
     workspace_.reset();
     weights_.clear();
+    sinks_.clear();
   }
   variable_list apply(variable_list&& grads) override;
 
@@ -311,6 +247,7 @@ class FusedMlpBackward : public torch::autograd::Node {
   Plan plan_;
   Tensor workspace_;
   std::vector<Tensor> weights_;
+  std::vector<Tensor> sinks_;  // W_0..W_{L-1}, b_0..b_{L-1} gradient buffers, or empty
 };
 
 variable_list FusedMlpBackward::apply(variable_list&& grads) {
@@ -329,25 +266,32 @@ variable_list FusedMlpBackward::apply(variable_list&& grads) {
   for (int64_t l = L - 1; l >= 0; --l) {
     const int64_t n_in = p.widths[l], n_out = p.widths[l + 1];
     const auto ul = static_cast<std::size_t>(l);
-    if (should_compute_output(static_cast<std::size_t>(3 + l))) {  // W~ = A^T Z~
-      Tensor w_bar = torch::empty({E, n_in, n_out}, torch::kFloat64);
+    const bool sink = !sinks_.empty();
+    if (sink || should_compute_output(static_cast<std::size_t>(3 + l))) {  // W~ = A^T Z~
+      Tensor w_bar = sink ? sinks_[ul] : torch::empty({E, n_in, n_out}, torch::kFloat64);
       gemm_tn(E, static_cast<int>(p.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
-              ws + p.act[ul], z_bar, w_bar.data_ptr<double>());
-      out[3 + ul] = w_bar;
+              ws + p.act[ul], z_bar, w_bar.data_ptr<double>(), /*beta=*/sink ? 1.0 : 0.0);
+      if (!sink) out[3 + ul] = w_bar;
     }
-    if (should_compute_output(static_cast<std::size_t>(3 + L + l))) {  // b~ = sum_batch Z~_0
+    if (sink || should_compute_output(static_cast<std::size_t>(3 + L + l))) {  // b~ = sum_batch Z~_0
       Tensor b_bar = torch::zeros({E, 1, n_out}, torch::kFloat64);
       double* pb = b_bar.data_ptr<double>();
       for (int64_t e = 0; e < E; ++e)
         for (int64_t r = 0; r < p.B; ++r)
           for (int64_t k = 0; k < n_out; ++k) pb[e * n_out + k] += z_bar[e * p.block(n_out) + r * n_out + k];
-      out[3 + L + ul] = b_bar;
+      if (sink) {
+        double* dst = sinks_[static_cast<std::size_t>(L) + ul].data_ptr<double>();
+        for (int64_t k = 0; k < E * n_out; ++k) dst[k] += pb[k];
+      } else {
+        out[3 + L + ul] = b_bar;
+      }
     }
     if (l == 0 && !(need_v || need_g || need_h)) break;
     gemm_nn(E, static_cast<int>(p.rows()), static_cast<int>(n_out), static_cast<int>(n_in), z_bar,
             weights_[ul].data_ptr<double>(), a_bar, /*transpose_b=*/true, 0.0);  // A~ = Z~ W^T
     if (l == 0) break;
-    tanh_jet_backward(p.ch, E, p.B * n_in, ws + p.pre[ul - 1], ws + p.tanh[ul - 1], a_bar, z_bar);
+    tanh_jet_backward(p.ch.d, p.ch.order, E, p.B * n_in, ws + p.pre[ul - 1], ws + p.tanh[ul - 1],
+                      a_bar, z_bar);
   }
   if (need_v) out[0] = input_adjoint(a_bar, 0);
   if (need_g) {
@@ -393,7 +337,10 @@ Tensor FusedMlpBackward::input_curvature_adjoint(const double* a_bar) const {
 FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
                       const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
                       const torch::Tensor& x_g, const torch::Tensor& x_h,
-                      const FusedMlpOptions& options) {
+                      const FusedMlpOptions& options,
+                      const std::vector<torch::Tensor>& gradient_sinks) {
+  TORCH_CHECK(gradient_sinks.empty() || gradient_sinks.size() == 2 * weights.size(),
+              "fused_mlp: expected one gradient sink per weight and bias");
   TORCH_CHECK(x_v.dim() == 3 && x_v.scalar_type() == torch::kFloat64,
               "fused_mlp: expected a float64 input [E, B, n], got ", x_v.sizes());
   TORCH_CHECK(!weights.empty() && weights.size() == biases.size(),
@@ -424,7 +371,7 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
     const int64_t n = plan.widths[ul + 1];
     double* t = ws + plan.tanh[ul];
     for (int64_t e = 0; e < plan.E; ++e) tanh_array(z + e * plan.block(n), t + e * plan.B * n, plan.B * n);
-    tanh_jet_forward(ch, plan.E, plan.B * n, z, t, ws + plan.act[ul + 1]);
+    tanh_jet_forward(ch.d, ch.order, plan.E, plan.B * n, z, t, ws + plan.act[ul + 1]);
   }
   FusedMlpJet jet = unpack_output(plan, ws + plan.out, x_v.options());
   std::vector<Tensor> inputs{x_v, x_g, x_h};
@@ -434,8 +381,12 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
       std::none_of(inputs.begin(), inputs.end(), [](const Tensor& t) { return t.defined() && t.requires_grad(); })) {
     return jet;
   }
-  auto node = std::shared_ptr<FusedMlpBackward>(new FusedMlpBackward(plan, workspace, weights),
-                                                torch::autograd::deleteNode);
+  auto node = std::shared_ptr<FusedMlpBackward>(
+      new FusedMlpBackward(plan, workspace, weights, gradient_sinks), torch::autograd::deleteNode);
+  if (!gradient_sinks.empty()) {  // parameters: written into the sinks, no edges
+    inputs.resize(3);
+    inputs.resize(3 + 2 * weights.size());
+  }
   node->set_next_edges(torch::autograd::collect_next_edges(inputs));
   for (Tensor* t : {&jet.v, &jet.g, &jet.h}) {
     if (t->defined()) torch::autograd::set_history(*t, node);

@@ -36,10 +36,19 @@ struct FusedMlpJet {
 /// jet's chain rule elementwise. Its backward is written out in
 /// fused_mlp.cpp; it is first-order only (no double backward), which is all
 /// training needs since derivatives w.r.t. x are carried forward as jets.
+///
+/// `gradient_sinks` (optional: empty, or one tensor per weight then one per
+/// bias, shaped like them): the backward adds the parameter gradients into
+/// these buffers directly (the trainer passes the aliases of its flat
+/// gradient buffer) instead of returning them to autograd, which saves an
+/// AccumulateGrad node, an allocation and an add per parameter and call.
+/// The parameters are then not part of the autograd graph (autograd::grad
+/// w.r.t. them is not available); gradients w.r.t. the input still are.
 FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
                       const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
                       const torch::Tensor& x_g, const torch::Tensor& x_h,
-                      const FusedMlpOptions& options);
+                      const FusedMlpOptions& options,
+                      const std::vector<torch::Tensor>& gradient_sinks = {});
 
 }  // namespace internal
 }  // namespace phnn

@@ -162,7 +162,8 @@ StackedMlp::StackedMlp(StackedMlpOptions options, const std::vector<std::uint64_
 
 torch::Tensor StackedMlp::forward(const torch::Tensor& x) const {
   if (!options_.fused) return reference_forward(x);
-  return internal::fused_mlp(weights_, biases_, x, {}, {}, internal::FusedMlpOptions{}).v;
+  return internal::fused_mlp(weights_, biases_, x, {}, {}, internal::FusedMlpOptions{},
+                             gradient_sinks_).v;
 }
 
 Jet StackedMlp::forward(const Jet& x) const {
@@ -170,14 +171,15 @@ Jet StackedMlp::forward(const Jet& x) const {
   const int order = x.order();
   const int directions = order >= 1 ? static_cast<int>(x.g.size(-2)) : 0;
   const auto out = internal::fused_mlp(weights_, biases_, x.v, x.g, x.h,
-                                       internal::FusedMlpOptions{directions, order});
+                                       internal::FusedMlpOptions{directions, order}, gradient_sinks_);
   return Jet{out.v, out.g, out.h};
 }
 
 Jet StackedMlp::forward_input(const torch::Tensor& x, int directions, int order) const {
   if (!options_.fused) return reference_forward_input(x, directions, order);
   const auto out = internal::fused_mlp(weights_, biases_, x, {}, {},
-                                       internal::FusedMlpOptions{order >= 1 ? directions : 0, order});
+                                       internal::FusedMlpOptions{order >= 1 ? directions : 0, order},
+                                       gradient_sinks_);
   return Jet{out.v, out.g, out.h};
 }
 
@@ -246,15 +248,20 @@ Jet StackedMlp::reference_forward_input(const torch::Tensor& x, int directions,
 
 void StackedMlp::bind_to(const torch::Tensor& values, const torch::Tensor& gradients,
                          int64_t* offset) {
+  std::vector<torch::Tensor> weight_sinks, bias_sinks;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
     for (torch::Tensor* p : {&weights_[l], &biases_[l]}) {
       const int64_t n = p->numel();
       const auto shape = p->sizes().vec();
       *p = values.narrow(0, *offset, n).view(shape).detach().requires_grad_(true);
       p->mutable_grad() = gradients.narrow(0, *offset, n).view(shape);
+      (p == &weights_[l] ? weight_sinks : bias_sinks).push_back(p->mutable_grad());
       *offset += n;
     }
   }
+  if (!options_.fused) return;  // the reference path accumulates through autograd
+  gradient_sinks_ = weight_sinks;
+  gradient_sinks_.insert(gradient_sinks_.end(), bias_sinks.begin(), bias_sinks.end());
 }
 
 std::vector<torch::Tensor> StackedMlp::parameters() const {

@@ -73,7 +73,9 @@ class StackedMlp {
   std::vector<torch::Tensor> parameters() const;
   /// Rebinds weights and biases to leaves aliasing `values` from *offset (the
   /// caller copied them there), with gradients aliasing `gradients`;
-  /// advances *offset.
+  /// advances *offset. From then on the fused backward adds the parameter
+  /// gradients into `gradients` directly (no AccumulateGrad nodes), so
+  /// backward() fills them but autograd::grad w.r.t. the parameters does not.
   void bind_to(const torch::Tensor& values, const torch::Tensor& gradients, int64_t* offset);
   int64_t members() const { return members_; }
   /// Trainable parameters of one member.
@@ -88,6 +90,9 @@ class StackedMlp {
   StackedMlpOptions options_;
   int64_t members_;
   std::vector<torch::Tensor> weights_, biases_;
+  // Set by bind_to: the weights' then the biases' gradient buffers, which
+  // the fused backward writes into directly (fused_mlp's gradient_sinks).
+  std::vector<torch::Tensor> gradient_sinks_;
 };
 
 }  // namespace phnn
