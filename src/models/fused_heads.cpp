@@ -357,6 +357,89 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
   }
 };
 
+// ---------------------------------------------------------------- PHNN-S
+// Per row: w = S_w0 e0 + S_w1 e1 + S_w3 u (S_ww = 0), and from w and the L_z
+// output l: f_i = S_i0 e0 + S_i1 e1 + S_i2 l^2 w + S_i3 u (i = 0, 1).
+// Backward: e~_j += sum_i f~_i S_ij, u~ += sum_i f~_i S_i3,
+//   l~ = 2 l w sum_i f~_i S_i2, w~ = l^2 sum_i f~_i S_i2 (and w's own rule).
+using StructureRows = std::array<std::array<double, 4>, 4>;
+
+class PhnnSWFunction : public torch::autograd::Function<PhnnSWFunction> {
+ public:
+  static Tensor forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& u_in,
+                        std::array<double, 3> s) {
+    const Tensor e = dense(e_in), u = dense(u_in);
+    const int64_t rows = e.size(0) * e.size(1);
+    Tensor w = torch::empty({e.size(0), e.size(1), 1}, e.options());
+    const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
+    double* pw = w.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) pw[r] = s[0] * pe[2 * r] + s[1] * pe[2 * r + 1] + s[2] * pu[r];
+    ctx->saved_data["s0"] = s[0], ctx->saved_data["s1"] = s[1], ctx->saved_data["s2"] = s[2];
+    ctx->saved_data["rows"] = rows;
+    return w;
+  }
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const double s0 = ctx->saved_data["s0"].toDouble(), s1 = ctx->saved_data["s1"].toDouble(),
+                 s2 = ctx->saved_data["s2"].toDouble();
+    const Tensor wb = dense(grads[0]);
+    const int64_t E = wb.size(0), B = wb.size(1), rows = E * B;
+    Tensor e_bar = torch::empty({E, B, 2}, wb.options()), u_bar = torch::empty({E, B, 1}, wb.options());
+    const double* pwb = wb.data_ptr<double>();
+    double *peb = e_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      peb[2 * r] = s0 * pwb[r], peb[2 * r + 1] = s1 * pwb[r], pub[r] = s2 * pwb[r];
+    }
+    return {e_bar, u_bar, Tensor()};
+  }
+};
+
+class PhnnSFieldFunction : public torch::autograd::Function<PhnnSFieldFunction> {
+ public:
+  static Tensor forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& u_in,
+                        const Tensor& l_in, const Tensor& w_in, StructureRows S) {
+    const Tensor e = dense(e_in), u = dense(u_in), l = dense(l_in), w = dense(w_in);
+    const int64_t rows = e.size(0) * e.size(1);
+    Tensor f = torch::empty_like(e);
+    const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
+    const double *pl = l.data_ptr<double>(), *pw = w.data_ptr<double>();
+    double* pf = f.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double z = pl[r] * pl[r] * pw[r];
+      for (int i = 0; i < 2; ++i) {
+        pf[2 * r + i] = S[i][0] * pe[2 * r] + S[i][1] * pe[2 * r + 1] + S[i][2] * z + S[i][3] * pu[r];
+      }
+    }
+    ctx->save_for_backward({l, w});
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 4; ++j) ctx->saved_data["S" + std::to_string(4 * i + j)] = S[i][j];
+    return f;
+  }
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const Tensor &l = saved[0], &w = saved[1];
+    double S[2][4];
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 4; ++j) S[i][j] = ctx->saved_data["S" + std::to_string(4 * i + j)].toDouble();
+    const Tensor fb = dense(grads[0]);
+    const int64_t E = l.size(0), B = l.size(1), rows = E * B;
+    Tensor e_bar = torch::empty({E, B, 2}, l.options()), u_bar = torch::empty_like(l);
+    Tensor l_bar = torch::empty_like(l), w_bar = torch::empty_like(w);
+    const double *pl = l.data_ptr<double>(), *pw = w.data_ptr<double>(), *pfb = fb.data_ptr<double>();
+    double *peb = e_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>();
+    double *plb = l_bar.data_ptr<double>(), *pwb = w_bar.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double f0 = pfb[2 * r], f1 = pfb[2 * r + 1];
+      peb[2 * r] = f0 * S[0][0] + f1 * S[1][0];
+      peb[2 * r + 1] = f0 * S[0][1] + f1 * S[1][1];
+      pub[r] = f0 * S[0][3] + f1 * S[1][3];
+      const double zb = f0 * S[0][2] + f1 * S[1][2];
+      plb[r] = 2.0 * pl[r] * pw[r] * zb;
+      pwb[r] = pl[r] * pl[r] * zb;
+    }
+    return {e_bar, u_bar, l_bar, w_bar, Tensor()};
+  }
+};
+
 // --------------------------------------------------------------- Gonzalez
 // Per row: n2 = |dx|^2, D = H1 - H0 - g.dx, k = D / n2 (0 if n2 < tau^2),
 // dg = g + k dx. Backward with dg~, s = dg~.dx (small rows: g~ = dg~ only):
@@ -453,6 +536,17 @@ torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
               "jr_field_head: expected e [E, B, 2], o [E, B, 6], u [E, B, 1], got ",
               effort.sizes(), ", ", o.sizes(), ", ", u.sizes());
   return JrFieldFunction::apply(effort, o, u.expand({effort.size(0), effort.size(1), 1}), J);
+}
+
+torch::Tensor phnn_s_w_head(const torch::Tensor& effort, const torch::Tensor& u,
+                           const std::array<double, 3>& s_w) {
+  return PhnnSWFunction::apply(effort, u.expand({effort.size(0), effort.size(1), 1}), s_w);
+}
+
+torch::Tensor phnn_s_field_head(const torch::Tensor& effort, const torch::Tensor& u,
+                                const torch::Tensor& l, const torch::Tensor& w,
+                                const std::array<std::array<double, 4>, 4>& S) {
+  return PhnnSFieldFunction::apply(effort, u.expand({effort.size(0), effort.size(1), 1}), l, w, S);
 }
 
 torch::Tensor gonzalez_head(const torch::Tensor& h_x, const torch::Tensor& h_x_dx,

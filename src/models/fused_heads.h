@@ -39,6 +39,15 @@ HamiltonianCurvature hamiltonian_curvature_head(const torch::Tensor& o, const to
 torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
                             const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J);
 
+/// PHNN-S (eq:f_theta-PHS-DAF), in two heads around the L_z network:
+///   w = S_wx e + S_wu u  (s_w = (S_w0, S_w1, S_w3); S_ww = 0),
+///   f = S_xx e + S_xw l(w)^2 w + S_xu u  (rows 0, 1 of S; l = L_z(w) [E, B, 1]).
+torch::Tensor phnn_s_w_head(const torch::Tensor& effort, const torch::Tensor& u,
+                           const std::array<double, 3>& s_w);
+torch::Tensor phnn_s_field_head(const torch::Tensor& effort, const torch::Tensor& u,
+                                const torch::Tensor& l, const torch::Tensor& w,
+                                const std::array<std::array<double, 4>, 4>& S);
+
 /// Gonzalez discrete gradient (eq: gonzalez-discrete-gradient) from H(x)
 /// [E, B, 1], H(x + dx) [E, B, 1], gradH(x + dx/2) [E, B, 2] and dx:
 ///   dg = g + (H(x+dx) - H(x) - g.dx) / |dx|^2 dx,  = g where |dx| < min_dx_norm.

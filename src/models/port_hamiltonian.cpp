@@ -206,6 +206,10 @@ PhnnS::PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds)
 
 Jet PhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_dissipation*/,
                              const torch::Tensor& u, int order) const {
+  if (order == 0 && nets_[1]->options().fused) {
+    const auto w = internal::phnn_s_w_head(effort.v, u, {S_[2][0], S_[2][1], S_[2][3]});
+    return Jet{internal::phnn_s_field_head(effort.v, u, nets_[1]->forward(w), w, S_), {}, {}};
+  }
   const Jet eq = effort.component(0), ep = effort.component(1);
   const Jet U = Jet::constant(u, /*directions=*/2, order);
   // w = S_wx e + S_wu u (S_ww = 0 for the three systems).
