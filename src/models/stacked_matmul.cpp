@@ -1,12 +1,8 @@
 // src/models/stacked_matmul.cpp
 #include "models/stacked_matmul.h"
 
+#include "models/blas.h"
 #include "phnn/common/check.h"
-
-extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
-                       const int* k, const double* alpha, const double* a, const int* lda,
-                       const double* b, const int* ldb, const double* beta, double* c,
-                       const int* ldc);
 
 namespace phnn {
 namespace internal {

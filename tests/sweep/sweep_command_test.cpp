@@ -238,7 +238,7 @@ TEST(SweepCommandTest, SplitCellsGiveBitwiseTheResultsOfWholeCells) {
   EXPECT_THAT(run_sweep(sweep, whole, 1, "--split off"), HasSubstr("to run in 3 items (3 cells, 0 split)"));
   const ResultsFile reference = ResultsFile::open_read_only(whole);
   for (RunStatus s : reference.read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
-  const std::pair<int, int> cases[] = {{1, 1}, {2, 2}, {2, 1}};  // ranks, max group size
+  const std::pair<int, int> cases[] = {{1, 1}, {2, 2}, {2, 1}, {3, 1}};  // ranks, max group size
   for (const auto& [ranks, group] : cases) {
     SCOPED_TRACE(std::to_string(ranks) + " ranks, groups of " + std::to_string(group));
     const std::string out = dir + "/split" + std::to_string(ranks) + std::to_string(group) + ".h5";

@@ -42,31 +42,32 @@ struct CostModel {
   /// size, no regularizer, indexed [ModelKind][IntegratorKind] (NODE-DG does
   /// not exist). Fit to bench/bench_training `stacked` (fused networks,
   /// docs/BENCHMARKS.md): t(E) = fixed + E member per step from the E = 1
-  /// and E = 10 timings, e.g. small PHNN-JR-RK2 292 and 112 us per
-  /// member-step give fixed 200 and member 92.
+  /// and E = 10 timings, e.g. small PHNN-JR-RK2 279 and 108 us per
+  /// member-step give fixed 190 and member 89.
   double fixed_us[3][2] = {
-      /*kNode=*/{/*kRk2=*/131.0, /*kDg=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/268.0, /*kDg=*/172.0},
-      /*kPhnnJr=*/{/*kRk2=*/200.0, /*kDg=*/193.0},
+      /*kNode=*/{/*kRk2=*/184.0, /*kDg=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/190.0, /*kDg=*/145.0},
+      /*kPhnnJr=*/{/*kRk2=*/190.0, /*kDg=*/197.0},
   };
   /// Per-step cost of each member of a stack [us], same indexing.
   double member_us[3][2] = {
-      /*kNode=*/{/*kRk2=*/43.0, /*kDg=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/113.0, /*kDg=*/129.0},
-      /*kPhnnJr=*/{/*kRk2=*/92.0, /*kDg=*/90.0},
+      /*kNode=*/{/*kRk2=*/33.0, /*kDg=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/103.0, /*kDg=*/80.0},
+      /*kPhnnJr=*/{/*kRk2=*/89.0, /*kDg=*/75.0},
   };
   /// Indexed by ModelSize: small, medium, large. Assumed independent of the
   /// width (the fixed part is per-operator overhead); not measured.
   double fixed_size_factor[3] = {1.0, 1.0, 1.0};
-  /// Indexed by ModelSize. At E = 10 the fused PHNN-JR-RK2 costs 118, 534
-  /// and 1497 us per member-step (small, medium, large; the other models'
-  /// medium/small ratios are 2.2-3.4): 4.0 and 16 with fixed_size_factor 1.
-  double member_size_factor[3] = {1.0, 4.0, 16.0};
+  /// Indexed by ModelSize. At E = 10 the fused models cost 2.5-3.8x (medium;
+  /// PHNN-JR-RK2 measured 534-890 us, noisy) and 13-17x (large PHNN-JR-RK2,
+  /// 1497-1819 us) their small cost per member-step: 3.5 and 16 with
+  /// fixed_size_factor 1.
+  double member_size_factor[3] = {1.0, 3.5, 16.0};
   /// Jacobian (second-order jets for the PHNNs), closed-form SVD /
   /// eigenvalues and their backward in every step (CN, SN, SR), on both
-  /// parts, indexed by ModelKind: measured 2.5x (NODE), 4.7-5.4x (PHNN-S),
-  /// 5.8-6.2x (PHNN-JR).
-  double regularizer_factor[3] = {2.5, 5.0, 6.0};
+  /// parts, indexed by ModelKind: measured with CN at E = 1 and E = 10:
+  /// 2.1-2.3x (NODE), 2.4-3.9x (PHNN-S), 3.1-5.0x (PHNN-JR).
+  double regularizer_factor[3] = {2.3, 3.0, 3.5};
   /// A training step on a batch smaller than reference_batch (N_train < 64)
   /// costs member_us x (1 - small_batch_saving x (64 - batch) / 64) per
   /// member (validation and inference are not affected).
