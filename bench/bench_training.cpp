@@ -64,19 +64,21 @@ double time_cell(CellSpec cell, int steps) {
   return seconds_since(t0);
 }
 
+// Every model x integrator of the paper.
+const std::pair<phnn::ModelKind, phnn::IntegratorKind> kModels[] = {
+    {phnn::ModelKind::kNode, phnn::IntegratorKind::kRk2},
+    {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kRk2},
+    {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kDg},
+    {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kRk2},
+    {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kDg}};
+
 // Fused networks against the op-by-op reference path, interleaved run by
 // run in one process (E = 10, batch 64): the before/after of the fused node.
 int compare(int repeats, phnn::ModelSize size) {
-  const std::pair<phnn::ModelKind, phnn::IntegratorKind> models[] = {
-      {phnn::ModelKind::kNode, phnn::IntegratorKind::kRk2},
-      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kRk2},
-      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kDg},
-      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kRk2},
-      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kDg}};
   std::printf("size %s, E = 10, µs per member-step, median of %d interleaved runs\n",
               phnn::to_string(size).c_str(), repeats);
   std::printf("| model | regularizer | reference | fused | speed-up |\n|---|---|---|---|---|\n");
-  for (const auto& [model, integrator] : models) {
+  for (const auto& [model, integrator] : kModels) {
     for (phnn::Regularizer reg : {phnn::Regularizer::kNone, phnn::Regularizer::kCn}) {
       CellSpec cell;
       cell.model = model;
@@ -106,15 +108,9 @@ int compare(int repeats, phnn::ModelSize size) {
 }
 
 int stacked(int repeats) {
-  const std::pair<phnn::ModelKind, phnn::IntegratorKind> models[] = {
-      {phnn::ModelKind::kNode, phnn::IntegratorKind::kRk2},
-      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kRk2},
-      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kDg},
-      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kRk2},
-      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kDg}};
   std::printf("| model | regularizer | E = 1 [µs/member-step] | E = 10 [µs/member-step] |\n");
   std::printf("|---|---|---|---|\n");
-  for (const auto& [model, integrator] : models) {
+  for (const auto& [model, integrator] : kModels) {
     for (phnn::Regularizer reg : {phnn::Regularizer::kNone, phnn::Regularizer::kCn}) {
       double us[2];
       int k = 0;

@@ -357,6 +357,120 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
   }
 };
 
+// ------------------------------------------------- PHNN-JR, first-order jet
+// The field and its x-tangents (direction i): eps = (e, u), eps_i = (K_i, 0)
+// with K_i = d e / d x_i, L_i = the lower triangle of o_g[i]:
+//   v = L eps,  v_i = L_i eps + L eps_i,  r = L^T v,  r_i = L_i^T v + L^T v_i,
+//   f_c = sum_j J_cj eps_j - r_c,  f_ic = sum_j J_cj eps_ij - r_ic   (c = 0, 1).
+// Backward with f~, f~_i (r~ = -f~, r~_i = -f~_i, third components 0):
+//   v~ = L r~ + sum_i L_i r~_i,  v~_i = L r~_i,
+//   L~ = v r~^T + sum_i v_i r~_i^T + v~ eps^T + sum_i v~_i eps_i^T,
+//   L~_i = v r~_i^T + v~_i eps^T,
+//   eps~ = J^T f~ + L^T v~ + sum_i L_i^T v~_i,  eps~_i = J^T f~_i + L^T v~_i,
+// keeping the lower-triangle entries of L~ and L~_i.
+class JrJetFunction : public torch::autograd::Function<JrJetFunction> {
+ public:
+  static variable_list forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& k_in,
+                               const Tensor& o_in, const Tensor& og_in, const Tensor& u_in,
+                               std::array<std::array<double, 3>, 3> J) {
+    const Tensor e = dense(e_in), K = dense(k_in), o = dense(o_in), og = dense(og_in), u = dense(u_in);
+    const int64_t E = e.size(0), B = e.size(1), rows = E * B;
+    Tensor f = torch::empty({E, B, 2}, e.options()), fg = torch::empty({E, B, 2, 2}, e.options());
+    const double *pe = e.data_ptr<double>(), *pk = K.data_ptr<double>(), *po = o.data_ptr<double>();
+    const double *pog = og.data_ptr<double>(), *pu = u.data_ptr<double>();
+    double *pf = f.data_ptr<double>(), *pfg = fg.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+      const double* L = po + 6 * r;
+      double v[3], rv[3];
+      lower_times(L, eps, v);
+      lower_transpose_times(L, v, rv);
+      for (int c = 0; c < 2; ++c) pf[2 * r + c] = J[c][0] * eps[0] + J[c][1] * eps[1] + J[c][2] * eps[2] - rv[c];
+      for (int i = 0; i < 2; ++i) {
+        const double eps_i[3] = {pk[4 * r + 2 * i], pk[4 * r + 2 * i + 1], 0.0};
+        const double* Li = pog + 12 * r + 6 * i;
+        double vi[3], a[3], b[3], ri[3];
+        lower_times(Li, eps, vi);
+        lower_times(L, eps_i, a);
+        for (int k = 0; k < 3; ++k) vi[k] += a[k];
+        lower_transpose_times(Li, v, ri);
+        lower_transpose_times(L, vi, b);
+        for (int c = 0; c < 2; ++c) {
+          pfg[4 * r + 2 * i + c] = J[c][0] * eps_i[0] + J[c][1] * eps_i[1] - (ri[c] + b[c]);
+        }
+      }
+    }
+    ctx->save_for_backward({e, K, o, og, u});
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) ctx->saved_data["J" + std::to_string(3 * i + j)] = J[i][j];
+    return {f, fg};
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const Tensor &e = saved[0], &K = saved[1], &o = saved[2], &og = saved[3], &u = saved[4];
+    double J[3][3];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) J[i][j] = ctx->saved_data["J" + std::to_string(3 * i + j)].toDouble();
+    const int64_t E = e.size(0), B = e.size(1), rows = E * B;
+    const Tensor fb = grads[0].defined() ? dense(grads[0]) : torch::zeros_like(e);
+    const Tensor fgb = grads[1].defined() ? dense(grads[1]) : torch::zeros({E, B, 2, 2}, e.options());
+    Tensor e_bar = torch::empty_like(e), k_bar = torch::empty_like(K), o_bar = torch::empty_like(o);
+    Tensor og_bar = torch::empty_like(og), u_bar = torch::empty_like(u);
+    const double *pe = e.data_ptr<double>(), *pk = K.data_ptr<double>(), *po = o.data_ptr<double>();
+    const double *pog = og.data_ptr<double>(), *pu = u.data_ptr<double>();
+    const double *pfb = fb.data_ptr<double>(), *pfgb = fgb.data_ptr<double>();
+    double *peb = e_bar.data_ptr<double>(), *pkb = k_bar.data_ptr<double>();
+    double *pob = o_bar.data_ptr<double>(), *pogb = og_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+      const double* L = po + 6 * r;
+      const double* Li[2] = {pog + 12 * r, pog + 12 * r + 6};
+      double eps_i[2][3], v[3], vi[2][3];
+      lower_times(L, eps, v);
+      for (int i = 0; i < 2; ++i) {
+        eps_i[i][0] = pk[4 * r + 2 * i], eps_i[i][1] = pk[4 * r + 2 * i + 1], eps_i[i][2] = 0.0;
+        double a[3];
+        lower_times(Li[i], eps, vi[i]);
+        lower_times(L, eps_i[i], a);
+        for (int k = 0; k < 3; ++k) vi[i][k] += a[k];
+      }
+      const double rb[3] = {-pfb[2 * r], -pfb[2 * r + 1], 0.0};
+      double rib[2][3], vb[3], vib[2][3], tmp[3];
+      lower_times(L, rb, vb);
+      for (int i = 0; i < 2; ++i) {
+        rib[i][0] = -pfgb[4 * r + 2 * i], rib[i][1] = -pfgb[4 * r + 2 * i + 1], rib[i][2] = 0.0;
+        lower_times(Li[i], rib[i], tmp);
+        for (int k = 0; k < 3; ++k) vb[k] += tmp[k];
+        lower_times(L, rib[i], vib[i]);
+      }
+      double* ob = pob + 6 * r;
+      for (int k = 0; k < 6; ++k) {
+        const int a = kRow[k], b = kCol[k];
+        double s = v[a] * rb[b] + vb[a] * eps[b];
+        for (int i = 0; i < 2; ++i) s += vi[i][a] * rib[i][b] + vib[i][a] * eps_i[i][b];
+        ob[k] = s;
+        for (int i = 0; i < 2; ++i) pogb[12 * r + 6 * i + k] = v[a] * rib[i][b] + vib[i][a] * eps[b];
+      }
+      double eb[3];
+      lower_transpose_times(L, vb, eb);
+      for (int i = 0; i < 2; ++i) {
+        lower_transpose_times(Li[i], vib[i], tmp);
+        for (int k = 0; k < 3; ++k) eb[k] += tmp[k];
+      }
+      for (int j = 0; j < 3; ++j) eb[j] += J[0][j] * pfb[2 * r] + J[1][j] * pfb[2 * r + 1];
+      peb[2 * r] = eb[0], peb[2 * r + 1] = eb[1], pub[r] = eb[2];
+      for (int i = 0; i < 2; ++i) {
+        lower_transpose_times(L, vib[i], tmp);
+        for (int a = 0; a < 2; ++a) {
+          pkb[4 * r + 2 * i + a] = tmp[a] + J[0][a] * pfgb[4 * r + 2 * i] + J[1][a] * pfgb[4 * r + 2 * i + 1];
+        }
+      }
+    }
+    return {e_bar, k_bar, o_bar, og_bar, u_bar, Tensor()};
+  }
+};
+
 // ---------------------------------------------------------------- PHNN-S
 // Per row: w = S_w0 e0 + S_w1 e1 + S_w3 u (S_ww = 0), and from w and the L_z
 // output l: f_i = S_i0 e0 + S_i1 e1 + S_i2 l^2 w + S_i3 u (i = 0, 1).
@@ -536,6 +650,16 @@ torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
               "jr_field_head: expected e [E, B, 2], o [E, B, 6], u [E, B, 1], got ",
               effort.sizes(), ", ", o.sizes(), ", ", u.sizes());
   return JrFieldFunction::apply(effort, o, u.expand({effort.size(0), effort.size(1), 1}), J);
+}
+
+JrFieldJet jr_field_jet_head(const torch::Tensor& effort, const torch::Tensor& effort_g,
+                             const torch::Tensor& o, const torch::Tensor& o_g, const torch::Tensor& u,
+                             const std::array<std::array<double, 3>, 3>& J) {
+  TORCH_CHECK(effort_g.dim() == 4 && effort_g.size(2) == 2 && o_g.dim() == 4 && o_g.size(2) == 2,
+              "jr_field_jet_head: expected 2 directions, got ", effort_g.sizes(), " and ", o_g.sizes());
+  const auto out = JrJetFunction::apply(effort, effort_g, o, o_g,
+                                        u.expand({effort.size(0), effort.size(1), 1}), J);
+  return {out[0], out[1]};
 }
 
 torch::Tensor phnn_s_w_head(const torch::Tensor& effort, const torch::Tensor& u,

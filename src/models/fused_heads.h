@@ -39,6 +39,17 @@ HamiltonianCurvature hamiltonian_curvature_head(const torch::Tensor& o, const to
 torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
                             const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J);
 
+/// The PHNN-JR field and its x-derivatives (first-order jet) from the effort
+/// e [E, B, 2] with its tangents e_g [E, B, 2 (direction), 2], the L_R outputs
+/// o [E, B, 6] with theirs o_g [E, B, 2, 6], and u [E, B, 1] (constant):
+/// returns f [E, B, 2] and g [E, B, 2 (direction), 2] = d f / d x_i.
+struct JrFieldJet {
+  torch::Tensor f, g;
+};
+JrFieldJet jr_field_jet_head(const torch::Tensor& effort, const torch::Tensor& effort_g,
+                             const torch::Tensor& o, const torch::Tensor& o_g, const torch::Tensor& u,
+                             const std::array<std::array<double, 3>, 3>& J);
+
 /// PHNN-S (eq:f_theta-PHS-DAF), in two heads around the L_z network:
 ///   w = S_wx e + S_wu u  (s_w = (S_w0, S_w1, S_w3); S_ww = 0),
 ///   f = S_xx e + S_xw l(w)^2 w + S_xu u  (rows 0, 1 of S; l = L_z(w) [E, B, 1]).

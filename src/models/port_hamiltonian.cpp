@@ -268,6 +268,10 @@ Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipat
   }
   // L_R(x, u): lower triangular 3 x 3 from 6 outputs, row by row.
   const Jet o = nets_[1]->forward_input(torch::cat({x_dissipation, u}, -1), 2, order);
+  if (order == 1 && nets_[1]->options().fused && effort.g.defined()) {
+    const auto jet = internal::jr_field_jet_head(effort.v, effort.g, o.v, o.g, u, J_);
+    return Jet{jet.f, jet.g, {}};
+  }
   Jet L[3][3];
   int idx = 0;
   for (int k = 0; k < 3; ++k)
