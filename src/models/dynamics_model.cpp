@@ -14,11 +14,12 @@ torch::Tensor DynamicsModel::discrete_gradient_field(const torch::Tensor&, const
   return {};
 }
 
-FieldEval DynamicsModel::discrete_gradient_field_with_jacobian(const torch::Tensor& x,
-                                                               const torch::Tensor& dx,
-                                                               const torch::Tensor& u,
-                                                               double min_dx_norm) const {
-  discrete_gradient_field(x, dx, u, min_dx_norm);  // throws: no Hamiltonian
+FieldEval DynamicsModel::discrete_gradient_field_with_jacobian(const torch::Tensor&,
+                                                               const torch::Tensor&,
+                                                               const torch::Tensor&,
+                                                               double) const {
+  PHNN_REQUIRE(false, "discrete_gradient_field_with_jacobian: " << to_string(options_.kind)
+                                                                << " has no Hamiltonian");
   return {};
 }
 

@@ -3,6 +3,7 @@
 #include "models/fused_heads.h"
 
 #include <cmath>
+#include <vector>
 
 namespace phnn {
 namespace internal {
@@ -25,6 +26,23 @@ struct SoftplusSigmoid {
 };
 
 Tensor dense(const Tensor& t) { return t.contiguous(); }
+
+// A head's constant structure matrix (J or S), kept for its backward as one
+// list entry of the context.
+template <std::size_t R, std::size_t C>
+void save_matrix(AutogradContext* ctx, const std::array<std::array<double, C>, R>& m) {
+  std::vector<double> flat;
+  for (const auto& row : m) flat.insert(flat.end(), row.begin(), row.end());
+  ctx->saved_data["matrix"] = flat;
+}
+template <std::size_t R, std::size_t C>
+std::array<std::array<double, C>, R> load_matrix(AutogradContext* ctx) {
+  const std::vector<double> flat = ctx->saved_data["matrix"].toDoubleVector();
+  std::array<std::array<double, C>, R> m;
+  for (std::size_t i = 0; i < R; ++i)
+    for (std::size_t j = 0; j < C; ++j) m[i][j] = flat[i * C + j];
+  return m;
+}
 
 // ------------------------------------------------------------ Hamiltonian
 // Per row, with l00 = softplus(o0), l10 = o1, l11 = softplus(o2), s_k =
@@ -320,17 +338,14 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
       }
     }
     ctx->save_for_backward({e, o, u});
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) ctx->saved_data["J" + std::to_string(3 * i + j)] = J[i][j];
+    save_matrix(ctx, J);
     return f;
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const Tensor &e = saved[0], &o = saved[1], &u = saved[2];
-    double J[3][3];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) J[i][j] = ctx->saved_data["J" + std::to_string(3 * i + j)].toDouble();
+    const auto J = load_matrix<3, 3>(ctx);
     const Tensor fb = dense(grads[0]);
     const int64_t rows = e.size(0) * e.size(1);
     Tensor e_bar = torch::empty_like(e), o_bar = torch::empty_like(o), u_bar = torch::empty_like(u);
@@ -401,17 +416,14 @@ class JrJetFunction : public torch::autograd::Function<JrJetFunction> {
       }
     }
     ctx->save_for_backward({e, K, o, og, u});
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) ctx->saved_data["J" + std::to_string(3 * i + j)] = J[i][j];
+    save_matrix(ctx, J);
     return {f, fg};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const Tensor &e = saved[0], &K = saved[1], &o = saved[2], &og = saved[3], &u = saved[4];
-    double J[3][3];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) J[i][j] = ctx->saved_data["J" + std::to_string(3 * i + j)].toDouble();
+    const auto J = load_matrix<3, 3>(ctx);
     const int64_t E = e.size(0), B = e.size(1), rows = E * B;
     const Tensor fb = grads[0].defined() ? dense(grads[0]) : torch::zeros_like(e);
     const Tensor fgb = grads[1].defined() ? dense(grads[1]) : torch::zeros({E, B, 2, 2}, e.options());
@@ -488,13 +500,12 @@ class PhnnSWFunction : public torch::autograd::Function<PhnnSWFunction> {
     const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
     double* pw = w.data_ptr<double>();
     for (int64_t r = 0; r < rows; ++r) pw[r] = s[0] * pe[2 * r] + s[1] * pe[2 * r + 1] + s[2] * pu[r];
-    ctx->saved_data["s0"] = s[0], ctx->saved_data["s1"] = s[1], ctx->saved_data["s2"] = s[2];
-    ctx->saved_data["rows"] = rows;
+    ctx->saved_data["s"] = std::vector<double>(s.begin(), s.end());
     return w;
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
-    const double s0 = ctx->saved_data["s0"].toDouble(), s1 = ctx->saved_data["s1"].toDouble(),
-                 s2 = ctx->saved_data["s2"].toDouble();
+    const std::vector<double> s = ctx->saved_data["s"].toDoubleVector();
+    const double s0 = s[0], s1 = s[1], s2 = s[2];
     const Tensor wb = dense(grads[0]);
     const int64_t E = wb.size(0), B = wb.size(1), rows = E * B;
     Tensor e_bar = torch::empty({E, B, 2}, wb.options()), u_bar = torch::empty({E, B, 1}, wb.options());
@@ -524,16 +535,13 @@ class PhnnSFieldFunction : public torch::autograd::Function<PhnnSFieldFunction> 
       }
     }
     ctx->save_for_backward({l, w});
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 4; ++j) ctx->saved_data["S" + std::to_string(4 * i + j)] = S[i][j];
+    save_matrix(ctx, S);
     return f;
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
     const Tensor &l = saved[0], &w = saved[1];
-    double S[2][4];
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 4; ++j) S[i][j] = ctx->saved_data["S" + std::to_string(4 * i + j)].toDouble();
+    const auto S = load_matrix<4, 4>(ctx);
     const Tensor fb = dense(grads[0]);
     const int64_t E = l.size(0), B = l.size(1), rows = E * B;
     Tensor e_bar = torch::empty({E, B, 2}, l.options()), u_bar = torch::empty_like(l);

@@ -35,7 +35,6 @@ DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tenso
   const bool have_cache = cache && cache->dfddx.defined() && cache->dfddx.size(0) == x.size(0) &&
                           cache->dfddx.size(1) == x.size(1);
   torch::Tensor jacobian = have_cache ? cache->dfddx : torch::zeros({x.size(0), x.size(1), 2, 2}, x.options());
-  auto refresh = torch::full(row_shape, !have_cache, x.options().dtype(torch::kBool));
   torch::Tensor previous_norm;
   for (int it = 0;; ++it) {
     // r(dx) = dx - h f_bar(x, dx, u);  r'(dx) = I - h d f_bar / d dx.
@@ -43,14 +42,17 @@ DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tenso
     const auto norm = std::get<0>(r.abs().max(-1));
     converged = converged.logical_or(norm <= options.tolerance);
     if (it == options.max_iterations || converged.all().item<bool>()) break;
-    if (previous_norm.defined()) refresh = refresh | (norm > 0.1 * previous_norm);
-    refresh = refresh & converged.logical_not();
+    // First iteration: every row without a cached Jacobian; then the rows
+    // whose residual shrank less than 10x.
+    const auto refresh = (previous_norm.defined()
+                              ? norm > 0.1 * previous_norm
+                              : torch::full(row_shape, !have_cache, converged.options())) &
+                         converged.logical_not();
     if (refresh.any().item<bool>()) {
       const auto fresh = model.discrete_gradient_field_with_jacobian(x, dx, u, options.min_dx_norm).dfdx;
       jacobian = torch::where(refresh.unsqueeze(-1).unsqueeze(-1), fresh, jacobian);
       ++out.jacobian_evaluations;
     }
-    refresh = torch::zeros_like(refresh);
     previous_norm = norm;
     const auto jac = -h * jacobian;  // + I on the diagonal below
     const auto a = 1.0 + jac.select(-1, 0).select(-1, 0), b = jac.select(-2, 0).select(-1, 1);

@@ -151,7 +151,7 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   std::unique_ptr<DynamicsModel> model =
       DynamicsModel::create(
-      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks}, seeds);
+          ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks}, seeds);
   // One contiguous leaf for the whole stack: Adam in a handful of ops.
   const DynamicsModel::FlatParameters flat = model->flatten_parameters();
   const std::vector<torch::Tensor> params = model->parameters();  // alias flat.values
@@ -239,9 +239,9 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
 
   BatchSampler sampler(cell.seeds, N, opt.batch_size);
   evaluate(0);
+  // Every pair in every step when N <= batch: no gather needed.
+  const bool full_batch = N <= opt.batch_size;
   for (int step = 1; step <= opt.steps; ++step) {
-    // Every pair in every step when N <= batch: no gather needed.
-    const bool full_batch = N <= opt.batch_size;
     const auto idx = full_batch ? torch::Tensor() : sampler.next();
     const auto x = full_batch ? Xall : X.index({idx});
     const auto xn = full_batch ? Xnall : Xn.index({idx});
