@@ -123,6 +123,12 @@ double Oscillator::dissipation_derivative(double w) const {
   return a[0] + w * (2.0 * a[1] + 3.0 * w * a[2]);
 }
 
+double Oscillator::dissipation_second_derivative(double w) const {
+  if (options_.kind != SystemKind::kSelfSustained) return 0.0;
+  const auto& a = options_.z_coefficients;
+  return 2.0 * a[1] + 6.0 * w * a[2];
+}
+
 Eigen::Matrix3d Oscillator::J() const {
   Eigen::Matrix3d j;
   if (options_.kind == SystemKind::kSelfSustained) {
@@ -189,6 +195,28 @@ Mat2 Oscillator::discrete_gradient_jacobian(const Vec2& x,
       grad_phi(1) = -num * 2.0 * dp / (n2 * n2);
       jac += phi * Mat2::Identity() + dx * grad_phi.transpose();
     }
+  }
+  return jac;
+}
+
+Vec2 Oscillator::average_vector_field_gradient(const Vec2& x,
+                                               const Vec2& dx) const {
+  const Vec2 mid = x + 0.5 * dx;
+  Vec2 g = grad_hamiltonian(mid);
+  if (options_.kind == SystemKind::kDuffing) {
+    // int_0^1 k3 (a + (s - 1/2) dq)^3 ds = k3 (a^3 + a dq^2 / 4).
+    g(0) += 0.25 * options_.cubic_stiffness * mid(0) * dx(0) * dx(0);
+  }
+  return g;
+}
+
+Mat2 Oscillator::average_vector_field_jacobian(const Vec2& x,
+                                               const Vec2& dx) const {
+  Mat2 jac = 0.5 * hessian(x + 0.5 * dx);
+  if (options_.kind == SystemKind::kDuffing) {
+    // d/d dq of k3 a dq^2 / 4 with a = q + dq/2: k3 (dq^2 / 8 + a dq / 2).
+    const double a = x(0) + 0.5 * dx(0), dq = dx(0);
+    jac(0, 0) += options_.cubic_stiffness * (dq * dq / 8.0 + 0.5 * a * dq);
   }
   return jac;
 }

@@ -77,6 +77,8 @@ class Oscillator {
   /// Dissipation law z(w) and z'(w).
   double dissipation(double w) const;
   double dissipation_derivative(double w) const;
+  /// z''(w): 0 for the linear dampers, 6 z3 w + 2 z2 for the cubic law.
+  double dissipation_second_derivative(double w) const;
 
   /// S of eq:phs_S (SPEC.md §1 table).
   const Eigen::Matrix4d& S() const { return S_; }
@@ -98,6 +100,17 @@ class Oscillator {
 
   /// d dg / d dx (2 x 2), used by Newton in the implicit DG step.
   Mat2 discrete_gradient_jacobian(const Vec2& x, const Vec2& dx) const;
+
+  /// Average-vector-field discrete gradient, exact for these polynomial H:
+  ///   avf(x, dx) = int_0^1 gradH(x + s dx) ds
+  ///             = gradH(a) + (k3 a dq^2 / 4) e_q,   a = x + dx/2 (midpoint),
+  /// (the odd moments of s - 1/2 vanish). It is a discrete gradient
+  /// (avf^T dx = H(x + dx) - H(x), avf(x, 0) = gradH(x)) and, unlike the
+  /// Gonzalez one, matches gradH(a) + H'''(a)[dx, dx] / 24 to O(|dx|^4):
+  /// the property the fourth-order scheme of discrete_gradient4.h needs.
+  Vec2 average_vector_field_gradient(const Vec2& x, const Vec2& dx) const;
+  /// d avf / d dx (2 x 2).
+  Mat2 average_vector_field_jacobian(const Vec2& x, const Vec2& dx) const;
 
   /// I_w = {w : z'(w) < 0} of Algorithm 4 (self-sustained only): the open
   /// interval between the roots of z'(w). Throws if it is empty.
