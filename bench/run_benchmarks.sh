@@ -52,3 +52,8 @@ echo "## anchor: plain PyTorch eager vs the stacked step"
 /usr/bin/python3 bench/pytorch_step.py --repeats "$REPEATS" --check
 
 if [[ ${FULL_CELL:-0} == 1 ]]; then run cell; fi
+
+echo "## integrator work-precision (true systems; CSV + PNG into docs/figures/)"
+cmake --build build --target work_precision
+build/work_precision --trajectories 10 --repeats 5 > docs/figures/work_precision.csv
+/usr/bin/python3 analysis/plot_work_precision.py docs/figures/work_precision.csv docs/figures

@@ -1,0 +1,213 @@
+// bench/work_precision.cpp — integrator work-precision study on the true
+// systems: wall time per trajectory against error, for the explicit
+// midpoint (RK2), the Gonzalez discrete gradient (DG), classical RK4 and
+// the fourth-order discrete gradient (DG4), over h = 1/12.5 s ... 1/3200 s.
+//
+//   build/work_precision [--trajectories N] [--repeats R] > wp.csv
+//   python3 analysis/plot_work_precision.py wp.csv docs/figures/
+//
+// Error: RMS over trajectories and the sample times t_k = k / 12.5 s
+// (k = 1..50, common to every h) of ||x(t_k) - x_ref(t_k)||, against RK4 at
+// h_ref = (1/3200 s) / 64 (its error, ~(omega h_ref)^4, is below
+// round-off). Trajectories: the first N of the inference split of the data
+// set (initial state and input by the generator's algorithms), 4 s each.
+// Time: median over R repeats of (wall time for all trajectories) / N.
+// Power residual: worst |H(x_{n+1}) - H(x_n) - h P_n| / (|H(x_n)| + h |P_n|)
+// with P_n the scheme's own discrete port power (DG, DG4: exact identities,
+// expected at round-off); RK2 and RK4 have no discrete port power, so the
+// trapezoidal P_n = -(p(x_n) + p(x_{n+1})) / 2 with p = z w + u y is used:
+// their residual shows how far they are from a balance (O(h^3) per step).
+// Reads no file, writes only to standard output.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "phnn/data/dataset.h"
+#include "phnn/integrators/discrete_gradient.h"
+#include "phnn/integrators/discrete_gradient4.h"
+#include "phnn/integrators/explicit_midpoint.h"
+#include "phnn/integrators/runge_kutta4.h"
+
+namespace phnn {
+namespace {
+
+constexpr double kSampleInterval = 1.0 / 12.5;  // s: the coarsest h
+constexpr int kSamples = 50;                    // 4 s
+constexpr int kLevels = 9;                      // h = 1/12.5 ... 1/3200
+constexpr double kDivergedNorm = 1e6;
+
+enum class Method { kRk2, kDg, kRk4, kDg4 };
+const char* name_of(Method m) {
+  switch (m) {
+    case Method::kRk2: return "rk2";
+    case Method::kDg: return "dg";
+    case Method::kRk4: return "rk4";
+    case Method::kDg4: return "dg4";
+  }
+  return "?";
+}
+
+// Continuous port power p(x) = z(w) w + u y at the true effort gradH(x).
+double port_power(const Oscillator& osc, const Vec2& x, double u) {
+  const PortFlows f = osc.flows(osc.grad_hamiltonian(x), u);
+  return f.z * f.w + u * f.y;
+}
+
+struct StepResult {
+  Vec2 x_next;
+  double balance_residual = 0.0;  // relative, see the file header
+  bool newton_failed = false;
+};
+
+StepResult step(Method m, const Oscillator& osc, const Vec2& x, double u,
+                double h) {
+  StepResult r;
+  double power = 0.0;  // h times the discrete port power of the step
+  if (m == Method::kDg) {
+    const DiscreteGradientStep s = discrete_gradient_step(osc, x, u, h);
+    r.x_next = s.x_next;
+    r.newton_failed = s.status != StepStatus::kConverged;
+    power = -h * (s.flows.z * s.flows.w + u * s.flows.y);
+  } else if (m == Method::kDg4) {
+    const DiscreteGradient4Step s = discrete_gradient4_step(osc, x, u, h);
+    r.x_next = s.x_next;
+    r.newton_failed = s.status != StepStatus::kConverged;
+    power = -h * (s.flows.z * s.flows.w + u * s.flows.y) +
+            h * h * h * s.correction_power;
+  } else {
+    r.x_next = m == Method::kRk2 ? explicit_midpoint_step(osc, x, u, h)
+                                 : runge_kutta4_step(osc, x, u, h);
+    power = -0.5 * h * (port_power(osc, x, u) + port_power(osc, r.x_next, u));
+  }
+  const double H0 = osc.hamiltonian(x);
+  const double dH = osc.hamiltonian(r.x_next) - H0;
+  r.balance_residual = std::abs(dH - power) / (std::abs(H0) + std::abs(power));
+  return r;
+}
+
+struct Run {
+  std::vector<Vec2> samples;  // x(t_k), k = 1..kSamples
+  double worst_balance = 0.0;
+  int newton_failures = 0;
+  bool diverged = false;
+};
+
+Run integrate(Method m, const Oscillator& osc, const TrajectorySpec& spec,
+              int steps_per_sample) {
+  const double h = kSampleInterval / steps_per_sample;
+  Run run;
+  Vec2 x = spec.x0;
+  for (int k = 0; k < kSamples && !run.diverged; ++k) {
+    for (int n = 0; n < steps_per_sample; ++n) {
+      const StepResult s = step(m, osc, x, spec.u, h);
+      run.worst_balance = std::max(run.worst_balance, s.balance_residual);
+      run.newton_failures += s.newton_failed;
+      x = s.x_next;
+      if (!x.allFinite() || x.norm() > kDivergedNorm) {
+        run.diverged = true;
+        break;
+      }
+    }
+    run.samples.push_back(x);
+  }
+  return run;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct Options {
+  int trajectories = 10;
+  int repeats = 5;
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if ((a == "--trajectories" || a == "--repeats") && i + 1 < argc) {
+      const int v = std::atoi(argv[++i]);
+      if (v < 1) {
+        std::fprintf(stderr, "work_precision: %s must be >= 1\n", a.c_str());
+        std::exit(2);
+      }
+      (a == "--trajectories" ? o.trajectories : o.repeats) = v;
+    } else {
+      std::fprintf(stderr,
+                   "usage: work_precision [--trajectories N] [--repeats R]\n");
+      std::exit(2);
+    }
+  }
+  return o;
+}
+
+void run_system(SystemKind kind, const Options& o) {
+  const Oscillator osc(OscillatorOptions::defaults(kind));
+  const DatasetOptions data;
+  std::vector<TrajectorySpec> specs;
+  for (int i = 0; i < o.trajectories; ++i) {
+    specs.push_back(trajectory_spec(osc, data, data.inference_begin() + i));
+  }
+  const int ref_steps = (1 << (kLevels - 1)) * 64;
+  std::vector<Run> reference;
+  for (const auto& s : specs) {
+    reference.push_back(integrate(Method::kRk4, osc, s, ref_steps));
+  }
+  for (Method m : {Method::kRk2, Method::kDg, Method::kRk4, Method::kDg4}) {
+    for (int level = 0; level < kLevels; ++level) {
+      const int per_sample = 1 << level;
+      std::vector<Run> runs;
+      std::vector<double> seconds;
+      for (int r = 0; r < o.repeats; ++r) {
+        runs.clear();
+        const auto t0 = std::chrono::steady_clock::now();
+        for (const auto& s : specs) runs.push_back(integrate(m, osc, s, per_sample));
+        const auto t1 = std::chrono::steady_clock::now();
+        seconds.push_back(std::chrono::duration<double>(t1 - t0).count() /
+                          o.trajectories);
+      }
+      double sum2 = 0.0, worst = 0.0, balance = 0.0;
+      int failures = 0, diverged = 0;
+      for (std::size_t i = 0; i < runs.size(); ++i) {
+        diverged += runs[i].diverged;
+        failures += runs[i].newton_failures;
+        balance = std::max(balance, runs[i].worst_balance);
+        for (int k = 0; k < kSamples; ++k) {
+          const double e =
+              runs[i].diverged
+                  ? std::numeric_limits<double>::infinity()
+                  : (runs[i].samples[k] - reference[i].samples[k]).norm();
+          sum2 += e * e;
+          worst = std::max(worst, e);
+        }
+      }
+      std::printf("%s,%s,%.10g,%d,%.6e,%.6e,%.6e,%.3e,%d,%d\n",
+                  to_string(kind).c_str(), name_of(m),
+                  kSampleInterval / per_sample, per_sample * kSamples,
+                  std::sqrt(sum2 / (runs.size() * kSamples)), worst,
+                  median(seconds), balance, failures, diverged);
+      std::fflush(stdout);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace phnn
+
+int main(int argc, char** argv) {
+  const phnn::Options o = phnn::parse(argc, argv);
+  std::printf(
+      "system,method,h,steps,rms_error,max_error,seconds_per_trajectory,"
+      "worst_balance_residual,newton_failures,diverged_trajectories\n");
+  for (phnn::SystemKind kind : phnn::all_systems()) phnn::run_system(kind, o);
+  return 0;
+}
