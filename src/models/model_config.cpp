@@ -1,6 +1,7 @@
 // src/models/model_config.cpp
 #include "phnn/models/model_config.h"
 
+#include <cctype>
 #include <stdexcept>
 
 namespace phnn {
@@ -15,7 +16,12 @@ std::string to_string(ModelKind kind) {
 }
 
 std::string to_string(IntegratorKind kind) {
-  return kind == IntegratorKind::kRk2 ? "rk2" : "dg";
+  switch (kind) {
+    case IntegratorKind::kRk2: return "rk2";
+    case IntegratorKind::kDg: return "dg";
+    case IntegratorKind::kRk4: return "rk4";
+  }
+  return "unknown";
 }
 
 std::string to_string(ModelSize size) {
@@ -38,7 +44,9 @@ ModelKind parse_model(const std::string& name) {
 IntegratorKind parse_integrator(const std::string& name) {
   if (name == "rk2") return IntegratorKind::kRk2;
   if (name == "dg") return IntegratorKind::kDg;
-  throw std::invalid_argument("unknown integrator \"" + name + "\"; expected one of: rk2, dg");
+  if (name == "rk4") return IntegratorKind::kRk4;
+  throw std::invalid_argument("unknown integrator \"" + name +
+                              "\"; expected one of: rk2, dg, rk4");
 }
 
 ModelSize parse_size(const std::string& name) {
@@ -82,7 +90,9 @@ long parameter_count(ModelKind kind, ModelSize size) {
 
 std::string model_label(ModelKind kind, IntegratorKind integrator) {
   std::string m = kind == ModelKind::kNode ? "NODE" : kind == ModelKind::kPhnnS ? "PHNN-S" : "PHNN-JR";
-  return m + "-" + (integrator == IntegratorKind::kRk2 ? "RK2" : "DG");
+  std::string i = to_string(integrator);
+  for (char& c : i) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return m + "-" + i;
 }
 
 }  // namespace phnn

@@ -44,6 +44,14 @@ std::vector<std::pair<ModelKind, IntegratorKind>> all_model_pairs() {
           {ModelKind::kPhnnS, IntegratorKind::kRk2}};
 }
 
+std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs() {
+  auto pairs = all_model_pairs();
+  for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnJr, ModelKind::kPhnnS}) {
+    pairs.emplace_back(kind, IntegratorKind::kRk4);
+  }
+  return pairs;
+}
+
 namespace {
 
 // ---------------------------------------------------------------------------
@@ -853,7 +861,7 @@ class Resolver {
 
   std::pair<ModelKind, IntegratorKind> parse_model_value(const Value& v) const {
     std::vector<std::string> allowed;
-    for (const auto& [kind, integrator] : all_model_pairs()) {
+    for (const auto& [kind, integrator] : known_model_pairs()) {
       if (model_key(kind, integrator) == v.string) return {kind, integrator};
       allowed.push_back(model_key(kind, integrator));
     }
@@ -871,7 +879,7 @@ class Resolver {
     const std::string formulation = s.substr(0, dash), integrator = s.substr(dash + 1);
     const bool formulation_ok =
         formulation == "node" || formulation == "phnn-jr" || formulation == "phnn-s";
-    const bool integrator_ok = integrator == "rk2" || integrator == "dg";
+    const bool integrator_ok = integrator == "rk2" || integrator == "dg" || integrator == "rk4";
     if (formulation_ok && !integrator_ok) {
       fail(v.line,
            "unknown integrator " + quoted(integrator) + " in models value " + v.raw + expected);

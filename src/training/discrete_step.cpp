@@ -11,6 +11,26 @@ torch::Tensor rk2_step(const DynamicsModel& model, const torch::Tensor& x,
   return x + h * model.field(x + (0.5 * h) * k1, u, false).f;
 }
 
+torch::Tensor rk4_step(const DynamicsModel& model, const torch::Tensor& x,
+                       const torch::Tensor& u, double h) {
+  const auto k1 = model.field(x, u, false).f;
+  const auto k2 = model.field(x + (0.5 * h) * k1, u, false).f;
+  const auto k3 = model.field(x + (0.5 * h) * k2, u, false).f;
+  const auto k4 = model.field(x + h * k3, u, false).f;
+  return x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+}
+
+torch::Tensor explicit_step(const DynamicsModel& model, IntegratorKind integrator,
+                            const torch::Tensor& x, const torch::Tensor& u, double h) {
+  switch (integrator) {
+    case IntegratorKind::kRk2: return rk2_step(model, x, u, h);
+    case IntegratorKind::kRk4: return rk4_step(model, x, u, h);
+    case IntegratorKind::kDg: break;
+  }
+  PHNN_CHECK(false, "explicit_step: " << to_string(integrator) << " is not explicit");
+  return {};
+}
+
 torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& x,
                                const torch::Tensor& x_next, const torch::Tensor& u, double h,
                                double min_dx_norm) {

@@ -175,7 +175,7 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   // L_d (Eq. 30): mean over batch and state components of |x_{n+1} - x_hat| / h.
   auto data_loss = [&](const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u) {
     const auto x_hat = use_dg ? dg_training_step(*model, x, xn, u, h, opt.dg_min_dx_norm)
-                              : rk2_step(*model, x, u, h);
+                              : explicit_step(*model, cell.integrator, x, u, h);
     return ((xn - x_hat).abs() / h).mean({1, 2});
   };
 
@@ -334,7 +334,7 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
       next = s.x_next;
       newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);
     } else {
-      next = rk2_step(*model, x, u, h_inf);
+      next = explicit_step(*model, cell.integrator, x, u, h_inf);
     }
     const auto bad = torch::isfinite(next).all(-1).logical_not() |
                      (next.norm(2, -1) > opt.divergence_norm);

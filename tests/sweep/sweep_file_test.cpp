@@ -221,12 +221,26 @@ TEST(SweepFileErrorTest, UnknownIntegratorInModelsListsTheModels) {
 [grid]
 models = [
   "node-rk2",
-  "phnn-s-rk4",
+  "phnn-s-rk3",
 ]
 )");
   EXPECT_STREQ(e.what(),
-               "x.toml:5: unknown integrator \"rk4\" in models value \"phnn-s-rk4\"; expected "
-               "one of: node-rk2, phnn-jr-dg, phnn-jr-rk2, phnn-s-dg, phnn-s-rk2");
+               "x.toml:5: unknown integrator \"rk3\" in models value \"phnn-s-rk3\"; expected "
+               "one of: node-rk2, phnn-jr-dg, phnn-jr-rk2, phnn-s-dg, phnn-s-rk2, node-rk4, "
+               "phnn-jr-rk4, phnn-s-rk4");
+}
+
+// The fourth-order explicit variants are sweep-file models like the others
+// (not in the default list, which is the paper's five).
+TEST(SweepFileTest, AcceptsRk4Models) {
+  const SweepSpec spec = parse_sweep_text(R"(name = "t"
+[grid]
+models = ["node-rk4", "phnn-jr-rk4", "phnn-s-rk4"]
+)", "x.toml");
+  EXPECT_THAT(spec.studies[0].models,
+              ElementsAre(Pair(ModelKind::kNode, IntegratorKind::kRk4),
+                          Pair(ModelKind::kPhnnJr, IntegratorKind::kRk4),
+                          Pair(ModelKind::kPhnnS, IntegratorKind::kRk4)));
 }
 
 TEST(SweepFileErrorTest, NodeWithDiscreteGradientIsRejected) {

@@ -98,5 +98,8 @@ std::string model_key(ModelKind kind, IntegratorKind integrator);
 /// The five valid pairs in the order node-rk2, phnn-jr-dg, phnn-jr-rk2,
 /// phnn-s-dg, phnn-s-rk2 (NODE has RK2 only, SPEC.md §3).
 std::vector<std::pair<ModelKind, IntegratorKind>> all_model_pairs();
+/// Every pair a sweep file may name: the paper's five and the RK4 variants
+/// of the three formulations (node-rk4, phnn-jr-rk4, phnn-s-rk4).
+std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs();
 
 }  // namespace phnn

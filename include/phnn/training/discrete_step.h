@@ -12,6 +12,16 @@ namespace phnn {
 torch::Tensor rk2_step(const DynamicsModel& model, const torch::Tensor& x,
                        const torch::Tensor& u, double h);
 
+/// Classical RK4 (include/phnn/integrators/runge_kutta4.h has the tableau):
+///   x_hat = x + h (k1 + 2 k2 + 2 k3 + k4) / 6, four evaluations of f.
+torch::Tensor rk4_step(const DynamicsModel& model, const torch::Tensor& x,
+                       const torch::Tensor& u, double h);
+
+/// The explicit discrete model of `integrator` (rk2 or rk4; throws for dg,
+/// which needs x_next in training and Newton at inference).
+torch::Tensor explicit_step(const DynamicsModel& model, IntegratorKind integrator,
+                            const torch::Tensor& x, const torch::Tensor& u, double h);
+
 /// DG in training, inverse-explicit (SPEC.md §4): with the data step
 /// dx = x_next - x, x_hat = x + h f_bar(x, dx, u).
 torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& x,
