@@ -90,7 +90,7 @@ int run_train(int argc, char** argv, int first) {
                      "then rolls every member out over the inference set (SPEC.md §3-§5).");
   parser.option("system", "harmonic | duffing | self-sustained", "", true);
   parser.option("model", "node | phnn-s | phnn-jr", "", true);
-  parser.option("integrator", "rk2 | dg | rk4 (node: rk2 or rk4)", "rk2");
+  parser.option("integrator", "rk2 | dg | rk4 | dg4 (node: rk2 or rk4)", "rk2");
   parser.option("size", "small | medium | large", "small");
   parser.option("n-train", "training pairs (1..400)", "25");
   parser.option("reg", "none | cn | sn | sr", "none");

@@ -23,6 +23,14 @@ FieldEval DynamicsModel::discrete_gradient_field_with_jacobian(const torch::Tens
   return {};
 }
 
+FieldEval DynamicsModel::discrete_gradient4_field(const torch::Tensor&, const torch::Tensor&,
+                                                   const torch::Tensor&, double, double) const {
+  PHNN_REQUIRE(false, "discrete_gradient4_field: " << to_string(options_.kind)
+                                                   << " has no Hamiltonian; the DG4 integrator "
+                                                      "needs phnn-s or phnn-jr");
+  return {};
+}
+
 torch::Tensor DynamicsModel::hamiltonian(const torch::Tensor&) const {
   PHNN_REQUIRE(false, "hamiltonian: " << to_string(options_.kind) << " has no Hamiltonian");
   return {};

@@ -20,6 +20,7 @@ std::string to_string(IntegratorKind kind) {
     case IntegratorKind::kRk2: return "rk2";
     case IntegratorKind::kDg: return "dg";
     case IntegratorKind::kRk4: return "rk4";
+    case IntegratorKind::kDg4: return "dg4";
   }
   return "unknown";
 }
@@ -45,8 +46,9 @@ IntegratorKind parse_integrator(const std::string& name) {
   if (name == "rk2") return IntegratorKind::kRk2;
   if (name == "dg") return IntegratorKind::kDg;
   if (name == "rk4") return IntegratorKind::kRk4;
+  if (name == "dg4") return IntegratorKind::kDg4;
   throw std::invalid_argument("unknown integrator \"" + name +
-                              "\"; expected one of: rk2, dg, rk4");
+                              "\"; expected one of: rk2, dg, rk4, dg4");
 }
 
 ModelSize parse_size(const std::string& name) {

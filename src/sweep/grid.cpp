@@ -30,7 +30,7 @@ CostParts cost_parts(const RunConfig& run, const CostModel& c) {
   const double validation = evaluations * run.data.num_validation / c.reference_batch;
   const double inference = static_cast<double>(run.data.num_inference) *
                            run.data.num_inference_steps() / c.reference_batch / c.rollout_speedup *
-                           (run.integrator == IntegratorKind::kDg ? c.dg_newton_factor : 1.0);
+                           (is_discrete_gradient(run.integrator) ? c.dg_newton_factor : 1.0);
   CostParts parts;
   parts.fixed_s = t.steps * fixed_us * 1e-6;
   parts.member_s = (t.steps * batch_scale + validation + inference) * member_us * 1e-6;

@@ -58,7 +58,7 @@ std::string RunConfig::cell_key() const {
   if (regularizer == Regularizer::kSn) s << ";lambda=" << num(t.lambda_sn);
   if (regularizer == Regularizer::kSr) s << ";lambda=" << num(t.lambda_sr);
   s << ";jac_eps=" << num(t.jacobian_eps);
-  if (integrator == IntegratorKind::kDg) {
+  if (is_discrete_gradient(integrator)) {
     s << ";newton=" << num(t.newton_tolerance) << "," << t.newton_max_iterations
       << ";tau=" << num(t.dg_min_dx_norm);
   }

@@ -49,6 +49,8 @@ std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs() {
   for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnJr, ModelKind::kPhnnS}) {
     pairs.emplace_back(kind, IntegratorKind::kRk4);
   }
+  pairs.emplace_back(ModelKind::kPhnnJr, IntegratorKind::kDg4);
+  pairs.emplace_back(ModelKind::kPhnnS, IntegratorKind::kDg4);
   return pairs;
 }
 
@@ -867,9 +869,9 @@ class Resolver {
     }
     const std::string expected = "; expected one of: " + join(allowed);
     const std::string& s = v.string;
-    if (s == "node-dg") {
+    if (s == "node-dg" || s == "node-dg4") {
       fail(v.line,
-           "models value \"node-dg\": NODE has no DG variant (SPEC.md §3: RK2 only)" + expected);
+           "models value " + v.raw + ": NODE has no discrete-gradient variant (it has no Hamiltonian; rk2 or rk4 only)" + expected);
     }
     const std::size_t dash = s.rfind('-');
     if (dash == std::string::npos) {
@@ -879,7 +881,8 @@ class Resolver {
     const std::string formulation = s.substr(0, dash), integrator = s.substr(dash + 1);
     const bool formulation_ok =
         formulation == "node" || formulation == "phnn-jr" || formulation == "phnn-s";
-    const bool integrator_ok = integrator == "rk2" || integrator == "dg" || integrator == "rk4";
+    const bool integrator_ok = integrator == "rk2" || integrator == "dg" || integrator == "rk4" ||
+                               integrator == "dg4";
     if (formulation_ok && !integrator_ok) {
       fail(v.line,
            "unknown integrator " + quoted(integrator) + " in models value " + v.raw + expected);

@@ -21,9 +21,10 @@ namespace phnn {
 
 void CellSpec::validate(const SystemData& data) const {
   training.validate();
-  PHNN_REQUIRE(!(model == ModelKind::kNode && integrator == IntegratorKind::kDg),
-               "Invalid CellSpec: integrator = dg with model = node; the discrete gradient "
-               "needs a Hamiltonian (use rk2, or phnn-s / phnn-jr)");
+  PHNN_REQUIRE(!(model == ModelKind::kNode && is_discrete_gradient(integrator)),
+               "Invalid CellSpec: integrator = " << to_string(integrator)
+                   << " with model = node; the discrete gradient needs a Hamiltonian (use rk2 "
+                      "or rk4, or phnn-s / phnn-jr)");
   PHNN_REQUIRE(n_train >= 1 && static_cast<std::size_t>(n_train) <= data.train.size(),
                "Invalid CellSpec: n_train = " << n_train << "; the data set has "
                                               << data.train.size() << " training pairs");
@@ -171,11 +172,13 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   const auto Xnall = Xn.unsqueeze(0).expand({E, -1, -1});
   const auto Uall = U.unsqueeze(0).expand({E, -1, -1});
 
-  const bool use_dg = cell.integrator == IntegratorKind::kDg;
+  const bool use_dg = is_discrete_gradient(cell.integrator);
   // L_d (Eq. 30): mean over batch and state components of |x_{n+1} - x_hat| / h.
   auto data_loss = [&](const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u) {
-    const auto x_hat = use_dg ? dg_training_step(*model, x, xn, u, h, opt.dg_min_dx_norm)
-                              : explicit_step(*model, cell.integrator, x, u, h);
+    const auto x_hat =
+        cell.integrator == IntegratorKind::kDg   ? dg_training_step(*model, x, xn, u, h, opt.dg_min_dx_norm)
+        : cell.integrator == IntegratorKind::kDg4 ? dg4_training_step(*model, x, xn, u, h, opt.dg_min_dx_norm)
+                                                  : explicit_step(*model, cell.integrator, x, u, h);
     return ((xn - x_hat).abs() / h).mean({1, 2});
   };
 
@@ -330,7 +333,9 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   for (int n = 1; n <= steps; ++n) {
     torch::Tensor next;
     if (use_dg) {
-      const auto s = dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
+      const auto s = cell.integrator == IntegratorKind::kDg4
+                         ? dg4_inference_step(*model, x, u, h_inf, dg_options)
+                         : dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
       next = s.x_next;
       newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);
     } else {

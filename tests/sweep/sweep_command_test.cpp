@@ -279,7 +279,7 @@ TEST(SweepCommandTest, BadSweepFilesExitTwoBeforeWritingAnything) {
       {"name = \"x\"\n[training]\nsteps = -5\n", ":3:"},
       {"name = \"x\"\n[grid]\nn_train = []\n", ":3:"},
       {"name = \"x\"\n[training]\nsteps = \"many\"\n", ":3:"},
-      {"name = \"x\"\n[grid]\nmodels = [\"phnn-s-rk4\"]\n", ":3:"},
+      {"name = \"x\"\n[grid]\nmodels = [\"phnn-s-rk3\"]\n", ":3:"},
   };
   for (const auto& [text, expected] : cases) {
     const std::string sweep = write_sweep(dir, text);

@@ -227,7 +227,7 @@ models = [
   EXPECT_STREQ(e.what(),
                "x.toml:5: unknown integrator \"rk3\" in models value \"phnn-s-rk3\"; expected "
                "one of: node-rk2, phnn-jr-dg, phnn-jr-rk2, phnn-s-dg, phnn-s-rk2, node-rk4, "
-               "phnn-jr-rk4, phnn-s-rk4");
+               "phnn-jr-rk4, phnn-s-rk4, phnn-jr-dg4, phnn-s-dg4");
 }
 
 // The fourth-order explicit variants are sweep-file models like the others
@@ -244,9 +244,12 @@ models = ["node-rk4", "phnn-jr-rk4", "phnn-s-rk4"]
 }
 
 TEST(SweepFileErrorTest, NodeWithDiscreteGradientIsRejected) {
-  const SweepFileError e = error_of("name = \"t\"\n[grid]\nmodels = [\"node-dg\"]\n");
-  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: models value \"node-dg\""),
-                              HasSubstr("RK2 only"), HasSubstr("expected one of: node-rk2")));
+  for (std::string model : {"node-dg", "node-dg4"}) {
+    const SweepFileError e = error_of("name = \"t\"\n[grid]\nmodels = [\"" + model + "\"]\n");
+    EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:3: models value \"" + model + "\""),
+                                HasSubstr("no Hamiltonian; rk2 or rk4 only"),
+                                HasSubstr("expected one of: node-rk2")));
+  }
 }
 
 TEST(SweepFileErrorTest, UnknownAxisValuesListTheAllowedValues) {

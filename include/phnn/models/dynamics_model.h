@@ -53,6 +53,14 @@ class DynamicsModel {
                                                           const torch::Tensor& dx,
                                                           const torch::Tensor& u,
                                                           double min_dx_norm) const;
+  /// Fourth-order DG (docs/METHOD.md "Fourth-order schemes"; PH models
+  /// only): x_next = x + h f, with f = F(m, e) + h^2 C in FieldEval::f, where
+  /// m = x + dx/2, e = the AVF discrete gradient of H_theta along dx, and in
+  /// FieldEval::dfdx the Jacobian A = dF/dx at (m, e) [E, B, 2, 2] that C
+  /// uses (Newton at inference takes I - (h/2) A as its matrix).
+  virtual FieldEval discrete_gradient4_field(const torch::Tensor& x, const torch::Tensor& dx,
+                                             const torch::Tensor& u, double h,
+                                             double min_dx_norm) const;
   /// H_theta(x) [E, B] and gradH_theta(x) [E, B, 2] (PH models only).
   virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;

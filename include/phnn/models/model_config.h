@@ -11,7 +11,12 @@ namespace phnn {
 enum class ModelKind { kNode = 0, kPhnnS = 1, kPhnnJr = 2 };
 /// Discrete-model integrator (Eqs. 26, 28-30): explicit midpoint or the
 /// Gonzalez discrete gradient. NODE supports RK2 only.
-enum class IntegratorKind { kRk2 = 0, kDg = 1, kRk4 = 2 };
+enum class IntegratorKind { kRk2 = 0, kDg = 1, kRk4 = 2, kDg4 = 3 };
+/// DG and DG4: need a Hamiltonian, are inverse-explicit in training and
+/// implicit (Newton) at inference.
+inline bool is_discrete_gradient(IntegratorKind kind) {
+  return kind == IntegratorKind::kDg || kind == IntegratorKind::kDg4;
+}
 /// Network size (paper Tables 10-12, SPEC.md §3).
 enum class ModelSize { kSmall = 0, kMedium = 1, kLarge = 2 };
 

@@ -44,6 +44,17 @@ class PortHamiltonianModel : public DynamicsModel {
                                                   const torch::Tensor& u,
                                                   double min_dx_norm) const override;
 
+  FieldEval discrete_gradient4_field(const torch::Tensor& x, const torch::Tensor& dx,
+                                     const torch::Tensor& u, double h,
+                                     double min_dx_norm) const override;
+
+  /// Average-vector-field discrete gradient of H_theta, made exact:
+  ///   g = sum_k w_k gradH(x + c_k dx)   (3-point Gauss-Legendre, error O(|dx|^6)),
+  ///   avf = g + (H(x+dx) - H(x) - g^T dx) / |dx|^2 dx   (= g below min_dx_norm),
+  /// so avf^T dx = H(x+dx) - H(x) to round-off and avf = int_0^1 gradH + O(|dx|^5).
+  torch::Tensor average_vector_field_gradient(const torch::Tensor& x, const torch::Tensor& dx,
+                                              double min_dx_norm) const;
+
   /// Gonzalez discrete gradient of H_theta (eq: gonzalez-discrete-gradient):
   ///   dg = gradH(x + dx/2) + (H(x+dx) - H(x) - gradH(x+dx/2)^T dx) / |dx|^2 dx,
   /// = gradH(x + dx/2) where |dx| < min_dx_norm (SPEC.md §4).

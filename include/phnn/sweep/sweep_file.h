@@ -99,7 +99,8 @@ std::string model_key(ModelKind kind, IntegratorKind integrator);
 /// phnn-s-dg, phnn-s-rk2 (NODE has RK2 only, SPEC.md §3).
 std::vector<std::pair<ModelKind, IntegratorKind>> all_model_pairs();
 /// Every pair a sweep file may name: the paper's five and the RK4 variants
-/// of the three formulations (node-rk4, phnn-jr-rk4, phnn-s-rk4).
+/// of the three formulations (node-rk4, phnn-jr-rk4, phnn-s-rk4), then the
+/// fourth-order discrete gradient of the PHNNs (phnn-jr-dg4, phnn-s-dg4).
 std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs();
 
 }  // namespace phnn

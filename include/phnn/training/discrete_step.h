@@ -28,6 +28,12 @@ torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& 
                                const torch::Tensor& x_next, const torch::Tensor& u, double h,
                                double min_dx_norm);
 
+/// DG4 in training, inverse-explicit like DG: with the data step dx,
+/// x_hat = x + h f4(x, dx, u) (DynamicsModel::discrete_gradient4_field).
+torch::Tensor dg4_training_step(const DynamicsModel& model, const torch::Tensor& x,
+                                const torch::Tensor& x_next, const torch::Tensor& u, double h,
+                                double min_dx_norm);
+
 /// Options of the implicit DG inference step.
 struct DgInferenceOptions {
   /// A row has converged when its residual max |dx - h f_bar| <= tolerance.
@@ -64,5 +70,15 @@ DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tenso
                                   const torch::Tensor& u, double h,
                                   const DgInferenceOptions& options = {},
                                   DgNewtonJacobian* cache = nullptr);
+
+/// DG4 at inference: solves r(dx) = dx - h f4(x, dx, u) = 0 from the RK4
+/// step by simplified Newton with the matrix I - (h/2) A, A = dF/dx at the
+/// current iterate (returned by the same field evaluation: no extra cost);
+/// a row whose residual shrinks less than 10x in one iteration switches to
+/// the Jacobian of r by forward differences (two more evaluations). Rows
+/// converge, freeze and are reported exactly as in dg_inference_step.
+DgInferenceStep dg4_inference_step(const DynamicsModel& model, const torch::Tensor& x,
+                                   const torch::Tensor& u, double h,
+                                   const DgInferenceOptions& options = {});
 
 }  // namespace phnn
