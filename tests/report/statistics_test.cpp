@@ -111,6 +111,20 @@ TEST(BootstrapTest, IntervalOfThreeValuesFollowsTheExactDistribution) {
   EXPECT_EQ(narrow.high, 20.0);
 }
 
+// n = 5 values 1..5: the bootstrap median is the 3rd smallest of 5 draws, so
+// P(median <= k) = P(at least 3 of 5 draws <= k) = 0.058, 0.317, 0.683, 0.942
+// for k = 1..4. At 90 % the 5 % and 95 % points are 1 and 5; at 80 % the
+// 10 % and 90 % points are 2 and 4 (B = 100 000: each margin >= 10 sigma).
+TEST(BootstrapTest, IntervalEndsAreTheTwoTailQuantilesOfTheBootstrapMedians) {
+  const std::vector<double> values = {4.0, 2.0, 5.0, 1.0, 3.0};
+  const Interval ninety = bootstrap_median_interval(values, options_with(100000, 0.9));
+  EXPECT_EQ(ninety.low, 1.0);
+  EXPECT_EQ(ninety.high, 5.0);
+  const Interval eighty = bootstrap_median_interval(values, options_with(100000, 0.8));
+  EXPECT_EQ(eighty.low, 2.0);
+  EXPECT_EQ(eighty.high, 4.0);
+}
+
 TEST(BootstrapTest, IntervalReachesInfinityWithoutNan) {
   // {1, 2, inf}: the median is inf with probability 7/27 > 2.5 %.
   const Interval i = bootstrap_median_interval({1.0, kInf, 2.0});
