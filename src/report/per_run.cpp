@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -45,7 +46,65 @@ std::string csv_double(double value) {
   return buf;
 }
 
-// Canonical keys of all records, in order of first appearance.
+// Canonical keys (RunConfig::canonical(), short) -> sweep-file names
+// (sweeps/FORMAT.md); a value of several comma-separated numbers gets one
+// name per part. Keys not listed, or with another number of parts, keep their
+// canonical name and value.
+const std::map<std::string, std::vector<std::string>>& column_names() {
+  static const std::map<std::string, std::vector<std::string>> names = {
+      {"h_gen", {"generation_step"}},
+      {"e0", {"energy_min", "energy_max"}},
+      {"eeq", {"equilibrium_energy_min", "equilibrium_energy_max"}},
+      {"n_traj", {"num_trajectories"}},
+      {"splits", {"num_train_max", "num_validation", "num_inference"}},
+      {"gen_tol", {"generation_newton_tolerance"}},
+      {"lr", {"learning_rate"}},
+      {"adam", {"adam_beta1", "adam_beta2", "adam_eps"}},
+      {"batch", {"batch_size"}},
+      {"jac_eps", {"jacobian_eps"}},
+      {"newton", {"newton_tolerance", "newton_max_iterations"}},
+      {"tau", {"dg_min_dx_norm"}},
+      {"divergence", {"divergence_norm"}},
+      {"z", {"z1", "z2", "z3"}},
+  };
+  return names;
+}
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> parts;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) parts.push_back(part);
+  if (text.empty() || text.back() == ',') parts.emplace_back();
+  return parts;
+}
+
+// One run's configuration columns: canonical pairs under sweep-file names.
+std::vector<std::pair<std::string, std::string>> config_columns(const std::string& canonical) {
+  const auto pairs = parse_canonical(canonical);
+  std::set<std::string> names;
+  for (const auto& kv : pairs) names.insert(kv.first);
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [key, value] : pairs) {
+    const auto it = column_names().find(key);
+    const std::vector<std::string> parts = split_commas(value);
+    bool rename = it != column_names().end() && it->second.size() == parts.size();
+    for (std::size_t i = 0; rename && i < parts.size(); ++i) {
+      rename = !names.count(it->second[i]);
+    }
+    if (!rename) {
+      out.emplace_back(key, value);
+      continue;
+    }
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      names.insert(it->second[i]);
+      out.emplace_back(it->second[i], parts[i]);
+    }
+  }
+  return out;
+}
+
+// Configuration columns of all records, in order of first appearance.
 std::vector<std::string> config_keys(
     const std::vector<std::vector<std::pair<std::string, std::string>>>& configs) {
   std::vector<std::string> keys;
@@ -62,7 +121,7 @@ std::vector<std::string> config_keys(
 
 std::string render_per_run_csv(const std::vector<RunRecord>& records) {
   std::vector<std::vector<std::pair<std::string, std::string>>> configs;
-  for (const RunRecord& r : records) configs.push_back(parse_canonical(r.canonical));
+  for (const RunRecord& r : records) configs.push_back(config_columns(r.canonical));
   const std::vector<std::string> keys = config_keys(configs);
   std::ostringstream out;
   out << "run_id,studies,model_label";

@@ -111,8 +111,8 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
 namespace {
 
 const char* const kTieNote =
-    "(tie): smallest median of its column, but its bootstrap 95 % interval overlaps the "
-    "interval of every other cell marked (tie) in that column, so none is bold.";
+    "(tie): no clear best in this column: the bootstrap 95 % interval of its smallest median "
+    "overlaps the intervals of the other cells marked (tie), so none is bold.";
 
 std::string format_number(const char* format, double value) {
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";

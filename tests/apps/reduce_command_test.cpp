@@ -105,7 +105,8 @@ TEST_F(ReduceCommandTest, PerRunCsvHasOneRowPerRunWithAxesAndExactValues) {
     return static_cast<std::size_t>(it - header.begin());
   };
   for (const char* axis : {"system", "model", "integrator", "size", "n_train", "regularizer",
-                           "seed", "cubic_stiffness", "steps", "lr"}) {
+                           "seed", "cubic_stiffness", "damping", "steps", "learning_rate",
+                           "energy_min", "num_validation", "newton_max_iterations"}) {
     column(axis);
   }
   for (std::size_t row = 0; row < grid_.runs.size(); ++row) {

@@ -63,6 +63,19 @@ TEST(PerRunCsvTest, OneRowPerRunWithEveryConfigKeyAndFullPrecision) {
   EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,duffing,phnn-s,0.5,1,1,done,0.002,"));
 }
 
+TEST(PerRunCsvTest, NamesColumnsAsTheSweepFileAndSplitsMultiNumberKeys) {
+  const std::string csv = render_per_run_csv(
+      {record("lr=0.001;e0=0.10000000000000001,1;z=3,-4,1.3;newton=1e-12,20;adam=0.9,0.999;"
+              "learning_rate=5;future_axis=a,b;seed=0",
+              RunStatus::kDone, 1.0)});
+  // adam has 2 parts, not 3: kept; lr would repeat learning_rate: kept.
+  EXPECT_THAT(csv, StartsWith("run_id,studies,model_label,lr,energy_min,energy_max,z1,z2,z3,"
+                              "newton_tolerance,newton_max_iterations,adam,learning_rate,"
+                              "future_axis,seed,status,"));
+  EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,0.001,0.10000000000000001,1,3,-4,1.3,1e-12,20,"
+                             "\"0.9,0.999\",5,\"a,b\",0,done,1,"));
+}
+
 TEST(PerRunCsvTest, SpellsInfinityAndNanForPandasAndQuotesMessages) {
   RunRecord diverged = record("seed=0", RunStatus::kDiverged,
                               std::numeric_limits<double>::infinity());

@@ -88,8 +88,8 @@ TEST_F(TableTest, MarkdownShowsMedianIqrIntervalTieDivergedAndMissing) {
             "**6.00e-03 [1.00e-03] (5.00e-03, 7.00e-03)** (n=3/5) |\n"
             "| PHNN-JR-DG | 3.00e-04 [inf] (1.00e-04, inf) (tie) (d=2) | — |\n"
             "\n"
-            "(tie): smallest median of its column, but its bootstrap 95 % interval overlaps the "
-            "interval of every other cell marked (tie) in that column, so none is bold.\n"
+            "(tie): no clear best in this column: the bootstrap 95 % interval of its smallest "
+            "median overlaps the intervals of the other cells marked (tie), so none is bold.\n"
             "\n");
 }
 
@@ -107,7 +107,7 @@ TEST_F(TableTest, BestIsBoldOnlyWhenItsIntervalOverlapsNoOther) {
   markdown = render(TableFormat::kMarkdown);
   EXPECT_THAT(markdown, Not(HasSubstr("**")));
   EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | 2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04) (tie) |"));
-  EXPECT_THAT(markdown, HasSubstr("(tie): smallest median of its column"));
+  EXPECT_THAT(markdown, HasSubstr("(tie): no clear best in this column"));
 }
 
 TEST_F(TableTest, LatexBoldsTheBestMarksTiesAndEscapesLabels) {
@@ -118,8 +118,8 @@ TEST_F(TableTest, LatexBoldsTheBestMarksTiesAndEscapesLabels) {
   EXPECT_THAT(latex, HasSubstr("NODE-RK2 & 3.00e-03 [2.00e-03] (1.00e-03, 5.00e-03) (tie) & "
                                "\\textbf{6.00e-03 [1.00e-03] (5.00e-03, 7.00e-03)} (n=3/5) \\\\"));
   EXPECT_THAT(latex, HasSubstr("PHNN-JR-DG & 3.00e-04 [inf] (1.00e-04, inf) (tie) (d=2) & -- \\\\"));
-  EXPECT_THAT(latex, HasSubstr("\\par\\smallskip{\\footnotesize (tie): smallest median of its "
-                               "column, but its bootstrap 95 \\% interval"));
+  EXPECT_THAT(latex, HasSubstr("\\par\\smallskip{\\footnotesize (tie): no clear best in this "
+                               "column: the bootstrap 95 \\% interval"));
   EXPECT_THAT(latex, Not(HasSubstr("—")));
   EXPECT_THAT(latex, HasSubstr("\\end{table}"));
 }

@@ -50,8 +50,13 @@ std::vector<std::pair<std::string, std::string>> parse_canonical(const std::stri
 /// appearance (system, model, integrator, size, n_train, regularizer, the
 /// physics, data and training keys, ..., seed), so any axis a sweep varies has
 /// its column; a key a run does not have (e.g. cubic_stiffness of a harmonic
-/// run) is empty. Values of the canonical keys are copied as stored (numbers
-/// with 17 significant digits). Doubles print "%.17g" (round-trip exact),
+/// run) is empty. Short canonical keys are renamed to their sweep-file names
+/// (lr -> learning_rate, tau -> dg_min_dx_norm, ...) and the ones holding
+/// several numbers are split, one column each (e0 -> energy_min, energy_max;
+/// splits -> num_train_max, num_validation, num_inference; adam; newton; eeq;
+/// z -> z1, z2, z3); unknown keys (and a rename that would repeat a name)
+/// keep their name and value. Configuration values are copied as stored
+/// (numbers with 17 significant digits). Doubles print "%.17g" (round-trip exact),
 /// +inf as "inf", -inf as "-inf", NaN as "nan" (a pending or failed run's
 /// numbers): what pandas.read_csv and R's read.csv parse as numbers. Fields
 /// are quoted as RFC 4180 says (a field holding a comma, a double quote, CR or
