@@ -1,4 +1,5 @@
-// src/report/tables.cpp — median [IQR] tables of the inference MSE.
+// src/report/tables.cpp — median [IQR] (bootstrap interval) tables of the
+// inference MSE with best/tie marks, and the seeds-per-mode view.
 #include "phnn/report/tables.h"
 
 #include <algorithm>
@@ -291,7 +292,10 @@ std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
 std::string summary_cell_text(const CellSummary& s, Mark mark, TableFormat format) {
   const std::string none = format == TableFormat::kMarkdown ? "—" : "--";
   if (s.finished() == 0) return none;                        // all missing
-  if (s.done == 0) return "inf" + annotations(s);            // all diverged
+  // All diverged at +inf: median and interval say nothing more than the count.
+  if (s.done == 0 && std::isinf(s.median) && std::isinf(s.median_interval.low)) {
+    return "inf" + annotations(s);
+  }
   std::string value = format_number("%.2e", s.median) + " [" + format_number("%.2e", s.iqr()) +
                       "] (" + format_number("%.2e", s.median_interval.low) + ", " +
                       format_number("%.2e", s.median_interval.high) + ")";

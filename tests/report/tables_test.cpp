@@ -153,6 +153,14 @@ TEST_F(TableTest, AllDivergedCellShowsInfinityAndCountNeverNan) {
   EXPECT_THAT(markdown + csv + render(TableFormat::kLatex), Not(HasSubstr("nan")));
 }
 
+TEST_F(TableTest, DivergedRunsWithAFiniteMseShowTheirNumbers) {
+  entries_.clear();
+  add("NODE-RK2", "25", RunStatus::kDiverged, 5e-3);  // e.g. a training loss that went NaN
+  const std::string markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **5.00e-03 [0.00e+00] (5.00e-03, 5.00e-03)** "
+                                  "(n=1/5) (d=1) |"));
+}
+
 // Every way +inf meets a quantile: neighbours both +inf, a median between a
 // finite value and +inf, an IQR with q75 = +inf, q25 = q75 = +inf.
 TEST_F(TableTest, InfiniteMsesNeverPrintNan) {

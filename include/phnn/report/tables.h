@@ -1,5 +1,7 @@
 // include/phnn/report/tables.h — the paper's result tables (Appendix F) from
-// run results. Pure functions: no HDF5, no MPI.
+// run results: median [IQR] (bootstrap interval of the median) per cell, the
+// best of a column only when the intervals separate it, and the seeds-per-mode
+// view. Pure functions: no HDF5, no MPI.
 #pragma once
 
 #include <string>
@@ -21,7 +23,8 @@ struct TableEntry {
   std::string row;
   std::string column;
   RunStatus status = RunStatus::kPending;
-  /// Inference MSE (Eq. 31); +inf for a diverged run; ignored unless done.
+  /// Inference MSE (Eq. 31); +inf for a diverged run (NaN is read as +inf);
+  /// ignored unless done or diverged.
   double mse = 0.0;
 };
 
