@@ -265,7 +265,9 @@ enum class Mark { kNone, kBest, kTie };
 
 // Best of one column (CellSummary order = rows): the smallest finite median
 // is best if its interval overlaps no other finished cell's interval; else it
-// and every cell overlapping it (or with an equal median) are a tie.
+// and every cell overlapping it (or with an equal median) are a tie. A cell
+// whose interval is [+inf, +inf] (all or nearly all runs diverged) cannot be
+// smaller than anything: sharing the point +inf is no tie.
 std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   std::vector<Mark> marks(column.size(), Mark::kNone);
   int best = -1;
@@ -280,6 +282,7 @@ std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   for (std::size_t r = 0; r < column.size(); ++r) {
     const CellSummary& s = column[r];
     if (static_cast<int>(r) == best || s.finished() == 0) continue;
+    if (std::isinf(s.median_interval.low)) continue;
     if (s.median_interval.overlaps(b.median_interval) || s.median == b.median) {
       marks[r] = Mark::kTie;
       tied = true;

@@ -153,6 +153,17 @@ TEST_F(TableTest, AllDivergedCellShowsInfinityAndCountNeverNan) {
   EXPECT_THAT(markdown + csv + render(TableFormat::kLatex), Not(HasSubstr("nan")));
 }
 
+TEST_F(TableTest, AllDivergedCellIsNoTieForABestWhoseIntervalReachesInfinity) {
+  entries_.clear();
+  // {1, 2}e-3 + inf: median 2e-3, interval [1e-3, inf] (P(median = inf) = 7/27).
+  for (double mse : {1e-3, 2e-3, kInf}) add("NODE-RK2", "25", RunStatus::kDone, mse);
+  for (int i = 0; i < 3; ++i) add("PHNN-JR-DG", "25", RunStatus::kDiverged, kInf);
+  const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 3);
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **2.00e-03 [inf] (1.00e-03, inf)** (d=1) | — |"));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | inf (d=3) | — |"));
+  EXPECT_THAT(markdown, Not(HasSubstr("(tie)")));
+}
+
 TEST_F(TableTest, DivergedRunsWithAFiniteMseShowTheirNumbers) {
   entries_.clear();
   add("NODE-RK2", "25", RunStatus::kDiverged, 5e-3);  // e.g. a training loss that went NaN

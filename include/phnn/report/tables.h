@@ -86,6 +86,7 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
 ///   - otherwise marked " (tie)", together with every cell of the column whose
 ///     interval overlaps it (and any cell with the same median); nothing is
 ///     bold, and a note under the table explains the mark (tie = 1 in CSV).
+///     A cell whose interval is [inf, inf] never ties (it shares only +inf).
 /// Annotations, appended in this order:
 ///   " (n=7/10)"  fewer than `expected` runs finished (n = done + diverged;
 ///                pending, failed or absent runs are missing);
