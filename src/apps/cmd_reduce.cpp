@@ -4,6 +4,7 @@
 // file, complete or partial.
 #include <algorithm>
 #include <iostream>
+#include <limits>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
@@ -36,6 +37,32 @@ Grid checked_grid(const ResultsFile& file, const SweepSpec& spec) {
     }
   }
   return grid;
+}
+
+// RunRecord's trace summary from /runs/trace ([rows, trace_points, 7]:
+// step, elapsed_s, train_loss, validation_loss, kappa, sigma_max, rho) and
+// /runs/trace_length.
+void add_trace_summaries(const ResultsFile& file, std::vector<RunRecord>& records) {
+  constexpr std::size_t kColumns = 7, kTrain = 2, kValidation = 3, kKappa = 4, kSigma = 5,
+                        kRho = 6;
+  const auto trace = file.read_double_column("trace");
+  const auto lengths = file.read_int_column("trace_length");
+  const auto points = static_cast<std::size_t>(file.layout().trace_points);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    RunRecord& r = records[i];
+    r.trace_points = lengths[i];
+    const std::size_t n = std::min(points, static_cast<std::size_t>(std::max<std::int64_t>(
+                                               0, lengths[i])));
+    const double* first = trace.data() + i * points * kColumns;
+    const double* last = first + (n == 0 ? 0 : n - 1) * kColumns;
+    r.initial_validation_loss = n > 0 ? first[kValidation] : nan;
+    r.final_train_loss = n > 0 ? last[kTrain] : nan;
+    r.final_validation_loss = n > 0 ? last[kValidation] : nan;
+    r.final_kappa = n > 0 ? last[kKappa] : nan;
+    r.final_sigma_max = n > 0 ? last[kSigma] : nan;
+    r.final_rho = n > 0 ? last[kRho] : nan;
+  }
 }
 
 // The scalar columns of every row of /runs.
@@ -71,6 +98,7 @@ std::vector<RunRecord> read_run_records(const ResultsFile& file, const Grid& gri
     r.diverged_rollouts = diverged_rollouts[i];
     r.newton_failures = newton_failures[i];
   }
+  add_trace_summaries(file, records);
   return records;
 }
 

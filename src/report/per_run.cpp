@@ -127,7 +127,8 @@ std::string render_per_run_csv(const std::vector<RunRecord>& records) {
   out << "run_id,studies,model_label";
   for (const std::string& key : keys) out << "," << csv_field(key);
   out << ",status,mse,best_step,best_validation_loss,wall_time_s,steps_taken,parameter_count,"
-         "diverged_rollouts,newton_failures,message\n";
+         "diverged_rollouts,newton_failures,trace_points,initial_validation_loss,final_train_loss,"
+         "final_validation_loss,final_kappa,final_sigma_max,final_rho,message\n";
   for (std::size_t i = 0; i < records.size(); ++i) {
     const RunRecord& r = records[i];
     out << csv_field(r.id) << "," << csv_field(r.studies) << "," << csv_field(r.model_label);
@@ -140,7 +141,11 @@ std::string render_per_run_csv(const std::vector<RunRecord>& records) {
     out << "," << to_string(r.status) << "," << csv_double(r.mse) << "," << r.best_step << ","
         << csv_double(r.best_validation_loss) << "," << csv_double(r.wall_time_s) << ","
         << r.steps_taken << "," << r.parameter_count << "," << r.diverged_rollouts << ","
-        << r.newton_failures << "," << csv_field(r.message) << "\n";
+        << r.newton_failures << "," << r.trace_points << ","
+        << csv_double(r.initial_validation_loss) << "," << csv_double(r.final_train_loss) << ","
+        << csv_double(r.final_validation_loss) << "," << csv_double(r.final_kappa) << ","
+        << csv_double(r.final_sigma_max) << "," << csv_double(r.final_rho) << ","
+        << csv_field(r.message) << "\n";
   }
   return out.str();
 }

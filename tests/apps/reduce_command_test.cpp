@@ -140,6 +140,25 @@ TEST_F(ReduceCommandTest, PerRunCsvHasOneRowPerRunWithAxesAndExactValues) {
     EXPECT_EQ(fields[column("best_step")], std::to_string(expected.best_step));
     EXPECT_EQ(fields[column("steps_taken")], std::to_string(expected.steps));
     EXPECT_EQ(fields[column("newton_failures")], std::to_string(expected.newton_failures));
+    EXPECT_EQ(fields[column("trace_points")], std::to_string(expected.trace.size()));
+    const auto number = [&](const char* name) {
+      return testing_util::bits(std::strtod(fields[column(name)].c_str(), nullptr));
+    };
+    if (expected.trace.empty()) {
+      EXPECT_EQ(fields[column("initial_validation_loss")], "nan");
+      EXPECT_EQ(fields[column("final_rho")], "nan");
+      continue;
+    }
+    const TracePoint& first = expected.trace.front();
+    const TracePoint& last = expected.trace.back();
+    EXPECT_EQ(number("initial_validation_loss"), testing_util::bits(first.validation_loss));
+    EXPECT_EQ(number("final_validation_loss"), testing_util::bits(last.validation_loss));
+    EXPECT_EQ(number("final_kappa"), testing_util::bits(last.kappa));
+    EXPECT_EQ(number("final_sigma_max"), testing_util::bits(last.sigma_max));
+    EXPECT_EQ(number("final_rho"), testing_util::bits(last.rho));
+    if (!std::isnan(last.train_loss)) {
+      EXPECT_EQ(number("final_train_loss"), testing_util::bits(last.train_loss));
+    }
   }
   EXPECT_THAT(csv, HasSubstr(",diverged,inf,"));
 }

@@ -44,6 +44,13 @@ RunRecord record(const std::string& canonical, RunStatus status, double mse) {
   r.parameter_count = 852;
   r.diverged_rollouts = 0;
   r.newton_failures = 3;
+  r.trace_points = 101;
+  r.initial_validation_loss = 0.5;
+  r.final_train_loss = 0.25;
+  r.final_validation_loss = 0.125;
+  r.final_kappa = 1000.0;
+  r.final_sigma_max = 2.0;
+  r.final_rho = 0.0625;
   return r;
 }
 
@@ -55,11 +62,13 @@ TEST(PerRunCsvTest, OneRowPerRunWithEveryConfigKeyAndFullPrecision) {
   EXPECT_THAT(csv, StartsWith("run_id,studies,model_label,system,model,damping,seed,"
                               "cubic_stiffness,status,mse,best_step,best_validation_loss,"
                               "wall_time_s,steps_taken,parameter_count,diverged_rollouts,"
-                              "newton_failures,message\n"));
+                              "newton_failures,trace_points,initial_validation_loss,"
+                              "final_train_loss,final_validation_loss,final_kappa,"
+                              "final_sigma_max,final_rho,message\n"));
   // %.17g round-trips: 1/3 and 0.1 print 17 digits; a key the run lacks is empty.
   EXPECT_THAT(csv, HasSubstr("\n00000000000000ab,\"I,II\",PHNN-S-DG,harmonic,phnn-s,0.5,0,,done,"
                              "0.33333333333333331,49000,0.10000000000000001,12.5,50000,852,0,3,"
-                             "\n"));
+                             "101,0.5,0.25,0.125,1000,2,0.0625,\n"));
   EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,duffing,phnn-s,0.5,1,1,done,0.002,"));
 }
 
@@ -92,7 +101,9 @@ TEST(PerRunCsvTest, SpellsInfinityAndNanForPandasAndQuotesMessages) {
 TEST(PerRunCsvTest, NoRecordsGiveTheFixedHeaderOnly) {
   EXPECT_EQ(render_per_run_csv({}),
             "run_id,studies,model_label,status,mse,best_step,best_validation_loss,wall_time_s,"
-            "steps_taken,parameter_count,diverged_rollouts,newton_failures,message\n");
+            "steps_taken,parameter_count,diverged_rollouts,newton_failures,trace_points,"
+            "initial_validation_loss,final_train_loss,final_validation_loss,final_kappa,"
+            "final_sigma_max,final_rho,message\n");
 }
 
 }  // namespace

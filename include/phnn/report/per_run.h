@@ -33,6 +33,14 @@ struct RunRecord {
   std::int64_t parameter_count = 0;
   std::int64_t diverged_rollouts = 0;
   std::int64_t newton_failures = 0;
+  /// From /runs/trace (the validation points, step 0 first): how many there
+  /// are, the validation loss at step 0 (how far training got: compare with
+  /// best_validation_loss), and train loss, validation loss, kappa,
+  /// sigma_max, rho at the last point; NaN for a run without a trace.
+  std::int64_t trace_points = 0;
+  double initial_validation_loss = 0.0;
+  double final_train_loss = 0.0, final_validation_loss = 0.0;
+  double final_kappa = 0.0, final_sigma_max = 0.0, final_rho = 0.0;
 };
 
 /// Splits "a=1;b=x,y;c=" into {{"a", "1"}, {"b", "x,y"}, {"c", ""}} (each
@@ -44,7 +52,9 @@ std::vector<std::pair<std::string, std::string>> parse_canonical(const std::stri
 ///
 ///   run_id,studies,model_label,<config keys>,status,mse,best_step,
 ///   best_validation_loss,wall_time_s,steps_taken,parameter_count,
-///   diverged_rollouts,newton_failures,message
+///   diverged_rollouts,newton_failures,trace_points,initial_validation_loss,
+///   final_train_loss,final_validation_loss,final_kappa,final_sigma_max,
+///   final_rho,message
 ///
 /// <config keys> are the canonical keys of all records in order of first
 /// appearance (system, model, integrator, size, n_train, regularizer, the
