@@ -66,11 +66,11 @@ std::vector<std::pair<std::string, std::string>> parse_canonical(const std::stri
 /// splits -> num_train_max, num_validation, num_inference; adam; newton; eeq;
 /// z -> z1, z2, z3); unknown keys (and a rename that would repeat a name)
 /// keep their name and value. Configuration values are copied as stored
-/// (numbers with 17 significant digits). Doubles print "%.17g" (round-trip exact),
-/// +inf as "inf", -inf as "-inf", NaN as "nan" (a pending or failed run's
-/// numbers): what pandas.read_csv and R's read.csv parse as numbers. Fields
-/// are quoted as RFC 4180 says (a field holding a comma, a double quote, CR or
-/// LF is enclosed in double quotes, its quotes doubled); lines end in "\n".
+/// (numbers with 17 significant digits). Doubles print "%.17g" (round-trip
+/// exact), +inf as "inf", -inf as "-inf", NaN as "nan" (a pending or failed
+/// run's numbers): pandas.read_csv reads them as float64. Fields are quoted
+/// as RFC 4180 says (a field holding a comma, a double quote, CR or LF is
+/// enclosed in double quotes, its quotes doubled); lines end in "\n".
 std::string render_per_run_csv(const std::vector<RunRecord>& records);
 
 }  // namespace phnn
