@@ -131,7 +131,7 @@ int run_reduce(int argc, char** argv, int first) {
       "rows = models, columns = the study's varied axis and cells = median [IQR]\n"
       "(low, high) of the inference MSE over seeds: quartiles by numpy's default linear\n"
       "interpolation, (low, high) a percentile-bootstrap 95 % interval of the median\n"
-      "(10 000 resamples, fixed seed). The best median of a column is bold only if its\n"
+      "(100 000 resamples, fixed seed). The best median of a column is bold only if its\n"
       "interval overlaps no other cell's; otherwise the overlapping cells are marked\n"
       "(tie). Works on partial files: missing and diverged runs are counted.");
   parser.positional("FILE", "results file written by `phnn sweep`");

@@ -66,7 +66,7 @@ class TableTest : public ::testing::Test {
   std::vector<TableEntry> entries_;
 };
 
-// Intervals here are exact: with B = 10 000 resamples the 2.5 % and 97.5 %
+// Intervals here are exact: with B = 100 000 resamples the 2.5 % and 97.5 %
 // points fall on the smallest / largest value whenever each is the bootstrap
 // median with probability well above 2.5 % (5 values: P(median = min) =
 // P(>= 3 of 5 draws are the min) = 0.058; 3 values: 7/27).
