@@ -1,11 +1,14 @@
 // src/apps/cmd_reduce.cpp — `phnn reduce results.h5`: the paper's Appendix-F
-// tables (median [IQR] of the inference MSE over seeds) from a results file,
-// complete or partial.
+// tables (median [IQR] and bootstrap interval of the inference MSE over
+// seeds), the seeds-per-mode view, or one CSV row per run, from a results
+// file, complete or partial.
 #include <algorithm>
 #include <iostream>
+#include <limits>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "phnn/report/per_run.h"
 #include "phnn/report/tables.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/results_file.h"
@@ -13,21 +16,12 @@
 
 namespace phnn {
 namespace apps {
+namespace {
 
-int run_reduce(int argc, char** argv, int first) {
-  cli::Parser parser("reduce",
-                     "Prints, for each study and system of the sweep that wrote FILE, a table with\n"
-                     "rows = models, columns = the study's varied axis and cells = median [IQR] of\n"
-                     "the inference MSE over seeds (quartiles: numpy's default linear\n"
-                     "interpolation). Works on partial files: missing and diverged runs are counted.");
-  parser.positional("FILE", "results file written by `phnn sweep`");
-  parser.option("format", "markdown | latex | csv", "markdown");
-  if (!parser.parse(argc, argv, first)) return 0;
-  const TableFormat format = parse_table_format(parser.get("format"));
-  const std::string path = parser.get("FILE");
-  const ResultsFile file = ResultsFile::open_read_only(path);
-  const SweepSpec spec = parse_sweep_text(file.sweep_text(), path + "@sweep_text");
-  const Grid grid = expand_grid(spec);
+// The grid of the file's sweep text, checked row by row against /runs/id.
+Grid checked_grid(const ResultsFile& file, const SweepSpec& spec) {
+  const std::string& path = file.path();
+  Grid grid = expand_grid(spec);
   const auto ids = file.read_run_ids();
   if (ids.size() != grid.runs.size()) {
     throw std::runtime_error(path + ": holds " + std::to_string(ids.size()) +
@@ -42,22 +36,138 @@ int run_reduce(int argc, char** argv, int first) {
                                "; was it written by another phnn version?");
     }
   }
+  return grid;
+}
+
+// RunRecord's trace summary from /runs/trace ([rows, trace_points, 7]:
+// step, elapsed_s, train_loss, validation_loss, kappa, sigma_max, rho) and
+// /runs/trace_length.
+void add_trace_summaries(const ResultsFile& file, std::vector<RunRecord>& records) {
+  constexpr std::size_t kColumns = 7, kTrain = 2, kValidation = 3, kKappa = 4, kSigma = 5,
+                        kRho = 6;
+  const auto trace = file.read_double_column("trace");
+  const auto lengths = file.read_int_column("trace_length");
+  const auto points = static_cast<std::size_t>(file.layout().trace_points);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    RunRecord& r = records[i];
+    r.trace_points = lengths[i];
+    const std::size_t n = std::min(points, static_cast<std::size_t>(std::max<std::int64_t>(
+                                               0, lengths[i])));
+    const double* first = trace.data() + i * points * kColumns;
+    const double* last = first + (n == 0 ? 0 : n - 1) * kColumns;
+    r.initial_validation_loss = n > 0 ? first[kValidation] : nan;
+    r.final_train_loss = n > 0 ? last[kTrain] : nan;
+    r.final_validation_loss = n > 0 ? last[kValidation] : nan;
+    r.final_kappa = n > 0 ? last[kKappa] : nan;
+    r.final_sigma_max = n > 0 ? last[kSigma] : nan;
+    r.final_rho = n > 0 ? last[kRho] : nan;
+  }
+}
+
+// The scalar columns of every row of /runs.
+std::vector<RunRecord> read_run_records(const ResultsFile& file, const Grid& grid) {
+  const auto ids = file.read_run_ids();
+  const auto studies = file.read_studies();
+  const auto canonical = file.read_canonical();
   const auto statuses = file.read_statuses();
+  const auto messages = file.read_string_column("message");
   const auto mse = file.read_double_column("mse");
+  const auto best_validation_loss = file.read_double_column("best_validation_loss");
+  const auto wall_time_s = file.read_double_column("wall_time_s");
+  const auto best_step = file.read_int_column("best_step");
+  const auto steps = file.read_int_column("steps");
+  const auto parameter_count = file.read_int_column("parameter_count");
+  const auto diverged_rollouts = file.read_int_column("diverged_rollouts");
+  const auto newton_failures = file.read_int_column("newton_failures");
+  std::vector<RunRecord> records(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    RunRecord& r = records[i];
+    r.id = ids[i];
+    r.studies = studies[i];
+    r.model_label = model_label(grid.runs[i].model, grid.runs[i].integrator);
+    r.canonical = canonical[i];
+    r.status = statuses[i];
+    r.message = messages[i];
+    r.mse = mse[i];
+    r.best_validation_loss = best_validation_loss[i];
+    r.wall_time_s = wall_time_s[i];
+    r.best_step = best_step[i];
+    r.steps_taken = steps[i];
+    r.parameter_count = parameter_count[i];
+    r.diverged_rollouts = diverged_rollouts[i];
+    r.newton_failures = newton_failures[i];
+  }
+  add_trace_summaries(file, records);
+  return records;
+}
+
+void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
+                             const std::vector<RunStatus>& statuses, bool seeds_summary) {
   int counts[4] = {0, 0, 0, 0};
   for (RunStatus s : statuses) ++counts[static_cast<int>(s)];
+  std::cout << "# " << spec.name << " — " << file.path() << "\n\n"
+            << counts[1] << " done, " << counts[2] << " diverged, " << counts[3] << " failed, "
+            << counts[0] << " pending of " << file.num_runs() << " runs. ";
+  if (seeds_summary) {
+    std::cout << "Cells: seeds whose inference MSE (Eq. 31) lies below / above the column's "
+                 "geometric midpoint m; (d=k) diverged runs (counted above), (n=k/N) finished "
+                 "of expected.\n\n";
+    return;
+  }
+  std::cout << "Cells: median [IQR] (bootstrap 95 % interval of the median) of the inference "
+               "MSE (Eq. 31) over seeds; **bold** = best median of its column, its interval "
+               "overlapping no other; (tie) = best median whose interval overlaps others', and "
+               "those others; (d=k) diverged runs (MSE +inf, included), (n=k/N) finished of "
+               "expected.\n\n";
+}
+
+}  // namespace
+
+int run_reduce(int argc, char** argv, int first) {
+  cli::Parser parser(
+      "reduce",
+      "Prints, for each study and system of the sweep that wrote FILE, a table with\n"
+      "rows = models, columns = the study's varied axis and cells = median [IQR]\n"
+      "(low, high) of the inference MSE over seeds: quartiles by numpy's default linear\n"
+      "interpolation, (low, high) a percentile-bootstrap 95 % interval of the median\n"
+      "(100 000 resamples, fixed seed). The best median of a column is bold only if its\n"
+      "interval overlaps no other cell's; otherwise the overlapping cells are marked\n"
+      "(tie). Works on partial files: missing and diverged runs are counted.");
+  parser.positional("FILE", "results file written by `phnn sweep`");
+  parser.option("format", "markdown | latex | csv", "markdown");
+  parser.flag("seeds-summary",
+              "instead of the statistics, count per cell the seeds below / above the column's "
+              "geometric midpoint of the MSE (shows bimodal cells)");
+  parser.flag("per-run",
+              "with --format csv: one row per run (every configuration key, status, MSE, best "
+              "step, wall time, ...) instead of the tables");
+  if (!parser.parse(argc, argv, first)) return 0;
+  const TableFormat format = parse_table_format(parser.get("format"));
+  const bool per_run = parser.flag_set("per-run"), seeds_summary = parser.flag_set("seeds-summary");
+  if (per_run && format != TableFormat::kCsv) {
+    throw cli::UsageError{"phnn reduce: --per-run writes CSV only; add --format csv"};
+  }
+  if (per_run && seeds_summary) {
+    throw cli::UsageError{"phnn reduce: --per-run and --seeds-summary exclude each other; "
+                          "pass one of them"};
+  }
+  const std::string path = parser.get("FILE");
+  const ResultsFile file = ResultsFile::open_read_only(path);
+  const SweepSpec spec = parse_sweep_text(file.sweep_text(), path + "@sweep_text");
+  const Grid grid = checked_grid(file, spec);
+  if (per_run) {
+    std::cout << render_per_run_csv(read_run_records(file, grid));
+    return 0;
+  }
+  const auto statuses = file.read_statuses();
+  const auto entries = make_table_entries(grid, statuses, file.read_double_column("mse"));
   std::size_t expected_seeds = 0;
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());
-  if (format == TableFormat::kMarkdown) {
-    std::cout << "# " << spec.name << " — " << path << "\n\n"
-              << counts[1] << " done, " << counts[2] << " diverged, " << counts[3] << " failed, "
-              << counts[0] << " pending of " << file.num_runs()
-              << " runs. Cells: median [IQR] of the inference MSE (Eq. 31) over seeds; "
-                 "**bold** = best median per column; (d=k) diverged runs, (n=k/N) finished "
-                 "of expected.\n\n";
-  }
-  std::cout << render_tables(grid.studies, make_table_entries(grid, statuses, mse), format,
-                             static_cast<int>(expected_seeds));
+  if (format == TableFormat::kMarkdown) print_markdown_preamble(file, spec, statuses, seeds_summary);
+  const int expected = static_cast<int>(expected_seeds);
+  std::cout << (seeds_summary ? render_seeds_summary(grid.studies, entries, format, expected)
+                              : render_tables(grid.studies, entries, format, expected));
   return 0;
 }
 

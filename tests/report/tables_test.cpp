@@ -17,38 +17,7 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
 
-// Quantiles of a handful of values: a few ulps of round-off at most.
-constexpr double kQuantileTolerance = 1e-12;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-TEST(QuantileTest, MatchesNumpyLinearOnEvenCount) {
-  // numpy.quantile([1, 2, 3, 4], [.25, .5, .75]) = [1.75, 2.5, 3.25].
-  const std::vector<double> values = {4.0, 1.0, 3.0, 2.0};
-  EXPECT_NEAR(quantile_linear(values, 0.25), 1.75, kQuantileTolerance);
-  EXPECT_NEAR(quantile_linear(values, 0.5), 2.5, kQuantileTolerance);
-  EXPECT_NEAR(quantile_linear(values, 0.75), 3.25, kQuantileTolerance);
-  EXPECT_EQ(quantile_linear(values, 0.0), 1.0);
-  EXPECT_EQ(quantile_linear(values, 1.0), 4.0);
-}
-
-TEST(QuantileTest, MatchesNumpyLinearOnOddCount) {
-  // h = 2 q: [5, 1, 3] -> q25 = 1 + 0.5 (3 - 1) = 2, median 3, q75 = 4.
-  EXPECT_NEAR(quantile_linear({5.0, 1.0, 3.0}, 0.25), 2.0, kQuantileTolerance);
-  EXPECT_NEAR(quantile_linear({5.0, 1.0, 3.0}, 0.5), 3.0, kQuantileTolerance);
-  EXPECT_NEAR(quantile_linear({5.0, 1.0, 3.0}, 0.75), 4.0, kQuantileTolerance);
-  // h = 4 q lands on elements: [1, 2, 3, 4, 10] -> 2, 3, 4.
-  EXPECT_NEAR(quantile_linear({10.0, 1.0, 2.0, 3.0, 4.0}, 0.25), 2.0, kQuantileTolerance);
-  EXPECT_NEAR(quantile_linear({10.0, 1.0, 2.0, 3.0, 4.0}, 0.5), 3.0, kQuantileTolerance);
-  EXPECT_NEAR(quantile_linear({10.0, 1.0, 2.0, 3.0, 4.0}, 0.75), 4.0, kQuantileTolerance);
-  EXPECT_EQ(quantile_linear({7.0}, 0.25), 7.0);
-}
-
-TEST(QuantileTest, RejectsEmptyValuesAndQOutsideUnitInterval) {
-  EXPECT_THROW(quantile_linear({}, 0.5), std::invalid_argument);
-  EXPECT_THROW(quantile_linear({1.0}, 1.5), std::invalid_argument);
-  EXPECT_THROW(quantile_linear({1.0}, -0.1), std::invalid_argument);
-  EXPECT_THROW(quantile_linear({1.0, std::nan("")}, 0.5), std::invalid_argument);
-}
 
 TEST(TableFormatTest, ParsesTheThreeFormatsAndListsThemOnError) {
   EXPECT_EQ(parse_table_format("markdown"), TableFormat::kMarkdown);
@@ -97,10 +66,17 @@ class TableTest : public ::testing::Test {
   std::vector<TableEntry> entries_;
 };
 
-TEST_F(TableTest, MarkdownShowsMedianIqrBestDivergedAndMissing) {
-  // NODE-RK2/25: median 3e-3, q25 2e-3, q75 4e-3, IQR 2e-3.
-  // PHNN-JR-DG/25: {1, 2, 3}e-4 + 2 x inf -> median 3e-4, q25 2e-4, q75 inf: best.
-  // NODE-RK2/100: {5, 6, 7}e-3 -> 6e-3 [1e-3], 3 of 5 finished; best (alone).
+// Intervals here are exact: with B = 100 000 resamples the 2.5 % and 97.5 %
+// points fall on the smallest / largest value whenever each is the bootstrap
+// median with probability well above 2.5 % (5 values: P(median = min) =
+// P(>= 3 of 5 draws are the min) = 0.058; 3 values: 7/27).
+TEST_F(TableTest, MarkdownShowsMedianIqrIntervalTieDivergedAndMissing) {
+  // NODE-RK2/25: {1..5}e-3: median 3e-3, IQR 2e-3, interval [1e-3, 5e-3].
+  // PHNN-JR-DG/25: {1, 2, 3}e-4 + 2 x inf: median 3e-4, q75 inf, interval
+  //   [1e-4, inf] (P(median = inf) = P(>= 3 of 5 draws diverged) = 0.32):
+  //   smallest median, but its interval overlaps NODE-RK2's: a tie.
+  // NODE-RK2/100: {5, 6, 7}e-3 -> 6e-3 [1e-3] (5e-3, 7e-3), 3 of 5 finished;
+  //   best (alone).
   EXPECT_EQ(render(TableFormat::kMarkdown),
             "### Study I — harmonic (columns: n_train)\n"
             "\n"
@@ -108,52 +84,145 @@ TEST_F(TableTest, MarkdownShowsMedianIqrBestDivergedAndMissing) {
             "\n"
             "| model | 25 | 100 |\n"
             "|---|---|---|\n"
-            "| NODE-RK2 | 3.00e-03 [2.00e-03] | **6.00e-03 [1.00e-03]** (n=3/5) |\n"
-            "| PHNN-JR-DG | **3.00e-04 [inf]** (d=2) | — |\n"
+            "| NODE-RK2 | 3.00e-03 [2.00e-03] (1.00e-03, 5.00e-03) (tie) | "
+            "**6.00e-03 [1.00e-03] (5.00e-03, 7.00e-03)** (n=3/5) |\n"
+            "| PHNN-JR-DG | 3.00e-04 [inf] (1.00e-04, inf) (tie) (d=2) | — |\n"
+            "\n"
+            "(tie): no clear best in this column: the bootstrap 95 % interval of its smallest "
+            "median overlaps the intervals of the other cells marked (tie), so none is bold.\n"
             "\n");
 }
 
-TEST_F(TableTest, LatexBoldsTheBestAndEscapesLabels) {
+TEST_F(TableTest, BestIsBoldOnlyWhenItsIntervalOverlapsNoOther) {
+  entries_.clear();
+  // Constant sample: interval [2e-4, 2e-4]; the runner-up's is [1e-3, 3e-3].
+  for (int seed = 0; seed < 5; ++seed) add("PHNN-JR-DG", "25", RunStatus::kDone, 2e-4);
+  for (double mse : {3e-3, 1e-3, 2e-3}) add("NODE-RK2", "25", RunStatus::kDone, mse);
+  std::string markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04)** |"));
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 2.00e-03 [1.00e-03] (1.00e-03, 3.00e-03) (n=3/5) |"));
+  EXPECT_THAT(markdown, Not(HasSubstr("(tie)")));
+  // One run of the runner-up as low as the best: the intervals now touch.
+  add("NODE-RK2", "25", RunStatus::kDone, 2e-4);
+  markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, Not(HasSubstr("**")));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | 2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04) (tie) |"));
+  EXPECT_THAT(markdown, HasSubstr("(tie): no clear best in this column"));
+}
+
+TEST_F(TableTest, LatexBoldsTheBestMarksTiesAndEscapesLabels) {
   const std::string latex = render(TableFormat::kLatex);
   EXPECT_THAT(latex, HasSubstr("\\begin{tabular}{lcc}"));
   EXPECT_THAT(latex, HasSubstr("Study I --- harmonic (columns: n\\_train)"));
   EXPECT_THAT(latex, HasSubstr("Model & 25 & 100 \\\\"));
-  EXPECT_THAT(latex, HasSubstr("NODE-RK2 & 3.00e-03 [2.00e-03] & \\textbf{6.00e-03 [1.00e-03]} "
-                               "(n=3/5) \\\\"));
-  EXPECT_THAT(latex, HasSubstr("PHNN-JR-DG & \\textbf{3.00e-04 [inf]} (d=2) & -- \\\\"));
+  EXPECT_THAT(latex, HasSubstr("NODE-RK2 & 3.00e-03 [2.00e-03] (1.00e-03, 5.00e-03) (tie) & "
+                               "\\textbf{6.00e-03 [1.00e-03] (5.00e-03, 7.00e-03)} (n=3/5) \\\\"));
+  EXPECT_THAT(latex, HasSubstr("PHNN-JR-DG & 3.00e-04 [inf] (1.00e-04, inf) (tie) (d=2) & -- \\\\"));
+  EXPECT_THAT(latex, HasSubstr("\\par\\smallskip{\\footnotesize (tie): no clear best in this "
+                               "column: the bootstrap 95 \\% interval"));
   EXPECT_THAT(latex, Not(HasSubstr("—")));
   EXPECT_THAT(latex, HasSubstr("\\end{table}"));
 }
 
-TEST_F(TableTest, CsvHasOneLinePerCellWithABestColumn) {
+TEST_F(TableTest, CsvHasOneLinePerCellWithIntervalBestAndTieColumns) {
   const std::string csv = render(TableFormat::kCsv);
-  EXPECT_THAT(csv, StartsWith("study,system,model,axis,column,median,q25,q75,iqr,done,diverged,"
-                              "missing,expected,best\n"));
+  EXPECT_THAT(csv, StartsWith("study,system,model,axis,column,median,q25,q75,iqr,ci_low,ci_high,"
+                              "done,diverged,missing,expected,best,tie\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,25,3.000000e-03,2.000000e-03,"
-                             "4.000000e-03,2.000000e-03,5,0,0,5,0\n"));
+                             "4.000000e-03,2.000000e-03,1.000000e-03,5.000000e-03,5,0,0,5,0,1\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,25,3.000000e-04,2.000000e-04,"
-                             "inf,inf,3,2,0,5,1\n"));
+                             "inf,inf,1.000000e-04,inf,3,2,0,5,0,1\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,100,6.000000e-03,5.500000e-03,"
-                             "6.500000e-03,1.000000e-03,3,0,2,5,1\n"));
-  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,100,,,,,0,0,5,5,0\n"));
+                             "6.500000e-03,1.000000e-03,5.000000e-03,7.000000e-03,3,0,2,5,1,0\n"));
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,100,,,,,,,0,0,5,5,0,0\n"));
   // Header + 4 cells.
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
 }
 
-TEST_F(TableTest, AllDivergedCellShowsDashAndCount) {
+TEST_F(TableTest, AllDivergedCellShowsInfinityAndCountNeverNan) {
   entries_.clear();
   for (int i = 0; i < 5; ++i) add("NODE-RK2", "25", RunStatus::kDiverged, kInf);
+  add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-3);
   const std::string markdown = render(TableFormat::kMarkdown);
-  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | — (d=5) | — |"));
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | inf (d=5) | — |"));
+  // The diverged cell's interval [inf, inf] overlaps nothing finite.
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **1.00e-03 [0.00e+00] (1.00e-03, 1.00e-03)** "
+                                  "(n=1/5) |"));
+  const std::string csv = render(TableFormat::kCsv);
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,25,inf,inf,inf,inf,inf,inf,0,5,0,5,0,0\n"));
+  EXPECT_THAT(markdown + csv + render(TableFormat::kLatex), Not(HasSubstr("nan")));
 }
 
-TEST_F(TableTest, TiedBestMediansAreAllMarked) {
+TEST_F(TableTest, AllDivergedCellIsNoTieForABestWhoseIntervalReachesInfinity) {
+  entries_.clear();
+  // {1, 2}e-3 + inf: median 2e-3, interval [1e-3, inf] (P(median = inf) = 7/27).
+  for (double mse : {1e-3, 2e-3, kInf}) add("NODE-RK2", "25", RunStatus::kDone, mse);
+  for (int i = 0; i < 3; ++i) add("PHNN-JR-DG", "25", RunStatus::kDiverged, kInf);
+  const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 3);
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **2.00e-03 [inf] (1.00e-03, inf)** (d=1) | — |"));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | inf (d=3) | — |"));
+  EXPECT_THAT(markdown, Not(HasSubstr("(tie)")));
+}
+
+TEST_F(TableTest, DivergedRunsWithAFiniteMseShowTheirNumbers) {
+  entries_.clear();
+  add("NODE-RK2", "25", RunStatus::kDiverged, 5e-3);  // e.g. a training loss that went NaN
+  const std::string markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **5.00e-03 [0.00e+00] (5.00e-03, 5.00e-03)** "
+                                  "(n=1/5) (d=1) |"));
+}
+
+// Every way +inf meets a quantile: neighbours both +inf, a median between a
+// finite value and +inf, an IQR with q75 = +inf, q25 = q75 = +inf.
+TEST_F(TableTest, InfiniteMsesNeverPrintNan) {
+  entries_.clear();
+  // {1, 2} + 2 x inf: median between 2 and inf -> inf; q25 1.75; q75 inf.
+  for (double mse : {1e-3, 2e-3}) add("NODE-RK2", "25", RunStatus::kDone, mse);
+  for (int i = 0; i < 2; ++i) add("NODE-RK2", "25", RunStatus::kDiverged, kInf);
+  // {1} + 4 x inf: q25 between inf and inf -> inf, IQR inf (not inf - inf).
+  add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-3);
+  for (int i = 0; i < 4; ++i) add("PHNN-JR-DG", "25", RunStatus::kDiverged, kInf);
+  // A done run with a NaN MSE counts as diverged (+inf).
+  add("NODE-RK2", "100", RunStatus::kDone, std::nan(""));
+  add("NODE-RK2", "100", RunStatus::kDone, 1e-3);
+  const std::string markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | inf [inf] (1.00e-03, inf) (n=4/5) (d=2) | "
+                                  "inf [inf] (1.00e-03, inf) (n=2/5) (d=1) |"));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | inf [inf] (1.00e-03, inf) (d=4) | — |"));
+  EXPECT_THAT(markdown + render(TableFormat::kCsv) + render(TableFormat::kLatex),
+              Not(HasSubstr("nan")));
+}
+
+TEST_F(TableTest, EqualBestMediansAreATie) {
   entries_.clear();
   add("NODE-RK2", "25", RunStatus::kDone, 1e-3);
   add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-3);
   const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 1);
-  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **1.00e-03 [0.00e+00]** | — |"));
-  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **1.00e-03 [0.00e+00]** | — |"));
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 1.00e-03 [0.00e+00] (1.00e-03, 1.00e-03) (tie) | — |"));
+  EXPECT_THAT(markdown,
+              HasSubstr("| PHNN-JR-DG | 1.00e-03 [0.00e+00] (1.00e-03, 1.00e-03) (tie) | — |"));
+}
+
+TEST_F(TableTest, SeedsSummaryCountsSeedsBelowAndAboveTheColumnMidpoint) {
+  entries_.clear();
+  // Column 25: finite MSEs 1e-2 .. 1e2 -> m = sqrt(1e-2 * 1e2) = 1.
+  for (double mse : {1e-2, 2e-2, 50.0, 1e2}) add("NODE-RK2", "25", RunStatus::kDone, mse);
+  add("NODE-RK2", "25", RunStatus::kDiverged, kInf);
+  for (double mse : {0.5, 0.9, 3e-2}) add("PHNN-JR-DG", "25", RunStatus::kDone, mse);
+  const std::string markdown =
+      render_seeds_summary({study_}, entries_, TableFormat::kMarkdown, /*expected_seeds=*/5);
+  EXPECT_THAT(markdown, HasSubstr("| model | 25 (m=1.00e+00) | 100 (m=—) |"));
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 2 / 3 (d=1) | — |"));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | 3 / 0 (n=3/5) | — |"));
+  EXPECT_THAT(markdown, HasSubstr("below / above: seeds with MSE <= m / > m"));
+  const std::string csv =
+      render_seeds_summary({study_}, entries_, TableFormat::kCsv, /*expected_seeds=*/5);
+  EXPECT_THAT(csv, StartsWith("study,system,model,axis,column,midpoint,below,above,diverged,"
+                              "missing,expected\n"));
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,25,1.000000e+00,2,3,1,0,5\n"));
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,100,,0,0,0,5,5\n"));
+  EXPECT_THAT(render_seeds_summary({study_}, entries_, TableFormat::kLatex, 5),
+              HasSubstr("NODE-RK2 & 2 / 3 (d=1) & -- \\\\"));
 }
 
 TEST(CellSummaryTest, CountsDoneDivergedAndMissing) {
@@ -170,9 +239,30 @@ TEST(CellSummaryTest, CountsDoneDivergedAndMissing) {
   EXPECT_EQ(s.diverged, 2);
   EXPECT_EQ(s.missing, 7);
   EXPECT_EQ(s.expected, 10);
-  // Diverged runs count as +inf (SPEC.md §5): {1, inf, inf} has median inf.
+  // Diverged runs count as +inf: {1, inf, inf} has median inf.
   EXPECT_EQ(s.median, kInf);
   EXPECT_EQ(s.q25, kInf);  // numpy: 1 + 0.5 (inf - 1)
+  EXPECT_EQ(s.q75, kInf);  // numpy: nan (inf + 0.5 (inf - inf))
+  EXPECT_EQ(s.iqr(), kInf);
+  EXPECT_EQ(s.median_interval.low, 1.0);
+  EXPECT_EQ(s.median_interval.high, kInf);
+}
+
+TEST(CellSummaryTest, AllDivergedHasInfiniteStatisticsAndNoRunsHasNan) {
+  std::vector<TableEntry> entries(3);
+  for (TableEntry& e : entries) {
+    e.status = RunStatus::kDiverged;
+    e.mse = kInf;
+  }
+  const CellSummary all = summarize_cell(entries, /*expected_seeds=*/3);
+  EXPECT_EQ(all.diverged, 3);
+  EXPECT_EQ(all.median, kInf);
+  EXPECT_EQ(all.iqr(), kInf);
+  EXPECT_EQ(all.median_interval.low, kInf);
+  EXPECT_EQ(all.median_interval.high, kInf);
+  const CellSummary none = summarize_cell({}, /*expected_seeds=*/3);
+  EXPECT_EQ(none.missing, 3);
+  EXPECT_TRUE(std::isnan(none.median));
 }
 
 TEST(TableEntriesTest, OneEntryPerRunAndStudyFromTheGrid) {

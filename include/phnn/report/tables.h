@@ -1,24 +1,18 @@
 // include/phnn/report/tables.h — the paper's result tables (Appendix F) from
-// run results. Pure functions: no HDF5, no MPI.
+// run results: median [IQR] (bootstrap interval of the median) per cell, the
+// best of a column only when the intervals separate it, and the seeds-per-mode
+// view. Pure functions: no HDF5, no MPI.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "phnn/report/statistics.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/systems/oscillators.h"
 #include "phnn/training/run_result.h"
 
 namespace phnn {
-
-/// The q-quantile of `values` with numpy's default ("linear") method:
-///
-///   h = (n - 1) q,   Q(q) = s[floor h] + (h - floor h) (s[floor h + 1] - s[floor h])
-///
-/// over the sorted values s (Hyndman & Fan type 7). E.g. {1, 2, 3, 4}:
-/// Q(0.25) = 1.75, Q(0.5) = 2.5, Q(0.75) = 3.25. Throws std::invalid_argument
-/// if `values` is empty, contains a NaN, or q is outside [0, 1].
-double quantile_linear(std::vector<double> values, double q);
 
 /// One run's outcome, placed in a table: study, system, row (model label,
 /// e.g. "PHNN-JR-DG") and column (StudyTable::columns label). A run shared by
@@ -29,7 +23,8 @@ struct TableEntry {
   std::string row;
   std::string column;
   RunStatus status = RunStatus::kPending;
-  /// Inference MSE (Eq. 31); +inf for a diverged run; ignored unless done.
+  /// Inference MSE (Eq. 31); +inf for a diverged run (NaN is read as +inf);
+  /// ignored unless done or diverged.
   double mse = 0.0;
 };
 
@@ -50,39 +45,56 @@ struct CellSummary {
   /// Runs with status done (and a finite MSE).
   int done = 0;
   /// Runs with status diverged (or done with a non-finite MSE): counted, and
-  /// their MSE (+inf for a diverged rollout) enters median and IQR.
+  /// their MSE (+inf for a diverged rollout) enters median, IQR and interval.
   int diverged = 0;
   /// expected - done - diverged (pending, failed or absent runs), >= 0.
   int missing = 0;
   /// max(expected_seeds, number of entries of the cell).
   int expected = 0;
-  /// Median, 25 % and 75 % quantiles (quantile_linear); NaN if done == 0.
+  /// Median, 25 % and 75 % quantiles (quantile_linear: exact with +inf, so
+  /// a cell whose runs all diverged has median +inf); NaN only if the cell
+  /// has no finished run (done + diverged == 0).
   double median = 0.0, q25 = 0.0, q75 = 0.0;
-  /// q75 - q25.
-  double iqr() const { return q75 - q25; }
+  /// Percentile-bootstrap interval of the median (bootstrap_median_interval
+  /// over the done and diverged runs); NaN ends if done + diverged == 0.
+  Interval median_interval;
+
+  /// Runs whose MSE enters the statistics.
+  int finished() const { return done + diverged; }
+  /// q75 - q25; +inf if q75 is +inf (also when q25 is: the spread of a cell
+  /// with that many diverged runs is unbounded, never NaN).
+  double iqr() const;
 };
 
 /// Summarizes the MSEs of one cell's entries.
-CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_seeds);
+CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_seeds,
+                           const BootstrapOptions& bootstrap = {});
 
-/// The paper's tables (Appendix F layout, SPEC.md §6): for each study and
-/// each of its systems, rows = StudyTable::rows (models, in order), columns =
+/// The paper's tables (Appendix F layout): for each study and each of its
+/// systems, rows = StudyTable::rows (models, in order), columns =
 /// StudyTable::columns (values of the varied axis), cells =
 ///
-///   median [IQR]   of the inference MSE over the runs with status done,
+///   median [IQR] (low, high)   of the inference MSE over the finished runs,
 ///
-/// both printed "%.2e" (e.g. "1.23e-03 [4.56e-04]"), IQR = q75 - q25 with
-/// quantile_linear (numpy's default linear interpolation). The best
-/// (smallest) median of each column is marked: **bold** in Markdown,
-/// \textbf{} in LaTeX, best = 1 in CSV (ties all marked). Annotations,
-/// appended in this order:
+/// all "%.2e" (e.g. "1.23e-03 [4.56e-04] (9.80e-04, 2.01e-03)"), IQR = q75 -
+/// q25 with quantile_linear (numpy's default linear interpolation), (low,
+/// high) the bootstrap 95 % interval of the median (bootstrap_median_interval
+/// with `bootstrap`). Best per column: among the cells with a finite median,
+/// the one with the smallest median is
+///   - marked best (**bold** in Markdown, \textbf{} in LaTeX, best = 1 in
+///     CSV) if its interval overlaps no other cell's interval of the column;
+///   - otherwise marked " (tie)", together with every cell of the column whose
+///     interval overlaps it (and any cell with the same median); nothing is
+///     bold, and a note under the table explains the mark (tie = 1 in CSV).
+///     A cell whose interval is [inf, inf] never ties (it shares only +inf).
+/// Annotations, appended in this order:
 ///   " (n=7/10)"  fewer than `expected` runs finished (n = done + diverged;
 ///                pending, failed or absent runs are missing);
 ///   " (d=2)"     diverged runs; their MSE (+inf for a diverged rollout) is
-///                included in median and IQR (SPEC.md §5: "its error is +inf
-///                and counted"), so IQR or median may print as inf.
+///                included in the statistics (a diverged run's error is +inf
+///                and counted), so IQR, median or interval may print as inf.
 /// A cell without any finished run shows just "—" (Markdown) or "--"
-/// (LaTeX); one whose runs all diverged shows "— (d=10)".
+/// (LaTeX); one whose runs all diverged shows "inf (d=10)".
 /// expected = max(expected_seeds, entries of the cell).
 ///
 /// Markdown: per table a heading "### Study I — harmonic (columns: n_train)",
@@ -90,12 +102,29 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
 /// LaTeX: per table a `table` float with a `tabular` (\hline rules, no
 /// packages needed) and the heading as caption; labels escaped.
 /// CSV: one header line, then one line per (study, system, model, column):
-///   study,system,model,axis,column,median,q25,q75,iqr,done,diverged,missing,expected,best
-/// numbers "%.6e" (empty when done = 0), best = 1 for the marked cells else 0.
+///   study,system,model,axis,column,median,q25,q75,iqr,ci_low,ci_high,done,
+///   diverged,missing,expected,best,tie
+/// numbers "%.6e" ("inf" for +inf; empty when the cell has no finished run).
 ///
 /// Entries whose study, system, row or column is not in `studies` are ignored.
 std::string render_tables(const std::vector<StudyTable>& studies,
                           const std::vector<TableEntry>& entries, TableFormat format,
-                          int expected_seeds);
+                          int expected_seeds, const BootstrapOptions& bootstrap = {});
+
+/// The seeds behind each cell, to make a bimodal cell visible: for each
+/// column of each table, the geometric midpoint of its finite positive MSEs
+/// (all rows), m = sqrt(min * max), and per cell
+///
+///   below / above    runs with MSE <= m / runs with MSE > m (diverged
+///                    runs, MSE +inf, count above and are also shown "(d=k)"),
+///
+/// with the same " (n=k/N)" annotation as render_tables. A column without a
+/// finite positive MSE has no midpoint ("—"); all its finished runs count
+/// above. Markdown and LaTeX: the render_tables layout, the midpoint in the
+/// column label ("25 (m=3.16e-01)") and a note under each table. CSV:
+///   study,system,model,axis,column,midpoint,below,above,diverged,missing,expected
+std::string render_seeds_summary(const std::vector<StudyTable>& studies,
+                                 const std::vector<TableEntry>& entries, TableFormat format,
+                                 int expected_seeds);
 
 }  // namespace phnn

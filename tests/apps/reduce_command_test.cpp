@@ -1,0 +1,189 @@
+// tests/apps/reduce_command_test.cpp — `phnn reduce` end to end on a small
+// results file written without training (rows from tests/sweep/sample_results.h).
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "sweep/sample_results.h"
+#include "test_util.h"
+
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/journal.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::StartsWith;
+
+constexpr const char* kSweepText = R"(name = "reduce-test"
+[grid]
+systems = ["harmonic", "duffing"]
+models = ["node-rk2", "phnn-s-dg"]
+seeds = [0, 1, 2]
+[study.a]
+n_train = [25, 100]
+)";
+
+// RFC 4180 records (quoted fields may hold commas, quotes and line breaks).
+std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
+  std::vector<std::vector<std::string>> rows(1);
+  std::string field;
+  bool quoted = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') field += text[++i];
+      else if (c == '"') quoted = false;
+      else field += c;
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',' || c == '\n') {
+      rows.back().push_back(field);
+      field.clear();
+      if (c == '\n') rows.emplace_back();
+    } else {
+      field += c;
+    }
+  }
+  rows.pop_back();  // after the last "\n"
+  return rows;
+}
+
+class ReduceCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = ::testing::TempDir() + "phnn_reduce_" + std::to_string(::getpid()) + ".h5";
+    grid_ = expand_grid(parse_sweep_text(kSweepText, "reduce-test.toml"));
+    std::vector<std::string> studies;
+    for (const auto& names : grid_.run_studies) {
+      std::string joined;
+      for (const std::string& n : names) joined += (joined.empty() ? "" : ",") + n;
+      studies.push_back(joined);
+    }
+    const ResultsLayout layout = testing_util::sample_layout();
+    ResultsFile file = ResultsFile::create(path_, MPI_COMM_NULL, grid_.runs, studies,
+                                           "reduce-test", kSweepText, "hash", "test", layout);
+    // The last row stays pending.
+    for (int row = 0; row + 1 < static_cast<int>(grid_.runs.size()); ++row) {
+      file.write_run(row, testing_util::sample_result(row, layout));
+    }
+    file.close();
+  }
+  void TearDown() override {
+    std::remove(path_.c_str());
+    remove_journals(path_);
+  }
+
+  int reduce(const std::string& args, std::string* output) const {
+    return testing_util::run_shell(std::string(PHNN_BINARY) + " reduce " + path_ + " " + args,
+                                   output);
+  }
+
+  std::string path_;
+  Grid grid_;
+};
+
+TEST_F(ReduceCommandTest, PerRunCsvHasOneRowPerRunWithAxesAndExactValues) {
+  std::string csv;
+  ASSERT_EQ(reduce("--format csv --per-run", &csv), 0) << csv;
+  const auto rows = parse_csv(csv);
+  ASSERT_EQ(rows.size(), grid_.runs.size() + 1);  // header + one per run
+  const std::vector<std::string>& header = rows[0];
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  for (const char* axis : {"system", "model", "integrator", "size", "n_train", "regularizer",
+                           "seed", "cubic_stiffness", "damping", "steps", "learning_rate",
+                           "energy_min", "num_validation", "newton_max_iterations"}) {
+    column(axis);
+  }
+  for (std::size_t row = 0; row < grid_.runs.size(); ++row) {
+    const std::vector<std::string>& fields = rows[row + 1];
+    ASSERT_EQ(fields.size(), header.size()) << "row " << row;
+    const RunConfig& run = grid_.runs[row];
+    EXPECT_EQ(fields[column("run_id")], run.id());
+    EXPECT_EQ(fields[column("system")], to_string(run.system));
+    EXPECT_EQ(fields[column("model_label")], model_label(run.model, run.integrator));
+    EXPECT_EQ(fields[column("n_train")], std::to_string(run.n_train));
+    EXPECT_EQ(fields[column("seed")], std::to_string(run.seed));
+    EXPECT_EQ(fields[column("studies")], "a");
+    if (row + 1 == grid_.runs.size()) {
+      EXPECT_EQ(fields[column("status")], "pending");
+      EXPECT_EQ(fields[column("mse")], "nan");
+      continue;
+    }
+    const RunResult expected = testing_util::sample_result(static_cast<int>(row),
+                                                           testing_util::sample_layout());
+    EXPECT_EQ(fields[column("status")], to_string(expected.status));
+    EXPECT_EQ(fields[column("message")], expected.message);
+    // strtod of "%.17g" gives the stored double back, bit for bit.
+    const double mse = std::strtod(fields[column("mse")].c_str(), nullptr);
+    if (std::isnan(expected.mse)) {
+      EXPECT_EQ(fields[column("mse")], "nan");
+    } else {
+      EXPECT_EQ(testing_util::bits(mse), testing_util::bits(expected.mse)) << "row " << row;
+    }
+    EXPECT_EQ(testing_util::bits(std::strtod(fields[column("wall_time_s")].c_str(), nullptr)),
+              testing_util::bits(expected.wall_time_s));
+    EXPECT_EQ(fields[column("best_step")], std::to_string(expected.best_step));
+    EXPECT_EQ(fields[column("steps_taken")], std::to_string(expected.steps));
+    EXPECT_EQ(fields[column("newton_failures")], std::to_string(expected.newton_failures));
+    EXPECT_EQ(fields[column("trace_points")], std::to_string(expected.trace.size()));
+    const auto number = [&](const char* name) {
+      return testing_util::bits(std::strtod(fields[column(name)].c_str(), nullptr));
+    };
+    if (expected.trace.empty()) {
+      EXPECT_EQ(fields[column("initial_validation_loss")], "nan");
+      EXPECT_EQ(fields[column("final_rho")], "nan");
+      continue;
+    }
+    const TracePoint& first = expected.trace.front();
+    const TracePoint& last = expected.trace.back();
+    EXPECT_EQ(number("initial_validation_loss"), testing_util::bits(first.validation_loss));
+    EXPECT_EQ(number("final_validation_loss"), testing_util::bits(last.validation_loss));
+    EXPECT_EQ(number("final_kappa"), testing_util::bits(last.kappa));
+    EXPECT_EQ(number("final_sigma_max"), testing_util::bits(last.sigma_max));
+    EXPECT_EQ(number("final_rho"), testing_util::bits(last.rho));
+    if (!std::isnan(last.train_loss)) {
+      EXPECT_EQ(number("final_train_loss"), testing_util::bits(last.train_loss));
+    }
+  }
+  EXPECT_THAT(csv, HasSubstr(",diverged,inf,"));
+}
+
+TEST_F(ReduceCommandTest, TablesShowIntervalsAndNeverNan) {
+  std::string out;
+  ASSERT_EQ(reduce("", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("bootstrap 95 % interval of the median"));
+  EXPECT_THAT(out, HasSubstr("### Study a — duffing (columns: n_train)"));
+  EXPECT_THAT(out, Not(HasSubstr("nan")));
+  ASSERT_EQ(reduce("--format csv", &out), 0) << out;
+  EXPECT_THAT(out, StartsWith("study,system,model,axis,column,median,q25,q75,iqr,ci_low,ci_high,"));
+  ASSERT_EQ(reduce("--seeds-summary", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("below / above"));
+  ASSERT_EQ(reduce("--seeds-summary --format csv", &out), 0) << out;
+  EXPECT_THAT(out, StartsWith("study,system,model,axis,column,midpoint,below,above,"));
+}
+
+TEST_F(ReduceCommandTest, PerRunNeedsCsvAndExcludesSeedsSummary) {
+  std::string out;
+  EXPECT_EQ(reduce("--per-run", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--per-run writes CSV only; add --format csv"));
+  EXPECT_EQ(reduce("--per-run --format csv --seeds-summary", &out), 2);
+  EXPECT_THAT(out, HasSubstr("exclude each other"));
+}
+
+}  // namespace
+}  // namespace phnn

@@ -1,0 +1,110 @@
+// tests/report/per_run_test.cpp — the per-run CSV export, without HDF5
+// (end to end through `phnn reduce`: tests/apps/reduce_command_test.cpp).
+#include "phnn/report/per_run.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace phnn {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::Pair;
+using ::testing::StartsWith;
+
+TEST(ParseCanonicalTest, SplitsKeyValuePairsAtTheFirstEquals) {
+  EXPECT_THAT(parse_canonical("system=duffing;e0=0.1,0.5;x=a=b;seed=3"),
+              ElementsAre(Pair("system", "duffing"), Pair("e0", "0.1,0.5"), Pair("x", "a=b"),
+                          Pair("seed", "3")));
+  EXPECT_THAT([] { parse_canonical("system=duffing;oops;seed=3"); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("part \"oops\"")));
+  EXPECT_THAT([] { parse_canonical("seed=1;seed=2"); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("key \"seed\" repeats")));
+}
+
+RunRecord record(const std::string& canonical, RunStatus status, double mse) {
+  RunRecord r;
+  r.id = "00000000000000ab";
+  r.studies = "I,II";
+  r.model_label = "PHNN-S-DG";
+  r.canonical = canonical;
+  r.status = status;
+  r.mse = mse;
+  r.best_validation_loss = 0.1;
+  r.wall_time_s = 12.5;
+  r.best_step = 49000;
+  r.steps_taken = 50000;
+  r.parameter_count = 852;
+  r.diverged_rollouts = 0;
+  r.newton_failures = 3;
+  r.trace_points = 101;
+  r.initial_validation_loss = 0.5;
+  r.final_train_loss = 0.25;
+  r.final_validation_loss = 0.125;
+  r.final_kappa = 1000.0;
+  r.final_sigma_max = 2.0;
+  r.final_rho = 0.0625;
+  return r;
+}
+
+TEST(PerRunCsvTest, OneRowPerRunWithEveryConfigKeyAndFullPrecision) {
+  const std::string csv = render_per_run_csv(
+      {record("system=harmonic;model=phnn-s;damping=0.5;seed=0", RunStatus::kDone, 1.0 / 3.0),
+       record("system=duffing;model=phnn-s;cubic_stiffness=1;damping=0.5;seed=1",
+              RunStatus::kDone, 2e-3)});
+  EXPECT_THAT(csv, StartsWith("run_id,studies,model_label,system,model,damping,seed,"
+                              "cubic_stiffness,status,mse,best_step,best_validation_loss,"
+                              "wall_time_s,steps_taken,parameter_count,diverged_rollouts,"
+                              "newton_failures,trace_points,initial_validation_loss,"
+                              "final_train_loss,final_validation_loss,final_kappa,"
+                              "final_sigma_max,final_rho,message\n"));
+  // %.17g round-trips: 1/3 and 0.1 print 17 digits; a key the run lacks is empty.
+  EXPECT_THAT(csv, HasSubstr("\n00000000000000ab,\"I,II\",PHNN-S-DG,harmonic,phnn-s,0.5,0,,done,"
+                             "0.33333333333333331,49000,0.10000000000000001,12.5,50000,852,0,3,"
+                             "101,0.5,0.25,0.125,1000,2,0.0625,\n"));
+  EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,duffing,phnn-s,0.5,1,1,done,0.002,"));
+}
+
+TEST(PerRunCsvTest, NamesColumnsAsTheSweepFileAndSplitsMultiNumberKeys) {
+  const std::string csv = render_per_run_csv(
+      {record("lr=0.001;e0=0.10000000000000001,1;z=3,-4,1.3;newton=1e-12,20;adam=0.9,0.999;"
+              "learning_rate=5;future_axis=a,b;seed=0",
+              RunStatus::kDone, 1.0)});
+  // adam has 2 parts, not 3: kept; lr would repeat learning_rate: kept.
+  EXPECT_THAT(csv, StartsWith("run_id,studies,model_label,lr,energy_min,energy_max,z1,z2,z3,"
+                              "newton_tolerance,newton_max_iterations,adam,learning_rate,"
+                              "future_axis,seed,status,"));
+  EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,0.001,0.10000000000000001,1,3,-4,1.3,1e-12,20,"
+                             "\"0.9,0.999\",5,\"a,b\",0,done,1,"));
+}
+
+TEST(PerRunCsvTest, SpellsInfinityAndNanForPandasAndQuotesMessages) {
+  RunRecord diverged = record("seed=0", RunStatus::kDiverged,
+                              std::numeric_limits<double>::infinity());
+  diverged.message = "rollout 1 diverged: ||x|| = 1.2e+06, \"stuck\"\nat step 42";
+  RunRecord failed = record("seed=1", RunStatus::kFailed, -std::nan(""));
+  failed.best_validation_loss = -std::numeric_limits<double>::infinity();
+  const std::string csv = render_per_run_csv({diverged, failed});
+  EXPECT_THAT(csv, HasSubstr(",0,diverged,inf,49000,"));
+  EXPECT_THAT(csv, HasSubstr(",\"rollout 1 diverged: ||x|| = 1.2e+06, \"\"stuck\"\"\nat step 42\"\n"));
+  EXPECT_THAT(csv, HasSubstr(",1,failed,nan,49000,-inf,12.5,"));  // no "-nan"
+  EXPECT_THAT(csv, Not(HasSubstr("-nan")));
+}
+
+TEST(PerRunCsvTest, NoRecordsGiveTheFixedHeaderOnly) {
+  EXPECT_EQ(render_per_run_csv({}),
+            "run_id,studies,model_label,status,mse,best_step,best_validation_loss,wall_time_s,"
+            "steps_taken,parameter_count,diverged_rollouts,newton_failures,trace_points,"
+            "initial_validation_loss,final_train_loss,final_validation_loss,final_kappa,"
+            "final_sigma_max,final_rho,message\n");
+}
+
+}  // namespace
+}  // namespace phnn

@@ -1,0 +1,171 @@
+// tests/report/statistics_test.cpp — quantiles with infinities and the
+// percentile bootstrap of the median, on cases with closed-form answers.
+#include "phnn/report/statistics.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Quantiles of a handful of values: a few ulps of round-off at most.
+constexpr double kQuantileTolerance = 1e-12;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+TEST(QuantileTest, MatchesNumpyLinearOnEvenCount) {
+  // numpy.quantile([1, 2, 3, 4], [.25, .5, .75]) = [1.75, 2.5, 3.25].
+  const std::vector<double> values = {4.0, 1.0, 3.0, 2.0};
+  EXPECT_NEAR(quantile_linear(values, 0.25), 1.75, kQuantileTolerance);
+  EXPECT_NEAR(quantile_linear(values, 0.5), 2.5, kQuantileTolerance);
+  EXPECT_NEAR(quantile_linear(values, 0.75), 3.25, kQuantileTolerance);
+  EXPECT_EQ(quantile_linear(values, 0.0), 1.0);
+  EXPECT_EQ(quantile_linear(values, 1.0), 4.0);
+}
+
+TEST(QuantileTest, MatchesNumpyLinearOnOddCount) {
+  // h = 2 q: [5, 1, 3] -> q25 = 1 + 0.5 (3 - 1) = 2, median 3, q75 = 4.
+  EXPECT_NEAR(quantile_linear({5.0, 1.0, 3.0}, 0.25), 2.0, kQuantileTolerance);
+  EXPECT_NEAR(quantile_linear({5.0, 1.0, 3.0}, 0.5), 3.0, kQuantileTolerance);
+  EXPECT_NEAR(quantile_linear({5.0, 1.0, 3.0}, 0.75), 4.0, kQuantileTolerance);
+  // h = 4 q lands on elements: [1, 2, 3, 4, 10] -> 2, 3, 4.
+  EXPECT_NEAR(quantile_linear({10.0, 1.0, 2.0, 3.0, 4.0}, 0.25), 2.0, kQuantileTolerance);
+  EXPECT_NEAR(quantile_linear({10.0, 1.0, 2.0, 3.0, 4.0}, 0.5), 3.0, kQuantileTolerance);
+  EXPECT_NEAR(quantile_linear({10.0, 1.0, 2.0, 3.0, 4.0}, 0.75), 4.0, kQuantileTolerance);
+  EXPECT_EQ(quantile_linear({7.0}, 0.25), 7.0);
+}
+
+TEST(QuantileTest, RejectsEmptyValuesAndQOutsideUnitInterval) {
+  EXPECT_THROW(quantile_linear({}, 0.5), std::invalid_argument);
+  EXPECT_THROW(quantile_linear({1.0}, 1.5), std::invalid_argument);
+  EXPECT_THROW(quantile_linear({1.0}, -0.1), std::invalid_argument);
+  EXPECT_THROW(quantile_linear({1.0, std::nan("")}, 0.5), std::invalid_argument);
+}
+
+TEST(QuantileTest, TwoInfiniteNeighboursGiveInfinityNotNan) {
+  // numpy gives nan here (inf + 0.5 (inf - inf)).
+  EXPECT_EQ(quantile_linear({1.0, 2.0, kInf, kInf}, 0.75), kInf);  // h = 2.25
+  EXPECT_EQ(quantile_linear({kInf, kInf}, 0.5), kInf);
+  EXPECT_EQ(quantile_linear({kInf, kInf, kInf}, 0.25), kInf);
+  EXPECT_EQ(quantile_linear({-kInf, -kInf}, 0.5), -kInf);
+}
+
+TEST(QuantileTest, BetweenAFiniteValueAndInfinityIsInfinity) {
+  EXPECT_EQ(quantile_linear({1.0, kInf}, 0.5), kInf);
+  EXPECT_EQ(quantile_linear({1.0, 2.0, kInf, kInf}, 0.5), kInf);       // h = 1.5: 2 .. inf
+  EXPECT_NEAR(quantile_linear({1.0, 2.0, kInf, kInf}, 0.25), 1.75, kQuantileTolerance);
+  EXPECT_EQ(quantile_linear({-kInf, 1.0}, 0.5), -kInf);
+  // A weight of exactly 0 on the infinite neighbour leaves the finite value.
+  EXPECT_EQ(quantile_linear({1.0, 2.0, kInf}, 0.5), 2.0);
+}
+
+BootstrapOptions options_with(int resamples, double confidence) {
+  BootstrapOptions options;
+  options.resamples = resamples;
+  options.confidence = confidence;
+  return options;
+}
+
+TEST(BootstrapTest, IntervalOfAConstantSampleIsThatConstant) {
+  const Interval i = bootstrap_median_interval({0.25, 0.25, 0.25, 0.25, 0.25, 0.25, 0.25});
+  EXPECT_EQ(i.low, 0.25);
+  EXPECT_EQ(i.high, 0.25);
+  const Interval one = bootstrap_median_interval({3e-3});
+  EXPECT_EQ(one.low, 3e-3);
+  EXPECT_EQ(one.high, 3e-3);
+}
+
+// n = 3, a < b < c: of the 27 equally likely resamples, 7 have median a
+// (at least two a's: 3 * 2 + 1), 7 have c, 13 have b.
+TEST(BootstrapTest, MedianFrequenciesOfThreeValuesMatchTheEnumeration) {
+  constexpr int kResamples = 27000;
+  const std::vector<double> medians =
+      bootstrap_medians({30.0, 10.0, 20.0}, options_with(kResamples, 0.95));
+  ASSERT_EQ(medians.size(), static_cast<std::size_t>(kResamples));
+  const auto frequency = [&](double v) {
+    return static_cast<double>(std::count(medians.begin(), medians.end(), v)) / kResamples;
+  };
+  // Binomial standard deviation sqrt(p (1 - p) / B) ~ 0.0027 (p = 7/27),
+  // 0.0030 (p = 13/27): 5 sigma.
+  constexpr double kFiveSigma = 0.015;
+  EXPECT_NEAR(frequency(10.0), 7.0 / 27.0, kFiveSigma);
+  EXPECT_NEAR(frequency(20.0), 13.0 / 27.0, kFiveSigma);
+  EXPECT_NEAR(frequency(30.0), 7.0 / 27.0, kFiveSigma);
+}
+
+TEST(BootstrapTest, IntervalOfThreeValuesFollowsTheExactDistribution) {
+  // 95 %: the 2.5 % and 97.5 % points of {a: 7/27, b: 13/27, c: 7/27}.
+  const Interval wide = bootstrap_median_interval({30.0, 10.0, 20.0});
+  EXPECT_EQ(wide.low, 10.0);
+  EXPECT_EQ(wide.high, 30.0);
+  // 40 %: the 30 % and 70 % points; 7/27 = 0.26 < 0.30 and 20/27 = 0.74 > 0.70.
+  const Interval narrow = bootstrap_median_interval({30.0, 10.0, 20.0}, options_with(10000, 0.4));
+  EXPECT_EQ(narrow.low, 20.0);
+  EXPECT_EQ(narrow.high, 20.0);
+}
+
+// n = 5 values 1..5: the bootstrap median is the 3rd smallest of 5 draws, so
+// P(median <= k) = P(at least 3 of 5 draws <= k) = 0.058, 0.317, 0.683, 0.942
+// for k = 1..4. At 90 % the 5 % and 95 % points are 1 and 5; at 80 % the
+// 10 % and 90 % points are 2 and 4 (B = 100 000: each margin >= 10 sigma).
+TEST(BootstrapTest, IntervalEndsAreTheTwoTailQuantilesOfTheBootstrapMedians) {
+  const std::vector<double> values = {4.0, 2.0, 5.0, 1.0, 3.0};
+  const Interval ninety = bootstrap_median_interval(values, options_with(100000, 0.9));
+  EXPECT_EQ(ninety.low, 1.0);
+  EXPECT_EQ(ninety.high, 5.0);
+  const Interval eighty = bootstrap_median_interval(values, options_with(100000, 0.8));
+  EXPECT_EQ(eighty.low, 2.0);
+  EXPECT_EQ(eighty.high, 4.0);
+}
+
+TEST(BootstrapTest, IntervalReachesInfinityWithoutNan) {
+  // {1, 2, inf}: the median is inf with probability 7/27 > 2.5 %.
+  const Interval i = bootstrap_median_interval({1.0, kInf, 2.0});
+  EXPECT_EQ(i.low, 1.0);
+  EXPECT_EQ(i.high, kInf);
+  const Interval all = bootstrap_median_interval({kInf, kInf, kInf});
+  EXPECT_EQ(all.low, kInf);
+  EXPECT_EQ(all.high, kInf);
+  // Two of five finite: P(median = inf) = P(>= 3 of 5 draws inf, p = 3/5) = 0.68.
+  const Interval mostly = bootstrap_median_interval({1.0, 2.0, kInf, kInf, kInf});
+  EXPECT_EQ(mostly.low, 1.0);
+  EXPECT_EQ(mostly.high, kInf);
+}
+
+TEST(BootstrapTest, IsReproducibleAndDependsOnTheSeedOnly) {
+  const std::vector<double> values = {0.05, 0.07, 12.0, 0.04, 800.0, 0.06, 35.0, 0.05, 2600.0};
+  BootstrapOptions other_seed;
+  other_seed.seed = 7;
+  const std::vector<double> a = bootstrap_medians(values);
+  EXPECT_EQ(a, bootstrap_medians(values));
+  std::vector<double> shuffled = values;
+  std::reverse(shuffled.begin(), shuffled.end());
+  EXPECT_EQ(a, bootstrap_medians(shuffled));  // the run order does not matter
+  EXPECT_NE(a, bootstrap_medians(values, other_seed));
+}
+
+TEST(BootstrapTest, RejectsFewResamplesBadConfidenceAndNan) {
+  EXPECT_THAT([] { bootstrap_medians({1.0}, options_with(1999, 0.95)); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("resamples = 1999")));
+  EXPECT_THAT([] { bootstrap_medians({1.0}, options_with(2000, 1.0)); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("confidence = 1")));
+  EXPECT_THROW(bootstrap_medians({}), std::invalid_argument);
+  EXPECT_THROW(bootstrap_median_interval({1.0, std::nan("")}), std::invalid_argument);
+}
+
+TEST(IntervalTest, ClosedIntervalsOverlapWhenTheyShareAPoint) {
+  EXPECT_TRUE((Interval{1.0, 2.0}.overlaps(Interval{2.0, 3.0})));
+  EXPECT_TRUE((Interval{1.0, kInf}.overlaps(Interval{5.0, 6.0})));
+  EXPECT_FALSE((Interval{1.0, 2.0}.overlaps(Interval{2.5, 3.0})));
+  EXPECT_FALSE((Interval{2.5, 3.0}.overlaps(Interval{1.0, 2.0})));
+}
+
+}  // namespace
+}  // namespace phnn
