@@ -141,6 +141,114 @@ class BatchSampler {
 
 }  // namespace
 
+namespace {
+
+// The autoregressive rollouts of Eq. 31 for every member of the stack:
+// the inference trajectories, then the two figure trajectories (rows B_inf,
+// B_inf + 1), from the model's current weights.
+struct Rollouts {
+  torch::Tensor sq_err;           // [E, B_inf]: sum over steps of |x - x_ref|^2
+  torch::Tensor diverged;         // [E, B_inf + 2]
+  torch::Tensor newton_failures;  // [E]
+  torch::Tensor figure;           // [E, steps + 1, 2, 2] (NaN after divergence)
+  int steps = 0;
+};
+
+Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const SystemData& data) {
+  torch::NoGradGuard no_grad;
+  const DynamicsModel* model = &model_ref;
+  const TrainerOptions& opt = cell.training;
+  const int64_t E = model_ref.members();
+  const bool use_dg = is_discrete_gradient(cell.integrator);
+  const InferenceSet& inf = data.inference;
+  const int64_t B_inf = static_cast<int64_t>(inf.size());
+  const int steps = static_cast<int>(inf.states.empty() ? 0 : inf.states[0].size() - 1);
+  const FigureSetup fig = figure_setup(data.system);
+  // Rows: the inference trajectories, then the two figure trajectories.
+  const int64_t B = B_inf + 2;
+  auto x0 = torch::empty({B, 2}, torch::kFloat64);
+  auto u0 = torch::empty({B, 1}, torch::kFloat64);
+  auto ref = torch::empty({steps + 1, B_inf, 2}, torch::kFloat64);
+  {
+    auto xa = x0.accessor<double, 2>();
+    auto ua = u0.accessor<double, 2>();
+    auto ra = ref.accessor<double, 3>();
+    for (int64_t i = 0; i < B_inf; ++i) {
+      const auto ui = static_cast<std::size_t>(i);
+      xa[i][0] = inf.states[ui][0](0);
+      xa[i][1] = inf.states[ui][0](1);
+      ua[i][0] = inf.u[ui];
+      for (int n = 0; n <= steps; ++n) {
+        ra[n][i][0] = inf.states[ui][static_cast<std::size_t>(n)](0);
+        ra[n][i][1] = inf.states[ui][static_cast<std::size_t>(n)](1);
+      }
+    }
+    xa[B_inf][0] = fig.x0_05(0);
+    xa[B_inf][1] = fig.x0_05(1);
+    xa[B_inf + 1][0] = fig.x0_075(0);
+    xa[B_inf + 1][1] = fig.x0_075(1);
+    ua[B_inf][0] = ua[B_inf + 1][0] = fig.u;
+  }
+  const double h_inf = inf.step;
+  auto x = x0.unsqueeze(0).expand({E, B, 2}).contiguous();
+  const auto u = u0.unsqueeze(0).expand({E, B, 1}).contiguous();
+  auto diverged = torch::zeros({E, B}, torch::kBool);
+  auto sq_err = torch::zeros({E, B_inf}, torch::kFloat64);
+  auto newton_failures = torch::zeros({E}, torch::kLong);
+  std::vector<torch::Tensor> figure_states{x.narrow(1, B_inf, 2).clone()};
+  DgInferenceOptions dg_options;
+  dg_options.tolerance = opt.newton_tolerance;
+  dg_options.max_iterations = opt.newton_max_iterations;
+  dg_options.min_dx_norm = opt.dg_min_dx_norm;
+  DgNewtonJacobian newton_jacobian;  // carried along the rollout
+  for (int n = 1; n <= steps; ++n) {
+    torch::Tensor next;
+    if (use_dg) {
+      const auto s = cell.integrator == IntegratorKind::kDg4
+                         ? dg4_inference_step(*model, x, u, h_inf, dg_options)
+                         : dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
+      next = s.x_next;
+      newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);
+    } else {
+      next = explicit_step(*model, cell.integrator, x, u, h_inf);
+    }
+    const auto bad = torch::isfinite(next).all(-1).logical_not() |
+                     (next.norm(2, -1) > opt.divergence_norm);
+    diverged = diverged | bad;
+    x = torch::where(diverged.unsqueeze(-1), torch::zeros_like(next), next);
+    const auto diff = x.narrow(1, 0, B_inf) - ref[n].unsqueeze(0);
+    sq_err += (diff * diff).sum(-1);
+    figure_states.push_back(torch::where(diverged.narrow(1, B_inf, 2).unsqueeze(-1),
+                                         torch::full_like(next.narrow(1, B_inf, 2), NAN),
+                                         next.narrow(1, B_inf, 2)));
+  }
+  Rollouts out;
+  out.sq_err = sq_err;
+  out.diverged = diverged;
+  out.newton_failures = newton_failures;
+  out.figure = torch::stack(figure_states, 1);
+  out.steps = steps;
+  return out;
+}
+
+// Eq. 31 per member from the rollouts: the mean over the inference
+// trajectories of their mean squared error, +inf if any diverged.
+std::vector<double> member_mse(const Rollouts& r) {
+  const int64_t E = r.sq_err.size(0), B_inf = r.sq_err.size(1);
+  std::vector<double> out(static_cast<std::size_t>(E));
+  for (int64_t e = 0; e < E; ++e) {
+    double total = 0.0;
+    for (int64_t i = 0; i < B_inf; ++i) {
+      total += r.diverged[e][i].item<bool>() ? std::numeric_limits<double>::infinity()
+                                             : r.sq_err[e][i].item<double>() / r.steps;
+    }
+    out[static_cast<std::size_t>(e)] = B_inf ? total / static_cast<double>(B_inf) : 0.0;
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
                                   const ProgressCallback& progress,
                                   std::unique_ptr<DynamicsModel>* trained) {
@@ -172,7 +280,6 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
   const auto Xnall = Xn.unsqueeze(0).expand({E, -1, -1});
   const auto Uall = U.unsqueeze(0).expand({E, -1, -1});
 
-  const bool use_dg = is_discrete_gradient(cell.integrator);
   // L_d (Eq. 30): mean over batch and state components of |x_{n+1} - x_hat| / h.
   auto data_loss = [&](const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u) {
     const auto x_hat =
@@ -242,6 +349,28 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
 
   BatchSampler sampler(cell.seeds, N, opt.batch_size);
   evaluate(0);
+  // Inference of the best weights so far at a step budget; the training
+  // weights are restored bitwise, so training goes on unchanged.
+  double checkpoint_overhead_s = 0.0;
+  std::size_t next_checkpoint = 0;
+  auto checkpoint = [&](int step) {
+    const auto begin = Clock::now();
+    const double train_s = (elapsed() - checkpoint_overhead_s) / static_cast<double>(E);
+    torch::NoGradGuard no_grad;
+    std::vector<torch::Tensor> current;
+    for (std::size_t k = 0; k < params.size(); ++k) {
+      current.push_back(params[k].detach().clone());
+      params[k].copy_(best[k]);
+    }
+    const std::vector<double> mse = member_mse(roll_out(*model, cell, data));
+    for (std::size_t k = 0; k < params.size(); ++k) params[k].copy_(current[k]);
+    for (std::size_t e = 0; e < results.size(); ++e) {
+      results[e].checkpoint_steps.push_back(step);
+      results[e].checkpoint_mse.push_back(mse[e]);
+      results[e].checkpoint_train_seconds.push_back(train_s);
+    }
+    checkpoint_overhead_s += std::chrono::duration<double>(Clock::now() - begin).count();
+  };
   // Every pair in every step when N <= batch: no gather needed.
   const bool full_batch = N <= opt.batch_size;
   for (int step = 1; step <= opt.steps; ++step) {
@@ -282,77 +411,29 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
       }
     }
     if (step % opt.eval_every == 0 || step == opt.steps) evaluate(step);
+    if (next_checkpoint < opt.checkpoints.size() && step == opt.checkpoints[next_checkpoint]) {
+      if (step < opt.steps) checkpoint(step);  // the last step's is the final inference
+      ++next_checkpoint;
+    }
     if (std::none_of(alive.begin(), alive.end(), [](bool a) { return a; })) break;
   }
 
   // Inference with each member's best-validation weights (SPEC.md §4).
   torch::NoGradGuard no_grad;
+  const double train_s = (elapsed() - checkpoint_overhead_s) / static_cast<double>(E);
   for (std::size_t k = 0; k < params.size(); ++k) params[k].copy_(best[k]);
 
+  const Rollouts rollouts = roll_out(*model, cell, data);
   const InferenceSet& inf = data.inference;
   const int64_t B_inf = static_cast<int64_t>(inf.size());
-  const int steps = static_cast<int>(inf.states.empty() ? 0 : inf.states[0].size() - 1);
+  const int steps = rollouts.steps;
   const FigureSetup fig = figure_setup(data.system);
-  // Rows: the inference trajectories, then the two figure trajectories.
-  const int64_t B = B_inf + 2;
-  auto x0 = torch::empty({B, 2}, torch::kFloat64);
-  auto u0 = torch::empty({B, 1}, torch::kFloat64);
-  auto ref = torch::empty({steps + 1, B_inf, 2}, torch::kFloat64);
-  {
-    auto xa = x0.accessor<double, 2>();
-    auto ua = u0.accessor<double, 2>();
-    auto ra = ref.accessor<double, 3>();
-    for (int64_t i = 0; i < B_inf; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      xa[i][0] = inf.states[ui][0](0);
-      xa[i][1] = inf.states[ui][0](1);
-      ua[i][0] = inf.u[ui];
-      for (int n = 0; n <= steps; ++n) {
-        ra[n][i][0] = inf.states[ui][static_cast<std::size_t>(n)](0);
-        ra[n][i][1] = inf.states[ui][static_cast<std::size_t>(n)](1);
-      }
-    }
-    xa[B_inf][0] = fig.x0_05(0);
-    xa[B_inf][1] = fig.x0_05(1);
-    xa[B_inf + 1][0] = fig.x0_075(0);
-    xa[B_inf + 1][1] = fig.x0_075(1);
-    ua[B_inf][0] = ua[B_inf + 1][0] = fig.u;
-  }
-  const double h_inf = inf.step;
-  auto x = x0.unsqueeze(0).expand({E, B, 2}).contiguous();
-  const auto u = u0.unsqueeze(0).expand({E, B, 1}).contiguous();
-  auto diverged = torch::zeros({E, B}, torch::kBool);
-  auto sq_err = torch::zeros({E, B_inf}, torch::kFloat64);
-  auto newton_failures = torch::zeros({E}, torch::kLong);
-  std::vector<torch::Tensor> figure_states{x.narrow(1, B_inf, 2).clone()};
-  DgInferenceOptions dg_options;
-  dg_options.tolerance = opt.newton_tolerance;
-  dg_options.max_iterations = opt.newton_max_iterations;
-  dg_options.min_dx_norm = opt.dg_min_dx_norm;
-  DgNewtonJacobian newton_jacobian;  // carried along the rollout
-  for (int n = 1; n <= steps; ++n) {
-    torch::Tensor next;
-    if (use_dg) {
-      const auto s = cell.integrator == IntegratorKind::kDg4
-                         ? dg4_inference_step(*model, x, u, h_inf, dg_options)
-                         : dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
-      next = s.x_next;
-      newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);
-    } else {
-      next = explicit_step(*model, cell.integrator, x, u, h_inf);
-    }
-    const auto bad = torch::isfinite(next).all(-1).logical_not() |
-                     (next.norm(2, -1) > opt.divergence_norm);
-    diverged = diverged | bad;
-    x = torch::where(diverged.unsqueeze(-1), torch::zeros_like(next), next);
-    const auto diff = x.narrow(1, 0, B_inf) - ref[n].unsqueeze(0);
-    sq_err += (diff * diff).sum(-1);
-    figure_states.push_back(torch::where(diverged.narrow(1, B_inf, 2).unsqueeze(-1),
-                                         torch::full_like(next.narrow(1, B_inf, 2), NAN),
-                                         next.narrow(1, B_inf, 2)));
-  }
-  const auto fig_stack = torch::stack(figure_states, 1);  // [E, steps+1, 2, 2]
+  const auto& sq_err = rollouts.sq_err;
+  const auto& diverged = rollouts.diverged;
+  const auto& newton_failures = rollouts.newton_failures;
+  const auto fig_stack = rollouts.figure;  // [E, steps+1, 2, 2]
   const double wall = elapsed();
+  const std::vector<double> final_mse = member_mse(rollouts);
   const auto ref05 = reference_trajectory(data.system, data.options, fig.x0_05, fig.u);
   const auto ref075 = reference_trajectory(data.system, data.options, fig.x0_075, fig.u);
   const double inf_value = std::numeric_limits<double>::infinity();
@@ -365,15 +446,20 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
     r.newton_failures = newton_failures[e].item<int64_t>();
     r.trajectory_errors.resize(static_cast<std::size_t>(B_inf));
     r.diverged_rollouts = 0;
-    double total = 0.0;
     for (int64_t i = 0; i < B_inf; ++i) {
       const bool div = diverged[e][i].item<bool>();
-      const double err = div ? inf_value : sq_err[e][i].item<double>() / steps;
-      r.trajectory_errors[static_cast<std::size_t>(i)] = err;
+      r.trajectory_errors[static_cast<std::size_t>(i)] =
+          div ? inf_value : sq_err[e][i].item<double>() / steps;
       r.diverged_rollouts += div;
-      total += err;
     }
-    r.mse = B_inf ? total / static_cast<double>(B_inf) : 0.0;
+    r.mse = final_mse[static_cast<std::size_t>(e)];
+    // Budgets not reached in the loop (the last step, or every member
+    // diverged earlier): the final best weights are the best up to them.
+    while (r.checkpoint_steps.size() < opt.checkpoints.size()) {
+      r.checkpoint_steps.push_back(opt.checkpoints[r.checkpoint_steps.size()]);
+      r.checkpoint_mse.push_back(r.mse);
+      r.checkpoint_train_seconds.push_back(train_s);
+    }
     auto fig_e = fig_stack[e].contiguous();
     auto fa = fig_e.accessor<double, 3>();
     for (int n = 0; n <= steps; ++n) {

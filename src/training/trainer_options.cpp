@@ -68,6 +68,13 @@ void TrainerOptions::validate() const {
     fail("newton_max_iterations", newton_max_iterations, "newton_max_iterations >= 1");
   if (!(dg_min_dx_norm >= 0.0)) fail("dg_min_dx_norm", dg_min_dx_norm, "dg_min_dx_norm >= 0");
   if (!(divergence_norm > 0.0)) fail("divergence_norm", divergence_norm, "divergence_norm > 0");
+  for (std::size_t i = 0; i < checkpoints.size(); ++i) {
+    const int s = checkpoints[i];
+    if (s < 1 || s > steps) fail("checkpoints", s, "1 <= checkpoint <= steps");
+    if (s % eval_every != 0 && s != steps)
+      fail("checkpoints", s, "a checkpoint is a validation step (a multiple of eval_every, or steps)");
+    if (i > 0 && s <= checkpoints[i - 1]) fail("checkpoints", s, "strictly increasing");
+  }
 }
 
 }  // namespace phnn

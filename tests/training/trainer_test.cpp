@@ -50,6 +50,57 @@ TEST(TrainerTest, StackingIsExact) {
   EXPECT_NE(stacked[0].mse, stacked[1].mse);  // members are different models
 }
 
+// A checkpoint's inference MSE is bitwise the MSE of a run trained for that
+// many steps (same first steps, same validations, same best weights), and
+// checkpoints leave the run's own results bitwise unchanged.
+TEST(TrainerTest, CheckpointsEqualShorterRunsAndChangeNothing) {
+  for (IntegratorKind integrator : {IntegratorKind::kRk2, IntegratorKind::kDg}) {
+    CellSpec cell;
+    cell.model = ModelKind::kPhnnS;
+    cell.integrator = integrator;
+    cell.n_train = 100;
+    cell.training.steps = 600;
+    cell.training.eval_every = 100;
+    cell.seeds = {2, 5};
+    const auto plain = train_cell(cell, small_data(SystemKind::kDuffing));
+    cell.training.checkpoints = {200, 400, 600};
+    const auto with = train_cell(cell, small_data(SystemKind::kDuffing));
+    for (std::size_t e = 0; e < 2; ++e) {
+      const std::string tag = to_string(integrator) + " member " + std::to_string(e);
+      EXPECT_EQ(with[e].mse, plain[e].mse) << tag;
+      EXPECT_EQ(with[e].best_step, plain[e].best_step) << tag;
+      EXPECT_EQ(with[e].trajectory_errors, plain[e].trajectory_errors) << tag;
+      ASSERT_EQ(with[e].checkpoint_steps, (std::vector<int>{200, 400, 600})) << tag;
+      EXPECT_EQ(with[e].checkpoint_mse[2], plain[e].mse) << tag;
+      ASSERT_EQ(with[e].checkpoint_train_seconds.size(), 3u);
+      EXPECT_LT(with[e].checkpoint_train_seconds[0], with[e].checkpoint_train_seconds[2]) << tag;
+    }
+    for (int budget : {200, 400}) {
+      CellSpec shorter = cell;
+      shorter.training.checkpoints.clear();
+      shorter.training.steps = budget;
+      const auto run = train_cell(shorter, small_data(SystemKind::kDuffing));
+      for (std::size_t e = 0; e < 2; ++e) {
+        EXPECT_EQ(with[e].checkpoint_mse[budget / 200 - 1], run[e].mse)
+            << to_string(integrator) << " member " << e << " budget " << budget;
+      }
+    }
+  }
+}
+
+// Checkpoints must be validation steps within the run, increasing.
+TEST(TrainerTest, CheckpointsAreValidated) {
+  TrainerOptions options;
+  options.steps = 1000;
+  options.eval_every = 500;
+  for (std::vector<int> bad : {std::vector<int>{250}, {500, 500}, {1500}, {0}}) {
+    options.checkpoints = bad;
+    EXPECT_THROW(options.validate(), std::invalid_argument) << bad[0];
+  }
+  options.checkpoints = {500, 1000};
+  EXPECT_NO_THROW(options.validate());
+}
+
 // Learning smoke test: every model x integrator on every system reduces the
 // validation loss >= 5x within 5 000 steps at N_train = 100, median over the
 // paper's 10 seeds. Single seeds can stall on a plateau: for Duffing

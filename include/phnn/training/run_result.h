@@ -41,6 +41,11 @@ struct RunResult {
   long parameter_count = 0;
   /// DG inference steps whose Newton did not converge (0 for RK2).
   std::int64_t newton_failures = 0;
+  /// TrainerOptions::checkpoints: per budget, the inference MSE (Eq. 31) of
+  /// the best-validation weights up to that step and the training wall time
+  /// spent to get there (this run's share of the stack, inference excluded).
+  std::vector<int> checkpoint_steps;
+  std::vector<double> checkpoint_mse, checkpoint_train_seconds;
   /// Predicted trajectories of paper Figures 7 and 9 ([n][2] each): from
   /// H(x0) = 0.5 J and 0.75 J, u = 0 (harmonic, Duffing) or a limit-cycle u
   /// (self-sustained); with the reference trajectories.

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace phnn {
 
@@ -40,6 +41,13 @@ struct TrainerOptions {
   double dg_min_dx_norm = 6e-6;
   /// Divergence: a rollout state with ||x|| > divergence_norm (or non-finite).
   double divergence_norm = 1e6;
+  /// Step budgets at which the inference MSE of the best-validation weights
+  /// seen so far is also evaluated (RunResult::checkpoints): one training run
+  /// answers "how good after s steps" for every s, bitwise what a run with
+  /// steps = s would give (the first s steps and their validations are the
+  /// same). Strictly increasing, each <= steps and a validation step
+  /// (a multiple of eval_every, or steps itself). Empty: none.
+  std::vector<int> checkpoints;
 
   /// Throws std::invalid_argument naming the field, value and constraint.
   void validate() const;
