@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include <gmock/gmock.h>
@@ -85,6 +86,38 @@ TEST(TrainerTest, CheckpointsEqualShorterRunsAndChangeNothing) {
             << to_string(integrator) << " member " << e << " budget " << budget;
       }
     }
+  }
+}
+
+// A NaN or inf anywhere in the data a cell uses is refused before training
+// with the set and index named (instead of NaN losses freezing every member).
+TEST(TrainerTest, NonFiniteDataIsRefusedWithItsPlace) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnJr;
+  cell.n_train = 25;
+  cell.training.steps = 10;
+  cell.seeds = {0};
+  {
+    SystemData data = small_data(SystemKind::kHarmonic);
+    data.train.x_next[3](1) = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THAT([&] { train_cell(cell, data); },
+                ThrowsMessage<std::invalid_argument>(HasSubstr("training pair 3 has a non-finite")));
+    data.train.x_next[3](1) = 0.0;
+    data.train.x[30](0) = std::numeric_limits<double>::infinity();  // beyond n_train: unused
+    EXPECT_NO_THROW(train_cell(cell, data));
+  }
+  {
+    SystemData data = small_data(SystemKind::kHarmonic);
+    data.validation.u[7] = std::numeric_limits<double>::infinity();
+    EXPECT_THAT([&] { train_cell(cell, data); },
+                ThrowsMessage<std::invalid_argument>(HasSubstr("validation pair 7")));
+  }
+  {
+    SystemData data = small_data(SystemKind::kHarmonic);
+    data.inference.states[2][40](0) = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THAT([&] { train_cell(cell, data); },
+                ThrowsMessage<std::invalid_argument>(
+                    HasSubstr("inference trajectory 2 has a non-finite value (input u or the state at step 40)")));
   }
 }
 
