@@ -40,6 +40,7 @@ from bench/ via analysis/plot_work_precision.py, not from a results file.
 """
 import os
 import sys
+import textwrap
 import tomllib
 from collections import Counter
 
@@ -149,7 +150,10 @@ def status_note(runs, rows):
     c = Counter(int(runs["status"][i]) for i in rows)
     parts = [f"{c[DONE] + c[DIVERGED]} of {len(rows)} runs drawn"]
     if c[DIVERGED]:
-        parts.append(f"{c[DIVERGED]} diverged")
+        parts.append(f"{c[DIVERGED]} diverged in training")
+    inf = sum(runs["status"][i] == DONE and np.isinf(runs["mse"][i]) for i in rows)
+    if inf:
+        parts.append(f"{inf} with a diverged rollout (MSE = +inf)")
     if c[FAILED]:
         parts.append(f"{c[FAILED]} failed (not drawn)")
     if c[PENDING]:
@@ -176,16 +180,21 @@ def mse_boxplots(runs, name, sweep, out):
                 continue
             cols = column_order(runs, axis, sel, sweep, study) if axis else [None]
             fig = mse_box_figure(runs, sel, axis, cols)
-            fig.axes[0].set_title(
-                f"{name}: {system}, study {study}" + (f" ({title})" if title else "")
-                + f"\ninference MSE, n = {seeds_per_cell(runs, sel)} seeds per cell; "
-                + status_note(runs, sel), fontsize=9)
+            suptitle(fig, f"{name}: {system}, study {study}" + (f" ({title})" if title else ""),
+                     f"inference MSE per seed (points), box = quartiles of the finite MSEs, "
+                     f"n = {seeds_per_cell(runs, sel)} seeds per cell; {status_note(runs, sel)}")
             fig.tight_layout()
             path = os.path.join(out, f"mse_{study}_{system}.png")
             fig.savefig(path, dpi=DPI)
             plt.close(fig)
             written.append(path)
     return written
+
+
+def suptitle(fig, *lines):
+    """Figure title, each line wrapped to the figure's width."""
+    width = int(fig.get_figwidth() * 13)
+    fig.suptitle("\n".join(textwrap.fill(line, width) for line in lines), fontsize=9)
 
 
 def ordered_systems(runs, rows):
@@ -197,7 +206,7 @@ def ordered_systems(runs, rows):
 def mse_box_figure(runs, sel, axis, cols):
     models = ordered_models(runs["model"][i] for i in sel)
     width = len(models) + 1
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.0 + 0.42 * width * len(cols)), 4.8))
+    fig, ax = plt.subplots(figsize=(max(8.0, 1.0 + 0.42 * width * len(cols)), 4.8))
     rng = np.random.default_rng(0)
     cells = []
     for c, col in enumerate(cols):
@@ -313,10 +322,10 @@ def trajectories(runs, name, out):
         axes[0, 2].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
         seeds = seeds_per_cell(runs, cell)
         note = "" if n_train == target else f" (paper: {target}, not in this file)"
-        fig.suptitle(f"{name}: {system}, small, no regularizer, N_train = {n_train}{note}; "
-                     f"n = {seeds} seeds per model\nreference vs NODE and the best PHNN (lowest "
-                     f"median MSE), each at its median-MSE seed; {status_note(runs, cell)}",
-                     fontsize=9)
+        suptitle(fig, f"{name}: {system}, small, no regularizer, N_train = {n_train}{note}; "
+                 f"n = {seeds} seeds per model",
+                 f"reference vs NODE and the best PHNN (lowest median MSE), each at its "
+                 f"median-MSE seed (named in the legend); {status_note(runs, cell)}")
         fig.tight_layout()
         path = os.path.join(out, f"trajectories_{system}.png")
         fig.savefig(path, dpi=DPI)
@@ -414,15 +423,17 @@ def trace_figure(runs, name, system, out, panels, stem, what):
         for col, (key, ylabel, log) in enumerate(panels):
             ax = axes[row, col]
             ax.set_yscale("log" if log else "linear")
-            ax.set_ylabel(f"{ylabel}\nregularizer {reg}" if col == 0 else ylabel, fontsize=8)
+            ax.set_ylabel(ylabel, fontsize=8)
+            ax.set_title(f"regularizer: {reg}", fontsize=8)
             ax.grid(alpha=0.3)
             if row == len(groups) - 1:
                 ax.set_xlabel("Adam step")
         axes[row, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     all_rows = [i for rows in trace_runs(runs, system)[0].values() for i in rows]
-    fig.suptitle(f"{name}: {system}, {size} models, N_train = {n_train}: {what}\n"
-                 f"median over seeds (n per model in legend), band = interquartile range; "
-                 f"{status_note(runs, all_rows)}", fontsize=9)
+    suptitle(fig, f"{name}: {system}, {size} models, N_train = {n_train}, one row per "
+             f"regularizer: {what}",
+             f"median over seeds (n per model in legend), band = interquartile range; "
+             f"{status_note(runs, all_rows)}")
     fig.tight_layout()
     path = os.path.join(out, f"{stem}_{system}.png")
     fig.savefig(path, dpi=DPI)
@@ -444,7 +455,8 @@ def loss_curves(runs, name, out):
     panels = [("train", "training loss [L_d]", True), ("validation", "validation loss [L_d]", True)]
     return [p for s in ordered_systems(runs, runs["rows"]) if (p := trace_figure(
         runs, name, s, out, panels, "loss",
-        "training / validation loss, L_d = mean |x_{n+1} − x̂_{n+1}| / h (m/s and kg m/s² mixed)"))]
+        "training / validation loss, L_d = mean |x_{n+1} − x̂_{n+1}| / h (m/s and kg m/s² mixed; "
+        "+ the regularizer's term where one is used)"))]
 
 
 # ------------------------------------------------------------------------------ time vs error
@@ -474,10 +486,9 @@ def time_vs_error(runs, name, out):
         ax.set_ylabel("inference MSE [m², (kg m/s)² mixed]")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
-        ax.set_title(f"{name}: {system}, all studies: wall time vs inference MSE; "
-                     f"diamonds = medians over all of a model's runs\n"
-                     f"n = {seeds_per_cell(runs, rows)} seeds per cell; {status_note(runs, rows)}",
-                     fontsize=9)
+        suptitle(fig, f"{name}: {system}, all studies: wall time vs inference MSE, every run a "
+                 f"point, diamonds = a model's medians over all its runs",
+                 f"n = {seeds_per_cell(runs, rows)} seeds per cell; {status_note(runs, rows)}")
         fig.tight_layout()
         path = os.path.join(out, f"time_vs_error_{system}.png")
         fig.savefig(path, dpi=DPI)
