@@ -218,9 +218,10 @@ def mse_box_figure(runs, sel, axis, cols):
     for x, model, vals in cells:
         draw_cell(ax, rng, x, model, vals)
     ax.set_yscale("log")
+    any_diverged = any(not np.isfinite(v) for _, _, vals in cells for v in vals)
     if finite_all:
         lo, hi = min(finite_all), max(finite_all)
-        ax.set_ylim(lo / 3, hi * 30)  # headroom for the diverged markers
+        ax.set_ylim(lo / 3, hi * (30 if any_diverged else 3))  # headroom for diverged markers
     for x, model, vals in cells:
         ndiv = sum(not np.isfinite(v) for v in vals)
         if ndiv:
