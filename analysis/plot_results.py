@@ -41,7 +41,6 @@ from bench/ via analysis/plot_work_precision.py, not from a results file.
 import os
 import sys
 import textwrap
-import tomllib
 from collections import Counter
 
 import h5py
@@ -50,6 +49,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+try:
+    import tomllib  # Python >= 3.11 (Debian bookworm)
+except ImportError:  # study titles/order then come from the known orders only
+    tomllib = None
 
 PENDING, DONE, DIVERGED, FAILED = 0, 1, 2, 3
 # One colour per model label, in every figure (tab10; the RK4/DG4 variants get the other five).
@@ -103,13 +107,19 @@ def load(path):
         for k in ("prediction_05", "prediction_075", "reference_05", "reference_075", "length"):
             runs[k] = r["figure/" + k][()]
         name = text([f.attrs.get("sweep_name", b"")])[0]
-        try:
-            sweep = tomllib.loads(text([f.attrs.get("sweep_text", b"")])[0])
-        except tomllib.TOMLDecodeError:
-            sweep = {}
+        sweep = parse_sweep(text([f.attrs.get("sweep_text", b"")])[0])
     runs["mse"] = np.where(runs["status"] == DIVERGED, np.inf, runs["mse"])
     runs["rows"] = np.arange(len(runs["status"]))
     return runs, name, sweep
+
+
+def parse_sweep(sweep_text):
+    if tomllib is None:
+        return {}
+    try:
+        return tomllib.loads(sweep_text)
+    except tomllib.TOMLDecodeError:
+        return {}
 
 
 def axis_value(runs, axis, i):
@@ -312,6 +322,7 @@ def trajectories(runs, name, out):
         cell, n_train, target = trajectory_cell(runs, system)
         picks, medians = chosen_models(runs, cell)
         if not picks:
+            print(f"  skipped trajectories_{system}.png: no finished run at N_train = {n_train}")
             continue
         fig, axes = plt.subplots(2, 3, figsize=(13, 7))
         for r, energy in enumerate(("05", "075")):
@@ -408,6 +419,7 @@ def trace_figure(runs, name, system, out, panels, stem, what):
     groups = {r: drawable(runs, rows) for r, rows in groups.items()}
     groups = {r: rows for r, rows in groups.items() if rows}
     if not groups:
+        print(f"  skipped {stem}_{system}.png: no finished {size} run at N_train = {n_train}")
         return None
     fig, axes = plt.subplots(len(groups), len(panels), squeeze=False,
                              figsize=(4.3 * len(panels) + 1.8, 2.9 * len(groups) + 0.9))

@@ -6,6 +6,8 @@ set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 py=${1:-/usr/bin/python3}
+# 77 = skipped (ctest SKIP_RETURN_CODE) when the Debian packages are not installed
+"$py" -c "import h5py, matplotlib, numpy" 2>/dev/null || { echo "h5py/matplotlib missing: skipped"; exit 77; }
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 "$py" "$here/make_fixture.py" "$out/fixture.h5"
