@@ -164,6 +164,9 @@ def status_note(runs, rows):
     inf = sum(runs["status"][i] == DONE and np.isinf(runs["mse"][i]) for i in rows)
     if inf:
         parts.append(f"{inf} with a diverged rollout (MSE = +inf)")
+    nan = sum(runs["status"][i] == DONE and np.isnan(runs["mse"][i]) for i in rows)
+    if nan:
+        parts.append(f"{nan} done without an MSE (NaN, not drawn)")
     if c[FAILED]:
         parts.append(f"{c[FAILED]} failed (not drawn)")
     if c[PENDING]:
@@ -233,7 +236,7 @@ def mse_box_figure(runs, sel, axis, cols):
         lo, hi = min(finite_all), max(finite_all)
         ax.set_ylim(lo / 3, hi * (30 if any_diverged else 3))  # headroom for diverged markers
     for x, model, vals in cells:
-        ndiv = sum(not np.isfinite(v) for v in vals)
+        ndiv = sum(np.isinf(v) for v in vals)
         if ndiv:
             ax.plot([x], [0.97], marker="^", ms=9, color=colour(model), mec="black",
                     transform=ax.get_xaxis_transform(), clip_on=False)
@@ -414,9 +417,11 @@ def trace_stats(runs, rows, column):
 
 
 def trace_figure(runs, name, system, out, panels, stem, what):
-    """One row per regularizer, one column per (trace column, axis label, log scale)."""
+    """One row per regularizer, one column per (trace column, axis label, log scale allowed);
+    a panel is drawn on a log axis only when its data span more than a factor of 30."""
     groups, size, n_train = trace_runs(runs, system)
-    groups = {r: drawable(runs, rows) for r, rows in groups.items()}
+    groups = {r: [i for i in drawable(runs, rows) if runs["trace_length"][i] > 0]
+              for r, rows in groups.items()}
     groups = {r: rows for r, rows in groups.items() if rows}
     if not groups:
         print(f"  skipped {stem}_{system}.png: no finished {size} run at N_train = {n_train}")
@@ -435,7 +440,8 @@ def trace_figure(runs, name, system, out, panels, stem, what):
                 ax.fill_between(steps, lo, hi, color=colour(m), alpha=0.18, lw=0)
         for col, (key, ylabel, log) in enumerate(panels):
             ax = axes[row, col]
-            ax.set_yscale("log" if log else "linear")
+            lo, hi = ax.dataLim.y0, ax.dataLim.y1
+            ax.set_yscale("log" if log and lo > 0 and hi / lo > 30 else "linear")
             ax.set_ylabel(ylabel, fontsize=8)
             ax.set_title(f"regularizer: {reg}", fontsize=8)
             ax.grid(alpha=0.3)
@@ -486,15 +492,16 @@ def time_vs_error(runs, name, out):
             mine = [i for i in sel if runs["model"][i] == m]
             t = np.array([runs["wall_time_s"][i] for i in mine])
             e = np.array([runs["mse"][i] for i in mine])
-            ok = np.isfinite(e)
+            ok, div = np.isfinite(e), np.isinf(e)
             ax.scatter(t[ok], e[ok], s=10, color=colour(m), alpha=0.6, lw=0)
-            ax.scatter(t[~ok], np.full((~ok).sum(), 0.97), marker="^", color=colour(m),
+            ax.scatter(t[div], np.full(div.sum(), 0.97), marker="^", color=colour(m),
                        edgecolor="black", transform=ax.get_xaxis_transform(), clip_on=False)
-            ax.scatter([np.median(t)], [np.median(np.nan_to_num(e, nan=np.inf))], s=90,
+            ax.scatter([np.median(t)], [np.median(e[~np.isnan(e)]) if ok.any() else np.nan], s=90,
                        color=colour(m), edgecolor="black", marker="D",
-                       label=f"{m}: {len(mine)} runs, {(~ok).sum()} diverged")
+                       label=f"{m}: {len(mine)} runs, {div.sum()} diverged")
         ax.set_xscale("log")
-        ax.set_yscale("log")
+        if any(np.isfinite(runs["mse"][i]) for i in sel):
+            ax.set_yscale("log")
         ax.set_xlabel("wall time per run [s] (stack time / seeds trained together)")
         ax.set_ylabel("inference MSE [m², (kg m/s)² mixed]")
         ax.grid(alpha=0.3)
