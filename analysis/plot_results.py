@@ -48,6 +48,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker as ticker  # noqa: E402
 import numpy as np  # noqa: E402
 
 try:
@@ -204,6 +205,14 @@ def mse_boxplots(runs, name, sweep, out):
     return written
 
 
+def study_names(runs, rows):
+    """'study I, III' for the studies the rows belong to (in first-seen order)."""
+    names = []
+    for i in rows:
+        names += [n for n in runs["studies"][i].split(",") if n and n not in names]
+    return ("studies " if len(names) > 1 else "study ") + ", ".join(names) if names else "no study"
+
+
 def suptitle(fig, *lines):
     """Figure title, each line wrapped to the figure's width."""
     width = int(fig.get_figwidth() * 13)
@@ -231,7 +240,8 @@ def mse_box_figure(runs, sel, axis, cols):
     for x, model, vals in cells:
         draw_cell(ax, rng, x, model, vals)
     ax.set_yscale("log")
-    any_diverged = any(not np.isfinite(v) for _, _, vals in cells for v in vals)
+    label_minor_log_ticks(ax.yaxis)
+    any_diverged = any(np.isinf(v) for _, _, vals in cells for v in vals)
     if finite_all:
         lo, hi = min(finite_all), max(finite_all)
         ax.set_ylim(lo / 3, hi * (30 if any_diverged else 3))  # headroom for diverged markers
@@ -257,6 +267,12 @@ def mse_box_figure(runs, sel, axis, cols):
     ax.legend(handles, models + ["diverged (count below)"], fontsize=7,
               loc="upper left", bbox_to_anchor=(1.0, 1.0))
     return fig
+
+
+def label_minor_log_ticks(axis):
+    """Label 2x and 5x ticks too when a log axis spans fewer than ~3 decades."""
+    axis.set_minor_formatter(ticker.LogFormatterSciNotation(labelOnlyBase=False,
+                                                            minor_thresholds=(3, 1.2)))
 
 
 def draw_cell(ax, rng, x, model, vals):
@@ -337,8 +353,8 @@ def trajectories(runs, name, out):
         axes[0, 2].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
         seeds = seeds_per_cell(runs, cell)
         note = "" if n_train == target else f" (paper: {target}, not in this file)"
-        suptitle(fig, f"{name}: {system}, small, no regularizer, N_train = {n_train}{note}; "
-                 f"n = {seeds} seeds per model",
+        suptitle(fig, f"{name}: {system}, {study_names(runs, cell)}, {runs['size'][cell[0]]}, "
+                 f"no regularizer, N_train = {n_train}{note}; n = {seeds} seeds per model",
                  f"reference vs NODE and the best PHNN (lowest median MSE), each at its "
                  f"median-MSE seed (named in the legend); {status_note(runs, cell)}")
         fig.tight_layout()
@@ -449,8 +465,8 @@ def trace_figure(runs, name, system, out, panels, stem, what):
                 ax.set_xlabel("Adam step")
         axes[row, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     all_rows = [i for rows in trace_runs(runs, system)[0].values() for i in rows]
-    suptitle(fig, f"{name}: {system}, {size} models, N_train = {n_train}, one row per "
-             f"regularizer: {what}",
+    suptitle(fig, f"{name}: {system}, {study_names(runs, all_rows)}, {size} models, "
+             f"N_train = {n_train}, one row per regularizer: {what}",
              f"median over seeds (n per model in legend), band = interquartile range; "
              f"{status_note(runs, all_rows)}")
     fig.tight_layout()
@@ -502,6 +518,7 @@ def time_vs_error(runs, name, out):
         ax.set_xscale("log")
         if any(np.isfinite(runs["mse"][i]) for i in sel):
             ax.set_yscale("log")
+            label_minor_log_ticks(ax.yaxis)
         ax.set_xlabel("wall time per run [s] (stack time / seeds trained together)")
         ax.set_ylabel("inference MSE [m², (kg m/s)² mixed]")
         ax.grid(alpha=0.3)
