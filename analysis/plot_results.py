@@ -41,6 +41,7 @@ from bench/ via analysis/plot_work_precision.py, not from a results file.
 import os
 import sys
 import textwrap
+import warnings
 from collections import Counter
 
 import h5py
@@ -115,6 +116,7 @@ def load(path):
 
 
 def parse_sweep(sweep_text):
+    """The sweep file stored in the results file, as a dict ({} if unreadable)."""
     if tomllib is None:
         return {}
     try:
@@ -158,6 +160,7 @@ def studies(runs, sweep):
 
 
 def status_note(runs, rows):
+    """'k of n runs drawn, ... diverged, ... failed, ... pending' for a figure title."""
     c = Counter(int(runs["status"][i]) for i in rows)
     parts = [f"{c[DONE] + c[DIVERGED]} of {len(rows)} runs drawn"]
     if c[DIVERGED]:
@@ -226,6 +229,8 @@ def ordered_systems(runs, rows):
 
 
 def mse_box_figure(runs, sel, axis, cols):
+    """Boxes of the finite MSEs per (column, model), seeds as jittered points, diverged runs as
+    triangles at the top edge with their count, drawn runs per box in grey at the bottom."""
     models = ordered_models(runs["model"][i] for i in sel)
     width = len(models) + 1
     fig, ax = plt.subplots(figsize=(max(8.0, 1.0 + 0.42 * width * len(cols)), 4.8))
@@ -276,6 +281,7 @@ def label_minor_log_ticks(axis):
 
 
 def draw_cell(ax, rng, x, model, vals):
+    """One box (quartiles, whiskers 1.5 IQR, no fliers: every seed is a point anyway)."""
     finite = [v for v in vals if np.isfinite(v)]
     if not finite:
         return
@@ -312,6 +318,7 @@ def median_seed_row(runs, cell):
 
 
 def trajectory_cell(runs, system):
+    """The baseline rows at the paper's N_train for this system (nearest available one)."""
     rows = baseline(runs, [i for i in runs["rows"] if runs["system"][i] == system])
     available = sorted({int(runs["n_train"][i]) for i in rows})
     target = TRAJECTORY_N_TRAIN.get(system, available[0])
@@ -371,6 +378,7 @@ def trajectory(runs, i, key, column):
 
 
 def draw_reference(runs, axes, i, energy):
+    """Reference q(t), p(t) and phase portrait of row i (energy '05' or '075'), axis labels."""
     ref = trajectory(runs, i, "reference_" + energy, 2 if energy == "05" else 3)
     t = np.arange(len(ref)) / float(canonical_value(runs, i, "sample_rate", 100))
     style = {"color": "black", "lw": 2.2, "label": "reference (data generator)"}
@@ -386,6 +394,7 @@ def draw_reference(runs, axes, i, energy):
 
 
 def draw_prediction(runs, axes, i, energy, model, median):
+    """Model rollout of row i; a rollout that turns non-finite is drawn up to there and noted."""
     pred = trajectory(runs, i, "prediction_" + energy, 0 if energy == "05" else 1)
     t = np.arange(len(pred)) / float(canonical_value(runs, i, "sample_rate", 100))
     finite = np.all(np.isfinite(pred), axis=1)
@@ -424,11 +433,9 @@ def trace_stats(runs, rows, column):
         if n == length:
             steps = runs["trace"][i][:n, 0]
     values[~np.isfinite(values)] = np.nan
-    with np.errstate(all="ignore"):
-        import warnings
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            q = np.nanpercentile(values, [25, 50, 75], axis=0)
+    with warnings.catch_warnings():  # all-NaN columns (every seed diverged there) give NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        q = np.nanpercentile(values, [25, 50, 75], axis=0)
     return steps, q[1], q[0], q[2]
 
 
