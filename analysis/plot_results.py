@@ -15,27 +15,33 @@ studies has one pseudo-study, e.g. "grid"):
                               and 0.75 J, reference vs NODE-RK2 and the best PHNN of the cell
                               (lowest median MSE); the seed drawn is the one with the median MSE
                               of its cell (lower median for even n), named in the legend.  Cell:
-                              small, no regularizer, N_train 25 / 100 / 25 for harmonic / Duffing /
-                              self-sustained (the nearest available N_train otherwise).
+                              the file's most common size (small in paper.toml), no regularizer,
+                              N_train 25 / 100 / 25 for harmonic / Duffing / self-sustained (the
+                              nearest available N_train otherwise, said in the title).
   jacobian_<sys>.png          paper Figs. 10/12: kappa [1], sigma_max [1/s], rho [1] of the learned
                               field's Jacobian at each validation point, median over seeds with the
                               interquartile band; one row per regularizer present (Study III),
-                              small models at the baseline N_train.
+                              most common size at the regularized runs' N_train (small, 25 in
+                              paper.toml).  Study I/II columns get no trace figure.
   loss_<sys>.png              training and validation loss L_d (+ regularizer term) per validation
                               point, median over seeds with the interquartile band, same runs as
                               jacobian_<sys>.png.
   time_vs_error_<sys>.png     wall time per run against inference MSE, every finished run a point,
-                              cell medians as large markers.  The trainer trains the seeds of a cell
+                              a model's median over all its runs as a diamond, diverged runs at the
+                              top edge.  The trainer trains the seeds of a cell
                               as one stacked model and stores wall time / members, so a run's time
                               is its share of the stack, not a time measured alone.
 
 Colours are fixed per model label (model + "-" + integrator, e.g. PHNN-S-DG4) in every figure;
 columns follow the study's order (the sweep file's order; numeric for N_train, small < medium <
-large, none < cn < sn < sr).  Pending runs (status 0) are skipped and counted.
+large, none < cn < sn < sr).  Pending runs (status 0) are skipped and counted; a figure with no
+finished run is not written, and the script says so.
+Tests: tests/analysis/plot_results_smoke.sh (synthetic file with every status) and
+tests/analysis/test_plot_results.py.
 
 NOT made, because the file cannot support them: the learned energy H_theta along a rollout against
-the true H (paper Figs. 7/9 lower panels) needs the trained weights, which format_version 1 does not
-store (issue 12 item 5: `phnn eval RESULTS --run ID`).  The integrator work-precision figure comes
+the true H needs the trained weights, which format_version 1 does not store (issue 12 item 5 asks
+for them and for `phnn eval RESULTS --run ID`).  The integrator work-precision figure comes
 from bench/ via analysis/plot_work_precision.py, not from a results file.
 """
 import os
