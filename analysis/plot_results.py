@@ -1,163 +1,550 @@
 #!/usr/bin/env python3
-"""Figures from a phnn-sweep results file (h5py + matplotlib, Debian packages).
+"""Figures from one phnn-sweep results file (Debian h5py + matplotlib + numpy).
 
-    python3 analysis/plot_results.py results/paper.h5 figures/
+    /usr/bin/python3 analysis/plot_results.py results/paper.h5 figures/
 
-Writes, per system:
-  mse_boxplot_<study>_<system>.png    inference MSE per model and study column
-                                      (paper Figures 6, 8, 11)
-  jacobian_trace_<system>.png         mean kappa / sigma_max / rho per validation
-                                      step over seeds, min-max band (Figures 10, 12)
-  trajectories_<system>.png           predicted vs reference trajectory from
-                                      H(x0) = 0.5 J (Figures 7, 9), seed 0
-Only finished runs (status done) are drawn; the file may be partial.
+Writes into OUTDIR, per system <sys> and study <st> (the file's [study.*] tables; a file without
+studies has one pseudo-study, e.g. "grid"):
+
+  mse_<st>_<sys>.png          inference MSE (Eq. 31) per model and study column (paper Figs. 6, 8,
+                              11): box = quartiles of the finite MSEs, every seed a jittered point,
+                              diverged runs (status diverged or MSE = +inf) as triangles at the top
+                              edge with their count, n per box under it; failed/pending runs counted
+                              in the title.
+  trajectories_<sys>.png      paper Figs. 7/9: q(t), p(t) and the phase portrait from H(x0) = 0.5 J
+                              and 0.75 J, reference vs NODE-RK2 and the best PHNN of the cell
+                              (lowest median MSE); the seed drawn is the one with the median MSE
+                              of its cell (lower median for even n), named in the legend.  Cell:
+                              the file's most common size (small in paper.toml), no regularizer,
+                              N_train 25 / 100 / 25 for harmonic / Duffing / self-sustained (the
+                              nearest available N_train otherwise, said in the title).
+  jacobian_<sys>.png          paper Figs. 10/12: kappa [1], sigma_max [1/s], rho [1] of the learned
+                              field's Jacobian at each validation point, median over seeds with the
+                              interquartile band; one row per regularizer present (Study III),
+                              most common size at the regularized runs' N_train (small, 25 in
+                              paper.toml).  Study I/II columns get no trace figure.
+  loss_<sys>.png              training and validation loss L_d (+ regularizer term) per validation
+                              point, median over seeds with the interquartile band, same runs as
+                              jacobian_<sys>.png.
+  time_vs_error_<sys>.png     wall time per run against inference MSE, every finished run a point,
+                              a model's median over all its runs as a diamond, diverged runs at the
+                              top edge.  The trainer trains the seeds of a cell
+                              as one stacked model and stores wall time / members, so a run's time
+                              is its share of the stack, not a time measured alone.
+
+Colours are fixed per model label (model + "-" + integrator, e.g. PHNN-S-DG4) in every figure;
+columns follow the study's order (the sweep file's order; numeric for N_train, small < medium <
+large, none < cn < sn < sr).  Pending runs (status 0) are skipped and counted; a figure with no
+finished run is not written, and the script says so.
+Tests: tests/analysis/plot_results_smoke.sh (synthetic file with every status) and
+tests/analysis/test_plot_results.py.
+
+NOT made, because the file cannot support them: the learned energy H_theta along a rollout against
+the true H needs the trained weights, which format_version 1 does not store (issue 12 item 5 asks
+for them and for `phnn eval RESULTS --run ID`).  The integrator work-precision figure comes
+from bench/ via analysis/plot_work_precision.py, not from a results file.
 """
 import os
 import sys
-from collections import defaultdict
+import textwrap
+import warnings
+from collections import Counter
 
 import h5py
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker as ticker  # noqa: E402
 import numpy as np  # noqa: E402
 
-STATUS_DONE = 1
-MODEL_ORDER = ["NODE-RK2", "PHNN-JR-DG", "PHNN-JR-RK2", "PHNN-S-DG", "PHNN-S-RK2"]
+try:
+    import tomllib  # Python >= 3.11 (Debian bookworm)
+except ImportError:  # study titles/order then come from the known orders only
+    tomllib = None
+
+PENDING, DONE, DIVERGED, FAILED = 0, 1, 2, 3
+# One colour per model label, in every figure (tab10; the RK4/DG4 variants get the other five).
+MODEL_COLOURS = {
+    "NODE-RK2": "#1f77b4", "PHNN-JR-DG": "#ff7f0e", "PHNN-JR-RK2": "#2ca02c",
+    "PHNN-S-DG": "#d62728", "PHNN-S-RK2": "#9467bd", "NODE-RK4": "#17becf",
+    "PHNN-JR-RK4": "#bcbd22", "PHNN-S-RK4": "#8c564b", "PHNN-JR-DG4": "#e377c2",
+    "PHNN-S-DG4": "#7f7f7f",
+}
+MODEL_ORDER = list(MODEL_COLOURS)
+KNOWN_ORDER = {"size": ["small", "medium", "large"], "regularizer": ["none", "cn", "sn", "sr"],
+               "system": ["harmonic", "duffing", "self-sustained"]}
+STUDY_KEYS = {"n_train": "n_train", "sizes": "size", "regularizers": "regularizer"}
+AXIS_LABEL = {"n_train": "N_train (training pairs)", "size": "model size",
+              "regularizer": "Jacobian regularizer"}
+TRAJECTORY_N_TRAIN = {"harmonic": 25, "duffing": 100, "self-sustained": 25}
+TRACE_COLUMNS = {"kappa": 4, "sigma_max": 5, "rho": 6, "train": 2, "validation": 3}
+DPI = 110
 
 
 def text(column):
-    return [v.decode() if isinstance(v, bytes) else str(v) for v in column]
+    return [v.decode().rstrip("\0") if isinstance(v, bytes) else str(v) for v in column]
 
 
-def label(model, integrator):
-    return {"node": "NODE", "phnn-s": "PHNN-S", "phnn-jr": "PHNN-JR"}[model] + "-" + integrator.upper()
+def model_label(model, integrator):
+    name = {"node": "NODE", "phnn-s": "PHNN-S", "phnn-jr": "PHNN-JR"}.get(model, model.upper())
+    return name + "-" + integrator.upper()
 
 
+def colour(label):
+    return MODEL_COLOURS.get(label, "black")
+
+
+def ordered_models(labels):
+    present = set(labels)
+    return [m for m in MODEL_ORDER if m in present] + sorted(present - set(MODEL_ORDER))
+
+
+# --------------------------------------------------------------------------------------- loading
 def load(path):
+    """All of /runs as numpy arrays/lists, plus the sweep's name and its parsed TOML text."""
     with h5py.File(path, "r") as f:
         if f.attrs.get("format", b"") not in (b"phnn-results", "phnn-results"):
             sys.exit(f"{path}: not a phnn results file (no format = phnn-results attribute)")
         r = f["runs"]
-        runs = {
-            "system": text(r["system"][()]),
-            "model": [label(m, i) for m, i in zip(text(r["model"][()]), text(r["integrator"][()]))],
-            "size": text(r["size"][()]),
-            "regularizer": text(r["regularizer"][()]),
-            "n_train": r["n_train"][()],
-            "seed": r["seed"][()],
-            "studies": text(r["studies"][()]),
-            "status": r["status"][()],
-            "mse": r["mse"][()],
-            "trace": r["trace"][()],
-            "trace_length": r["trace_length"][()],
-            "prediction_05": r["figure/prediction_05"][()],
-            "reference_05": r["figure/reference_05"][()],
-        }
-    return runs
+        runs = {k: text(r[k][()]) for k in ("system", "size", "regularizer", "studies", "canonical")}
+        runs["model"] = [model_label(m, i) for m, i in zip(text(r["model"][()]),
+                                                           text(r["integrator"][()]))]
+        for k in ("n_train", "seed", "status", "mse", "wall_time_s", "trace", "trace_length"):
+            runs[k] = r[k][()]
+        for k in ("prediction_05", "prediction_075", "reference_05", "reference_075", "length"):
+            runs[k] = r["figure/" + k][()]
+        name = text([f.attrs.get("sweep_name", b"")])[0]
+        sweep = parse_sweep(text([f.attrs.get("sweep_text", b"")])[0])
+    runs["mse"] = np.where(runs["status"] == DIVERGED, np.inf, runs["mse"])
+    runs["rows"] = np.arange(len(runs["status"]))
+    return runs, name, sweep
 
 
-def study_axis(runs, rows):
-    for axis in ("n_train", "size", "regularizer"):
-        if len({str(runs[axis][i]) for i in rows}) > 1:
-            return axis
-    return None
+def parse_sweep(sweep_text):
+    """The sweep file stored in the results file, as a dict ({} if unreadable)."""
+    if tomllib is None:
+        return {}
+    try:
+        return tomllib.loads(sweep_text)
+    except tomllib.TOMLDecodeError:
+        return {}
 
 
-def boxplots(runs, out):
-    by_study = defaultdict(list)
-    for i, studies in enumerate(runs["studies"]):
-        for s in studies.split(","):
-            if s:
-                by_study[s].append(i)
-    for study, rows in by_study.items():
-        axis = study_axis(runs, rows)
-        for system in sorted({runs["system"][i] for i in rows}):
-            sel = [i for i in rows if runs["system"][i] == system and runs["status"][i] == STATUS_DONE]
-            if not sel:
+def axis_value(runs, axis, i):
+    return int(runs[axis][i]) if axis == "n_train" else runs[axis][i]
+
+
+def column_order(runs, axis, rows, sweep, study):
+    """The study column values in the study's order (sweep file first, then known order)."""
+    values = {axis_value(runs, axis, i) for i in rows}
+    key = {v: k for k, v in STUDY_KEYS.items()}[axis]
+    declared = sweep.get("study", {}).get(study, {}).get(key, [])
+    first = [v for v in declared if v in values]
+    rest = values - set(first)
+    known = KNOWN_ORDER.get(axis, [])
+    rest = sorted(rest, key=lambda v: (known.index(v) if v in known else len(known), v))
+    return first + rest
+
+
+def studies(runs, sweep):
+    """{study: (title, rows, axis or None)} from the per-run study lists."""
+    out = {}
+    names = []
+    for s in runs["studies"]:
+        names += [n for n in s.split(",") if n and n not in names]
+    for name in names:
+        rows = [i for i in runs["rows"] if name in runs["studies"][i].split(",")]
+        axis = None
+        for a in ("n_train", "size", "regularizer"):
+            if len({axis_value(runs, a, i) for i in rows}) > 1:
+                axis = a
+                break
+        title = sweep.get("study", {}).get(name, {}).get("title", "")
+        out[name] = (title, rows, axis)
+    return out
+
+
+def status_note(runs, rows):
+    """'k of n runs drawn, ... diverged, ... failed, ... pending' for a figure title."""
+    c = Counter(int(runs["status"][i]) for i in rows)
+    parts = [f"{c[DONE] + c[DIVERGED]} of {len(rows)} runs drawn"]
+    if c[DIVERGED]:
+        parts.append(f"{c[DIVERGED]} diverged in training")
+    inf = sum(runs["status"][i] == DONE and np.isinf(runs["mse"][i]) for i in rows)
+    if inf:
+        parts.append(f"{inf} with a diverged rollout (MSE = +inf)")
+    nan = sum(runs["status"][i] == DONE and np.isnan(runs["mse"][i]) for i in rows)
+    if nan:
+        parts.append(f"{nan} done without an MSE (NaN, not drawn)")
+    if c[FAILED]:
+        parts.append(f"{c[FAILED]} failed (not drawn)")
+    if c[PENDING]:
+        parts.append(f"{c[PENDING]} pending (not drawn)")
+    return ", ".join(parts)
+
+
+def seeds_per_cell(runs, rows):
+    return len({int(runs["seed"][i]) for i in rows})
+
+
+def drawable(runs, rows):
+    return [i for i in rows if runs["status"][i] in (DONE, DIVERGED)]
+
+
+# ----------------------------------------------------------------------------- MSE box plots
+def mse_boxplots(runs, name, sweep, out):
+    """Paper Figs. 6, 8, 11: one figure per (study, system)."""
+    written = []
+    for study, (title, rows, axis) in studies(runs, sweep).items():
+        for system in ordered_systems(runs, rows):
+            sel = [i for i in rows if runs["system"][i] == system]
+            if not drawable(runs, sel):
                 continue
-            columns = sorted({str(runs[axis][i]) for i in sel}, key=lambda c: (len(c), c)) if axis else ["all"]
-            models = [m for m in MODEL_ORDER if any(runs["model"][i] == m for i in sel)]
-            fig, ax = plt.subplots(figsize=(1.6 + 1.4 * len(columns) * len(models) / 3, 4))
-            data, positions, colors = [], [], []
-            for c, column in enumerate(columns):
-                for m, model in enumerate(models):
-                    values = [runs["mse"][i] for i in sel if runs["model"][i] == model
-                              and (axis is None or str(runs[axis][i]) == column)]
-                    values = [v for v in values if np.isfinite(v)]
-                    if values:
-                        data.append(values)
-                        positions.append(c * (len(models) + 1) + m)
-                        colors.append(f"C{m}")
-            box = ax.boxplot(data, positions=positions, widths=0.8, patch_artist=True)
-            for patch, color in zip(box["boxes"], colors):
-                patch.set_facecolor(color)
-            ax.set_yscale("log")
-            ax.set_xticks([c * (len(models) + 1) + (len(models) - 1) / 2 for c in range(len(columns))])
-            ax.set_xticklabels(columns)
-            ax.set_xlabel(axis or "")
-            ax.set_ylabel("inference MSE")
-            ax.set_title(f"study {study}: {system}")
-            ax.legend([plt.Rectangle((0, 0), 1, 1, color=f"C{m}") for m in range(len(models))], models,
-                      fontsize=7)
+            cols = column_order(runs, axis, sel, sweep, study) if axis else [None]
+            fig = mse_box_figure(runs, sel, axis, cols)
+            suptitle(fig, f"{name}: {system}, study {study}" + (f" ({title})" if title else ""),
+                     f"inference MSE per seed (points), box = quartiles of the finite MSEs, "
+                     f"n = {seeds_per_cell(runs, sel)} seeds per cell; {status_note(runs, sel)}")
             fig.tight_layout()
-            fig.savefig(os.path.join(out, f"mse_boxplot_{study}_{system}.png"), dpi=120)
+            path = os.path.join(out, f"mse_{study}_{system}.png")
+            fig.savefig(path, dpi=DPI)
             plt.close(fig)
+            written.append(path)
+    return written
 
 
-def jacobian_traces(runs, out):
-    for system in sorted(set(runs["system"])):
-        fig, axes = plt.subplots(1, 3, figsize=(13, 3.5))
-        for m, model in enumerate(MODEL_ORDER):
-            sel = [i for i in range(len(runs["system"])) if runs["system"][i] == system
-                   and runs["model"][i] == model and runs["status"][i] == STATUS_DONE
-                   and runs["regularizer"][i] == "none" and runs["size"][i] == "small"
-                   and runs["n_train"][i] == 25]
-            if not sel:
-                continue
-            n = int(min(runs["trace_length"][i] for i in sel))
-            traces = np.stack([runs["trace"][i][:n] for i in sel])  # [seeds, n, 7]
-            steps = traces[0, :, 0]
-            for a, (col, name) in enumerate([(4, "condition number"), (5, "spectral norm"),
-                                             (6, "stiffness ratio")]):
-                values = traces[:, :, col]
-                axes[a].plot(steps, values.mean(0), color=f"C{m}", label=model)
-                axes[a].fill_between(steps, values.min(0), values.max(0), color=f"C{m}", alpha=0.2)
-                axes[a].set_yscale("log")
-                axes[a].set_xlabel("optimizer step")
-                axes[a].set_title(name)
-        axes[0].legend(fontsize=7)
-        fig.suptitle(f"{system}: small models, N_train = 25, no regularizer")
+def study_names(runs, rows):
+    """'study I, III' for the studies the rows belong to (in first-seen order)."""
+    names = []
+    for i in rows:
+        names += [n for n in runs["studies"][i].split(",") if n and n not in names]
+    return ("studies " if len(names) > 1 else "study ") + ", ".join(names) if names else "no study"
+
+
+def suptitle(fig, *lines):
+    """Figure title, each line wrapped to the figure's width."""
+    width = int(fig.get_figwidth() * 13)
+    fig.suptitle("\n".join(textwrap.fill(line, width) for line in lines), fontsize=9)
+
+
+def ordered_systems(runs, rows):
+    present = {runs["system"][i] for i in rows}
+    known = KNOWN_ORDER["system"]
+    return [s for s in known if s in present] + sorted(present - set(known))
+
+
+def mse_box_figure(runs, sel, axis, cols):
+    """Boxes of the finite MSEs per (column, model), seeds as jittered points, diverged runs as
+    triangles at the top edge with their count, drawn runs per box in grey at the bottom."""
+    models = ordered_models(runs["model"][i] for i in sel)
+    width = len(models) + 1
+    fig, ax = plt.subplots(figsize=(max(8.0, 1.0 + 0.42 * width * len(cols)), 4.8))
+    rng = np.random.default_rng(0)
+    cells = []
+    for c, col in enumerate(cols):
+        for m, model in enumerate(models):
+            cell = [i for i in drawable(runs, sel) if runs["model"][i] == model
+                    and (axis is None or axis_value(runs, axis, i) == col)]
+            cells.append((c * width + m, model, [runs["mse"][i] for i in cell]))
+    finite_all = [v for _, _, vals in cells for v in vals if np.isfinite(v)]
+    for x, model, vals in cells:
+        draw_cell(ax, rng, x, model, vals)
+    ax.set_yscale("log")
+    label_minor_log_ticks(ax.yaxis)
+    any_diverged = any(np.isinf(v) for _, _, vals in cells for v in vals)
+    if finite_all:
+        lo, hi = min(finite_all), max(finite_all)
+        ax.set_ylim(lo / 3, hi * (30 if any_diverged else 3))  # headroom for diverged markers
+    for x, model, vals in cells:
+        ndiv = sum(np.isinf(v) for v in vals)
+        if ndiv:
+            ax.plot([x], [0.97], marker="^", ms=9, color=colour(model), mec="black",
+                    transform=ax.get_xaxis_transform(), clip_on=False)
+            ax.text(x, 0.91, f"{ndiv}", ha="center", va="top", fontsize=7,
+                    transform=ax.get_xaxis_transform())
+        ax.text(x, 0.01, f"{len(vals)}", ha="center", va="bottom", fontsize=6, color="0.4",
+                transform=ax.get_xaxis_transform())
+    ax.set_xticks([c * width + (len(models) - 1) / 2 for c in range(len(cols))])
+    ax.set_xticklabels(["all runs" if c is None else str(c) for c in cols])
+    for c in range(1, len(cols)):
+        ax.axvline(c * width - 1, color="0.85", lw=0.8)
+    ax.set_xlim(-1, len(cols) * width - 1)
+    ax.set_xlabel(AXIS_LABEL.get(axis, "") + ("  (grey numbers: seeds per box)" if axis else
+                                              "grey numbers: seeds per box"))
+    ax.set_ylabel("inference MSE [m², (kg m/s)² mixed]")
+    handles = [plt.Rectangle((0, 0), 1, 1, fc=colour(m), alpha=0.5, ec=colour(m)) for m in models]
+    handles.append(plt.Line2D([], [], marker="^", ls="", color="0.5", mec="black"))
+    ax.legend(handles, models + ["diverged (count below)"], fontsize=7,
+              loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    return fig
+
+
+def label_minor_log_ticks(axis):
+    """Label 2x and 5x ticks too when a log axis spans fewer than ~3 decades."""
+    axis.set_minor_formatter(ticker.LogFormatterSciNotation(labelOnlyBase=False,
+                                                            minor_thresholds=(3, 1.2)))
+
+
+def draw_cell(ax, rng, x, model, vals):
+    """One box (quartiles, whiskers 1.5 IQR, no fliers: every seed is a point anyway)."""
+    finite = [v for v in vals if np.isfinite(v)]
+    if not finite:
+        return
+    box = ax.boxplot([finite], positions=[x], widths=0.75, patch_artist=True, showfliers=False,
+                     medianprops={"color": "black"})
+    box["boxes"][0].set(facecolor=colour(model), alpha=0.45, edgecolor=colour(model))
+    jitter = rng.uniform(-0.22, 0.22, len(finite))
+    ax.scatter(x + jitter, finite, s=12, color=colour(model), edgecolor="black", lw=0.4, zorder=3)
+
+
+# ------------------------------------------------------------------------- trajectories (7/9)
+def canonical_value(runs, i, key, default):
+    for part in runs["canonical"][i].split(";"):
+        k, _, v = part.partition("=")
+        if k == key:
+            return v
+    return default
+
+
+def baseline(runs, rows):
+    """Rows at the most common size and regularizer 'none' (Study I/II/III share this cell)."""
+    size = Counter(runs["size"][i] for i in rows).most_common(1)[0][0]
+    sel = [i for i in rows if runs["size"][i] == size and runs["regularizer"][i] == "none"]
+    return sel or rows
+
+
+def median_seed_row(runs, cell):
+    """The run with the median MSE of its cell (lower median for even n; +inf sorts last)."""
+    done = [i for i in cell if runs["status"][i] in (DONE, DIVERGED)]
+    if not done:
+        return None
+    done.sort(key=lambda i: (np.nan_to_num(runs["mse"][i], nan=np.inf), runs["seed"][i]))
+    return done[(len(done) - 1) // 2]
+
+
+def trajectory_cell(runs, system):
+    """The baseline rows at the paper's N_train for this system (nearest available one)."""
+    rows = baseline(runs, [i for i in runs["rows"] if runs["system"][i] == system])
+    available = sorted({int(runs["n_train"][i]) for i in rows})
+    target = TRAJECTORY_N_TRAIN.get(system, available[0])
+    n_train = min(available, key=lambda n: (abs(n - target), n))
+    return [i for i in rows if runs["n_train"][i] == n_train], n_train, target
+
+
+def chosen_models(runs, cell):
+    """NODE-RK2 and the PHNN label with the lowest median MSE over the cell's finished runs."""
+    medians = {}
+    for m in ordered_models(runs["model"][i] for i in cell):
+        v = [runs["mse"][i] for i in cell if runs["model"][i] == m and runs["status"][i] in
+             (DONE, DIVERGED)]
+        if v:
+            medians[m] = float(np.median(np.nan_to_num(v, nan=np.inf)))
+    phnn = [m for m in medians if m.startswith("PHNN")]
+    picks = [m for m in medians if m.startswith("NODE")][:1]
+    if phnn:
+        picks.append(min(phnn, key=lambda m: medians[m]))
+    return picks, medians
+
+
+def trajectories(runs, name, out):
+    """Paper Figs. 7/9 for each system; see the module docstring."""
+    written = []
+    for system in ordered_systems(runs, runs["rows"]):
+        cell, n_train, target = trajectory_cell(runs, system)
+        picks, medians = chosen_models(runs, cell)
+        if not picks:
+            print(f"  skipped trajectories_{system}.png: no finished run at N_train = {n_train}")
+            continue
+        fig, axes = plt.subplots(2, 3, figsize=(13, 7))
+        for r, energy in enumerate(("05", "075")):
+            draw_reference(runs, axes[r], median_seed_row(runs, cell), energy)
+            for m in picks:
+                i = median_seed_row(runs, [j for j in cell if runs["model"][j] == m])
+                draw_prediction(runs, axes[r], i, energy, m, medians[m])
+            axes[r, 0].set_ylabel(f"H(x0) = {0.5 if energy == '05' else 0.75} J\nq [m]")
+        axes[0, 2].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+        seeds = seeds_per_cell(runs, cell)
+        note = "" if n_train == target else f" (paper: {target}, not in this file)"
+        suptitle(fig, f"{name}: {system}, {study_names(runs, cell)}, {runs['size'][cell[0]]}, "
+                 f"no regularizer, N_train = {n_train}{note}; n = {seeds} seeds per model",
+                 f"reference vs NODE and the best PHNN (lowest median MSE), each at its "
+                 f"median-MSE seed (named in the legend); {status_note(runs, cell)}")
         fig.tight_layout()
-        fig.savefig(os.path.join(out, f"jacobian_trace_{system}.png"), dpi=120)
+        path = os.path.join(out, f"trajectories_{system}.png")
+        fig.savefig(path, dpi=DPI)
         plt.close(fig)
+        written.append(path)
+    return written
 
 
-def trajectories(runs, out):
-    for system in sorted(set(runs["system"])):
-        fig, ax = plt.subplots(figsize=(5, 4))
-        reference_drawn = False
-        for m, model in enumerate(MODEL_ORDER):
-            sel = [i for i in range(len(runs["system"])) if runs["system"][i] == system
-                   and runs["model"][i] == model and runs["status"][i] == STATUS_DONE
-                   and runs["seed"][i] == 0 and runs["regularizer"][i] == "none"]
-            if not sel:
-                continue
-            i = sel[0]
-            if not reference_drawn:
-                ref = runs["reference_05"][i]
-                ax.plot(ref[:, 0], ref[:, 1], "k-", lw=2, label="reference (DG, 400 Hz)")
-                reference_drawn = True
-            pred = runs["prediction_05"][i]
-            ax.plot(pred[:, 0], pred[:, 1], color=f"C{m}", lw=1, label=model)
-        ax.set_xlabel("q [m]")
-        ax.set_ylabel("p [kg m/s]")
-        ax.set_title(f"{system}: from H(x0) = 0.5 J, seed 0")
-        ax.legend(fontsize=7)
+def trajectory(runs, i, key, column):
+    length = int(runs["length"][i][column])
+    return runs[key][i][:length]
+
+
+def draw_reference(runs, axes, i, energy):
+    """Reference q(t), p(t) and phase portrait of row i (energy '05' or '075'), axis labels."""
+    ref = trajectory(runs, i, "reference_" + energy, 2 if energy == "05" else 3)
+    t = np.arange(len(ref)) / float(canonical_value(runs, i, "sample_rate", 100))
+    style = {"color": "black", "lw": 2.2, "label": "reference (data generator)"}
+    axes[0].plot(t, ref[:, 0], **style)
+    axes[1].plot(t, ref[:, 1], **style)
+    axes[2].plot(ref[:, 0], ref[:, 1], **style)
+    for ax, xl, yl in ((axes[0], "t [s]", None), (axes[1], "t [s]", "p [kg m/s]"),
+                       (axes[2], "q [m]", "p [kg m/s]")):
+        ax.set_xlabel(xl)
+        if yl:
+            ax.set_ylabel(yl)
+        ax.grid(alpha=0.3)
+
+
+def draw_prediction(runs, axes, i, energy, model, median):
+    """Model rollout of row i; a rollout that turns non-finite is drawn up to there and noted."""
+    pred = trajectory(runs, i, "prediction_" + energy, 0 if energy == "05" else 1)
+    t = np.arange(len(pred)) / float(canonical_value(runs, i, "sample_rate", 100))
+    finite = np.all(np.isfinite(pred), axis=1)
+    label = (f"{model}, seed {int(runs['seed'][i])} (MSE {runs['mse'][i]:.2g}; "
+             f"cell median {median:.2g})")
+    style = {"color": colour(model), "lw": 1.3, "ls": "--", "label": label}
+    axes[0].plot(t[finite], pred[finite, 0], **style)
+    axes[1].plot(t[finite], pred[finite, 1], **style)
+    axes[2].plot(pred[finite, 0], pred[finite, 1], **style)
+    if not finite.all():
+        axes[0].text(0.02, 0.02, f"{model}: rollout non-finite after t = {t[~finite][0]:.2f} s",
+                     transform=axes[0].transAxes, fontsize=7, color=colour(model))
+
+
+# ------------------------------------------------------------- Jacobian (10/12) and loss traces
+def trace_runs(runs, system):
+    """Small-size runs of a system at the N_train the regularized runs use: {regularizer: rows}."""
+    rows = [i for i in runs["rows"] if runs["system"][i] == system]
+    size = Counter(runs["size"][i] for i in rows).most_common(1)[0][0]
+    rows = [i for i in rows if runs["size"][i] == size]
+    regularized = [i for i in rows if runs["regularizer"][i] != "none"] or rows
+    n_train = Counter(int(runs["n_train"][i]) for i in regularized).most_common(1)[0][0]
+    rows = [i for i in rows if runs["n_train"][i] == n_train]
+    regs = column_order(runs, "regularizer", rows, {}, "")
+    return {r: [i for i in rows if runs["regularizer"][i] == r] for r in regs}, size, n_train
+
+
+def trace_stats(runs, rows, column):
+    """steps, median, 25 % and 75 % over the rows' traces (NaN-padded; diverged points skipped)."""
+    length = max(int(runs["trace_length"][i]) for i in rows)
+    values = np.full((len(rows), length), np.nan)
+    steps = None
+    for k, i in enumerate(rows):
+        n = int(runs["trace_length"][i])
+        values[k, :n] = runs["trace"][i][:n, column]
+        if n == length:
+            steps = runs["trace"][i][:n, 0]
+    values[~np.isfinite(values)] = np.nan
+    with warnings.catch_warnings():  # all-NaN columns (every seed diverged there) give NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        q = np.nanpercentile(values, [25, 50, 75], axis=0)
+    return steps, q[1], q[0], q[2]
+
+
+def trace_figure(runs, name, system, out, panels, stem, what):
+    """One row per regularizer, one column per (trace column, axis label, log scale allowed);
+    a panel is drawn on a log axis only when its data span more than a factor of 30."""
+    groups, size, n_train = trace_runs(runs, system)
+    groups = {r: [i for i in drawable(runs, rows) if runs["trace_length"][i] > 0]
+              for r, rows in groups.items()}
+    groups = {r: rows for r, rows in groups.items() if rows}
+    if not groups:
+        print(f"  skipped {stem}_{system}.png: no finished {size} run at N_train = {n_train}")
+        return None
+    fig, axes = plt.subplots(len(groups), len(panels), squeeze=False,
+                             figsize=(4.3 * len(panels) + 1.8, 2.9 * len(groups) + 0.9))
+    for row, (reg, rows) in enumerate(groups.items()):
+        for m in ordered_models(runs["model"][i] for i in rows):
+            sel = [i for i in rows if runs["model"][i] == m and runs["trace_length"][i] > 0]
+            for col, (key, ylabel, log) in enumerate(panels):
+                if not sel:
+                    continue
+                steps, med, lo, hi = trace_stats(runs, sel, TRACE_COLUMNS[key])
+                ax = axes[row, col]
+                ax.plot(steps, med, color=colour(m), lw=1.3, label=f"{m} (n = {len(sel)})")
+                ax.fill_between(steps, lo, hi, color=colour(m), alpha=0.18, lw=0)
+        for col, (key, ylabel, log) in enumerate(panels):
+            ax = axes[row, col]
+            lo, hi = ax.dataLim.y0, ax.dataLim.y1
+            ax.set_yscale("log" if log and lo > 0 and hi / lo > 30 else "linear")
+            ax.set_ylabel(ylabel, fontsize=8)
+            ax.set_title(f"regularizer: {reg}", fontsize=8)
+            ax.grid(alpha=0.3)
+            if row == len(groups) - 1:
+                ax.set_xlabel("Adam step")
+        axes[row, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    all_rows = [i for rows in trace_runs(runs, system)[0].values() for i in rows]
+    suptitle(fig, f"{name}: {system}, {study_names(runs, all_rows)}, {size} models, "
+             f"N_train = {n_train}, one row per regularizer: {what}",
+             f"median over seeds (n per model in legend), band = interquartile range; "
+             f"{status_note(runs, all_rows)}")
+    fig.tight_layout()
+    path = os.path.join(out, f"{stem}_{system}.png")
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
+
+
+def jacobian_traces(runs, name, out):
+    """Paper Figs. 10/12: kappa, sigma_max and rho of the learned field's Jacobian."""
+    panels = [("kappa", "condition number κ [1]", True),
+              ("sigma_max", "spectral norm σ_max [1/s]", True),
+              ("rho", "stiffness ratio ρ [1]", False)]
+    return [p for s in ordered_systems(runs, runs["rows"]) if (p := trace_figure(
+        runs, name, s, out, panels, "jacobian", "Jacobian of the learned field at validation points"))]
+
+
+def loss_curves(runs, name, out):
+    """Training and validation loss L_d per validation point (the regularizer term included)."""
+    panels = [("train", "training loss [L_d]", True), ("validation", "validation loss [L_d]", True)]
+    return [p for s in ordered_systems(runs, runs["rows"]) if (p := trace_figure(
+        runs, name, s, out, panels, "loss",
+        "training / validation loss, L_d = mean |x_{n+1} − x̂_{n+1}| / h (m/s and kg m/s² mixed; "
+        "+ the regularizer's term where one is used)"))]
+
+
+# ------------------------------------------------------------------------------ time vs error
+def time_vs_error(runs, name, out):
+    """Wall time per run against inference MSE, per system; diverged runs at the top edge."""
+    written = []
+    for system in ordered_systems(runs, runs["rows"]):
+        rows = [i for i in runs["rows"] if runs["system"][i] == system]
+        sel = drawable(runs, rows)
+        if not sel:
+            continue
+        fig, ax = plt.subplots(figsize=(8, 4.8))
+        for m in ordered_models(runs["model"][i] for i in sel):
+            mine = [i for i in sel if runs["model"][i] == m]
+            t = np.array([runs["wall_time_s"][i] for i in mine])
+            e = np.array([runs["mse"][i] for i in mine])
+            ok, div = np.isfinite(e), np.isinf(e)
+            ax.scatter(t[ok], e[ok], s=10, color=colour(m), alpha=0.6, lw=0)
+            ax.scatter(t[div], np.full(div.sum(), 0.97), marker="^", color=colour(m),
+                       edgecolor="black", transform=ax.get_xaxis_transform(), clip_on=False)
+            ax.scatter([np.median(t)], [np.median(e[~np.isnan(e)]) if ok.any() else np.nan], s=90,
+                       color=colour(m), edgecolor="black", marker="D",
+                       label=f"{m}: {len(mine)} runs, {div.sum()} diverged")
+        ax.set_xscale("log")
+        if any(np.isfinite(runs["mse"][i]) for i in sel):
+            ax.set_yscale("log")
+            label_minor_log_ticks(ax.yaxis)
+        ax.set_xlabel("wall time per run [s] (stack time / seeds trained together)")
+        ax.set_ylabel("inference MSE [m², (kg m/s)² mixed]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+        suptitle(fig, f"{name}: {system}, all studies: wall time vs inference MSE, every run a "
+                 f"point, diamonds = a model's medians over all its runs",
+                 f"n = {seeds_per_cell(runs, rows)} seeds per cell; {status_note(runs, rows)}")
         fig.tight_layout()
-        fig.savefig(os.path.join(out, f"trajectories_{system}.png"), dpi=120)
+        path = os.path.join(out, f"time_vs_error_{system}.png")
+        fig.savefig(path, dpi=DPI)
         plt.close(fig)
+        written.append(path)
+    return written
 
 
 def main():
@@ -167,11 +554,18 @@ def main():
     if not os.path.exists(path):
         sys.exit(f"{path}: no such file; run `phnn sweep` first")
     os.makedirs(out, exist_ok=True)
-    runs = load(path)
-    boxplots(runs, out)
-    jacobian_traces(runs, out)
-    trajectories(runs, out)
-    print(f"figures written to {out}/")
+    runs, name, sweep = load(path)
+    name = name or os.path.basename(path)
+    written = []
+    for make in (mse_boxplots,):
+        written += make(runs, name, sweep, out)
+    for make in (trajectories, jacobian_traces, loss_curves, time_vs_error):
+        written += make(runs, name, out)
+    c = Counter(int(s) for s in runs["status"])
+    print(f"{len(written)} figures written to {out}/ ({c[DONE]} done, {c[DIVERGED]} diverged, "
+          f"{c[FAILED]} failed, {c[PENDING]} pending of {len(runs['status'])} runs)")
+    for p in written:
+        print("  " + os.path.basename(p))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,23 @@
+#!/bin/sh
+# Smoke test of analysis/plot_results.py: build a synthetic results file with every run status
+# (tests/analysis/make_fixture.py), plot it, and check that each kind of figure was written;
+# first the unit tests of the script's choices (tests/analysis/test_plot_results.py).
+# ctest: add_test(NAME plot_results_smoke COMMAND sh ${CMAKE_SOURCE_DIR}/tests/analysis/plot_results_smoke.sh)
+#        set_tests_properties(plot_results_smoke PROPERTIES SKIP_RETURN_CODE 77)
+#   tests/analysis/plot_results_smoke.sh [PYTHON]     (default /usr/bin/python3, Debian h5py+mpl)
+set -eu
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$here/../.." && pwd)
+py=${1:-/usr/bin/python3}
+# 77 = skipped (ctest SKIP_RETURN_CODE) when the Debian packages are not installed
+"$py" -c "import h5py, matplotlib, numpy" 2>/dev/null || { echo "h5py/matplotlib missing: skipped"; exit 77; }
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+"$py" "$here/test_plot_results.py"
+"$py" "$here/make_fixture.py" "$out/fixture.h5"
+"$py" "$root/analysis/plot_results.py" "$out/fixture.h5" "$out/fig"
+for f in mse_I_harmonic mse_III_duffing trajectories_harmonic jacobian_duffing loss_harmonic \
+         time_vs_error_duffing; do
+    test -s "$out/fig/$f.png" || { echo "missing $f.png" >&2; exit 1; }
+done
+echo "plot_results smoke test passed"

@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""Unit tests of analysis/plot_results.py's choices: column order, median seed, status counts.
+
+    /usr/bin/python3 tests/analysis/test_plot_results.py
+"""
+import os
+import sys
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "analysis"))
+import plot_results as pr  # noqa: E402
+
+
+def runs_of(**columns):
+    n = len(next(iter(columns.values())))
+    runs = {"rows": np.arange(n), "studies": ["I"] * n}
+    runs.update({k: (np.array(v) if k in ("n_train", "seed", "status", "mse") else list(v))
+                 for k, v in columns.items()})
+    return runs
+
+
+class ColumnOrder(unittest.TestCase):
+    def test_numeric_not_string_length(self):
+        runs = runs_of(n_train=[400, 25, 100, 25])
+        self.assertEqual(pr.column_order(runs, "n_train", runs["rows"], {}, "I"), [25, 100, 400])
+
+    def test_known_orders(self):
+        runs = runs_of(size=["large", "small", "medium"], regularizer=["sr", "none", "cn"])
+        self.assertEqual(pr.column_order(runs, "size", runs["rows"], {}, "II"),
+                         ["small", "medium", "large"])
+        self.assertEqual(pr.column_order(runs, "regularizer", runs["rows"], {}, "III"),
+                         ["none", "cn", "sr"])
+
+    def test_sweep_file_order_wins(self):
+        runs = runs_of(regularizer=["none", "cn", "sn"])
+        sweep = {"study": {"III": {"regularizers": ["sn", "none", "cn"]}}}
+        self.assertEqual(pr.column_order(runs, "regularizer", runs["rows"], sweep, "III"),
+                         ["sn", "none", "cn"])
+
+
+class MedianSeed(unittest.TestCase):
+    def test_lower_median_and_inf_last(self):
+        runs = runs_of(seed=[0, 1, 2, 3], status=[1, 1, 2, 1], mse=[3.0, 1.0, np.inf, 2.0])
+        self.assertEqual(pr.median_seed_row(runs, [0, 1, 2, 3]), 3)  # sorted 1, 2, 3, inf
+
+    def test_pending_skipped(self):
+        runs = runs_of(seed=[0, 1, 2], status=[0, 1, 1], mse=[np.nan, 5.0, 4.0])
+        self.assertEqual(pr.median_seed_row(runs, [0, 1, 2]), 2)
+
+
+class Labels(unittest.TestCase):
+    def test_model_labels_and_fixed_colours(self):
+        self.assertEqual(pr.model_label("phnn-jr", "dg4"), "PHNN-JR-DG4")
+        self.assertEqual(pr.model_label("node", "rk4"), "NODE-RK4")
+        self.assertEqual(len(set(pr.MODEL_COLOURS.values())), len(pr.MODEL_COLOURS))
+
+    def test_status_note_counts_everything(self):
+        runs = runs_of(status=[1, 1, 2, 3, 0, 0], mse=[1.0, np.inf, np.inf, np.nan, np.nan, np.nan])
+        self.assertEqual(pr.status_note(runs, range(6)),
+                         "3 of 6 runs drawn, 1 diverged in training, 1 with a diverged rollout "
+                         "(MSE = +inf), 1 failed (not drawn), 2 pending (not drawn)")
+
+
+if __name__ == "__main__":
+    unittest.main()
