@@ -63,6 +63,12 @@ std::string RunConfig::cell_key() const {
       << ";tau=" << num(t.dg_min_dx_norm);
   }
   s << ";divergence=" << num(t.divergence_norm);
+  // Only when set, so the identity of every run without checkpoints is
+  // unchanged from before they existed.
+  if (!t.checkpoints.empty()) {
+    s << ";checkpoints=";
+    for (std::size_t i = 0; i < t.checkpoints.size(); ++i) s << (i ? "," : "") << t.checkpoints[i];
+  }
   return s.str();
 }
 

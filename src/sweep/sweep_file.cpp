@@ -990,7 +990,11 @@ class Resolver {
             {"newton_tolerance", number(t.newton_tolerance)},
             {"newton_max_iterations", integer(t.newton_max_iterations, 1)},
             {"dg_min_dx_norm", number(t.dg_min_dx_norm)},
-            {"divergence_norm", number(t.divergence_norm)}};
+            {"divergence_norm", number(t.divergence_norm)},
+            {"checkpoints", [this, &t](const Entry& e) {
+               t.checkpoints = get_int_axis(e, 1, nullptr);
+               std::sort(t.checkpoints.begin(), t.checkpoints.end());
+             }}};
   }
 
   // Only the parameters the system uses (RunConfig::cell_key() hashes exactly

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "phnn/sweep/grid.h"
 #include "phnn/sweep/run_config.h"
 
 namespace phnn {
@@ -14,6 +15,7 @@ namespace {
 using ::testing::AllOf;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 const std::string kSweeps = std::string(PHNN_SOURCE_DIR) + "/sweeps/";
@@ -228,6 +230,24 @@ models = [
                "x.toml:5: unknown integrator \"rk3\" in models value \"phnn-s-rk3\"; expected "
                "one of: node-rk2, phnn-jr-dg, phnn-jr-rk2, phnn-s-dg, phnn-s-rk2, node-rk4, "
                "phnn-jr-rk4, phnn-s-rk4, phnn-jr-dg4, phnn-s-dg4");
+}
+
+// [training] checkpoints: sorted step budgets, checked like every other
+// training option, and part of a run's identity only when set.
+TEST(SweepFileTest, CheckpointsAreTrainingOptions) {
+  const SweepSpec spec = parse_sweep_text(R"(name = "t"
+[training]
+steps = 1000
+checkpoints = [1000, 500]
+)", "x.toml");
+  const Grid grid = expand_grid(spec);
+  ASSERT_FALSE(grid.runs.empty());
+  EXPECT_EQ(grid.runs[0].training.checkpoints, (std::vector<int>{500, 1000}));
+  EXPECT_THAT(grid.runs[0].canonical(), HasSubstr(";checkpoints=500,1000"));
+  const Grid plain = expand_grid(parse_sweep_text("name = \"t\"\n", "x.toml"));
+  EXPECT_THAT(plain.runs[0].canonical(), Not(HasSubstr("checkpoints")));
+  const SweepFileError e = error_of("name = \"t\"\n[training]\nsteps = 1000\ncheckpoints = [300]\n");
+  EXPECT_THAT(e.what(), AllOf(StartsWith("x.toml:4:"), HasSubstr("checkpoints = 300")));
 }
 
 // The fourth-order explicit variants are sweep-file models like the others
