@@ -59,13 +59,19 @@ def load(path):
         if "checkpoint_mse" not in runs:
             sys.exit(f"{path}: no /runs/checkpoint_mse; the sweep must set [training] checkpoints "
                      "(see sweeps/time-vs-error.toml)")
+        steps = runs["checkpoint_steps"][()]
+        status = runs["status"][()]
+        used = [r for r in range(len(status)) if status[r] in (STATUS_DONE, STATUS_DIVERGED)]
+        budgets = sorted({tuple(int(s) for s in steps[r] if s > 0) for r in used})
+        if len(budgets) > 1:
+            sys.exit(f"{path}: runs have different checkpoints {budgets}; one set per file")
         return {
-            "budgets": [int(s) for s in runs["checkpoint_mse"].attrs["steps"]],
+            "budgets": list(budgets[0]) if budgets else [],
             "system": text(runs["system"][()]),
             "model": [label(m, i) for m, i in zip(text(runs["model"][()]),
                                                   text(runs["integrator"][()]))],
             "n_train": runs["n_train"][()],
-            "status": runs["status"][()],
+            "status": status,
             "mse": runs["checkpoint_mse"][()],
             "seconds": runs["checkpoint_train_seconds"][()],
         }
@@ -129,7 +135,7 @@ def write_markdown(table, budgets, path):
                 for b, p in enumerate(e["budgets"]):
                     mark = " *" if (m, b) in front else ""
                     cells.append(f"{p['median']:.2e} [{p['q75'] - p['q25']:.1e}], "
-                                 f"{p['seconds']:.0f} s{mark}")
+                                 f"{p['seconds']:.3g} s{mark}")
                 lines.append(f"| {m} | {e['n']} | " + " | ".join(cells) + " |")
             lines.append("")
     lines.append("Cell: median [IQR] inference MSE over seeds, median training core-seconds per "

@@ -55,6 +55,9 @@ const std::string kPrediction075 = "/runs/figure/prediction_075";
 const std::string kReference05 = "/runs/figure/reference_05";
 const std::string kReference075 = "/runs/figure/reference_075";
 const std::string kFigureLength = "/runs/figure/length";
+const std::string kCheckpointSteps = "/runs/checkpoint_steps";
+const std::string kCheckpointMse = "/runs/checkpoint_mse";
+const std::string kCheckpointTrainSeconds = "/runs/checkpoint_train_seconds";
 
 const std::string kStateUnits = "q [m], p [kg m/s]";
 const std::string kMseUnits =
@@ -202,6 +205,8 @@ ResultsLayout ResultsLayout::for_runs(const std::vector<RunConfig>& runs) {
     }
     layout.figure_points =
         std::max(layout.figure_points, run.data.num_inference_steps() + 1);
+    layout.checkpoints =
+        std::max(layout.checkpoints, static_cast<int>(run.training.checkpoints.size()));
   }
   return layout;
 }
@@ -216,6 +221,8 @@ void ResultsLayout::validate() const {
   require(figure_points > 0, "Invalid ResultsLayout: figure_points = " +
                                  std::to_string(figure_points) +
                                  "; violated constraint: figure_points > 0.");
+  require(checkpoints >= 0, "Invalid ResultsLayout: checkpoints = " + std::to_string(checkpoints) +
+                                "; violated constraint: checkpoints >= 0.");
 }
 
 struct ResultsFile::Impl {
@@ -237,6 +244,8 @@ struct ResultsFile::Impl {
     layout.num_inference = static_cast<int>(file.dims(kTrajectoryErrors).at(1));
     layout.trace_points = static_cast<int>(file.dims(kTrace).at(1));
     layout.figure_points = static_cast<int>(file.dims(kPrediction05).at(1));
+    layout.checkpoints =
+        file.exists(kCheckpointMse) ? static_cast<int>(file.dims(kCheckpointMse).at(1)) : 0;
   }
 
   // "[rank 3/8] " in a parallel file, "" in a serial one.
@@ -426,6 +435,16 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
     file.set_attribute(kFigureLength, "columns",
                        std::string("prediction_05, prediction_075, reference_05, "
                                    "reference_075"));
+    if (layout.checkpoints > 0) {
+      const auto K = static_cast<std::uint64_t>(layout.checkpoints);
+      ints(kCheckpointSteps, {R, K}, "step budgets (TrainerOptions::checkpoints); 0 after the "
+                                     "run's own count");
+      floats(kCheckpointMse, {R, K},
+             kMseUnits + "; of the best-validation weights up to each budget");
+      floats(kCheckpointTrainSeconds, {R, K},
+             "s; training wall time to each budget, this run's share of its stack, inference "
+             "excluded");
+    }
 
     // The config columns: rank 0 writes them (independent raw-data writes).
     if (comm_rank(comm) == 0) {
@@ -532,6 +551,12 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     figure_length[k] = static_cast<std::int64_t>(size / 2);
   }
 
+  require(r.checkpoint_steps.size() <= static_cast<std::size_t>(L.checkpoints) &&
+              r.checkpoint_mse.size() == r.checkpoint_steps.size() &&
+              r.checkpoint_train_seconds.size() == r.checkpoint_steps.size(),
+          where + "has " + std::to_string(r.checkpoint_steps.size()) +
+              " checkpoints, the file holds " + std::to_string(L.checkpoints) +
+              " (ResultsLayout::checkpoints)");
   std::vector<double> trace(static_cast<std::size_t>(L.trace_points) * kTraceColumns, kNaN);
   for (std::size_t i = 0; i < r.trace.size(); ++i) {
     const TracePoint& t = r.trace[i];
@@ -567,6 +592,14 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     for (int k = 0; k < 4; ++k) f.write_rows(*figure_sets[k], at, 1, padded(*figures[k], F).data());
     f.write_rows(kFigureLength, at, 1, figure_length);
     f.write_string_rows(kMessage, at, {truncate_message(r.message, kMessageLength)});
+    if (L.checkpoints > 0) {
+      const auto K = static_cast<std::size_t>(L.checkpoints);
+      std::vector<std::int64_t> steps(K, 0);
+      std::copy(r.checkpoint_steps.begin(), r.checkpoint_steps.end(), steps.begin());
+      f.write_rows(kCheckpointSteps, at, 1, steps.data());
+      f.write_rows(kCheckpointMse, at, 1, padded(r.checkpoint_mse, K).data());
+      f.write_rows(kCheckpointTrainSeconds, at, 1, padded(r.checkpoint_train_seconds, K).data());
+    }
     // Last: until this lands the row reads as pending.
     put_int(kStatus, static_cast<std::int64_t>(r.status));
   });
@@ -635,6 +668,14 @@ RunResult ResultsFile::read_run(int row) const {
   r.figure_prediction_075 = unpadded(impl.doubles(kPrediction075, at, 1), 2 * lengths.at(1));
   r.figure_reference_05 = unpadded(impl.doubles(kReference05, at, 1), 2 * lengths.at(2));
   r.figure_reference_075 = unpadded(impl.doubles(kReference075, at, 1), 2 * lengths.at(3));
+  if (impl.layout.checkpoints > 0) {
+    for (std::int64_t s : impl.ints(kCheckpointSteps, at, 1)) {
+      if (s > 0) r.checkpoint_steps.push_back(static_cast<int>(s));
+    }
+    const auto count = static_cast<std::int64_t>(r.checkpoint_steps.size());
+    r.checkpoint_mse = unpadded(impl.doubles(kCheckpointMse, at, 1), count);
+    r.checkpoint_train_seconds = unpadded(impl.doubles(kCheckpointTrainSeconds, at, 1), count);
+  }
   return r;
 }
 

@@ -53,6 +53,16 @@ class ResultsFileTest : public ::testing::Test {
                                kSweepHash, "phnn-sweep 0.1.0", sample_layout());
   }
 
+  // A file made without checkpoints has no such columns and reads none.
+  void create_plain_and_check_no_checkpoints() const {
+    std::remove(path_.c_str());
+    remove_journals(path_);
+    create().close();
+    const ResultsFile file = ResultsFile::open_read_only(path_);
+    EXPECT_EQ(file.layout().checkpoints, 0);
+    EXPECT_TRUE(file.read_run(0).checkpoint_mse.empty());
+  }
+
   std::string path_;
 };
 
@@ -84,6 +94,40 @@ TEST_F(ResultsFileTest, RoundTripsEveryFieldBitExactly) {
   EXPECT_TRUE(std::isnan(trace[(1 * layout.trace_points + 2) * 7]));  // row 1 has 2 points
   EXPECT_EQ(bits(file.read_double_column("mse")[1]),
             bits(std::numeric_limits<double>::infinity()));
+}
+
+// Checkpoint columns exist only when the layout asks for them; a run's own
+// count (<= the layout's) round-trips bit-exactly, +inf included, and a run
+// with more checkpoints than the file holds is refused.
+TEST_F(ResultsFileTest, RoundTripsCheckpointsWhenTheLayoutHasThem) {
+  ResultsLayout layout = sample_layout();
+  layout.checkpoints = 3;
+  RunResult two = sample_result(0, layout), three = sample_result(3, layout);
+  two.checkpoint_steps = {500, 1000};
+  two.checkpoint_mse = {0.25, std::numeric_limits<double>::infinity()};
+  two.checkpoint_train_seconds = {1.5, 3.25};
+  three.checkpoint_steps = {100, 200, 300};
+  three.checkpoint_mse = {3e-4, 2e-4, 1e-4};
+  three.checkpoint_train_seconds = {0.1, 0.2, 0.3};
+  {
+    ResultsFile file = ResultsFile::create(path_, MPI_COMM_NULL, sample_runs(kNumRuns),
+                                           sample_studies(kNumRuns), "demo", "x", kSweepHash,
+                                           "phnn-sweep 0.1.0", layout);
+    file.write_run(0, two);
+    file.write_run(3, three);
+    RunResult four = three;
+    four.checkpoint_steps.push_back(400);
+    four.checkpoint_mse.push_back(1.0);
+    four.checkpoint_train_seconds.push_back(1.0);
+    EXPECT_THROW(file.write_run(1, four), std::exception);
+    file.close();
+  }
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  EXPECT_EQ(file.layout().checkpoints, 3);
+  expect_bit_equal(two, file.read_run(0));
+  expect_bit_equal(three, file.read_run(3));
+  EXPECT_TRUE(file.read_run(2).checkpoint_steps.empty());  // pending
+  create_plain_and_check_no_checkpoints();
 }
 
 TEST_F(ResultsFileTest, StoresConfigColumnsAndFileAttributes) {

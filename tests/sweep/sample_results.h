@@ -161,6 +161,9 @@ inline void expect_bit_equal(const RunResult& expected, const RunResult& actual)
   EXPECT_EQ(bits(expected.figure_prediction_075), bits(actual.figure_prediction_075));
   EXPECT_EQ(bits(expected.figure_reference_05), bits(actual.figure_reference_05));
   EXPECT_EQ(bits(expected.figure_reference_075), bits(actual.figure_reference_075));
+  EXPECT_EQ(expected.checkpoint_steps, actual.checkpoint_steps);
+  EXPECT_EQ(bits(expected.checkpoint_mse), bits(actual.checkpoint_mse));
+  EXPECT_EQ(bits(expected.checkpoint_train_seconds), bits(actual.checkpoint_train_seconds));
 }
 
 }  // namespace testing_util

@@ -25,6 +25,9 @@ struct ResultsLayout {
   int trace_points = 102;
   /// Points of each /runs/figure/* trajectory (x_0 ... x_500).
   int figure_points = 501;
+  /// Columns of /runs/checkpoint_* (the most TrainerOptions::checkpoints of
+  /// any run); 0: those datasets are not created (files before them have none).
+  int checkpoints = 0;
 
   /// The smallest layout that holds every run of `runs`: max num_inference,
   /// max steps / eval_every + 2, max num_inference_steps() + 1.
