@@ -65,6 +65,24 @@ void add_trace_summaries(const ResultsFile& file, std::vector<RunRecord>& record
   }
 }
 
+// RunRecord's checkpoints from /runs/checkpoint_* ([rows, K], step 0 =
+// padding), when the file has them.
+void add_checkpoints(const ResultsFile& file, std::vector<RunRecord>& records) {
+  const auto K = static_cast<std::size_t>(file.layout().checkpoints);
+  if (K == 0) return;
+  const auto steps = file.read_int_column("checkpoint_steps");
+  const auto mse = file.read_double_column("checkpoint_mse");
+  const auto seconds = file.read_double_column("checkpoint_train_seconds");
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    for (std::size_t k = 0; k < K; ++k) {
+      if (steps[i * K + k] <= 0) continue;
+      records[i].checkpoint_steps.push_back(steps[i * K + k]);
+      records[i].checkpoint_mse.push_back(mse[i * K + k]);
+      records[i].checkpoint_train_seconds.push_back(seconds[i * K + k]);
+    }
+  }
+}
+
 // The scalar columns of every row of /runs.
 std::vector<RunRecord> read_run_records(const ResultsFile& file, const Grid& grid) {
   const auto ids = file.read_run_ids();
@@ -99,6 +117,7 @@ std::vector<RunRecord> read_run_records(const ResultsFile& file, const Grid& gri
     r.newton_failures = newton_failures[i];
   }
   add_trace_summaries(file, records);
+  add_checkpoints(file, records);
   return records;
 }
 

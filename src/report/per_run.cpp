@@ -1,6 +1,7 @@
 // src/report/per_run.cpp — the per-run CSV export (tidy data).
 #include "phnn/report/per_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -123,12 +124,17 @@ std::string render_per_run_csv(const std::vector<RunRecord>& records) {
   std::vector<std::vector<std::pair<std::string, std::string>>> configs;
   for (const RunRecord& r : records) configs.push_back(config_columns(r.canonical));
   const std::vector<std::string> keys = config_keys(configs);
+  std::set<std::int64_t> budget_set;
+  for (const RunRecord& r : records) budget_set.insert(r.checkpoint_steps.begin(), r.checkpoint_steps.end());
+  const std::vector<std::int64_t> budgets(budget_set.begin(), budget_set.end());
   std::ostringstream out;
   out << "run_id,studies,model_label";
   for (const std::string& key : keys) out << "," << csv_field(key);
   out << ",status,mse,best_step,best_validation_loss,wall_time_s,steps_taken,parameter_count,"
          "diverged_rollouts,newton_failures,trace_points,initial_validation_loss,final_train_loss,"
-         "final_validation_loss,final_kappa,final_sigma_max,final_rho,message\n";
+         "final_validation_loss,final_kappa,final_sigma_max,final_rho";
+  for (std::int64_t s : budgets) out << ",mse_at_" << s << ",train_s_at_" << s;
+  out << ",message\n";
   for (std::size_t i = 0; i < records.size(); ++i) {
     const RunRecord& r = records[i];
     out << csv_field(r.id) << "," << csv_field(r.studies) << "," << csv_field(r.model_label);
@@ -144,8 +150,20 @@ std::string render_per_run_csv(const std::vector<RunRecord>& records) {
         << r.newton_failures << "," << r.trace_points << ","
         << csv_double(r.initial_validation_loss) << "," << csv_double(r.final_train_loss) << ","
         << csv_double(r.final_validation_loss) << "," << csv_double(r.final_kappa) << ","
-        << csv_double(r.final_sigma_max) << "," << csv_double(r.final_rho) << ","
-        << csv_field(r.message) << "\n";
+        << csv_double(r.final_sigma_max) << "," << csv_double(r.final_rho);
+    for (std::int64_t s : budgets) {
+      out << ",";
+      for (std::size_t k = 0; k < r.checkpoint_steps.size(); ++k) {
+        if (r.checkpoint_steps[k] == s) {
+          out << csv_double(r.checkpoint_mse[k]) << "," << csv_double(r.checkpoint_train_seconds[k]);
+        }
+      }
+      if (std::find(r.checkpoint_steps.begin(), r.checkpoint_steps.end(), s) ==
+          r.checkpoint_steps.end()) {
+        out << ",";
+      }
+    }
+    out << "," << csv_field(r.message) << "\n";
   }
   return out.str();
 }

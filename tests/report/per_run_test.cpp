@@ -72,6 +72,24 @@ TEST(PerRunCsvTest, OneRowPerRunWithEveryConfigKeyAndFullPrecision) {
   EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,duffing,phnn-s,0.5,1,1,done,0.002,"));
 }
 
+// Checkpoints become mse_at_<step>, train_s_at_<step> columns over the
+// union of every run's budgets, empty where a run has no such budget.
+TEST(PerRunCsvTest, CheckpointsBecomeOneColumnPairPerBudget) {
+  RunRecord a = record("seed=0", RunStatus::kDone, 0.5);
+  a.checkpoint_steps = {500, 1000};
+  a.checkpoint_mse = {0.75, 0.5};
+  a.checkpoint_train_seconds = {1.5, 3.0};
+  RunRecord b = record("seed=1", RunStatus::kDone, 0.25);
+  b.checkpoint_steps = {1000};
+  b.checkpoint_mse = {std::numeric_limits<double>::infinity()};
+  b.checkpoint_train_seconds = {2.0};
+  const std::string csv = render_per_run_csv({a, b});
+  EXPECT_THAT(csv, HasSubstr(",final_rho,mse_at_500,train_s_at_500,mse_at_1000,train_s_at_1000,"
+                             "message\n"));
+  EXPECT_THAT(csv, HasSubstr(",0.0625,0.75,1.5,0.5,3,\n"));
+  EXPECT_THAT(csv, HasSubstr(",0.0625,,,inf,2,\n"));
+}
+
 TEST(PerRunCsvTest, NamesColumnsAsTheSweepFileAndSplitsMultiNumberKeys) {
   const std::string csv = render_per_run_csv(
       {record("lr=0.001;e0=0.10000000000000001,1;z=3,-4,1.3;newton=1e-12,20;adam=0.9,0.999;"

@@ -38,6 +38,11 @@ struct RunRecord {
   /// best_validation_loss), and train loss, validation loss, kappa,
   /// sigma_max, rho at the last point; NaN for a run without a trace.
   std::int64_t trace_points = 0;
+  /// /runs/checkpoint_*: per step budget, the inference MSE of the best
+  /// weights up to it and the training seconds to reach it (empty when the
+  /// sweep set no checkpoints). Rendered as mse_at_<step>, train_s_at_<step>.
+  std::vector<std::int64_t> checkpoint_steps;
+  std::vector<double> checkpoint_mse, checkpoint_train_seconds;
   double initial_validation_loss = 0.0;
   double final_train_loss = 0.0, final_validation_loss = 0.0;
   double final_kappa = 0.0, final_sigma_max = 0.0, final_rho = 0.0;
