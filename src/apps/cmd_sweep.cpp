@@ -551,10 +551,11 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
 }  // namespace
 
 int run_sweep(int argc, char** argv, int first) {
-  mpi::environment env(argc, argv);
-  // At once: a SIGTERM while starting up is a clean stop too (exit 75), not 143.
+  // Before MPI_Init: a SIGTERM/SIGUSR1 while starting up is a clean stop too
+  // (exit 75), not 143/138.
   std::signal(SIGTERM, request_stop);
   std::signal(SIGUSR1, request_stop);
+  mpi::environment env(argc, argv);
   return SweepRun(argc, argv, first).run();
 }
 
