@@ -77,7 +77,7 @@ done
 sinfo -h -o %t | grep -qE "idle|mix|alloc" || die "the node did not come up: $(sinfo 2>&1)"
 log "$(sinfo -V): node $HOST $(sinfo -h -o %t), $(srun --mpi=list 2>&1 | tr '\n' ' ')"
 
-# --- a small sweep: 6 cells of 1 run, ~7 s each ---------------------------------
+# --- a small sweep: 10 cells of 1 run, ~7 s each --------------------------------
 rm -rf "$WORK" && mkdir -p "$WORK"
 cat > "$WORK/sweep.toml" <<'TOML'
 name = "slurm-test"
@@ -91,7 +91,7 @@ batch_size = 16
 [grid]
 systems = ["harmonic"]
 models = ["node-rk2", "phnn-s-rk2"]
-n_train = [25, 26, 27]
+n_train = [25, 26, 27, 28, 29]
 seeds = [0]
 TOML
 OUT=$WORK/results.h5
@@ -124,9 +124,9 @@ sed 's/^/    /' "$WORK/job-$JOB.log"
 check=$("$PHNN" sweep "$WORK/sweep.toml" --out "$OUT" --dry-run >/dev/null && \
         "$PHNN" sweep "$WORK/sweep.toml" --out "$OUT" --quiet 2>&1)
 echo "$check" | sed 's/^/    /'
-echo "$check" | grep -q "6 finished before, 0 to run" || die "the results file is not complete"
+echo "$check" | grep -q "10 finished before, 0 to run" || die "the results file is not complete"
 "$PHNN" reduce "$OUT" | sed 's/^/    /'
 grep -q "stopped on a signal" "$WORK/job-$JOB.log" || die "the USR1 stop is not in the job log"
-grep "finished before" "$WORK/job-$JOB.log" | tail -1 | grep -qE "; [1-5] finished before" ||
+grep "finished before" "$WORK/job-$JOB.log" | tail -1 | grep -qE "; [1-9] finished before" ||
   die "the last start had nothing left to do: scontrol requeue did not interrupt the sweep"
 log "PASSED: submit -> USR1 -> requeue -> scontrol requeue -> finished table"
