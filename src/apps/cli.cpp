@@ -148,21 +148,29 @@ std::vector<std::int64_t> parse_int_list(const std::string& option,
   std::string part;
   auto bad = [&]() {
     return UsageError{"--" + option + " = \"" + text +
-                      "\": expected non-negative integers like 0-9 or 0,3,5"};
+                      "\": expected integers in [0, 2147483647] like 0-9 or 0,3,5"};
+  };
+  auto too_long = [&]() {
+    return UsageError{"--" + option + " = \"" + text + "\": more than " +
+                      std::to_string(kMaxListLength) +
+                      " values; write fewer (like a sweep file's seeds, e.g. 0-9)"};
   };
   while (std::getline(ss, part, ',')) {
     const auto dash = part.find('-');
     char* end = nullptr;
     if (dash == std::string::npos) {
       const long long v = std::strtoll(part.c_str(), &end, 10);
-      if (part.empty() || *end != '\0' || v < 0) throw bad();
+      if (part.empty() || *end != '\0' || v < 0 || v > kMaxListValue) throw bad();
+      if (out.size() >= kMaxListLength) throw too_long();
       out.push_back(v);
     } else {
       const std::string a = part.substr(0, dash), b = part.substr(dash + 1);
       const long long lo = std::strtoll(a.c_str(), &end, 10);
       if (a.empty() || *end != '\0') throw bad();
       const long long hi = std::strtoll(b.c_str(), &end, 10);
-      if (b.empty() || *end != '\0' || lo < 0 || hi < lo) throw bad();
+      if (b.empty() || *end != '\0' || lo < 0 || hi < lo || hi > kMaxListValue) throw bad();
+      // Counted before expanding: "0-100000000" must not allocate first.
+      if (hi - lo >= static_cast<long long>(kMaxListLength - out.size())) throw too_long();
       for (long long v = lo; v <= hi; ++v) out.push_back(v);
     }
   }

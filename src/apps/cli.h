@@ -3,6 +3,7 @@
 // bad numbers exit with status 2 and a message naming the option.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -55,7 +56,13 @@ class Parser {
   std::map<std::string, std::string> values_;
 };
 
-/// Parses "0-9", "0,3,5" or "0-2,7" into a list of non-negative integers.
+/// Longest list parse_int_list accepts: the sweep parser's cap on seeds.
+constexpr std::size_t kMaxListLength = 100000;
+/// Largest value parse_int_list accepts (values become int seeds and ranks).
+constexpr long long kMaxListValue = 2147483647;
+
+/// Parses "0-9", "0,3,5" or "0-2,7" into a list of non-negative integers;
+/// throws UsageError for more than kMaxListLength values (before expanding).
 std::vector<std::int64_t> parse_int_list(const std::string& option,
                                          const std::string& text);
 

@@ -1,4 +1,6 @@
 // src/apps/cmd_data.cpp — `phnn data`: a system's splits into one HDF5 file.
+#include <sys/stat.h>
+
 #include <chrono>
 #include <iostream>
 
@@ -34,6 +36,13 @@ int run_data(int argc, char** argv, int first) {
   if (n_train < 1 || n_train > options.num_train_max) {
     throw cli::UsageError{"phnn data: --n-train = " + std::to_string(n_train) +
                           " outside [1, " + std::to_string(options.num_train_max) + "]"};
+  }
+  const std::string out = parser.get("out");
+  struct stat st;
+  if (::lstat(out.c_str(), &st) == 0 && !is_dataset_file(out)) {
+    throw cli::UsageError{"phnn data: --out " + out +
+                          " exists and is not a data-set file written by `phnn data`; phnn "
+                          "data only replaces its own files: pass a new path or move it away"};
   }
   const auto start = std::chrono::steady_clock::now();
   const SystemData data = make_system_data(system, options, static_cast<int>(n_train));

@@ -11,6 +11,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/provenance.h"
 #include "phnn/common/check.h"
 #include "phnn/data/dataset_file.h"
 #include "phnn/report/tables.h"
@@ -62,7 +63,8 @@ std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
 }
 
 void write_cell_file(const std::string& path, const CellSpec& cell, const SystemData& data,
-                     const std::vector<RunResult>& results) {
+                     const std::vector<RunResult>& results, const Provenance& provenance,
+                     const std::string& started) {
   const std::string text = cell_sweep_text(cell, data);
   const SweepSpec spec = parse_sweep_text(text, path + "@sweep_text");
   const Grid grid = expand_grid(spec);
@@ -73,13 +75,24 @@ void write_cell_file(const std::string& path, const CellSpec& cell, const System
   ResultsFile file = ResultsFile::create(path, MPI_COMM_NULL, grid.runs, studies, spec.name, text,
                                          spec.text_hash, program_version(),
                                          ResultsLayout::for_runs(grid.runs));
+  file.begin_session(provenance);
   file.store_system_data(to_string(data.system.kind), data);
+  const std::string finished = utc_now();
   // Grid rows are ordered by seed, like the cell's members.
   for (std::size_t i = 0; i < grid.runs.size(); ++i) {
     const auto it = std::find(cell.seeds.begin(), cell.seeds.end(), grid.runs[i].seed);
+    file.write_run_times(static_cast<int>(i), started, finished);
     file.write_run(static_cast<int>(i), results[static_cast<std::size_t>(it - cell.seeds.begin())]);
   }
+  file.end_session(finished);
   file.close();
+}
+
+std::string provenance_value(const Provenance& provenance, const std::string& key) {
+  for (const auto& [k, v] : provenance) {
+    if (k == key) return v;
+  }
+  return "";
 }
 
 }  // namespace
@@ -152,6 +165,7 @@ int run_train(int argc, char** argv, int first) {
             << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
             << " steps=" << cell.training.steps << "\n";
   const bool quiet = parser.flag_set("quiet");
+  const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
   if (parser.has("out") && std::ifstream(parser.get("out")).good()) {
     throw cli::UsageError{"phnn train: --out " + parser.get("out") +
                           " exists; choose a new path (train never overwrites results)"};
@@ -181,7 +195,8 @@ int run_train(int argc, char** argv, int first) {
   std::printf("median [IQR]: %.2e [%.2e]   parameters/member: %ld   wall time: %.1f s\n", q50,
               q75 - q25, results.empty() ? 0L : results[0].parameter_count, wall);
   if (parser.has("out")) {
-    write_cell_file(parser.get("out"), cell, data, results);
+    write_cell_file(parser.get("out"), cell, data, results, provenance,
+                    provenance_value(provenance, "started"));
     std::printf("runs written to %s\n", parser.get("out").c_str());
   }
   return 0;

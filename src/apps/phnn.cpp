@@ -6,6 +6,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/provenance.h"
 
 namespace {
 
@@ -19,7 +20,8 @@ const char* kUsage =
     "  train    train one cell (all seeds of one configuration)\n"
     "  sweep    run a sweep file over MPI ranks into one HDF5 results file\n"
     "  reduce   print the paper's median [IQR] tables from a results file\n\n"
-    "`phnn <command> --help` lists each command's options.\n";
+    "`phnn <command> --help` lists each command's options; `phnn --version` prints\n"
+    "the version, git commit and library versions.\n";
 
 }  // namespace
 
@@ -27,6 +29,10 @@ int main(int argc, char** argv) {
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     std::cout << kUsage;
     return argc < 2 ? phnn::cli::kUsageError : 0;
+  }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::cout << phnn::apps::version_text();
+    return 0;
   }
   const std::string command = argv[1];
   try {

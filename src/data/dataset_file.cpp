@@ -1,6 +1,8 @@
 // src/data/dataset_file.cpp
 #include "phnn/data/dataset_file.h"
 
+#include <sys/stat.h>
+
 #include <stdexcept>
 
 #include "data/dataset_file_io.h"
@@ -185,6 +187,20 @@ SystemData read_system_data(const h5::File& file, const std::string& group) {
 void write_dataset_file(const std::string& path, const SystemData& data) {
   h5::File file = h5::File::create(path);
   internal::write_system_data(file, "/", data);
+}
+
+bool is_dataset_file(const std::string& path) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || !h5::File::is_hdf5(path)) {
+    return false;
+  }
+  try {
+    const h5::File file = h5::File::open(path, h5::Access::kReadOnly);
+    return file.has_attribute("/", "format") &&
+           file.string_attribute("/", "format") == "phnn-dataset";
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 SystemData read_dataset_file(const std::string& path) {

@@ -161,6 +161,33 @@ void File::create_group(const std::string& group) {
   }
 }
 
+void File::remove(const std::string& object) {
+  if (!exists(object)) return;
+  if (H5Ldelete(id_, object.c_str(), H5P_DEFAULT) < 0) fail(path_, "cannot remove " + object);
+}
+
+std::vector<std::string> File::attribute_names(const std::string& object) const {
+  std::vector<std::string> names;
+  Handle obj(open_object(id_, object), H5Oclose);
+  if (!obj.ok()) fail(path_, "no object " + object);
+  auto collect = [](hid_t, const char* name, const H5A_info_t*, void* data) -> herr_t {
+    static_cast<std::vector<std::string>*>(data)->push_back(name);
+    return 0;
+  };
+  hsize_t index = 0;
+  if (H5Aiterate2(obj.get(), H5_INDEX_NAME, H5_ITER_INC, &index, collect, &names) < 0) {
+    fail(path_, "cannot list the attributes of " + object);
+  }
+  return names;
+}
+
+std::string library_version() {
+  unsigned major = 0, minor = 0, release = 0;
+  H5get_libversion(&major, &minor, &release);
+  return "HDF5 " + std::to_string(major) + "." + std::to_string(minor) + "." +
+         std::to_string(release);
+}
+
 namespace {
 void write_attribute(hid_t file, const std::string& fname, const std::string& object,
                      const std::string& name, hid_t type, const void* value) {

@@ -23,6 +23,9 @@ enum class Access { kReadOnly, kReadWrite };
 /// Element types of datasets.
 enum class Type { kFloat64, kInt64, kString };
 
+/// "HDF5 1.10.8" (the library linked at run time).
+std::string library_version();
+
 /// RAII HDF5 file. Serial (comm == MPI_COMM_NULL) or parallel (MPI-IO): in
 /// parallel, create/open, create_dataset, attributes and close are
 /// collective; write_rows/read are independent.
@@ -49,6 +52,9 @@ class File {
   bool exists(const std::string& object) const;
   /// Creates every missing group along `group` ("a/b/c").
   void create_group(const std::string& group);
+  /// Unlinks `object` (a group with everything under it, or a dataset);
+  /// collective in parallel. A missing object is no error.
+  void remove(const std::string& object);
 
   /// Attributes on an object ("/" for the file, a group or a dataset).
   void set_attribute(const std::string& object, const std::string& name,
@@ -58,6 +64,9 @@ class File {
   void set_attribute(const std::string& object, const std::string& name,
                      std::int64_t value);
   bool has_attribute(const std::string& object, const std::string& name) const;
+  /// Names of the attributes of `object`, in creation-index order if
+  /// tracked, else by name.
+  std::vector<std::string> attribute_names(const std::string& object) const;
   std::string string_attribute(const std::string& object,
                                const std::string& name) const;
   double double_attribute(const std::string& object,

@@ -58,6 +58,11 @@ const std::string kFigureLength = "/runs/figure/length";
 const std::string kCheckpointSteps = "/runs/checkpoint_steps";
 const std::string kCheckpointMse = "/runs/checkpoint_mse";
 const std::string kCheckpointTrainSeconds = "/runs/checkpoint_train_seconds";
+// Added with provenance; files written before them have neither.
+const std::string kStartedUtc = "/runs/started_utc";
+const std::string kFinishedUtc = "/runs/finished_utc";
+const std::string kProvenance = "/provenance";
+constexpr std::size_t kUtcLength = 20;  // "2024-05-01T12:00:00Z"
 
 const std::string kStateUnits = "q [m], p [kg m/s]";
 const std::string kMseUnits =
@@ -233,6 +238,8 @@ struct ResultsFile::Impl {
   bool open = true;
   int num_runs = 0;
   ResultsLayout layout;
+  bool has_run_times = false;  // false in files written before provenance
+  std::string session;         // this process's /provenance/session_<k>
 
   Impl(h5::File f, MPI_Comm c)
       : file(std::move(f)), comm(c), rank(comm_rank(c)), size(comm_size(c)) {
@@ -246,6 +253,7 @@ struct ResultsFile::Impl {
     layout.figure_points = static_cast<int>(file.dims(kPrediction05).at(1));
     layout.checkpoints =
         file.exists(kCheckpointMse) ? static_cast<int>(file.dims(kCheckpointMse).at(1)) : 0;
+    has_run_times = file.exists(kStartedUtc) && file.exists(kFinishedUtc);
   }
 
   // "[rank 3/8] " in a parallel file, "" in a serial one.
@@ -445,6 +453,10 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
              "s; training wall time to each budget, this run's share of its stack, inference "
              "excluded");
     }
+    text(kStartedUtc, kUtcLength,
+         "UTC, ISO 8601: when training of the run's work item started; empty if pending "
+         "or recovered from a journal");
+    text(kFinishedUtc, kUtcLength, "UTC, ISO 8601: when the run's work item finished");
 
     // The config columns: rank 0 writes them (independent raw-data writes).
     if (comm_rank(comm) == 0) {
@@ -721,6 +733,7 @@ void ResultsFile::store_system_data(const std::string& system_name, const System
   require(!has_system_data(system_name),
           path() + ": " + group + " is already stored; check has_system_data() first");
   impl_->collective([&] {
+    impl_->file.remove(group);  // a group left incomplete by a crash
     internal::write_system_data(impl_->file, group, data);
     impl_->file.set_attribute(group, "complete", std::int64_t{1});
     impl_->file.flush();
@@ -735,6 +748,71 @@ bool ResultsFile::has_system_data(const std::string& system_name) const {
 SystemData ResultsFile::read_system_data(const std::string& system_name) const {
   const std::string group = data_group(system_name);
   return impl_->independent([&] { return internal::read_system_data(impl_->file, group); });
+}
+
+void ResultsFile::write_run_times(int row, const std::string& started,
+                                  const std::string& finished) {
+  Impl& impl = *impl_;
+  require(row >= 0 && row < impl.num_runs,
+          impl.prefix() + path() + ": write_run_times(row " + std::to_string(row) +
+              "): row outside [0, " + std::to_string(impl.num_runs) + ")");
+  if (!impl.has_run_times) return;
+  impl.independent([&] {
+    const auto at = static_cast<std::uint64_t>(row);
+    impl.file.write_string_rows(kStartedUtc, at, {started.substr(0, kUtcLength)});
+    impl.file.write_string_rows(kFinishedUtc, at, {finished.substr(0, kUtcLength)});
+  });
+}
+
+bool ResultsFile::has_run_times() const { return impl_->has_run_times; }
+
+std::vector<std::string> ResultsFile::read_started_utc() const {
+  if (!impl_->has_run_times) return std::vector<std::string>(static_cast<std::size_t>(num_runs()));
+  return impl_->strings(kStartedUtc);
+}
+
+std::vector<std::string> ResultsFile::read_finished_utc() const {
+  if (!impl_->has_run_times) return std::vector<std::string>(static_cast<std::size_t>(num_runs()));
+  return impl_->strings(kFinishedUtc);
+}
+
+int ResultsFile::begin_session(const Provenance& provenance) {
+  Impl& impl = *impl_;
+  // Every rank reads the same metadata, so every rank picks the same k.
+  int k = 0;
+  impl.independent([&] {
+    while (impl.file.exists(kProvenance + "/session_" + std::to_string(k))) ++k;
+  });
+  impl.session = kProvenance + "/session_" + std::to_string(k);
+  impl.collective([&] {
+    impl.file.create_group(impl.session);
+    for (const auto& [key, value] : provenance) impl.file.set_attribute(impl.session, key, value);
+    impl.file.flush();
+  });
+  return k;
+}
+
+void ResultsFile::end_session(const std::string& finished_utc) {
+  Impl& impl = *impl_;
+  if (impl.session.empty()) return;
+  impl.collective([&] { impl.file.set_attribute(impl.session, "finished", finished_utc); });
+}
+
+std::vector<Provenance> ResultsFile::read_sessions() const {
+  const Impl& impl = *impl_;
+  std::vector<Provenance> sessions;
+  impl.independent([&] {
+    for (int k = 0;; ++k) {
+      const std::string group = kProvenance + "/session_" + std::to_string(k);
+      if (!impl.file.exists(group)) break;
+      Provenance p;
+      for (const std::string& name : impl.file.attribute_names(group)) {
+        p.emplace_back(name, impl.file.string_attribute(group, name));
+      }
+      sessions.push_back(std::move(p));
+    }
+  });
+  return sessions;
 }
 
 void ResultsFile::flush() {

@@ -7,11 +7,16 @@
 // value keeps the line it came from, so every error can name its line.
 #include "phnn/sweep/sweep_file.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
@@ -21,6 +26,7 @@
 #include <sstream>
 #include <utility>
 
+#include "phnn/sweep/output_check.h"
 #include "phnn/sweep/run_config.h"
 
 namespace phnn {
@@ -612,7 +618,7 @@ class Resolver {
     if (!has_name) {
       fail(1, "missing required key \"name\"; add `name = \"...\"` at the top of the file");
     }
-    if (!has_output) spec.output = "results/" + spec.name + ".h5";
+    if (!has_output) spec.output = "results/" + sanitize_file_name(spec.name) + ".h5";
 
     // Whole-struct constraints (e.g. energy_max >= energy_min), reported at
     // the line of the key the message names.
@@ -1027,6 +1033,12 @@ class Resolver {
 }  // namespace
 
 SweepSpec parse_sweep_text(const std::string& text, const std::string& display_name) {
+  if (text.size() > kMaxSweepFileBytes) {
+    throw SweepFileError(display_name, 0, std::to_string(text.size()) + " bytes, more than the " +
+                                              std::to_string(kMaxSweepFileBytes) +
+                                              " a sweep file may have (its text is stored in "
+                                              "the results file)");
+  }
   const std::vector<Table> tables = DocumentParser(text, display_name).parse();
   SweepSpec spec = Resolver(display_name).resolve(tables);
   spec.source_path = display_name;
@@ -1036,16 +1048,40 @@ SweepSpec parse_sweep_text(const std::string& text, const std::string& display_n
 }
 
 SweepSpec parse_sweep_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused below.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
     throw SweepFileError(path, 0,
-                         "cannot open the sweep file; check the path (sweep files live in "
-                         "sweeps/, e.g. sweeps/paper.toml)");
+                         "cannot open the sweep file (" + std::string(std::strerror(errno)) +
+                             "); check the path (sweep files live in sweeps/, e.g. "
+                             "sweeps/paper.toml)");
   }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw SweepFileError(path, 0, "cannot read the sweep file");
-  return parse_sweep_text(buffer.str(), path);
+  struct FdCloser {
+    int fd;
+    ~FdCloser() { ::close(fd); }
+  } closer{fd};
+  struct stat st;
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    throw SweepFileError(path, 0, "not a regular file (a FIFO, device, directory or socket); "
+                                  "a sweep file is a text file, e.g. sweeps/paper.toml");
+  }
+  if (static_cast<std::uint64_t>(st.st_size) > kMaxSweepFileBytes) {
+    throw SweepFileError(path, 0, std::to_string(st.st_size) + " bytes, more than the " +
+                                      std::to_string(kMaxSweepFileBytes) +
+                                      " a sweep file may have (its text is stored in the "
+                                      "results file); use [study.*] tables and seed ranges");
+  }
+  std::string text(kMaxSweepFileBytes + 1, '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw SweepFileError(path, 0, "cannot read the sweep file: " + std::string(std::strerror(errno)));
+    if (n == 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  text.resize(got);
+  return parse_sweep_text(text, path);
 }
 
 }  // namespace phnn

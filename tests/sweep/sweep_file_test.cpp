@@ -4,7 +4,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <dirent.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
 #include <string>
+#include <vector>
 
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/run_config.h"
@@ -426,6 +433,74 @@ TEST(SweepFileErrorTest, MissingFileNamesThePath) {
     EXPECT_THAT(e.what(), StartsWith("/nonexistent/dir/sweep.toml: cannot open the sweep file"));
     EXPECT_EQ(e.line(), 0);
   }
+}
+
+// The SweepFileError of reading `path`; fails the test if it parses.
+SweepFileError file_error_of(const std::string& path) {
+  try {
+    parse_sweep_file(path);
+  } catch (const SweepFileError& error) {
+    return error;
+  }
+  ADD_FAILURE() << "expected a SweepFileError for " << path;
+  return SweepFileError(path, 0, "no error");
+}
+
+// Each would hang (FIFO), never end (/dev/zero) or read a directory: all are
+// refused before a byte is read.
+TEST(SweepFileErrorTest, RefusesWhatIsNotARegularFileWithoutWaiting) {
+  const std::string fifo = ::testing::TempDir() + "phnn_sweep_fifo_" + std::to_string(::getpid());
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  for (const std::string& path : {fifo, std::string("/dev/zero"), ::testing::TempDir()}) {
+    SCOPED_TRACE(path);
+    EXPECT_THAT(file_error_of(path).what(), StartsWith(path + ": not a regular file"));
+  }
+  std::remove(fifo.c_str());
+}
+
+TEST(SweepFileErrorTest, RefusesAFileOverTheSizeCapBeforeParsing) {
+  const std::string path = ::testing::TempDir() + "phnn_sweep_big_" + std::to_string(::getpid());
+  std::ofstream(path) << "name = \"big\"\n" << std::string(kMaxSweepFileBytes, '#') << "\n";
+  EXPECT_THAT(file_error_of(path).what(),
+              AllOf(StartsWith(path + ": "), HasSubstr("more than the 60000 a sweep file may have")));
+  std::remove(path.c_str());
+  EXPECT_THAT(error_of("name = \"big\"\n" + std::string(kMaxSweepFileBytes, '#')).what(),
+              HasSubstr("more than the 60000"));
+}
+
+// tests/fixtures/hostile/: 60+ malformed sweep files (syntax, types, ranges,
+// unknown names, NUL bytes, deep nesting, ...): each is refused with an
+// error that names it (`phnn sweep` launches of a sample: sweep_guard_test).
+TEST(SweepFileErrorTest, EveryHostileFixtureIsRefusedNamingTheFile) {
+  const std::string dir = std::string(PHNN_SOURCE_DIR) + "/tests/fixtures/hostile/";
+  std::vector<std::string> names;
+  if (DIR* d = ::opendir(dir.c_str())) {
+    while (const dirent* e = ::readdir(d)) {
+      if (std::string(e->d_name).size() > 5) names.push_back(e->d_name);
+    }
+    ::closedir(d);
+  }
+  ASSERT_GE(names.size(), 60u);
+  for (const std::string& name : names) {
+    SCOPED_TRACE(name);
+    EXPECT_THAT(file_error_of(dir + name).what(), StartsWith(dir + name + ":"));
+  }
+}
+
+TEST(SweepFileTest, AFileAtTheSizeCapParses) {
+  std::string text = "name = \"full\"\n#";
+  text += std::string(kMaxSweepFileBytes - text.size() - 1, '#') + "\n";
+  ASSERT_EQ(text.size(), kMaxSweepFileBytes);
+  EXPECT_EQ(parse_sweep_text(text, "x.toml").name, "full");
+}
+
+TEST(SweepFileTest, DefaultOutputStaysInsideResultsWhateverTheName) {
+  EXPECT_EQ(parse_sweep_text("name = \"../../x\"\n", "x.toml").output, "results/_._.._x.h5");
+  EXPECT_EQ(parse_sweep_text("name = \"a/b\"\n", "x.toml").output, "results/a_b.h5");
+  EXPECT_EQ(parse_sweep_text("name = \"ok\"\noutput = \"../elsewhere.h5\"\n", "x.toml").output,
+            "../elsewhere.h5")
+      << "an explicit output is the user's choice";
 }
 
 TEST(SweepFileErrorTest, IsAnInvalidArgument) {

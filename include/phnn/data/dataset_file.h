@@ -29,6 +29,10 @@ SystemData make_system_data(const OscillatorOptions& system,
 /// units as attributes on the root.
 void write_dataset_file(const std::string& path, const SystemData& data);
 
+/// True if `path` is a regular HDF5 file whose root says format =
+/// "phnn-dataset" (a file write_dataset_file wrote). Never throws.
+bool is_dataset_file(const std::string& path);
+
 /// Reads a file written by write_dataset_file; throws std::runtime_error
 /// naming the file if it is missing, not HDF5, or not a phnn data set.
 SystemData read_dataset_file(const std::string& path);

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "phnn/data/dataset_file.h"
@@ -36,6 +37,12 @@ struct ResultsLayout {
   /// Throws std::invalid_argument naming the field and value unless all > 0.
   void validate() const;
 };
+
+/// Where and how one session (one `phnn sweep` or `phnn train --out`
+/// invocation) ran, as (key, value) string pairs: program_version,
+/// git_commit, libtorch, blas, hdf5, mpi, compiler, hosts, ranks,
+/// command_line, started (UTC); end_session adds finished.
+using Provenance = std::vector<std::pair<std::string, std::string>>;
 
 /// Largest stored strings; create() refuses longer canonical configs and
 /// studies, write_run() truncates longer messages (ending them in "...").
@@ -166,6 +173,26 @@ class ResultsFile {
   bool has_system_data(const std::string& system_name) const;
   /// Reads a data set stored by store_system_data.
   SystemData read_system_data(const std::string& system_name) const;
+
+  /// Independent: UTC start and end (ISO 8601) of the work item that
+  /// trained run `row`, in /runs/started_utc and /runs/finished_utc. Call
+  /// it before write_run (whose status lands last). A no-op in a file
+  /// written before these columns existed (has_run_times() false).
+  void write_run_times(int row, const std::string& started, const std::string& finished);
+  bool has_run_times() const;
+  /// One entry per row; "" where unknown (pending, recovered from a
+  /// journal, or an older file).
+  std::vector<std::string> read_started_utc() const;
+  std::vector<std::string> read_finished_utc() const;
+
+  /// Collective (same `provenance` on every rank): records a session as the
+  /// string attributes of a new group /provenance/session_<k> (k = 0, 1, ...
+  /// in the order of the sessions) and returns k.
+  int begin_session(const Provenance& provenance);
+  /// Collective: adds attribute "finished" to the group of begin_session (no-op without one).
+  void end_session(const std::string& finished_utc);
+  /// Every session, in order; empty for files written before provenance.
+  std::vector<Provenance> read_sessions() const;
 
   /// Collective: flushes HDF5's buffers to the file.
   void flush();

@@ -1,6 +1,7 @@
 // include/phnn/sweep/sweep_file.h — sweep files: what a sweep trains.
 #pragma once
 
+#include <cstddef>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -84,13 +85,20 @@ struct SweepSpec {
   std::vector<StudySpec> studies;
 };
 
+/// Largest sweep file, in bytes: its text is stored verbatim in one HDF5
+/// attribute of the results file (an object header message < 64 KiB).
+constexpr std::size_t kMaxSweepFileBytes = 60000;
+
 /// Reads and parses a sweep file (format: sweeps/FORMAT.md). Throws
-/// SweepFileError naming the path if the file cannot be read, or the line of
-/// the first problem otherwise.
+/// SweepFileError naming the path, without waiting or reading past the cap,
+/// if it cannot be opened, is not a regular file (a FIFO, /dev/zero, a
+/// directory) or has more than kMaxSweepFileBytes bytes; otherwise the line
+/// of the first problem.
 SweepSpec parse_sweep_file(const std::string& path);
 
 /// Parses sweep-file text; `display_name` is used in error messages and as
-/// SweepSpec::source_path. Throws SweepFileError.
+/// SweepSpec::source_path. Throws SweepFileError (also for a text over
+/// kMaxSweepFileBytes).
 SweepSpec parse_sweep_text(const std::string& text, const std::string& display_name);
 
 /// "node-rk2", "phnn-jr-dg", ...: the sweep-file spelling of a model.

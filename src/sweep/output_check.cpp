@@ -1,0 +1,135 @@
+// src/sweep/output_check.cpp — classifies a sweep's output path before the
+// sweep touches it (see include/phnn/sweep/output_check.h).
+#include "phnn/sweep/output_check.h"
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <stdexcept>
+
+#include "h5/h5file.h"
+#include "phnn/sweep/journal.h"
+#include "phnn/sweep/results_file.h"
+
+namespace phnn {
+namespace {
+
+// The 8-byte HDF5 format signature at offset 0 (no user block: our files).
+bool has_hdf5_signature(const std::string& path) {
+  static const char kSignature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+  char head[8] = {};
+  std::ifstream in(path, std::ios::binary);
+  return in.read(head, 8) && std::memcmp(head, kSignature, 8) == 0;
+}
+
+OutputCheck refused(const std::string& message) { return {OutputState::kRefused, message}; }
+
+// `out` is an HDF5 file: ours and resumable, damaged, or refused.
+OutputCheck inspect_hdf5(const std::string& out, const std::string& sweep_hash) {
+  std::string format;
+  try {
+    const h5::File file = h5::File::open(out, h5::Access::kReadOnly);
+    format = file.has_attribute("/", "format") ? file.string_attribute("/", "format")
+                                               : std::string("(missing)");
+  } catch (const std::exception& e) {
+    return {OutputState::kDamaged, std::string("cannot be opened as HDF5 (") + e.what() + ")"};
+  }
+  if (format != ResultsFile::kFormat) {
+    return refused(out + ": an HDF5 file but not a phnn results file (attribute format = \"" +
+                   format + "\"); phnn sweep never replaces other files: pass another --out "
+                   "path or move it away");
+  }
+  try {
+    const ResultsFile file = ResultsFile::open_read_only(out);
+    if (file.sweep_hash() != sweep_hash) {
+      return refused(out + " was written by sweep '" + file.sweep_name() + "' (hash " +
+                     file.sweep_hash() + "), not by this sweep file (hash " + sweep_hash +
+                     "); pass a new --out path or delete the file");
+    }
+    file.read_run_ids();
+    try {
+      file.read_statuses();  // throws std::runtime_error on a status outside 0..3
+    } catch (const h5::Error&) {
+      throw;
+    } catch (const std::runtime_error& e) {
+      return refused(std::string(e.what()) +
+                     " (phnn never writes such a value); to rebuild the file from its "
+                     "journals, move it away and run the same command again");
+    }
+  } catch (const h5::Error& e) {
+    return {OutputState::kDamaged, e.what()};
+  } catch (const std::exception& e) {
+    return refused(e.what());  // another format version, ...
+  }
+  return {OutputState::kResumable, ""};
+}
+
+}  // namespace
+
+OutputCheck inspect_output(const std::string& out, const std::string& sweep_path,
+                           const std::string& sweep_hash) {
+  try {
+    struct stat journal;
+    const std::string journal_dir = journal_directory(out);
+    if (::stat(journal_dir.c_str(), &journal) == 0 && !S_ISDIR(journal.st_mode)) {
+      return refused(journal_dir + ": not a directory, but the journal of " + out +
+                     " must live there; move it away or pass another --out path");
+    }
+    struct stat st;
+    if (::stat(out.c_str(), &st) != 0) {
+      if (errno == ENOENT) return {OutputState::kMissing, ""};
+      return refused(out + ": cannot inspect the output path: " + std::strerror(errno));
+    }
+    if (!S_ISREG(st.st_mode)) {
+      return refused(out + ": not a regular file (" +
+                     (S_ISDIR(st.st_mode) ? std::string("a directory") : std::string("a FIFO, "
+                                            "device or socket")) +
+                     "); pass a results-file path with --out");
+    }
+    struct stat sweep;
+    if (::stat(sweep_path.c_str(), &sweep) == 0 && sweep.st_dev == st.st_dev &&
+        sweep.st_ino == st.st_ino) {
+      return refused(out + ": is the sweep file itself; pass a results-file path with --out "
+                           "(e.g. results/<name>.h5)");
+    }
+    if (st.st_size == 0) return {OutputState::kEmpty, "an empty file"};
+    if (!has_hdf5_signature(out)) {
+      return refused(out + ": exists and is not an HDF5 file, so not a phnn results file; "
+                           "phnn sweep never replaces other files: pass another --out path or "
+                           "move it away");
+    }
+    return inspect_hdf5(out, sweep_hash);
+  } catch (const std::exception& e) {
+    return refused(out + ": cannot inspect the output path: " + e.what());
+  }
+}
+
+std::string move_aside(const std::string& path, const std::string& reason) {
+  const std::string base = path + "." + reason + "-" + std::to_string(std::time(nullptr));
+  std::string aside = base;
+  struct stat st;
+  for (int k = 1; ::stat(aside.c_str(), &st) == 0; ++k) aside = base + "-" + std::to_string(k);
+  if (std::rename(path.c_str(), aside.c_str()) != 0) {
+    throw std::runtime_error(path + ": cannot move it aside to " + aside + ": " +
+                             std::strerror(errno));
+  }
+  return aside;
+}
+
+std::string sanitize_file_name(const std::string& name) {
+  if (name.empty()) return "unnamed";
+  std::string out = name;
+  for (char& c : out) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '.' || c == '_' || c == '+' || c == '-';
+    if (!ok) c = '_';
+  }
+  if (out[0] == '.') out[0] = '_';
+  return out;
+}
+
+}  // namespace phnn

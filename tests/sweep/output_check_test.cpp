@@ -1,0 +1,148 @@
+// tests/sweep/output_check_test.cpp — what a sweep may do with what is at its
+// output path: resume, create, move a damaged file of ours aside, or refuse.
+#include "phnn/sweep/output_check.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "h5/h5file.h"
+#include "phnn/data/dataset_file.h"
+#include "phnn/sweep/journal.h"
+#include "phnn/sweep/results_file.h"
+#include "sample_results.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+constexpr char kHash[] = "1a2b3c4d5e6f7081";
+
+class OutputCheckTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = ::testing::TempDir() + "phnn_output_" + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::system(("rm -rf " + dir_ + " && mkdir -p " + dir_).c_str());
+    out_ = dir_ + "/out.h5";
+    sweep_ = dir_ + "/sweep.toml";
+    std::ofstream(sweep_) << "name = \"x\"\n";
+  }
+  void TearDown() override { std::system(("rm -rf " + dir_).c_str()); }
+
+  void create_results(const std::string& hash = kHash) const {
+    ResultsFile file = ResultsFile::create(out_, MPI_COMM_NULL, testing_util::sample_runs(3),
+                                           testing_util::sample_studies(3), "demo", "text", hash,
+                                           "phnn-sweep 0.1.0", testing_util::sample_layout());
+    file.close();
+  }
+  OutputCheck check() const { return inspect_output(out_, sweep_, kHash); }
+
+  std::string dir_, out_, sweep_;
+};
+
+TEST_F(OutputCheckTest, NothingThereMeansCreate) {
+  EXPECT_EQ(check().state, OutputState::kMissing);
+}
+
+TEST_F(OutputCheckTest, OurResultsFileOfThisSweepIsResumed) {
+  create_results();
+  EXPECT_EQ(check().state, OutputState::kResumable) << check().message;
+}
+
+TEST_F(OutputCheckTest, RefusesADirectoryAFifoAndTheSweepFileItself) {
+  ASSERT_EQ(::mkdir(out_.c_str(), 0755), 0);
+  EXPECT_EQ(check().state, OutputState::kRefused);
+  EXPECT_THAT(check().message, HasSubstr("not a regular file (a directory)"));
+  ASSERT_EQ(::rmdir(out_.c_str()), 0);
+  ASSERT_EQ(::mkfifo(out_.c_str(), 0644), 0);
+  EXPECT_EQ(check().state, OutputState::kRefused);
+  EXPECT_THAT(check().message, HasSubstr("FIFO"));
+  const OutputCheck itself = inspect_output(sweep_, sweep_, kHash);
+  EXPECT_EQ(itself.state, OutputState::kRefused);
+  EXPECT_THAT(itself.message, HasSubstr("is the sweep file itself"));
+}
+
+TEST_F(OutputCheckTest, RefusesATextFileAndAnotherProgramsHdf5File) {
+  std::ofstream(out_) << "my thesis\n";
+  EXPECT_EQ(check().state, OutputState::kRefused);
+  EXPECT_THAT(check().message, HasSubstr("not an HDF5 file"));
+  std::remove(out_.c_str());
+  write_dataset_file(out_, make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic),
+                                            DatasetOptions{}, 2));
+  EXPECT_EQ(check().state, OutputState::kRefused);
+  EXPECT_THAT(check().message, HasSubstr("not a phnn results file"));
+}
+
+TEST_F(OutputCheckTest, RefusesAnotherSweepsResults) {
+  create_results("ffffffffffffffff");
+  EXPECT_EQ(check().state, OutputState::kRefused);
+  EXPECT_THAT(check().message, HasSubstr("was written by sweep 'demo'"));
+}
+
+TEST_F(OutputCheckTest, EmptyFileIsMovedAsideNotRefused) {
+  std::ofstream{out_};
+  EXPECT_EQ(check().state, OutputState::kEmpty);
+}
+
+TEST_F(OutputCheckTest, TruncatedResultsFileIsDamaged) {
+  create_results();
+  struct stat st;
+  ASSERT_EQ(::stat(out_.c_str(), &st), 0);
+  ASSERT_EQ(::truncate(out_.c_str(), st.st_size / 2), 0);
+  const OutputCheck c = check();
+  EXPECT_EQ(c.state, OutputState::kDamaged) << c.message;
+}
+
+TEST_F(OutputCheckTest, RefusesAnImpossibleStatusNamingTheRowAndTheFix) {
+  create_results();
+  {
+    h5::File file = h5::File::open(out_, h5::Access::kReadWrite);
+    const std::int64_t bad = 7;
+    file.write_rows("/runs/status", 1, 1, &bad);
+  }
+  const OutputCheck c = check();
+  EXPECT_EQ(c.state, OutputState::kRefused);
+  EXPECT_THAT(c.message, HasSubstr("/runs/status[1] = 7"));
+  EXPECT_THAT(c.message, HasSubstr("rebuild the file from its journals"));
+}
+
+TEST_F(OutputCheckTest, RefusesAJournalPathThatIsNotADirectory) {
+  std::ofstream(journal_directory(out_)) << "not a journal\n";
+  const OutputCheck c = check();
+  EXPECT_EQ(c.state, OutputState::kRefused);
+  EXPECT_THAT(c.message, StartsWith(journal_directory(out_) + ": not a directory"));
+}
+
+TEST_F(OutputCheckTest, MoveAsidePicksAFreeNameAndKeepsTheBytes) {
+  std::ofstream(out_) << "a";
+  const std::string first = move_aside(out_, "damaged");
+  std::ofstream(out_) << "b";
+  const std::string second = move_aside(out_, "damaged");
+  EXPECT_NE(first, second);
+  EXPECT_THAT(first, StartsWith(out_ + ".damaged-"));
+  std::ifstream a(first), b(second);
+  EXPECT_EQ(a.get(), 'a');
+  EXPECT_EQ(b.get(), 'b');
+}
+
+TEST(SanitizeFileNameTest, KeepsOneComponentInsideTheDirectory) {
+  EXPECT_EQ(sanitize_file_name("paper"), "paper");
+  EXPECT_EQ(sanitize_file_name("run-1.2_b+c"), "run-1.2_b+c");
+  EXPECT_EQ(sanitize_file_name("../../x"), "_._.._x");
+  EXPECT_EQ(sanitize_file_name(".."), "_.");
+  EXPECT_EQ(sanitize_file_name("/etc/passwd"), "_etc_passwd");
+  EXPECT_EQ(sanitize_file_name("a b\n"), "a_b_");
+  EXPECT_EQ(sanitize_file_name(""), "unnamed");
+}
+
+}  // namespace
+}  // namespace phnn
