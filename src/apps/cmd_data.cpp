@@ -14,7 +14,7 @@ namespace apps {
 int run_data(int argc, char** argv, int first) {
   cli::Parser parser("data",
                      "Generates the train / validation / inference splits of one "
-                     "system (SPEC.md §2)\nwith the Gonzalez discrete gradient and "
+                     "system (docs/METHOD.md §2)\nwith the Gonzalez discrete gradient and "
                      "writes them to an HDF5 file.");
   parser.option("system", "harmonic | duffing | self-sustained", "", true);
   parser.option("out", "output HDF5 file", "", true);

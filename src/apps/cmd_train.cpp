@@ -100,7 +100,7 @@ std::string provenance_value(const Provenance& provenance, const std::string& ke
 int run_train(int argc, char** argv, int first) {
   cli::Parser parser("train",
                      "Trains one cell (all seeds of one configuration) as one stacked model,\n"
-                     "then rolls every member out over the inference set (SPEC.md §3-§5).");
+                     "then rolls every member out over the inference set (docs/METHOD.md §3-§5).");
   parser.option("system", "harmonic | duffing | self-sustained", "", true);
   parser.option("model", "node | phnn-s | phnn-jr", "", true);
   parser.option("integrator", "rk2 | dg | rk4 | dg4 (node: rk2 or rk4)", "rk2");

@@ -67,7 +67,7 @@ constexpr std::size_t kUtcLength = 20;  // "2024-05-01T12:00:00Z"
 const std::string kStateUnits = "q [m], p [kg m/s]";
 const std::string kMseUnits =
     "m^2 and (kg m/s)^2 mixed: mean of ||x - x_hat||^2 over the inference "
-    "trajectories and steps (SPEC.md section 5); +inf if a rollout diverged";
+    "trajectories and steps (docs/METHOD.md section 5); +inf if a rollout diverged";
 const std::string kLossUnits =
     "m/s and kg m/s^2 mixed: L_d = mean |x_{n+1} - x_hat_{n+1}| / h (+ regularizer)";
 const std::string kFileUnits =

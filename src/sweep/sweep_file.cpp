@@ -2,7 +2,7 @@
 //
 // Two passes. parse_document() turns the text into tables of key = value
 // entries (the TOML subset; syntax errors only). resolve() then maps tables
-// and keys onto SPEC.md's defaults (OscillatorOptions, DatasetOptions,
+// and keys onto the defaults of docs/METHOD.md (OscillatorOptions, DatasetOptions,
 // TrainerOptions, the grid axes) and checks names, types and ranges. Every
 // value keeps the line it came from, so every error can name its line.
 #include "phnn/sweep/sweep_file.h"
@@ -523,7 +523,7 @@ class DocumentParser {
 };
 
 // ---------------------------------------------------------------------------
-// Pass 2: tables and keys onto SPEC.md's options.
+// Pass 2: tables and keys onto the options of docs/METHOD.md.
 
 // Axes of [grid] or of one [study.NAME]; unset axes are inherited.
 struct AxisSet {
@@ -637,7 +637,7 @@ class Resolver {
           label, physics_lines[kind], header);
     }
 
-    // Studies: the grid's axes, overridden per study; SPEC.md §6 defaults.
+    // Studies: the grid's axes, overridden per study; docs/METHOD.md §6 defaults.
     if (studies.empty()) studies.emplace_back("grid", AxisSet());
     for (const auto& [name, axes] : studies) {
       StudySpec study;

@@ -69,7 +69,7 @@ void OscillatorOptions::validate() const {
 
 Oscillator::Oscillator(OscillatorOptions options) : options_(options) {
   options_.validate();
-  // SPEC.md §1: rows (x_q, x_p, w, y), columns (grad_q H, grad_p H, z, u).
+  // docs/METHOD.md §1: rows (x_q, x_p, w, y), columns (grad_q H, grad_p H, z, u).
   if (options_.kind == SystemKind::kSelfSustained) {
     S_ << 0, -1, 1, 0,  //
         1, 0, 0, 0,     //

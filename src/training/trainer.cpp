@@ -1,4 +1,6 @@
-// src/training/trainer.cpp
+// src/training/trainer.cpp — train_cell as CellTrainer's phases: prepare,
+// step / validate / checkpoint, finish (the rollouts are in rollout.cpp, the
+// minibatch order in batch_sampler.h, CellSpec's checks in cell_spec.cpp).
 #include "phnn/training/trainer.h"
 
 #include <algorithm>
@@ -16,102 +18,10 @@
 #include "phnn/training/discrete_step.h"
 #include "phnn/training/flat_adam.h"
 #include "phnn/training/regularizers.h"
+#include "training/batch_sampler.h"
+#include "training/rollout.h"
 
 namespace phnn {
-
-namespace {
-
-// A non-finite value in the data would turn every member's loss into NaN
-// (all frozen at step 0) or every rollout error into NaN: refuse the data
-// instead, naming the set, the index and the fix.
-void require_finite_pairs(const PairSet& pairs, std::size_t count, const char* what) {
-  for (std::size_t i = 0; i < std::min(count, pairs.size()); ++i) {
-    PHNN_REQUIRE(pairs.x[i].allFinite() && pairs.x_next[i].allFinite() && std::isfinite(pairs.u[i]),
-                 "Invalid data: " << what << " pair " << i << " has a non-finite value (x = ("
-                                  << pairs.x[i](0) << ", " << pairs.x[i](1) << "), x_next = ("
-                                  << pairs.x_next[i](0) << ", " << pairs.x_next[i](1)
-                                  << "), u = " << pairs.u[i]
-                                  << "); regenerate the data set (phnn data) or fix its source");
-  }
-}
-
-void require_finite_data(const SystemData& data, int n_train) {
-  require_finite_pairs(data.train, static_cast<std::size_t>(n_train), "training");
-  require_finite_pairs(data.validation, data.validation.size(), "validation");
-  const InferenceSet& inf = data.inference;
-  for (std::size_t i = 0; i < inf.size(); ++i) {
-    bool finite = std::isfinite(inf.u[i]);
-    std::size_t bad_step = 0;
-    for (std::size_t n = 0; finite && n < inf.states[i].size(); ++n) {
-      finite = inf.states[i][n].allFinite();
-      bad_step = n;
-    }
-    PHNN_REQUIRE(finite, "Invalid data: inference trajectory "
-                             << i << " has a non-finite value (input u or the state at step "
-                             << bad_step
-                             << "); regenerate the data set (phnn data) or fix its source");
-  }
-}
-
-}  // namespace
-
-void CellSpec::validate(const SystemData& data) const {
-  training.validate();
-  PHNN_REQUIRE(!(model == ModelKind::kNode && is_discrete_gradient(integrator)),
-               "Invalid CellSpec: integrator = " << to_string(integrator)
-                   << " with model = node; the discrete gradient needs a Hamiltonian (use rk2 "
-                      "or rk4, or phnn-s / phnn-jr)");
-  PHNN_REQUIRE(n_train >= 1 && static_cast<std::size_t>(n_train) <= data.train.size(),
-               "Invalid CellSpec: n_train = " << n_train << "; the data set has "
-                                              << data.train.size() << " training pairs");
-  PHNN_REQUIRE(!seeds.empty(), "Invalid CellSpec: no seeds");
-  for (std::size_t i = 0; i < seeds.size(); ++i) {
-    PHNN_REQUIRE(seeds[i] >= 0, "Invalid CellSpec: seed = " << seeds[i] << " must be >= 0");
-    for (std::size_t j = 0; j < i; ++j) {
-      PHNN_REQUIRE(seeds[i] != seeds[j], "Invalid CellSpec: seed " << seeds[i] << " listed twice");
-    }
-  }
-  PHNN_REQUIRE(!data.validation.x.empty(), "Invalid CellSpec: the data set has no validation pairs");
-  require_finite_data(data, n_train);
-}
-
-FigureSetup figure_setup(const OscillatorOptions& system) {
-  auto q_at_energy = [&](double energy) {
-    const double b = 0.5 * system.stiffness;
-    const double a = system.kind == SystemKind::kDuffing ? 0.25 * system.cubic_stiffness : 0.0;
-    return std::sqrt(2.0 * energy / (b + std::sqrt(b * b + 4.0 * a * energy)));
-  };
-  FigureSetup setup;
-  setup.x0_05 = Vec2(q_at_energy(0.5), 0.0);
-  setup.x0_075 = Vec2(q_at_energy(0.75), 0.0);
-  if (system.kind == SystemKind::kSelfSustained) {
-    const auto iw = Oscillator(system).self_oscillation_interval();
-    setup.u = -0.5 * (iw[0] + iw[1]);
-  }
-  return setup;
-}
-
-std::vector<double> reference_trajectory(const OscillatorOptions& system,
-                                         const DatasetOptions& options, const Vec2& x0, double u) {
-  const Oscillator osc(system);
-  const int stride = options.stride();
-  const int steps = options.num_inference_steps();
-  std::vector<double> out;
-  out.reserve(2 * static_cast<std::size_t>(steps + 1));
-  Vec2 x = x0;
-  for (int n = 0; n <= steps; ++n) {
-    out.push_back(x(0));
-    out.push_back(x(1));
-    if (n == steps) break;
-    for (int k = 0; k < stride; ++k) {
-      const auto step = discrete_gradient_step(osc, x, u, options.generation_step, options.newton);
-      PHNN_REQUIRE(step.status == StepStatus::kConverged,
-                   "reference_trajectory: Newton failed at step " << n);
-      x = step.x_next;
-    }
-  }
-  return out;
-}
 
 namespace {
 
@@ -133,155 +43,318 @@ torch::Tensor to_tensor(const std::vector<double>& v, std::size_t count) {
       .unsqueeze(-1);
 }
 
-// Per-member minibatch order: member e reshuffles its own permutation every
-// epoch from its own stream, so its batches do not depend on the stack.
-class BatchSampler {
- public:
-  BatchSampler(const std::vector<int>& seeds, int n, int batch) : n_(n), batch_(batch) {
-    for (int s : seeds) {
-      rngs_.emplace_back(mix64(static_cast<std::uint64_t>(s) ^ 0x7368756666ULL));
-      std::vector<int64_t> p(static_cast<std::size_t>(n));
-      for (int i = 0; i < n; ++i) p[static_cast<std::size_t>(i)] = i;
-      perms_.push_back(p);
-    }
-  }
-  // [E, b] indices of the next minibatch.
-  torch::Tensor next() {
-    const int64_t E = static_cast<int64_t>(perms_.size());
-    if (n_ <= batch_) {
-      return torch::arange(n_, torch::kLong).unsqueeze(0).expand({E, n_}).contiguous();
-    }
-    if (cursor_ == 0) {
-      for (std::size_t e = 0; e < perms_.size(); ++e) {  // Fisher-Yates
-        auto& p = perms_[e];
-        for (std::size_t i = p.size() - 1; i > 0; --i) {
-          std::swap(p[i], p[rngs_[e].below(i + 1)]);
-        }
-      }
-    }
-    const int size = std::min(batch_, n_ - cursor_);
-    auto idx = torch::empty({E, size}, torch::kLong);
-    auto a = idx.accessor<int64_t, 2>();
-    for (int64_t e = 0; e < E; ++e)
-      for (int j = 0; j < size; ++j)
-        a[e][j] = perms_[static_cast<std::size_t>(e)][static_cast<std::size_t>(cursor_ + j)];
-    cursor_ += size;
-    if (cursor_ >= n_) cursor_ = 0;
-    return idx;
-  }
-
- private:
-  int n_, batch_, cursor_ = 0;
-  std::vector<CounterRng> rngs_;
-  std::vector<std::vector<int64_t>> perms_;
-};
 
 }  // namespace
 
+
 namespace {
 
-// The autoregressive rollouts of Eq. 31 for every member of the stack:
-// the inference trajectories, then the two figure trajectories (rows B_inf,
-// B_inf + 1), from the model's current weights.
-struct Rollouts {
-  torch::Tensor sq_err;           // [E, B_inf]: sum over steps of |x - x_ref|^2
-  torch::Tensor diverged;         // [E, B_inf + 2]
-  torch::Tensor newton_failures;  // [E]
-  torch::Tensor figure;           // [E, steps + 1, 2, 2] (NaN after divergence)
-  int steps = 0;
+// One cell's training as named phases (docs: the trainer in one sitting):
+//   CellTrainer trainer(cell, data, progress);   // prepare: model, Adam, tensors
+//   trainer.train();                             // step / validate / checkpoint
+//   results = trainer.finish();                  // best weights, rollouts, results
+// Each phase is a member function that fits on a screen; the state they
+// share is the members below.
+class CellTrainer {
+ public:
+  CellTrainer(const CellSpec& cell, const SystemData& data, const ProgressCallback& progress);
+
+  void train();
+  std::vector<RunResult> finish();
+  std::unique_ptr<DynamicsModel> release_model() { return std::move(model_); }
+
+ private:
+  // The data of the cell as tensors; *_all / validation ones expanded over
+  // the E members (views, no copies).
+  struct Tensors {
+    torch::Tensor x, x_next, u;              // [N, 2], [N, 2], [N, 1]
+    torch::Tensor x_all, x_next_all, u_all;  // [E, N, .]
+    torch::Tensor xv, xv_next, uv;           // [E, V, .]
+  };
+  Tensors make_tensors() const;
+
+  double elapsed() const {
+    return std::chrono::duration<double>(Clock::now() - start_).count();
+  }
+  // L_d (Eq. 30) per member: mean over batch and components of |x_{n+1} - x_hat| / h.
+  torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn,
+                          const torch::Tensor& u) const;
+  void step(int step, BatchSampler& sampler);
+  void freeze_non_finite(const torch::Tensor& loss, int step, std::vector<int64_t>* dead);
+  void validate(int step);
+  void report_progress(int step, std::vector<double> live_best) const;
+  void checkpoint(int step);
+  double train_seconds_per_run() const {
+    return (elapsed() - checkpoint_overhead_s_) / static_cast<double>(E_);
+  }
+  void fill_result(int64_t e, const Rollouts& rollouts, const FigureReferences& references,
+                   double mse, double train_s, double wall);
+
+  const CellSpec& cell_;
+  const SystemData& data_;
+  const TrainerOptions& opt_;
+  const ProgressCallback& progress_;
+  const Clock::time_point start_ = Clock::now();
+  const int64_t E_;
+  const double h_;
+  std::unique_ptr<DynamicsModel> model_;
+  DynamicsModel::FlatParameters flat_;
+  std::vector<torch::Tensor> params_, grads_;  // alias flat_.values / gradients
+  std::unique_ptr<FlatAdam> adam_;
+  Tensors t_;
+  std::vector<RunResult> results_;
+  std::vector<bool> alive_;
+  std::vector<int> diverged_at_;
+  std::vector<double> best_val_;
+  std::vector<torch::Tensor> best_, frozen_;
+  double checkpoint_overhead_s_ = 0.0;
 };
 
-Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const SystemData& data) {
-  torch::NoGradGuard no_grad;
-  const DynamicsModel* model = &model_ref;
-  const TrainerOptions& opt = cell.training;
-  const int64_t E = model_ref.members();
-  const bool use_dg = is_discrete_gradient(cell.integrator);
-  const InferenceSet& inf = data.inference;
-  const int64_t B_inf = static_cast<int64_t>(inf.size());
-  const int steps = static_cast<int>(inf.states.empty() ? 0 : inf.states[0].size() - 1);
-  const FigureSetup fig = figure_setup(data.system);
-  // Rows: the inference trajectories, then the two figure trajectories.
-  const int64_t B = B_inf + 2;
-  auto x0 = torch::empty({B, 2}, torch::kFloat64);
-  auto u0 = torch::empty({B, 1}, torch::kFloat64);
-  auto ref = torch::empty({steps + 1, B_inf, 2}, torch::kFloat64);
-  {
-    auto xa = x0.accessor<double, 2>();
-    auto ua = u0.accessor<double, 2>();
-    auto ra = ref.accessor<double, 3>();
-    for (int64_t i = 0; i < B_inf; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      xa[i][0] = inf.states[ui][0](0);
-      xa[i][1] = inf.states[ui][0](1);
-      ua[i][0] = inf.u[ui];
-      for (int n = 0; n <= steps; ++n) {
-        ra[n][i][0] = inf.states[ui][static_cast<std::size_t>(n)](0);
-        ra[n][i][1] = inf.states[ui][static_cast<std::size_t>(n)](1);
-      }
-    }
-    xa[B_inf][0] = fig.x0_05(0);
-    xa[B_inf][1] = fig.x0_05(1);
-    xa[B_inf + 1][0] = fig.x0_075(0);
-    xa[B_inf + 1][1] = fig.x0_075(1);
-    ua[B_inf][0] = ua[B_inf + 1][0] = fig.u;
+CellTrainer::CellTrainer(const CellSpec& cell, const SystemData& data,
+                         const ProgressCallback& progress)
+    : cell_(cell), data_(data), opt_(cell.training), progress_(progress),
+      E_(static_cast<int64_t>(cell.seeds.size())), h_(data.train.step) {
+  std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
+  model_ = DynamicsModel::create(
+      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks}, seeds);
+  // One contiguous leaf for the whole stack: Adam in a handful of ops.
+  flat_ = model_->flatten_parameters();
+  params_ = model_->parameters();
+  grads_ = model_->unflatten(flat_.gradients);
+  adam_ = std::make_unique<FlatAdam>(flat_.values, flat_.gradients, opt_);
+  t_ = make_tensors();
+  const auto E = static_cast<std::size_t>(E_);
+  results_.resize(E);
+  alive_.assign(E, true);
+  diverged_at_.assign(E, -1);
+  best_val_.assign(E, std::numeric_limits<double>::infinity());
+  for (const auto& p : params_) {
+    best_.push_back(p.detach().clone());
+    frozen_.push_back(p.detach().clone());
   }
-  const double h_inf = inf.step;
-  auto x = x0.unsqueeze(0).expand({E, B, 2}).contiguous();
-  const auto u = u0.unsqueeze(0).expand({E, B, 1}).contiguous();
-  auto diverged = torch::zeros({E, B}, torch::kBool);
-  auto sq_err = torch::zeros({E, B_inf}, torch::kFloat64);
-  auto newton_failures = torch::zeros({E}, torch::kLong);
-  std::vector<torch::Tensor> figure_states{x.narrow(1, B_inf, 2).clone()};
-  DgInferenceOptions dg_options;
-  dg_options.tolerance = opt.newton_tolerance;
-  dg_options.max_iterations = opt.newton_max_iterations;
-  dg_options.min_dx_norm = opt.dg_min_dx_norm;
-  DgNewtonJacobian newton_jacobian;  // carried along the rollout
-  for (int n = 1; n <= steps; ++n) {
-    torch::Tensor next;
-    if (use_dg) {
-      const auto s = cell.integrator == IntegratorKind::kDg4
-                         ? dg4_inference_step(*model, x, u, h_inf, dg_options)
-                         : dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
-      next = s.x_next;
-      newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);
-    } else {
-      next = explicit_step(*model, cell.integrator, x, u, h_inf);
-    }
-    const auto bad = torch::isfinite(next).all(-1).logical_not() |
-                     (next.norm(2, -1) > opt.divergence_norm);
-    diverged = diverged | bad;
-    x = torch::where(diverged.unsqueeze(-1), torch::zeros_like(next), next);
-    const auto diff = x.narrow(1, 0, B_inf) - ref[n].unsqueeze(0);
-    sq_err += (diff * diff).sum(-1);
-    figure_states.push_back(torch::where(diverged.narrow(1, B_inf, 2).unsqueeze(-1),
-                                         torch::full_like(next.narrow(1, B_inf, 2), NAN),
-                                         next.narrow(1, B_inf, 2)));
-  }
-  Rollouts out;
-  out.sq_err = sq_err;
-  out.diverged = diverged;
-  out.newton_failures = newton_failures;
-  out.figure = torch::stack(figure_states, 1);
-  out.steps = steps;
-  return out;
 }
 
-// Eq. 31 per member from the rollouts: the mean over the inference
-// trajectories of their mean squared error, +inf if any diverged.
-std::vector<double> member_mse(const Rollouts& r) {
-  const int64_t E = r.sq_err.size(0), B_inf = r.sq_err.size(1);
-  std::vector<double> out(static_cast<std::size_t>(E));
-  for (int64_t e = 0; e < E; ++e) {
-    double total = 0.0;
-    for (int64_t i = 0; i < B_inf; ++i) {
-      total += r.diverged[e][i].item<bool>() ? std::numeric_limits<double>::infinity()
-                                             : r.sq_err[e][i].item<double>() / r.steps;
+CellTrainer::Tensors CellTrainer::make_tensors() const {
+  const auto N = static_cast<std::size_t>(cell_.n_train);
+  const std::size_t V = data_.validation.size();
+  Tensors t;
+  t.x = to_tensor(data_.train.x, N);
+  t.x_next = to_tensor(data_.train.x_next, N);
+  t.u = to_tensor(data_.train.u, N);
+  t.x_all = t.x.unsqueeze(0).expand({E_, -1, -1});
+  t.x_next_all = t.x_next.unsqueeze(0).expand({E_, -1, -1});
+  t.u_all = t.u.unsqueeze(0).expand({E_, -1, -1});
+  t.xv = to_tensor(data_.validation.x, V).unsqueeze(0).expand({E_, -1, -1});
+  t.xv_next = to_tensor(data_.validation.x_next, V).unsqueeze(0).expand({E_, -1, -1});
+  t.uv = to_tensor(data_.validation.u, V).unsqueeze(0).expand({E_, -1, -1});
+  return t;
+}
+
+torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor& xn,
+                                     const torch::Tensor& u) const {
+  const DynamicsModel& m = *model_;
+  const auto x_hat =
+      cell_.integrator == IntegratorKind::kDg    ? dg_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
+      : cell_.integrator == IntegratorKind::kDg4 ? dg4_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
+                                                 : explicit_step(m, cell_.integrator, x, u, h_);
+  return ((xn - x_hat).abs() / h_).mean({1, 2});
+}
+
+void CellTrainer::train() {
+  BatchSampler sampler(cell_.seeds, cell_.n_train, opt_.batch_size);
+  validate(0);
+  std::size_t next_checkpoint = 0;
+  for (int s = 1; s <= opt_.steps; ++s) {
+    step(s, sampler);
+    if (s % opt_.eval_every == 0 || s == opt_.steps) validate(s);
+    if (next_checkpoint < opt_.checkpoints.size() && s == opt_.checkpoints[next_checkpoint]) {
+      if (s < opt_.steps) checkpoint(s);  // the last step's is the final inference
+      ++next_checkpoint;
     }
-    out[static_cast<std::size_t>(e)] = B_inf ? total / static_cast<double>(B_inf) : 0.0;
+    if (std::none_of(alive_.begin(), alive_.end(), [](bool a) { return a; })) break;
   }
-  return out;
+}
+
+// One Adam step on a minibatch (every pair when N <= batch: no gather).
+void CellTrainer::step(int step, BatchSampler& sampler) {
+  const bool full_batch = cell_.n_train <= opt_.batch_size;
+  const auto idx = full_batch ? torch::Tensor() : sampler.next();
+  const auto x = full_batch ? t_.x_all : t_.x.index({idx});
+  const auto xn = full_batch ? t_.x_next_all : t_.x_next.index({idx});
+  const auto u = full_batch ? t_.u_all : t_.u.index({idx});
+  auto loss = data_loss(x, xn, u);
+  if (cell_.regularizer != Regularizer::kNone) {
+    const auto stats = jacobian_stats(model_->field(x, u, true).dfdx, opt_.jacobian_eps);
+    loss = loss + regularizer_penalty(cell_.regularizer, stats, opt_);
+  }
+  adam_->zero_grad();
+  loss.sum().backward();
+  std::vector<int64_t> dead;
+  freeze_non_finite(loss, step, &dead);
+  const auto dead_idx = torch::tensor(dead, torch::kLong);
+  if (!dead.empty()) {
+    for (const auto& g : grads_) g.index_fill_(0, dead_idx, 0.0);
+  }
+  adam_->step();
+  if (!dead.empty()) {
+    torch::NoGradGuard no_grad;
+    for (std::size_t k = 0; k < params_.size(); ++k) {
+      params_[k].index_copy_(0, dead_idx, frozen_[k].index_select(0, dead_idx));
+    }
+  }
+}
+
+// A member whose loss is non-finite is frozen at its last finite weights;
+// *dead lists every frozen member.
+void CellTrainer::freeze_non_finite(const torch::Tensor& loss, int step,
+                                    std::vector<int64_t>* dead) {
+  const auto finite = torch::isfinite(loss.detach());
+  const auto finite_a = finite.accessor<bool, 1>();
+  for (int64_t e = 0; e < E_; ++e) {
+    const auto ue = static_cast<std::size_t>(e);
+    if (alive_[ue] && !finite_a[e]) {
+      alive_[ue] = false;
+      diverged_at_[ue] = step;
+      torch::NoGradGuard no_grad;
+      for (std::size_t k = 0; k < params_.size(); ++k) frozen_[k][e].copy_(params_[k][e]);
+    }
+    if (!alive_[ue]) dead->push_back(e);
+  }
+}
+
+// Validation point: losses and Jacobian statistics into the trace, best
+// weights kept per member.
+void CellTrainer::validate(int step) {
+  torch::NoGradGuard no_grad;
+  const auto val = data_loss(t_.xv, t_.xv_next, t_.uv);
+  const auto train = data_loss(t_.x_all, t_.x_next_all, t_.u_all);
+  const auto stats = jacobian_stats(model_->field(t_.x_all, t_.u_all, true).dfdx, opt_.jacobian_eps);
+  const auto kappa = stats.kappa.mean(-1), sigma = stats.sigma_max.mean(-1),
+             rho = stats.rho.mean(-1);
+  std::vector<int64_t> improved;
+  std::vector<double> live_best;
+  for (int64_t e = 0; e < E_; ++e) {
+    const auto ue = static_cast<std::size_t>(e);
+    if (!alive_[ue]) continue;
+    TracePoint tp;
+    tp.step = step;
+    tp.elapsed_s = elapsed();
+    tp.train_loss = train[e].item<double>();
+    tp.validation_loss = val[e].item<double>();
+    tp.kappa = kappa[e].item<double>();
+    tp.sigma_max = sigma[e].item<double>();
+    tp.rho = rho[e].item<double>();
+    results_[ue].trace.push_back(tp);
+    if (std::isfinite(tp.validation_loss) && tp.validation_loss < best_val_[ue]) {
+      best_val_[ue] = tp.validation_loss;
+      results_[ue].best_step = step;
+      improved.push_back(e);
+    }
+    live_best.push_back(best_val_[ue]);
+  }
+  if (!improved.empty()) {
+    const auto idx = torch::tensor(improved, torch::kLong);
+    for (std::size_t k = 0; k < params_.size(); ++k) {
+      best_[k].index_copy_(0, idx, params_[k].detach().index_select(0, idx));
+    }
+  }
+  report_progress(step, std::move(live_best));
+}
+
+void CellTrainer::report_progress(int step, std::vector<double> live_best) const {
+  if (!progress_) return;
+  TrainProgress p;
+  p.step = step;
+  p.total_steps = opt_.steps;
+  p.elapsed_s = elapsed();
+  if (!live_best.empty()) {
+    const auto middle = live_best.begin() + static_cast<long>(live_best.size() / 2);
+    std::nth_element(live_best.begin(), middle, live_best.end());
+    p.best_validation_loss = *middle;
+  }
+  progress_(p);
+}
+
+// Inference of the best weights so far at a step budget; the training
+// weights are restored bitwise, so training goes on unchanged.
+void CellTrainer::checkpoint(int step) {
+  const auto begin = Clock::now();
+  const double train_s = train_seconds_per_run();
+  torch::NoGradGuard no_grad;
+  std::vector<torch::Tensor> current;
+  for (std::size_t k = 0; k < params_.size(); ++k) {
+    current.push_back(params_[k].detach().clone());
+    params_[k].copy_(best_[k]);
+  }
+  const std::vector<double> mse = member_mse(roll_out(*model_, cell_, data_));
+  for (std::size_t k = 0; k < params_.size(); ++k) params_[k].copy_(current[k]);
+  for (std::size_t e = 0; e < results_.size(); ++e) {
+    results_[e].checkpoint_steps.push_back(step);
+    results_[e].checkpoint_mse.push_back(mse[e]);
+    results_[e].checkpoint_train_seconds.push_back(train_s);
+  }
+  checkpoint_overhead_s_ += std::chrono::duration<double>(Clock::now() - begin).count();
+}
+
+// Inference with each member's best-validation weights, then the results.
+std::vector<RunResult> CellTrainer::finish() {
+  torch::NoGradGuard no_grad;
+  const double train_s = train_seconds_per_run();
+  for (std::size_t k = 0; k < params_.size(); ++k) params_[k].copy_(best_[k]);
+  const Rollouts rollouts = roll_out(*model_, cell_, data_);
+  const double wall = elapsed();
+  const std::vector<double> mse = member_mse(rollouts);
+  const FigureReferences references = figure_references(data_);
+  for (int64_t e = 0; e < E_; ++e) {
+    fill_result(e, rollouts, references, mse[static_cast<std::size_t>(e)], train_s, wall);
+  }
+  return std::move(results_);
+}
+
+void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
+                              const FigureReferences& references, double mse, double train_s,
+                              double wall) {
+  RunResult& r = results_[static_cast<std::size_t>(e)];
+  const int64_t B_inf = rollouts.sq_err.size(1);
+  r.steps = opt_.steps;
+  r.parameter_count = model_->parameter_count();
+  r.best_validation_loss = best_val_[static_cast<std::size_t>(e)];
+  r.wall_time_s = wall / static_cast<double>(E_);
+  r.newton_failures = rollouts.newton_failures[e].item<int64_t>();
+  r.trajectory_errors.resize(static_cast<std::size_t>(B_inf));
+  r.diverged_rollouts = 0;
+  for (int64_t i = 0; i < B_inf; ++i) {
+    const bool div = rollouts.diverged[e][i].item<bool>();
+    r.trajectory_errors[static_cast<std::size_t>(i)] =
+        div ? std::numeric_limits<double>::infinity()
+            : rollouts.sq_err[e][i].item<double>() / rollouts.steps;
+    r.diverged_rollouts += div;
+  }
+  r.mse = mse;
+  // Budgets not reached in the loop (the last step, or every member
+  // diverged earlier): the final best weights are the best up to them.
+  while (r.checkpoint_steps.size() < opt_.checkpoints.size()) {
+    r.checkpoint_steps.push_back(opt_.checkpoints[r.checkpoint_steps.size()]);
+    r.checkpoint_mse.push_back(r.mse);
+    r.checkpoint_train_seconds.push_back(train_s);
+  }
+  fill_figures(rollouts, e, references, &r);
+  r.status = RunStatus::kDone;
+  std::ostringstream msg;
+  if (diverged_at_[static_cast<std::size_t>(e)] >= 0) {
+    r.status = RunStatus::kDiverged;
+    msg << "training loss non-finite at step " << diverged_at_[static_cast<std::size_t>(e)]
+        << "; inference used the best weights (step " << r.best_step << "). ";
+  }
+  if (r.diverged_rollouts > 0) {
+    r.status = RunStatus::kDiverged;
+    msg << r.diverged_rollouts << " of " << B_inf << " rollouts diverged (non-finite or |x| > "
+        << opt_.divergence_norm << "). ";
+  }
+  if (r.newton_failures > 0) {
+    msg << r.newton_failures << " DG Newton steps did not converge.";
+  }
+  r.message = msg.str();
 }
 
 }  // namespace
@@ -290,241 +363,10 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
                                   const ProgressCallback& progress,
                                   std::unique_ptr<DynamicsModel>* trained) {
   cell.validate(data);
-  const auto start = Clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-  const TrainerOptions& opt = cell.training;
-  const int64_t E = static_cast<int64_t>(cell.seeds.size());
-  std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
-  std::unique_ptr<DynamicsModel> model =
-      DynamicsModel::create(
-          ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks}, seeds);
-  // One contiguous leaf for the whole stack: Adam in a handful of ops.
-  const DynamicsModel::FlatParameters flat = model->flatten_parameters();
-  const std::vector<torch::Tensor> params = model->parameters();  // alias flat.values
-  const std::vector<torch::Tensor> grads = model->unflatten(flat.gradients);
-  FlatAdam adam(flat.values, flat.gradients, opt);
-
-  const int N = cell.n_train;
-  const double h = data.train.step;
-  const auto X = to_tensor(data.train.x, static_cast<std::size_t>(N));
-  const auto Xn = to_tensor(data.train.x_next, static_cast<std::size_t>(N));
-  const auto U = to_tensor(data.train.u, static_cast<std::size_t>(N));
-  const std::size_t V = data.validation.size();
-  const auto Xv = to_tensor(data.validation.x, V).unsqueeze(0).expand({E, -1, -1});
-  const auto Xvn = to_tensor(data.validation.x_next, V).unsqueeze(0).expand({E, -1, -1});
-  const auto Uv = to_tensor(data.validation.u, V).unsqueeze(0).expand({E, -1, -1});
-  const auto Xall = X.unsqueeze(0).expand({E, -1, -1});
-  const auto Xnall = Xn.unsqueeze(0).expand({E, -1, -1});
-  const auto Uall = U.unsqueeze(0).expand({E, -1, -1});
-
-  // L_d (Eq. 30): mean over batch and state components of |x_{n+1} - x_hat| / h.
-  auto data_loss = [&](const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u) {
-    const auto x_hat =
-        cell.integrator == IntegratorKind::kDg   ? dg_training_step(*model, x, xn, u, h, opt.dg_min_dx_norm)
-        : cell.integrator == IntegratorKind::kDg4 ? dg4_training_step(*model, x, xn, u, h, opt.dg_min_dx_norm)
-                                                  : explicit_step(*model, cell.integrator, x, u, h);
-    return ((xn - x_hat).abs() / h).mean({1, 2});
-  };
-
-  std::vector<RunResult> results(static_cast<std::size_t>(E));
-  std::vector<bool> alive(static_cast<std::size_t>(E), true);
-  std::vector<int> diverged_at(static_cast<std::size_t>(E), -1);
-  std::vector<double> best_val(static_cast<std::size_t>(E), std::numeric_limits<double>::infinity());
-  std::vector<torch::Tensor> best, frozen;
-  for (const auto& p : params) {
-    best.push_back(p.detach().clone());
-    frozen.push_back(p.detach().clone());
-  }
-
-  auto evaluate = [&](int step) {
-    torch::NoGradGuard no_grad;
-    const auto val = data_loss(Xv, Xvn, Uv);
-    const auto train = data_loss(Xall, Xnall, Uall);
-    const auto stats = jacobian_stats(model->field(Xall, Uall, true).dfdx, opt.jacobian_eps);
-    const auto kappa = stats.kappa.mean(-1), sigma = stats.sigma_max.mean(-1),
-               rho = stats.rho.mean(-1);
-    std::vector<int64_t> improved;
-    std::vector<double> live_best;
-    for (int64_t e = 0; e < E; ++e) {
-      const auto ue = static_cast<std::size_t>(e);
-      if (!alive[ue]) continue;
-      TracePoint tp;
-      tp.step = step;
-      tp.elapsed_s = elapsed();
-      tp.train_loss = train[e].item<double>();
-      tp.validation_loss = val[e].item<double>();
-      tp.kappa = kappa[e].item<double>();
-      tp.sigma_max = sigma[e].item<double>();
-      tp.rho = rho[e].item<double>();
-      results[ue].trace.push_back(tp);
-      if (std::isfinite(tp.validation_loss) && tp.validation_loss < best_val[ue]) {
-        best_val[ue] = tp.validation_loss;
-        results[ue].best_step = step;
-        improved.push_back(e);
-      }
-      live_best.push_back(best_val[ue]);
-    }
-    if (!improved.empty()) {
-      const auto idx = torch::tensor(improved, torch::kLong);
-      for (std::size_t k = 0; k < params.size(); ++k) {
-        best[k].index_copy_(0, idx, params[k].detach().index_select(0, idx));
-      }
-    }
-    if (progress) {
-      TrainProgress p;
-      p.step = step;
-      p.total_steps = opt.steps;
-      p.elapsed_s = elapsed();
-      if (!live_best.empty()) {
-        std::nth_element(live_best.begin(), live_best.begin() + static_cast<long>(live_best.size() / 2),
-                         live_best.end());
-        p.best_validation_loss = live_best[live_best.size() / 2];
-      }
-      progress(p);
-    }
-  };
-
-  BatchSampler sampler(cell.seeds, N, opt.batch_size);
-  evaluate(0);
-  // Inference of the best weights so far at a step budget; the training
-  // weights are restored bitwise, so training goes on unchanged.
-  double checkpoint_overhead_s = 0.0;
-  std::size_t next_checkpoint = 0;
-  auto checkpoint = [&](int step) {
-    const auto begin = Clock::now();
-    const double train_s = (elapsed() - checkpoint_overhead_s) / static_cast<double>(E);
-    torch::NoGradGuard no_grad;
-    std::vector<torch::Tensor> current;
-    for (std::size_t k = 0; k < params.size(); ++k) {
-      current.push_back(params[k].detach().clone());
-      params[k].copy_(best[k]);
-    }
-    const std::vector<double> mse = member_mse(roll_out(*model, cell, data));
-    for (std::size_t k = 0; k < params.size(); ++k) params[k].copy_(current[k]);
-    for (std::size_t e = 0; e < results.size(); ++e) {
-      results[e].checkpoint_steps.push_back(step);
-      results[e].checkpoint_mse.push_back(mse[e]);
-      results[e].checkpoint_train_seconds.push_back(train_s);
-    }
-    checkpoint_overhead_s += std::chrono::duration<double>(Clock::now() - begin).count();
-  };
-  // Every pair in every step when N <= batch: no gather needed.
-  const bool full_batch = N <= opt.batch_size;
-  for (int step = 1; step <= opt.steps; ++step) {
-    const auto idx = full_batch ? torch::Tensor() : sampler.next();
-    const auto x = full_batch ? Xall : X.index({idx});
-    const auto xn = full_batch ? Xnall : Xn.index({idx});
-    const auto u = full_batch ? Uall : U.index({idx});
-    auto loss = data_loss(x, xn, u);
-    if (cell.regularizer != Regularizer::kNone) {
-      const auto stats = jacobian_stats(model->field(x, u, true).dfdx, opt.jacobian_eps);
-      loss = loss + regularizer_penalty(cell.regularizer, stats, opt);
-    }
-    adam.zero_grad();
-    loss.sum().backward();
-    // A member whose loss is non-finite is frozen at its last finite weights.
-    const auto finite = torch::isfinite(loss.detach());
-    const auto finite_a = finite.accessor<bool, 1>();
-    std::vector<int64_t> dead;
-    for (int64_t e = 0; e < E; ++e) {
-      const auto ue = static_cast<std::size_t>(e);
-      if (alive[ue] && !finite_a[e]) {
-        alive[ue] = false;
-        diverged_at[ue] = step;
-        torch::NoGradGuard no_grad;
-        for (std::size_t k = 0; k < params.size(); ++k) frozen[k][e].copy_(params[k][e]);
-      }
-      if (!alive[ue]) dead.push_back(e);
-    }
-    const auto dead_idx = torch::tensor(dead, torch::kLong);
-    if (!dead.empty()) {
-      for (const auto& g : grads) g.index_fill_(0, dead_idx, 0.0);
-    }
-    adam.step();
-    if (!dead.empty()) {
-      torch::NoGradGuard no_grad;
-      for (std::size_t k = 0; k < params.size(); ++k) {
-        params[k].index_copy_(0, dead_idx, frozen[k].index_select(0, dead_idx));
-      }
-    }
-    if (step % opt.eval_every == 0 || step == opt.steps) evaluate(step);
-    if (next_checkpoint < opt.checkpoints.size() && step == opt.checkpoints[next_checkpoint]) {
-      if (step < opt.steps) checkpoint(step);  // the last step's is the final inference
-      ++next_checkpoint;
-    }
-    if (std::none_of(alive.begin(), alive.end(), [](bool a) { return a; })) break;
-  }
-
-  // Inference with each member's best-validation weights (SPEC.md §4).
-  torch::NoGradGuard no_grad;
-  const double train_s = (elapsed() - checkpoint_overhead_s) / static_cast<double>(E);
-  for (std::size_t k = 0; k < params.size(); ++k) params[k].copy_(best[k]);
-
-  const Rollouts rollouts = roll_out(*model, cell, data);
-  const InferenceSet& inf = data.inference;
-  const int64_t B_inf = static_cast<int64_t>(inf.size());
-  const int steps = rollouts.steps;
-  const FigureSetup fig = figure_setup(data.system);
-  const auto& sq_err = rollouts.sq_err;
-  const auto& diverged = rollouts.diverged;
-  const auto& newton_failures = rollouts.newton_failures;
-  const auto fig_stack = rollouts.figure;  // [E, steps+1, 2, 2]
-  const double wall = elapsed();
-  const std::vector<double> final_mse = member_mse(rollouts);
-  const auto ref05 = reference_trajectory(data.system, data.options, fig.x0_05, fig.u);
-  const auto ref075 = reference_trajectory(data.system, data.options, fig.x0_075, fig.u);
-  const double inf_value = std::numeric_limits<double>::infinity();
-  for (int64_t e = 0; e < E; ++e) {
-    RunResult& r = results[static_cast<std::size_t>(e)];
-    r.steps = opt.steps;
-    r.parameter_count = model->parameter_count();
-    r.best_validation_loss = best_val[static_cast<std::size_t>(e)];
-    r.wall_time_s = wall / static_cast<double>(E);
-    r.newton_failures = newton_failures[e].item<int64_t>();
-    r.trajectory_errors.resize(static_cast<std::size_t>(B_inf));
-    r.diverged_rollouts = 0;
-    for (int64_t i = 0; i < B_inf; ++i) {
-      const bool div = diverged[e][i].item<bool>();
-      r.trajectory_errors[static_cast<std::size_t>(i)] =
-          div ? inf_value : sq_err[e][i].item<double>() / steps;
-      r.diverged_rollouts += div;
-    }
-    r.mse = final_mse[static_cast<std::size_t>(e)];
-    // Budgets not reached in the loop (the last step, or every member
-    // diverged earlier): the final best weights are the best up to them.
-    while (r.checkpoint_steps.size() < opt.checkpoints.size()) {
-      r.checkpoint_steps.push_back(opt.checkpoints[r.checkpoint_steps.size()]);
-      r.checkpoint_mse.push_back(r.mse);
-      r.checkpoint_train_seconds.push_back(train_s);
-    }
-    auto fig_e = fig_stack[e].contiguous();
-    auto fa = fig_e.accessor<double, 3>();
-    for (int n = 0; n <= steps; ++n) {
-      r.figure_prediction_05.push_back(fa[n][0][0]);
-      r.figure_prediction_05.push_back(fa[n][0][1]);
-      r.figure_prediction_075.push_back(fa[n][1][0]);
-      r.figure_prediction_075.push_back(fa[n][1][1]);
-    }
-    r.figure_reference_05 = ref05;
-    r.figure_reference_075 = ref075;
-    std::ostringstream msg;
-    r.status = RunStatus::kDone;
-    if (diverged_at[static_cast<std::size_t>(e)] >= 0) {
-      r.status = RunStatus::kDiverged;
-      msg << "training loss non-finite at step " << diverged_at[static_cast<std::size_t>(e)]
-          << "; inference used the best weights (step " << r.best_step << "). ";
-    }
-    if (r.diverged_rollouts > 0) {
-      r.status = RunStatus::kDiverged;
-      msg << r.diverged_rollouts << " of " << B_inf << " rollouts diverged (non-finite or |x| > "
-          << opt.divergence_norm << "). ";
-    }
-    if (r.newton_failures > 0) {
-      msg << r.newton_failures << " DG Newton steps did not converge.";
-    }
-    r.message = msg.str();
-  }
-  if (trained) *trained = std::move(model);
+  CellTrainer trainer(cell, data, progress);
+  trainer.train();
+  std::vector<RunResult> results = trainer.finish();
+  if (trained) *trained = trainer.release_model();
   return results;
 }
 

@@ -23,7 +23,7 @@ std::unique_ptr<DynamicsModel> make(ModelKind kind, SystemKind structure,
   return DynamicsModel::create(ModelOptions{kind, size, structure}, kSeeds);
 }
 
-// SPEC.md §3 table: per component and per model, every size.
+// docs/METHOD.md §3 table: per component and per model, every size.
 TEST(ModelParameterCountTest, MatchesSpecTable) {
   struct Row { ModelSize size; long node, l_h, l_r, l_z; };
   const Row rows[] = {{ModelSize::kSmall, 746, 371, 438, 481},

@@ -141,7 +141,7 @@ TEST(GridTest, ExpansionIsDeterministic) {
 TEST(GridTest, RunIdIsStableForAFixedConfig) {
   const Grid grid = paper_grid();
   const RunConfig& run = grid.runs[0];
-  // Written by hand from SPEC.md's defaults: changing the canonical form
+  // Written by hand from the defaults of docs/METHOD.md: changing the canonical form
   // changes every run id and orphans existing results files.
   EXPECT_THAT(run.canonical(),
               StartsWith("system=harmonic;model=node;integrator=rk2;size=small;n_train=25;"
@@ -187,7 +187,7 @@ TEST(GridTest, GroupCostFollowsTheDocumentedModel) {
   model.small_batch_saving = 0.0;  // the hand computation below is for full batches
   model.rollout_speedup = 20.0;
   model.dg_newton_factor = 4.0;
-  RunConfig run;  // SPEC.md defaults: 50000 steps, eval every 500, 2500 / 100 x 500
+  RunConfig run;  // docs/METHOD.md defaults: 50000 steps, eval every 500, 2500 / 100 x 500
   run.model = ModelKind::kPhnnJr;
   run.integrator = IntegratorKind::kDg;
   // fixed  = 50000 x 500e-6 = 25 s;

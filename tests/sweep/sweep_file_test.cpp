@@ -64,7 +64,7 @@ TEST(SweepFileTest, PaperSweepHasThreeStudiesOnSpecDefaults) {
                                                   Pair(ModelKind::kPhnnS, IntegratorKind::kRk2)));
   EXPECT_THAT(spec.studies[0].systems,
               ElementsAre(SystemKind::kHarmonic, SystemKind::kDuffing, SystemKind::kSelfSustained));
-  // SPEC.md values, bit for bit (the file restates some, which must not
+  // docs/METHOD.md values, bit for bit (the file restates some, which must not
   // change them).
   const TrainerOptions training;
   EXPECT_EQ(spec.training.steps, 50000);

@@ -58,7 +58,7 @@ TEST(OscillatorTest, GradientMatchesFiniteDifferencesOfHamiltonian) {
 TEST(OscillatorTest, SelfOscillationIntervalIsWhereZPrimeIsNegative) {
   const Oscillator osc(OscillatorOptions::defaults(SystemKind::kSelfSustained));
   const auto iw = osc.self_oscillation_interval();
-  // SPEC.md §1: I_w = (0.4939, 1.5573).
+  // docs/METHOD.md §1: I_w = (0.4939, 1.5573).
   EXPECT_NEAR(iw[0], 0.4939, 1e-4);
   EXPECT_NEAR(iw[1], 1.5573, 1e-4);
   EXPECT_NEAR(osc.dissipation_derivative(iw[0]), 0.0, 1e-12);
@@ -77,12 +77,12 @@ TEST(OscillatorTest, EquilibriumIsAFixedPoint) {
 }
 
 TEST(OscillatorTest, DefaultDampingDissipates99PercentInFiveSeconds) {
-  // SPEC.md §1: c = m ln(100) / 5, energy envelope e^{-c t / m}.
+  // docs/METHOD.md §1: c = m ln(100) / 5, energy envelope e^{-c t / m}.
   const OscillatorOptions o = OscillatorOptions::defaults(SystemKind::kHarmonic);
   EXPECT_NEAR(std::exp(-o.damping / o.mass * 5.0), 0.01, 1e-12);
   EXPECT_NEAR(o.damping, 0.14737, 1e-5);
   // k = 1/0.16 with m = 0.16 gives omega0 = 6.25 rad/s: f0 = 0.9947 Hz, the
-  // paper's "1 Hz" is nominal (SPEC.md §1 fixes m and k, not f0).
+  // paper's "1 Hz" is nominal (docs/METHOD.md §1 fixes m and k, not f0).
   EXPECT_DOUBLE_EQ(std::sqrt(o.stiffness / o.mass), 6.25);
 }
 

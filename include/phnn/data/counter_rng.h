@@ -15,7 +15,7 @@ constexpr std::uint64_t mix64(std::uint64_t z) {
 /// Counter-based random stream: draw i is mix64(key + (i + 1) * golden), so a
 /// stream is addressed by its key alone and never shares state with another.
 /// Keys are derived from (data seed, system, trajectory index, purpose), so any
-/// trajectory can be generated alone, bit-identically (SPEC.md §2).
+/// trajectory can be generated alone, bit-identically (docs/METHOD.md §2).
 class CounterRng {
  public:
   /// Purposes of the streams of one trajectory.

@@ -10,7 +10,7 @@
 
 namespace phnn {
 
-/// Data-set options (paper §5.2, Appendix E; SPEC.md §2). Defaults are SPEC.md's.
+/// Data-set options (paper §5.2, Appendix E; docs/METHOD.md §2). Defaults: docs/METHOD.md.
 struct DatasetOptions {
   /// Keys every random stream with (data_seed, system, trajectory, purpose).
   std::uint64_t data_seed = 0;

@@ -9,7 +9,7 @@ namespace phnn {
 
 /// Everything one system contributes to an experiment: the training pairs
 /// (first n_train of them are used by a run), validation pairs and inference
-/// trajectories (SPEC.md §2).
+/// trajectories (docs/METHOD.md §2).
 struct SystemData {
   OscillatorOptions system;
   DatasetOptions options;

@@ -8,16 +8,16 @@
 
 namespace phnn {
 
-/// Options of the implicit discrete-gradient step. Defaults are SPEC.md §2.
+/// Options of the implicit discrete-gradient step. Defaults are docs/METHOD.md §2.
 struct DiscreteGradientOptions {
   /// Newton stops when ||dx - h f_bar(dx)||_inf <= newton_tolerance. The
   /// power-balance error of a step equals gradbar^T (residual), so this
-  /// tolerance shows up directly in the balance (SPEC.md §2).
+  /// tolerance shows up directly in the balance (docs/METHOD.md §2).
   double newton_tolerance = 1e-14;
   /// Reaching the cap is reported in DiscreteGradientStep::status.
   int max_newton_iterations = 50;
   /// Below this ||dx|| the generic Gonzalez quotient is 0/0-prone: use
-  /// gradH(x + dx/2) alone (SPEC.md §4: tau = 6e-6, about cbrt(eps)).
+  /// gradH(x + dx/2) alone (docs/METHOD.md §4: tau = 6e-6, about cbrt(eps)).
   double min_dx_norm = 6e-6;
 
   /// Throws std::invalid_argument naming the field, value and constraint.
@@ -52,7 +52,7 @@ struct DiscreteGradientStep {
   double residual = 0.0;  // ||dx - h f_bar||_inf at exit
 };
 
-/// Implicit DG step of the oscillator's PH-DAE (SPEC.md §2):
+/// Implicit DG step of the oscillator's PH-DAE (docs/METHOD.md §2):
 ///   dx / h = S_xx dg(x, dx) + S_xw z(w) + S_xu u,  w = S_wx dg + S_wu u,
 /// solved for dx by Newton from the explicit-midpoint step, with the
 /// oscillator's cancellation-free closed-form discrete gradient.

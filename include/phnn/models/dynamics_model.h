@@ -42,7 +42,7 @@ class DynamicsModel {
                           bool with_jacobian) const = 0;
   /// True for PHNN-S and PHNN-JR (they have H_theta and support DG).
   virtual bool is_port_hamiltonian() const { return false; }
-  /// Inverse-explicit DG field (SPEC.md §4): gradH replaced by the Gonzalez
+  /// Inverse-explicit DG field (docs/METHOD.md §4): gradH replaced by the Gonzalez
   /// discrete gradient dg_theta(x, dx); R_theta at x + dx/2.
   virtual torch::Tensor discrete_gradient_field(const torch::Tensor& x, const torch::Tensor& dx,
                                                 const torch::Tensor& u,

@@ -17,12 +17,12 @@ enum class IntegratorKind { kRk2 = 0, kDg = 1, kRk4 = 2, kDg4 = 3 };
 inline bool is_discrete_gradient(IntegratorKind kind) {
   return kind == IntegratorKind::kDg || kind == IntegratorKind::kDg4;
 }
-/// Network size (paper Tables 10-12, SPEC.md §3).
+/// Network size (paper Tables 10-12, docs/METHOD.md §3).
 enum class ModelSize { kSmall = 0, kMedium = 1, kLarge = 2 };
 
 /// "node", "phnn-s", "phnn-jr".
 std::string to_string(ModelKind kind);
-/// "rk2", "dg".
+/// "rk2", "dg", "rk4", "dg4".
 std::string to_string(IntegratorKind kind);
 /// "small", "medium", "large".
 std::string to_string(ModelSize size);
@@ -33,7 +33,7 @@ ModelKind parse_model(const std::string& name);
 IntegratorKind parse_integrator(const std::string& name);
 ModelSize parse_size(const std::string& name);
 
-/// Hidden widths of each MLP of a model (SPEC.md §3 table).
+/// Hidden widths of each MLP of a model (docs/METHOD.md §3 table).
 struct NetworkWidths {
   std::vector<int> node;  // NODE: 3 -> ... -> 2
   std::vector<int> l_h;   // L_H: 2 -> ... -> 3
@@ -42,7 +42,7 @@ struct NetworkWidths {
 };
 NetworkWidths network_widths(ModelSize size);
 
-/// Number of trainable parameters of one member (SPEC.md §3): NODE 746 /
+/// Number of trainable parameters of one member (docs/METHOD.md §3): NODE 746 /
 /// 4022 / 20802; PHNN-JR = L_H + L_R; PHNN-S = L_H + L_z.
 long parameter_count(ModelKind kind, ModelSize size);
 /// Parameters of an MLP with the given input, hidden widths and output.

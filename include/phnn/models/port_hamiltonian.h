@@ -57,7 +57,7 @@ class PortHamiltonianModel : public DynamicsModel {
 
   /// Gonzalez discrete gradient of H_theta (eq: gonzalez-discrete-gradient):
   ///   dg = gradH(x + dx/2) + (H(x+dx) - H(x) - gradH(x+dx/2)^T dx) / |dx|^2 dx,
-  /// = gradH(x + dx/2) where |dx| < min_dx_norm (SPEC.md §4).
+  /// = gradH(x + dx/2) where |dx| < min_dx_norm (docs/METHOD.md §4).
   torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
                                   double min_dx_norm) const;
 

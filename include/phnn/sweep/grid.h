@@ -30,7 +30,7 @@ namespace phnn {
 ///
 /// with evaluations = 1 + floor(steps / eval_every) (+ 1 when steps is not a
 /// multiple of eval_every): step 0, every eval_every steps and the last step
-/// (SPEC.md §4). The fixed part is the per-step cost that does not shrink
+/// (docs/METHOD.md §4). The fixed part is the per-step cost that does not shrink
 /// with fewer members (operator dispatch, autograd bookkeeping, Adam's calls):
 /// it is why a stack of E members is cheaper than E single runs, and why
 /// splitting a cell into groups costs core-hours. Validation (2500 pairs) and
@@ -113,7 +113,7 @@ struct Cell {
   double cost_s(int members) const { return fixed_cost_s + members * member_cost_s; }
 };
 
-/// What one study's tables are made of (paper Appendix F; SPEC.md §6): one
+/// What one study's tables are made of (paper Appendix F; docs/METHOD.md §6): one
 /// table per system, rows = models, columns = values of the varied axis.
 struct StudyTable {
   /// StudySpec::name and title.

@@ -57,7 +57,7 @@ struct StudySpec {
   std::vector<int> seeds;
 };
 
-/// A parsed and validated sweep file: SPEC.md defaults overridden by the file.
+/// A parsed and validated sweep file: docs/METHOD.md defaults overridden by the file.
 ///
 ///   const SweepSpec spec = parse_sweep_file("sweeps/paper.toml");
 ///   const Grid grid = expand_grid(spec);  // phnn/sweep/grid.h
@@ -104,7 +104,7 @@ SweepSpec parse_sweep_text(const std::string& text, const std::string& display_n
 /// "node-rk2", "phnn-jr-dg", ...: the sweep-file spelling of a model.
 std::string model_key(ModelKind kind, IntegratorKind integrator);
 /// The five valid pairs in the order node-rk2, phnn-jr-dg, phnn-jr-rk2,
-/// phnn-s-dg, phnn-s-rk2 (NODE has RK2 only, SPEC.md §3).
+/// phnn-s-dg, phnn-s-rk2 (NODE has RK2 only, docs/METHOD.md §3).
 std::vector<std::pair<ModelKind, IntegratorKind>> all_model_pairs();
 /// Every pair a sweep file may name: the paper's five and the RK4 variants
 /// of the three formulations (node-rk4, phnn-jr-rk4, phnn-s-rk4), then the

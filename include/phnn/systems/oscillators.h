@@ -13,7 +13,7 @@ using Vec2 = Eigen::Vector2d;
 using Mat2 = Eigen::Matrix2d;
 
 /// The three controlled oscillators of the paper (tab:PHS-examples-and-formulations,
-/// SPEC.md §1).
+/// docs/METHOD.md §1).
 enum class SystemKind { kHarmonic = 0, kDuffing = 1, kSelfSustained = 2 };
 
 /// "harmonic", "duffing", "self-sustained".
@@ -24,7 +24,7 @@ SystemKind parse_system(const std::string& name);
 /// All systems, in paper order.
 std::vector<SystemKind> all_systems();
 
-/// Physical parameters of one oscillator. Defaults are SPEC.md §1; build them
+/// Physical parameters of one oscillator. Defaults are docs/METHOD.md §1; build them
 /// with OscillatorOptions::defaults(kind).
 struct OscillatorOptions {
   SystemKind kind = SystemKind::kHarmonic;
@@ -34,14 +34,14 @@ struct OscillatorOptions {
   double stiffness = 1.0 / 0.16;
   /// k3 [N/m^3] of the Duffing oscillator (ignored by the others).
   double cubic_stiffness = 100.0 / 0.16;
-  /// c [N s/m] of z(w) = c w (harmonic, Duffing). SPEC.md §1: the text's
+  /// c [N s/m] of z(w) = c w (harmonic, Duffing). docs/METHOD.md §1: the text's
   /// "99 % of the energy dissipated in 5 s" gives c = m ln(100) / 5 = 0.14737;
   /// the paper's Table 5 prints 0.9 (see sweeps/paper-table-damping.toml).
   double damping = 0.16 * 4.605170185988091 / 5.0;
   /// z(w) = z1 w + z2 w^2 + z3 w^3 of the self-sustained oscillator.
   std::array<double, 3> z_coefficients = {3.0, -4.0, 1.3};
 
-  /// SPEC.md §1 defaults for `kind`.
+  /// docs/METHOD.md §1 defaults for `kind`.
   static OscillatorOptions defaults(SystemKind kind);
   /// Throws std::invalid_argument naming the field, value and constraint.
   void validate() const;
@@ -80,7 +80,7 @@ class Oscillator {
   /// z''(w): 0 for the linear dampers, 6 z3 w + 2 z2 for the cubic law.
   double dissipation_second_derivative(double w) const;
 
-  /// S of eq:phs_S (SPEC.md §1 table).
+  /// S of eq:phs_S (docs/METHOD.md §1 table).
   const Eigen::Matrix4d& S() const { return S_; }
   /// J of eq:phs_JR, rows (x_q, x_p, y), columns (grad_q H, grad_p H, u).
   Eigen::Matrix3d J() const;
@@ -116,7 +116,7 @@ class Oscillator {
   /// interval between the roots of z'(w). Throws if it is empty.
   std::array<double, 2> self_oscillation_interval() const;
 
-  /// Equilibrium state x* for a constant input u (SPEC.md §2, Appendix E):
+  /// Equilibrium state x* for a constant input u (docs/METHOD.md §2, Appendix E):
   /// harmonic/Duffing: (q*, 0) with k q* + k3 q*^3 = -u;
   /// self-sustained: (0, m z(-u)).
   Vec2 equilibrium(double u) const;

@@ -7,7 +7,7 @@
 
 namespace phnn {
 
-/// RK2 (eq: rk2-method with the factor h the paper drops; SPEC.md §4):
+/// RK2 (eq: rk2-method with the factor h the paper drops; docs/METHOD.md §4):
 ///   x_hat = x + h f(x + (h/2) f(x, u), u).
 torch::Tensor rk2_step(const DynamicsModel& model, const torch::Tensor& x,
                        const torch::Tensor& u, double h);
@@ -22,7 +22,7 @@ torch::Tensor rk4_step(const DynamicsModel& model, const torch::Tensor& x,
 torch::Tensor explicit_step(const DynamicsModel& model, IntegratorKind integrator,
                             const torch::Tensor& x, const torch::Tensor& u, double h);
 
-/// DG in training, inverse-explicit (SPEC.md §4): with the data step
+/// DG in training, inverse-explicit (docs/METHOD.md §4): with the data step
 /// dx = x_next - x, x_hat = x + h f_bar(x, dx, u).
 torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& x,
                                const torch::Tensor& x_next, const torch::Tensor& u, double h,

@@ -1,4 +1,4 @@
-// include/phnn/training/regularizers.h — Jacobian regularizers (SPEC.md §4).
+// include/phnn/training/regularizers.h — Jacobian regularizers (docs/METHOD.md §4).
 #pragma once
 
 #include <torch/torch.h>

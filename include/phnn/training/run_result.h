@@ -17,7 +17,7 @@ RunStatus parse_run_status(const std::string& name);
 struct TracePoint {
   int step = 0;
   double elapsed_s = 0.0;     // wall time since the cell started training
-  double train_loss = 0.0;    // L_d (+ regularizer) of the last minibatch
+  double train_loss = 0.0;    // L_d over the whole training set (no regularizer)
   double validation_loss = 0.0;
   double kappa = 0.0;         // batch-mean condition number of df/dx
   double sigma_max = 0.0;     // batch-mean spectral norm

@@ -44,7 +44,7 @@ using ProgressCallback = std::function<void(const TrainProgress&)>;
 
 /// Trains the cell on `data` (the first n_train training pairs, the
 /// validation pairs), keeps each member's best-validation weights, rolls all
-/// members out over the inference set (SPEC.md §5) and the two figure
+/// members out over the inference set (docs/METHOD.md §5) and the two figure
 /// trajectories. Result e belongs to seeds[e] and depends on nothing but the
 /// cell, the data and that seed. A member whose loss turns non-finite is
 /// frozen and reported as diverged; the others go on.

@@ -8,14 +8,14 @@
 namespace phnn {
 
 /// Jacobian regularizer (eq:condition-number-loss, eq:spectral-norm-loss,
-/// eq:stiffness-ratio-loss; SPEC.md §4).
+/// eq:stiffness-ratio-loss; docs/METHOD.md §4).
 enum class Regularizer { kNone = 0, kCn = 1, kSn = 2, kSr = 3 };
 /// "none", "cn", "sn", "sr".
 std::string to_string(Regularizer reg);
 /// Throws std::invalid_argument naming the value and the allowed values.
 Regularizer parse_regularizer(const std::string& name);
 
-/// Optimizer and schedule of one run (SPEC.md §4). Defaults are SPEC.md's.
+/// Optimizer and schedule of one run (docs/METHOD.md §4). Defaults: docs/METHOD.md.
 struct TrainerOptions {
   /// Adam steps.
   int steps = 50000;
@@ -34,7 +34,9 @@ struct TrainerOptions {
   double lambda_sr = 1e-4;
   /// Eps in kappa = s_max / (s_min + eps) and rho = max|Re l| / (min|Re l| + eps).
   double jacobian_eps = 1e-6;
-  /// DG inference Newton (SPEC.md §4): tolerance on ||delta dx||_inf, cap.
+  /// DG/DG4 inference Newton (docs/METHOD.md §4): a row has converged when its
+  /// residual max |dx - h f_bar| <= newton_tolerance; at most
+  /// newton_max_iterations updates.
   double newton_tolerance = 1e-12;
   int newton_max_iterations = 20;
   /// DG training fallback threshold tau on ||dx||.

@@ -1,0 +1,43 @@
+// src/training/rollout.h — the inference phase of a cell (private to
+// src/training): autoregressive rollouts of every member of a stack over the
+// inference set and the two figure trajectories, Eq. 31 per member, and the
+// figure trajectories of a RunResult. Touches no file.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <torch/torch.h>
+
+#include "phnn/models/dynamics_model.h"
+#include "phnn/training/run_result.h"
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+
+// The autoregressive rollouts of Eq. 31 for every member of the stack:
+// the inference trajectories, then the two figure trajectories (rows B_inf,
+// B_inf + 1), from the model's current weights.
+struct Rollouts {
+  torch::Tensor sq_err;           // [E, B_inf]: sum over steps of |x - x_ref|^2
+  torch::Tensor diverged;         // [E, B_inf + 2]
+  torch::Tensor newton_failures;  // [E]
+  torch::Tensor figure;           // [E, steps + 1, 2, 2] (NaN after divergence)
+  int steps = 0;
+};
+Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const SystemData& data);
+
+// Eq. 31 per member from the rollouts: the mean over the inference
+// trajectories of their mean squared error, +inf if any diverged.
+std::vector<double> member_mse(const Rollouts& rollouts);
+
+// The reference trajectories of the figures (paper Figures 7 and 9), made
+// once per cell, and member e's predicted ones, into r.
+struct FigureReferences {
+  std::vector<double> at_05, at_075;
+};
+FigureReferences figure_references(const SystemData& data);
+void fill_figures(const Rollouts& rollouts, int64_t e, const FigureReferences& references,
+                  RunResult* r);
+
+}  // namespace phnn
