@@ -89,15 +89,6 @@ std::string all_hosts(MPI_Comm comm) {
 
 }  // namespace
 
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return buf;
-}
-
 Provenance build_provenance() {
   return {{"program_version", program_version()},
           {"git_commit", git_commit()},

@@ -6,13 +6,11 @@
 
 #include <string>
 
+#include "phnn/common/utc_time.h"
 #include "phnn/sweep/results_file.h"
 
 namespace phnn {
 namespace apps {
-
-/// "2024-05-01T12:00:00Z" (now, UTC).
-std::string utc_now();
 
 /// program_version, git_commit, compiler, libtorch, blas, hdf5, mpi.
 Provenance build_provenance();

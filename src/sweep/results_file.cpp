@@ -11,6 +11,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "phnn/common/utc_time.h"
 #include "data/dataset_file_io.h"
 #include "h5/h5file.h"
 
@@ -83,14 +84,6 @@ std::string dirname_of(const std::string& path) {
   return path.substr(0, slash);
 }
 
-std::string utc_now_iso8601() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return buf;
-}
 
 int comm_rank(MPI_Comm comm) {
   int rank = 0;
@@ -369,7 +362,7 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
     }
     return "";
   });
-  const std::string created = broadcast(comm, utc_now_iso8601());
+  const std::string created = broadcast(comm, utc_now());
 
   std::unique_ptr<Impl> impl;
   collective_or_abort(comm, [&] {

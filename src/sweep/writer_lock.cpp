@@ -14,19 +14,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "phnn/common/utc_time.h"
+
 namespace phnn {
 namespace {
 
 std::string errno_text() { return std::strerror(errno); }
-
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return buf;
-}
 
 // The whole file behind `fd` (at most 4 KiB: a lock file is a few lines).
 std::string read_fd(int fd) {

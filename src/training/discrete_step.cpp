@@ -38,6 +38,23 @@ torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& 
   return x + h * model.discrete_gradient_field(x, x_next - x, u, min_dx_norm);
 }
 
+namespace {
+
+// The Newton update delta = -M^{-1} r of every row by Cramer's rule, with
+// M = m (+ I when add_identity) [.., 2, 2] and r [.., 2]. The identity is
+// added as 1 + m_ii, so callers passing -h J get I - h J to the bit.
+torch::Tensor newton_update(const torch::Tensor& m, bool add_identity, const torch::Tensor& r) {
+  const double one = add_identity ? 1.0 : 0.0;
+  const auto m00 = m.select(-2, 0).select(-1, 0), m11 = m.select(-2, 1).select(-1, 1);
+  const auto a = add_identity ? one + m00 : m00, b = m.select(-2, 0).select(-1, 1);
+  const auto c = m.select(-2, 1).select(-1, 0), d = add_identity ? one + m11 : m11;
+  const auto r0 = r.select(-1, 0), r1 = r.select(-1, 1);
+  const auto det = a * d - b * c;  // [a b; c d] delta = -r
+  return torch::stack({(b * r1 - d * r0) / det, (c * r0 - a * r1) / det}, -1);
+}
+
+}  // namespace
+
 DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tensor& x,
                                   const torch::Tensor& u, double h,
                                   const DgInferenceOptions& options, DgNewtonJacobian* cache) {
@@ -75,12 +92,7 @@ DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tenso
       ++out.jacobian_evaluations;
     }
     previous_norm = norm;
-    const auto jac = -h * jacobian;  // + I on the diagonal below
-    const auto a = 1.0 + jac.select(-1, 0).select(-1, 0), b = jac.select(-2, 0).select(-1, 1);
-    const auto c = jac.select(-2, 1).select(-1, 0), d = 1.0 + jac.select(-1, 1).select(-1, 1);
-    const auto r0 = r.select(-1, 0), r1 = r.select(-1, 1);
-    const auto det = a * d - b * c;  // Cramer's rule, 2 x 2: [a b; c d] delta = -r
-    const auto delta = torch::stack({(b * r1 - d * r0) / det, (c * r0 - a * r1) / det}, -1);
+    const auto delta = newton_update(-h * jacobian, /*add_identity=*/true, r);
     // Converged rows keep their solution.
     dx = dx + torch::where(converged.unsqueeze(-1), torch::zeros_like(delta), delta);
     out.iterations = it + 1;
@@ -153,11 +165,7 @@ DgInferenceStep dg4_inference_step(const DynamicsModel& model, const torch::Tens
       jac = torch::where(need.unsqueeze(-1).unsqueeze(-1), exact, jac);
       ++out.jacobian_evaluations;
     }
-    const auto a = jac.select(-2, 0).select(-1, 0), b = jac.select(-2, 0).select(-1, 1);
-    const auto c = jac.select(-2, 1).select(-1, 0), d = jac.select(-2, 1).select(-1, 1);
-    const auto r0 = r.select(-1, 0), r1 = r.select(-1, 1);
-    const auto det = a * d - b * c;  // Cramer's rule, 2 x 2: [a b; c d] delta = -r
-    const auto delta = torch::stack({(b * r1 - d * r0) / det, (c * r0 - a * r1) / det}, -1);
+    const auto delta = newton_update(jac, /*add_identity=*/false, r);
     dx = dx + torch::where(converged.unsqueeze(-1), torch::zeros_like(delta), delta);
     out.iterations = it + 1;
   }
