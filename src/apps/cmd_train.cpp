@@ -1,4 +1,6 @@
 // src/apps/cmd_train.cpp — `phnn train`: one cell, all its seeds stacked.
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -95,6 +97,21 @@ std::string provenance_value(const Provenance& provenance, const std::string& ke
   return "";
 }
 
+// --out is checked before training, not after: it must not exist (train
+// never overwrites results) and its directory must exist and be writable.
+void require_new_output(const std::string& path) {
+  if (std::ifstream(path).good()) {
+    throw cli::UsageError{"phnn train: --out " + path +
+                          " exists; choose a new path (train never overwrites results)"};
+  }
+  const std::size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+  if (::access(dir.c_str(), W_OK) != 0) {
+    throw cli::UsageError{"phnn train: --out " + path + ": directory " + dir +
+                          " does not exist or is not writable; create it or choose another path"};
+  }
+}
+
 }  // namespace
 
 int run_train(int argc, char** argv, int first) {
@@ -166,16 +183,18 @@ int run_train(int argc, char** argv, int first) {
             << " steps=" << cell.training.steps << "\n";
   const bool quiet = parser.flag_set("quiet");
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  if (parser.has("out") && std::ifstream(parser.get("out")).good()) {
-    throw cli::UsageError{"phnn train: --out " + parser.get("out") +
-                          " exists; choose a new path (train never overwrites results)"};
-  }
+  if (parser.has("out")) require_new_output(parser.get("out"));
+  // A terminal gets one self-overwriting line; a log file a plain line per
+  // tenth of the run (no carriage returns in logs).
+  const bool terminal = ::isatty(STDERR_FILENO) != 0;
   const auto results = train_cell(cell, data, [&](const TrainProgress& p) {
     if (quiet) return;
+    const int tenth = std::max(1, p.total_steps / 10);
+    if (!terminal && p.step % tenth != 0 && p.step != p.total_steps) return;
     const double eta = p.step > 0 ? p.elapsed_s / p.step * (p.total_steps - p.step) : 0.0;
-    std::fprintf(stderr, "\r  step %d/%d  best val %.3e  elapsed %.0f s  ETA %.0f s   ", p.step,
-                 p.total_steps, p.best_validation_loss, p.elapsed_s, eta);
-    if (p.step == p.total_steps) std::fprintf(stderr, "\n");
+    std::fprintf(stderr, "%s  step %d/%d  best val %.3e  elapsed %.0f s  ETA %.0f s   %s",
+                 terminal ? "\r" : "", p.step, p.total_steps, p.best_validation_loss, p.elapsed_s,
+                 eta, terminal && p.step != p.total_steps ? "" : "\n");
   });
   std::vector<double> mses;
   double wall = 0.0;

@@ -137,8 +137,11 @@ std::string truncate_message(const std::string& text, std::size_t length) {
 // another sweep.
 std::string results_file_problem(const std::string& path, const std::string* expected_hash) {
   if (::access(path.c_str(), F_OK) != 0) {
-    return path + ": no such results file; check the path, or start a new sweep "
-                  "instead of resuming";
+    return expected_hash != nullptr
+               ? path + ": no such results file; check the path, or start a new sweep "
+                        "instead of resuming"
+               : path + ": no such results file; check the path (results files are written "
+                        "by `phnn sweep` and `phnn train --out`)";
   }
   if (!h5::File::is_hdf5(path)) {
     return path + ": not an HDF5 file, so not a phnn results file; pass a new --out "

@@ -47,20 +47,20 @@ void require_finite_data(const SystemData& data, int n_train) {
 void CellSpec::validate(const SystemData& data) const {
   training.validate();
   PHNN_REQUIRE(!(model == ModelKind::kNode && is_discrete_gradient(integrator)),
-               "Invalid CellSpec: integrator = " << to_string(integrator)
-                   << " with model = node; the discrete gradient needs a Hamiltonian (use rk2 "
-                      "or rk4, or phnn-s / phnn-jr)");
+               "integrator = " << to_string(integrator)
+                   << " with model = node: the discrete gradient needs a Hamiltonian, which "
+                      "NODE has not (use rk2 or rk4, or phnn-s / phnn-jr)");
   PHNN_REQUIRE(n_train >= 1 && static_cast<std::size_t>(n_train) <= data.train.size(),
-               "Invalid CellSpec: n_train = " << n_train << "; the data set has "
+               "n_train = " << n_train << "; the data set has "
                                               << data.train.size() << " training pairs");
-  PHNN_REQUIRE(!seeds.empty(), "Invalid CellSpec: no seeds");
+  PHNN_REQUIRE(!seeds.empty(), "no seeds");
   for (std::size_t i = 0; i < seeds.size(); ++i) {
-    PHNN_REQUIRE(seeds[i] >= 0, "Invalid CellSpec: seed = " << seeds[i] << " must be >= 0");
+    PHNN_REQUIRE(seeds[i] >= 0, "seed = " << seeds[i] << " must be >= 0");
     for (std::size_t j = 0; j < i; ++j) {
-      PHNN_REQUIRE(seeds[i] != seeds[j], "Invalid CellSpec: seed " << seeds[i] << " listed twice");
+      PHNN_REQUIRE(seeds[i] != seeds[j], "seed " << seeds[i] << " listed twice");
     }
   }
-  PHNN_REQUIRE(!data.validation.x.empty(), "Invalid CellSpec: the data set has no validation pairs");
+  PHNN_REQUIRE(!data.validation.x.empty(), "the data set has no validation pairs");
   require_finite_data(data, n_train);
 }
 

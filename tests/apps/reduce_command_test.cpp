@@ -185,5 +185,16 @@ TEST_F(ReduceCommandTest, PerRunNeedsCsvAndExcludesSeedsSummary) {
   EXPECT_THAT(out, HasSubstr("exclude each other"));
 }
 
+// A missing file gets a reducer's hint, not the sweep's "start a new sweep
+// instead of resuming".
+TEST(ReduceCommandMissingFileTest, NamesThePathWithoutSweepAdvice) {
+  std::string out;
+  EXPECT_EQ(testing_util::run_shell(std::string(PHNN_BINARY) + " reduce /nonexistent-dir/r.h5",
+                                    &out),
+            1);
+  EXPECT_THAT(out, HasSubstr("/nonexistent-dir/r.h5: no such results file; check the path"));
+  EXPECT_THAT(out, Not(HasSubstr("start a new sweep")));
+}
+
 }  // namespace
 }  // namespace phnn

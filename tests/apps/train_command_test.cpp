@@ -18,6 +18,7 @@ namespace phnn {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 int run(const std::string& args, std::string* output) {
   return testing_util::run_shell(std::string(PHNN_BINARY) + " " + args, output);
@@ -48,6 +49,7 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
   std::string log;
   EXPECT_EQ(run("train --system harmonic --model node --integrator dg --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("integrator = dg with model = node"));
+  EXPECT_THAT(log, Not(HasSubstr("CellSpec")));  // no internal names in messages
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --steps -4", &log), 2);
   EXPECT_THAT(log, HasSubstr("--steps = -4"));
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 3-1", &log), 2);
@@ -56,6 +58,27 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
   EXPECT_THAT(log, HasSubstr("seed 1 listed twice"));
   EXPECT_EQ(run("train --system harmonic --model mlp", &log), 2);
   EXPECT_THAT(log, HasSubstr("unknown model \"mlp\""));
+}
+
+// --out into a missing directory is refused before training (it used to
+// train for the whole run, then fail to write).
+TEST(TrainCommandTest, UnwritableOutIsRefusedBeforeTraining) {
+  std::string log;
+  EXPECT_EQ(run("train --system harmonic --model phnn-jr --steps 50000 --seeds 0-9 "
+                "--out /nonexistent-dir/x.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("directory /nonexistent-dir does not exist or is not writable"));
+  EXPECT_THAT(log, Not(HasSubstr("median [IQR]")));
+}
+
+// Progress written to a file (not a terminal) has no carriage returns: one
+// plain line per tenth of the run.
+TEST(TrainCommandTest, ProgressInALogFileHasNoCarriageReturns) {
+  std::string log;
+  ASSERT_EQ(run("train --system harmonic --model phnn-jr --steps 100 --eval-every 10 --seeds 0",
+                &log), 0) << log;
+  EXPECT_EQ(log.find('\r'), std::string::npos);
+  EXPECT_THAT(log, HasSubstr("step 100/100"));
+  EXPECT_THAT(log, HasSubstr("step 50/100"));
 }
 
 }  // namespace
