@@ -74,6 +74,45 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
+// Rank 0's [progress] line: items done, runs per minute, elapsed time, an ETA
+// from the cost model (the estimated cost still to do over the estimated
+// cost done per elapsed second: items are handed out largest first, so a
+// count of items would overestimate), and the UTC time. Under static
+// scheduling rank 0 sees only its own items (every size-th): the line counts
+// that share and says so.
+class ProgressLine {
+ public:
+  ProgressLine(const std::vector<WorkItem>& work, int ranks, bool static_share)
+      : static_share_(static_share) {
+    cost_.push_back(0.0);
+    runs_.push_back(0);
+    for (std::size_t i = 0; i < work.size(); i += static_share ? static_cast<std::size_t>(ranks) : 1) {
+      cost_.push_back(cost_.back() + work[i].estimated_cost_s);
+      runs_.push_back(runs_.back() + static_cast<long>(work[i].runs.size()));
+    }
+  }
+
+  void print(int items_done, double elapsed_s) const {
+    const std::size_t n = cost_.size() - 1;
+    const std::size_t done = std::min<std::size_t>(static_cast<std::size_t>(items_done), n);
+    const double minutes = elapsed_s / 60.0;
+    std::string eta = "--";
+    if (done > 0 && done < n && cost_[done] > 0.0) {
+      eta = format_duration(elapsed_s * (cost_[n] - cost_[done]) / cost_[done]);
+    }
+    std::printf("[progress] items %zu/%zu%s  %.1f runs/min  elapsed %s  ETA %s  (%s)\n", done, n,
+                static_share_ ? " (rank 0's share, static scheduling)" : "",
+                minutes > 0 ? static_cast<double>(runs_[done]) / minutes : 0.0,
+                format_duration(elapsed_s).c_str(), eta.c_str(), utc_now().c_str());
+    std::fflush(stdout);
+  }
+
+ private:
+  bool static_share_;
+  std::vector<double> cost_;  // cumulative estimated cost of the items rank 0 counts
+  std::vector<long> runs_;    // cumulative runs of the same items
+};
+
 // --split and --max-group-size; throws cli::UsageError.
 SplitOptions split_options(const cli::Parser& parser) {
   SplitOptions options;
@@ -468,20 +507,11 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   const bool quiet = parser_.flag_set("quiet");
   int my_runs = 0;
   double last_progress = -1e9;
+  const ProgressLine progress_line(work, size_, queue.mode() == ScheduleMode::kStatic);
   auto report_progress = [&](bool force) {
-    if (!root_ || (!force && elapsed() - last_progress < 10.0)) return;
+    if (!root_ || quiet || (!force && elapsed() - last_progress < 10.0)) return;
     last_progress = elapsed();
-    const int items_done = queue.done();
-    const double minutes = elapsed() / 60.0;
-    const double rate = minutes > 0 ? items_done / minutes : 0.0;
-    const double runs_per_item = work.empty() ? 0.0 : static_cast<double>(runs_to_do) / work.size();
-    std::string eta = "--";
-    if (items_done > 0 && items_done < static_cast<int>(work.size())) {
-      eta = format_duration((work.size() - items_done) / rate * 60.0);
-    }
-    std::printf("[progress] items %d/%zu  %.1f runs/min  elapsed %s  ETA %s\n", items_done,
-                work.size(), rate * runs_per_item, format_duration(elapsed()).c_str(), eta.c_str());
-    std::fflush(stdout);
+    progress_line.print(queue.done(), elapsed());
   };
   // An I/O error on this rank: it takes no more items; the others finish
   // theirs, then every rank learns of it (agree below) and exits 1.

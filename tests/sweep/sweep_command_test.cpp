@@ -26,6 +26,7 @@ namespace phnn {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string temp_dir(const std::string& name) {
   const std::string dir = ::testing::TempDir() + "phnn_sweep_" + name + "_" + std::to_string(::getpid());
@@ -124,6 +125,7 @@ TEST(SweepCommandTest, ResultsDoNotDependOnTheNumberOfRanksOrScheduling) {
               0)
         << log;
     EXPECT_THAT(log, HasSubstr(is_static ? "static scheduling" : "dynamic scheduling"));
+    EXPECT_THAT(log, Not(HasSubstr("[progress]")));  // --quiet means quiet
     files.push_back(ResultsFile::open_read_only(out));
   }
   const auto statuses = files[0].read_statuses();
@@ -135,6 +137,18 @@ TEST(SweepCommandTest, ResultsDoNotDependOnTheNumberOfRanksOrScheduling) {
       expect_same_run(files[f].read_run(row), files[0].read_run(row), row);
     }
   }
+}
+
+// Under --static rank 0 sees only its own items: its progress line counts
+// that share and says so (it used to report its items against the total).
+TEST(SweepCommandTest, StaticProgressCountsRankZerosShare) {
+  const std::string dir = temp_dir("progress");
+  const std::string sweep = write_sweep(dir, kSweep);
+  std::string log;
+  ASSERT_EQ(shell(mpiexec(2) + " sweep " + sweep + " --static --out " + dir + "/s.h5", &log), 0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("(rank 0's share, static scheduling)"));
+  EXPECT_THAT(log, HasSubstr("Z)\n"));  // the UTC time ends the line
 }
 
 TEST(SweepCommandTest, KilledRankThenRerunCompletesEveryRunOnce) {
