@@ -33,6 +33,7 @@
 #include "phnn/sweep/results_file.h"
 #include "phnn/sweep/scheduler.h"
 #include "phnn/sweep/sweep_file.h"
+#include "phnn/sweep/sweep_growth.h"
 #include "phnn/sweep/version.h"
 #include "phnn/sweep/work_plan.h"
 #include "phnn/sweep/writer_lock.h"
@@ -224,10 +225,12 @@ std::string launch_problem(int size) {
 }
 
 // Rank 0, holding nothing yet: takes the writer lock of `out`, then decides
-// what to do with what is there. Returns 0 = create, 1 = resume; throws
-// (UsageError: refusal, status 2; runtime_error: lock held, status 1).
+// what to do with what is there; a results file of another sweep text is
+// replaced by its new version first (sweep_growth.h). Returns 0 = create,
+// 1 = resume; throws (UsageError: refusal, status 2; runtime_error: lock
+// held, I/O, status 1).
 int prepare_output(const std::string& out, const std::string& sweep_path, const SweepSpec& spec,
-                   WriterLock* lock) {
+                   const Grid& grid, WriterLock* lock) {
   make_parent_directories(out);
   const LockOutcome outcome = lock->acquire(out, spec.text_hash);
   if (!outcome.acquired) throw std::runtime_error(outcome.message);
@@ -237,6 +240,14 @@ int prepare_output(const std::string& out, const std::string& sweep_path, const 
     case OutputState::kMissing:
       return 0;
     case OutputState::kResumable:
+      return 1;
+    case OutputState::kOtherText:
+      try {
+        std::cout << "phnn sweep: " << write_grown_results(out, spec, grid, program_version())
+                  << "\n";
+      } catch (const RunSetRefused& e) {
+        throw cli::UsageError{std::string("phnn sweep: ") + e.what()};
+      }
       return 1;
     case OutputState::kEmpty:
     case OutputState::kDamaged: {
@@ -370,7 +381,7 @@ class SweepRun {
     out_ = parser_.has("out") ? parser_.get("out") : spec_.output;
     int action = 0;
     if (int status = agreed(world_, root_, [&] {
-          action = prepare_output(out_, parser_.get("FILE"), spec_, &lock_);
+          action = prepare_output(out_, parser_.get("FILE"), spec_, grid_, &lock_);
         })) {
       return status;
     }

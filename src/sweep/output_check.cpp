@@ -43,13 +43,10 @@ OutputCheck inspect_hdf5(const std::string& out, const std::string& sweep_hash) 
                    format + "\"); phnn sweep never replaces other files: pass another --out "
                    "path or move it away");
   }
+  bool same_text = false;
   try {
     const ResultsFile file = ResultsFile::open_read_only(out);
-    if (file.sweep_hash() != sweep_hash) {
-      return refused(out + " was written by sweep '" + file.sweep_name() + "' (hash " +
-                     file.sweep_hash() + "), not by this sweep file (hash " + sweep_hash +
-                     "); pass a new --out path or delete the file");
-    }
+    same_text = file.sweep_hash() == sweep_hash;
     file.read_run_ids();
     try {
       file.read_statuses();  // throws std::runtime_error on a status outside 0..3
@@ -65,6 +62,7 @@ OutputCheck inspect_hdf5(const std::string& out, const std::string& sweep_hash) 
   } catch (const std::exception& e) {
     return refused(e.what());  // another format version, ...
   }
+  if (!same_text) return {OutputState::kOtherText, "written by another sweep text"};
   return {OutputState::kResumable, ""};
 }
 

@@ -307,6 +307,41 @@ TEST(SweepCommandTest, BadSweepFilesExitTwoBeforeWritingAnything) {
   }
 }
 
+// A sweep file that adds seeds (and a comment) resumes into a new version of
+// its results file: the finished runs are kept bitwise, only the new ones are
+// trained, and the whole equals a fresh run of the grown sweep. A sweep file
+// that changes a run's configuration is refused on every rank, file unchanged.
+TEST(SweepCommandTest, GrownSweepKeepsFinishedRunsAndChangedSweepIsRefused) {
+  const std::string dir = temp_dir("grow");
+  std::string text = kSweep;
+  text.replace(text.find("seeds = [0, 1, 2]"), 17, "seeds = [0, 1]");
+  const std::string out = dir + "/grow.h5", fresh = dir + "/fresh.h5";
+  std::string log;
+  ASSERT_EQ(shell(mpiexec(2) + " sweep " + write_sweep(dir, text) + " --quiet --out " + out, &log),
+            0) << log;
+  std::string grown = "# grown by one seed\n" + text;
+  grown.replace(grown.find("seeds = [0, 1]"), 14, "seeds = [0, 1, 2]");
+  const std::string sweep = write_sweep(dir, grown);
+  ASSERT_EQ(shell(mpiexec(2) + " sweep " + sweep + " --quiet --out " + out, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("grew by 3 runs; new version of the file with 6 runs with results "
+                             "kept bitwise"));
+  EXPECT_THAT(log, HasSubstr("6 finished before, 3 to run"));
+  ASSERT_EQ(shell(mpiexec(1) + " sweep " + sweep + " --quiet --out " + fresh, &log), 0) << log;
+  {
+    const ResultsFile a = ResultsFile::open_read_only(out), b = ResultsFile::open_read_only(fresh);
+    ASSERT_EQ(a.read_run_ids(), b.read_run_ids());
+    for (int row = 0; row < a.num_runs(); ++row) expect_same_run(a.read_run(row), b.read_run(row), row);
+  }
+  std::string changed = grown;
+  changed.replace(changed.find("steps = 30"), 10, "steps = 40");
+  const std::string hash_before = ResultsFile::open_read_only(out).sweep_hash();
+  EXPECT_EQ(shell(mpiexec(2) + " sweep " + write_sweep(dir, changed) + " --out " + out, &log), 2)
+      << log;
+  EXPECT_THAT(log, HasSubstr("steps: 30 -> 40 (9 runs"));
+  EXPECT_THAT(log, Not(HasSubstr("MPI_ABORT")));
+  EXPECT_EQ(ResultsFile::open_read_only(out).sweep_hash(), hash_before);
+}
+
 TEST(SweepCommandTest, DryRunPrintsRunsAndCellsOfThePaper) {
   std::string log;
   ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + PHNN_SOURCE_DIR + "/sweeps/paper.toml --dry-run", &log), 0);

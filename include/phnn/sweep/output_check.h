@@ -11,6 +11,7 @@ namespace phnn {
 enum class OutputState {
   kMissing,     ///< nothing there: create
   kResumable,   ///< a phnn results file of this sweep: resume
+  kOtherText,   ///< a phnn results file of another sweep text: compare the runs (sweep_growth.h)
   kEmpty,       ///< an empty regular file (a crash right after creating it): move aside, create
   kDamaged,     ///< HDF5 signature but unreadable (truncated): move aside, rebuild from journals
   kRefused,     ///< anything else: refuse, message says why and what to do
@@ -25,8 +26,7 @@ struct OutputCheck {
 /// Inspects `out` (serial, no MPI) for a sweep read from `sweep_path` whose
 /// hash is `sweep_hash`. Refused: a directory, FIFO, device or other
 /// non-regular file; the sweep file itself; a non-HDF5 file with content; an
-/// HDF5 file that is not a phnn results file; another format version;
-/// another sweep's results; a results file with an impossible value (a
+/// HDF5 file that is not a phnn results file; another format version; a results file with an impossible value (a
 /// status outside 0..3: something other than phnn wrote into it); a journal
 /// path (`<out>.journal`) that is not a directory. Never throws.
 OutputCheck inspect_output(const std::string& out, const std::string& sweep_path,

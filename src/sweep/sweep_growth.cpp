@@ -1,0 +1,314 @@
+// src/sweep/sweep_growth.cpp — run-set comparison and the new version of a
+// results file whose sweep grew (see include/phnn/sweep/sweep_growth.h).
+#include "phnn/sweep/sweep_growth.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <set>
+#include <utility>
+
+#include "phnn/sweep/journal.h"
+#include "phnn/sweep/results_file.h"
+
+namespace phnn {
+namespace {
+
+using KeyValues = std::map<std::string, std::string>;
+
+// "system=duffing;model=node;..." -> {system: duffing, model: node, ...}.
+KeyValues split_canonical(const std::string& canonical) {
+  KeyValues fields;
+  std::size_t start = 0;
+  while (start <= canonical.size()) {
+    std::size_t end = canonical.find(';', start);
+    if (end == std::string::npos) end = canonical.size();
+    const std::string item = canonical.substr(start, end - start);
+    const std::size_t eq = item.find('=');
+    if (eq != std::string::npos) fields[item.substr(0, eq)] = item.substr(eq + 1);
+    start = end + 1;
+  }
+  return fields;
+}
+
+// The grid point of a run: the axes of a sweep file's [grid] tables.
+const char* const kGridAxes[] = {"system", "model", "integrator", "size", "n_train",
+                                 "regularizer", "seed"};
+
+std::string grid_point(const KeyValues& fields) {
+  std::string point;
+  for (const char* axis : kGridAxes) {
+    auto it = fields.find(axis);
+    point += std::string(axis) + "=" + (it == fields.end() ? "" : it->second) + ";";
+  }
+  return point;
+}
+
+// "duffing phnn-jr-rk2 small n_train=25 none seed=0".
+std::string describe_point(const KeyValues& f) {
+  auto get = [&](const char* key) {
+    auto it = f.find(key);
+    return it == f.end() ? std::string("?") : it->second;
+  };
+  return get("system") + " " + get("model") + "-" + get("integrator") + " " + get("size") +
+         " n_train=" + get("n_train") + " " + get("regularizer") + " seed=" + get("seed");
+}
+
+// "steps: 50000 -> 25000; lr: 0.001 -> 0.0001" (keys in the order of `after`
+// then keys only `before` has).
+std::string describe_difference(const KeyValues& before, const KeyValues& after) {
+  std::string text;
+  auto add = [&](const std::string& key, const std::string& a, const std::string& b) {
+    text += (text.empty() ? "" : "; ") + key + ": " + a + " -> " + b;
+  };
+  for (const auto& [key, value] : after) {
+    auto it = before.find(key);
+    if (it == before.end()) {
+      add(key, "(unset)", value);
+    } else if (it->second != value) {
+      add(key, it->second, value);
+    }
+  }
+  for (const auto& [key, value] : before) {
+    if (!after.count(key)) add(key, value, "(unset)");
+  }
+  return text;
+}
+
+struct ChangeGroup {
+  int count = 0;
+  std::string example;
+};
+
+}  // namespace
+
+bool RunSetComparison::same_runs_in_order() const {
+  if (added || !dropped_pending_rows.empty() || refused()) return false;
+  for (std::size_t i = 0; i < file_row_of_run.size(); ++i) {
+    if (file_row_of_run[i] != static_cast<int>(i)) return false;
+  }
+  return true;
+}
+
+RunSetComparison compare_run_sets(const std::vector<std::string>& file_canonical,
+                                  const std::vector<RunStatus>& file_status,
+                                  const std::vector<RunConfig>& sweep_runs) {
+  if (file_canonical.size() != file_status.size()) {
+    throw std::invalid_argument("compare_run_sets: " + std::to_string(file_canonical.size()) +
+                                " canonical configurations but " +
+                                std::to_string(file_status.size()) + " statuses");
+  }
+  std::map<std::string, int> file_row;
+  for (std::size_t row = 0; row < file_canonical.size(); ++row) {
+    file_row.emplace(file_canonical[row], static_cast<int>(row));
+  }
+  RunSetComparison result;
+  std::set<int> kept_rows;
+  std::map<std::string, KeyValues> added_at_point;  // grid point -> fields of the new run
+  for (const RunConfig& run : sweep_runs) {
+    const std::string canonical = run.canonical();
+    auto it = file_row.find(canonical);
+    result.file_row_of_run.push_back(it == file_row.end() ? -1 : it->second);
+    if (it != file_row.end()) {
+      kept_rows.insert(it->second);
+      continue;
+    }
+    ++result.added;
+    KeyValues fields = split_canonical(canonical);
+    added_at_point.emplace(grid_point(fields), std::move(fields));
+  }
+  std::map<std::string, ChangeGroup> groups;  // difference -> count, example
+  for (std::size_t row = 0; row < file_canonical.size(); ++row) {
+    if (kept_rows.count(static_cast<int>(row))) continue;
+    const KeyValues before = split_canonical(file_canonical[row]);
+    auto replacement = added_at_point.find(grid_point(before));
+    if (replacement != added_at_point.end()) {
+      ChangeGroup& group = groups[describe_difference(before, replacement->second)];
+      if (group.count++ == 0) group.example = describe_point(before);
+    } else if (file_status[row] == RunStatus::kPending) {
+      result.dropped_pending_rows.push_back(static_cast<int>(row));
+    } else {
+      result.removed_result_rows.push_back(static_cast<int>(row));
+    }
+  }
+  for (const auto& [difference, group] : groups) {
+    result.changes.push_back(difference + " (" + std::to_string(group.count) +
+                             (group.count == 1 ? " run: " : " runs, e.g. ") + group.example + ")");
+  }
+  return result;
+}
+
+namespace {
+
+constexpr std::size_t kListedRows = 5;
+
+std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
+                            const std::vector<std::string>& file_canonical) {
+  std::string text = out + ": this sweep file does not only add runs to the results file:";
+  if (!cmp.changes.empty()) {
+    text += "\n  it changes the configuration of runs (a results file holds one configuration "
+            "per grid point):";
+    for (const std::string& change : cmp.changes) text += "\n    " + change;
+  }
+  if (!cmp.removed_result_rows.empty()) {
+    text += "\n  " + std::to_string(cmp.removed_result_rows.size()) +
+            " runs with results are no longer in it, e.g.:";
+    for (std::size_t k = 0; k < std::min(kListedRows, cmp.removed_result_rows.size()); ++k) {
+      text += "\n    " + describe_point(split_canonical(file_canonical[cmp.removed_result_rows[k]]));
+    }
+  }
+  return text + "\n  restore the sweep file's settings and runs, or write to a new results "
+                "file with --out (or another `output`); the file is unchanged";
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+void fsync_path(const std::string& path, int flags) {
+  const int fd = ::open(path.c_str(), flags);
+  if (fd < 0) throw std::runtime_error(path + ": cannot open to sync: " + errno_text());
+  const int status = ::fsync(fd);
+  ::close(fd);
+  if (status != 0 && flags != O_RDONLY) {
+    throw std::runtime_error(path + ": fsync failed: " + errno_text());
+  }
+}
+
+std::string parent_directory(const std::string& path) {
+  const std::size_t slash = path.rfind('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+// Our scratch name next to `out`; a leftover of a crash is ours to replace
+// (empty, or an HDF5 file), anything else is refused.
+std::string scratch_path(const std::string& out) {
+  const std::string path = out + ".new-version";
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) return path;
+  char head[4] = {};
+  std::ifstream in(path, std::ios::binary);
+  const bool hdf5 = in.read(head, 4) && std::memcmp(head, "\x89HDF", 4) == 0;
+  if (!S_ISREG(st.st_mode) || (st.st_size > 0 && !hdf5)) {
+    throw std::runtime_error(path + ": exists and is not a results file phnn left behind; move "
+                             "it away (phnn writes a results file's new version there)");
+  }
+  if (std::remove(path.c_str()) != 0) {
+    throw std::runtime_error(path + ": cannot remove a leftover new version: " + errno_text());
+  }
+  return path;
+}
+
+ResultsLayout wider_layout(const ResultsLayout& a, const ResultsLayout& b) {
+  ResultsLayout layout;
+  layout.num_inference = std::max(a.num_inference, b.num_inference);
+  layout.trace_points = std::max(a.trace_points, b.trace_points);
+  layout.figure_points = std::max(a.figure_points, b.figure_points);
+  layout.checkpoints = std::max(a.checkpoints, b.checkpoints);
+  return layout;
+}
+
+std::string join_studies(const std::vector<std::string>& studies) {
+  std::string text;
+  for (const std::string& s : studies) text += (text.empty() ? "" : ",") + s;
+  return text;
+}
+
+// The old file's sessions, in order, into the new file.
+void copy_sessions(const ResultsFile& from, ResultsFile* to) {
+  for (Provenance session : from.read_sessions()) {
+    std::string finished;
+    auto it = std::find_if(session.begin(), session.end(),
+                           [](const auto& kv) { return kv.first == "finished"; });
+    if (it != session.end()) {
+      finished = it->second;
+      session.erase(it);
+    }
+    to->begin_session(session);
+    if (!finished.empty()) to->end_session(finished);
+  }
+}
+
+// Copies every row of `from` that holds a result into its row of `to`;
+// returns the (sweep run, file row) pairs copied.
+std::vector<std::pair<int, int>> copy_results(const ResultsFile& from, const RunSetComparison& cmp,
+                                              ResultsFile* to) {
+  const std::vector<RunStatus> status = from.read_statuses();
+  const bool times = from.has_run_times();
+  const std::vector<std::string> started = times ? from.read_started_utc() : std::vector<std::string>();
+  const std::vector<std::string> finished = times ? from.read_finished_utc() : std::vector<std::string>();
+  std::vector<std::pair<int, int>> copied;
+  for (std::size_t run = 0; run < cmp.file_row_of_run.size(); ++run) {
+    const int row = cmp.file_row_of_run[run];
+    if (row < 0 || status[row] == RunStatus::kPending) continue;
+    if (times) to->write_run_times(static_cast<int>(run), started[row], finished[row]);
+    to->write_run(static_cast<int>(run), from.read_run(row));
+    copied.emplace_back(static_cast<int>(run), row);
+  }
+  return copied;
+}
+
+// Every copied row reads back bit for bit (journal encoding: hex floats).
+void verify_copies(const ResultsFile& from, const std::string& written,
+                   const std::vector<std::pair<int, int>>& copied) {
+  const ResultsFile check = ResultsFile::open_read_only(written);
+  for (const auto& [run, row] : copied) {
+    if (internal::encode_journal_record("x", check.read_run(run), 0) !=
+        internal::encode_journal_record("x", from.read_run(row), 0)) {
+      throw std::runtime_error(written + ": row " + std::to_string(run) + " does not read back as "
+                               "row " + std::to_string(row) + " of the previous version; the "
+                               "previous version is left in place");
+    }
+  }
+}
+
+}  // namespace
+
+std::string write_grown_results(const std::string& out, const SweepSpec& spec, const Grid& grid,
+                                const std::string& program_version) {
+  std::vector<std::pair<int, int>> copied;
+  std::string scratch;
+  RunSetComparison cmp;
+  {
+    const ResultsFile old = ResultsFile::open_read_only(out);
+    const std::vector<std::string> canonical = old.read_canonical();
+    cmp = compare_run_sets(canonical, old.read_statuses(), grid.runs);
+    if (cmp.refused()) throw RunSetRefused(refusal_message(out, cmp, canonical));
+    std::vector<std::string> studies;
+    for (const auto& s : grid.run_studies) studies.push_back(join_studies(s));
+    scratch = scratch_path(out);
+    ResultsFile fresh = ResultsFile::create(
+        scratch, MPI_COMM_NULL, grid.runs, studies, spec.name, spec.text, spec.text_hash,
+        program_version, wider_layout(old.layout(), ResultsLayout::for_runs(grid.runs)));
+    copy_sessions(old, &fresh);
+    copied = copy_results(old, cmp, &fresh);
+    fresh.close();
+    verify_copies(old, scratch, copied);
+  }
+  fsync_path(scratch, O_RDWR);
+  if (std::rename(scratch.c_str(), out.c_str()) != 0) {
+    throw std::runtime_error(scratch + ": cannot rename it to " + out + ": " + errno_text());
+  }
+  fsync_path(parent_directory(out), O_RDONLY);
+  const std::string kept = std::to_string(copied.size()) + " runs with results kept bitwise";
+  const std::size_t dropped = cmp.dropped_pending_rows.size();
+  std::string what;
+  if (cmp.added) {
+    what = "the sweep grew by " + std::to_string(cmp.added) + " runs";
+  } else if (dropped) {
+    what = "the sweep no longer has " + std::to_string(dropped) + " of its pending runs";
+  } else {
+    what = cmp.same_runs_in_order() ? "the sweep file's text changed, not its runs"
+                                    : "the sweep file lists the same runs in another order";
+  }
+  if (cmp.added && dropped) what += " and no longer has " + std::to_string(dropped) + " pending runs";
+  return out + ": " + what + "; new version of the file with " + kept;
+}
+
+}  // namespace phnn

@@ -1,0 +1,203 @@
+// tests/sweep/sweep_growth_test.cpp — a results file's identity is its set
+// of runs: added runs grow it (finished runs kept bitwise), text-only edits
+// rewrite it, changed runs and dropped results are refused.
+#include "phnn/sweep/sweep_growth.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <map>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/sweep/results_file.h"
+#include "sample_results.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+// 4 runs: node-rk2 seeds 0, 1 (rows 0, 1), phnn-s-dg seeds 0, 1 (rows 2, 3).
+const char* kSweep = R"(name = "grow"
+[training]
+steps = 30
+eval_every = 10
+[grid]
+systems = ["duffing"]
+models = ["node-rk2", "phnn-s-dg"]
+n_train = [25]
+seeds = [0, 1]
+)";
+
+std::string edited(std::string text, const std::string& from, const std::string& to) {
+  text.replace(text.find(from), from.size(), to);
+  return text;
+}
+
+Grid grid_of(const std::string& text) { return expand_grid(parse_sweep_text(text, "sweep.toml")); }
+
+std::vector<RunStatus> statuses(std::initializer_list<RunStatus> list) { return list; }
+
+std::vector<std::string> canonical_of(const Grid& grid) {
+  std::vector<std::string> out;
+  for (const RunConfig& run : grid.runs) out.push_back(run.canonical());
+  return out;
+}
+
+constexpr RunStatus kPending = RunStatus::kPending, kDone = RunStatus::kDone;
+
+TEST(CompareRunSetsTest, TheSameRunsInOrderDifferOnlyInText) {
+  const Grid grid = grid_of(kSweep);
+  const RunSetComparison cmp = compare_run_sets(
+      canonical_of(grid), statuses({kDone, kDone, kPending, kDone}),
+      grid_of(edited(kSweep, "[grid]", "# a comment\n[grid]  # and another")).runs);
+  EXPECT_TRUE(cmp.same_runs_in_order());
+  EXPECT_FALSE(cmp.refused());
+  EXPECT_THAT(cmp.file_row_of_run, ElementsAre(0, 1, 2, 3));
+}
+
+TEST(CompareRunSetsTest, MoreSeedsAreAddedAndMappedToTheirOldRows) {
+  const Grid grid = grid_of(kSweep);
+  const RunSetComparison cmp =
+      compare_run_sets(canonical_of(grid), statuses({kDone, kDone, kDone, kDone}),
+                       grid_of(edited(kSweep, "seeds = [0, 1]", "seeds = [0, 1, 2]")).runs);
+  EXPECT_EQ(cmp.added, 2);
+  EXPECT_FALSE(cmp.refused());
+  EXPECT_FALSE(cmp.same_runs_in_order());
+  // New order: node 0, 1, 2, phnn-s 0, 1, 2 (seed fastest).
+  EXPECT_THAT(cmp.file_row_of_run, ElementsAre(0, 1, -1, 2, 3, -1));
+}
+
+TEST(CompareRunSetsTest, AChangedSettingIsReportedOnceWithItsCount) {
+  const Grid grid = grid_of(kSweep);
+  const RunSetComparison cmp =
+      compare_run_sets(canonical_of(grid), statuses({kDone, kPending, kPending, kPending}),
+                       grid_of(edited(kSweep, "steps = 30", "steps = 40")).runs);
+  EXPECT_TRUE(cmp.refused());
+  EXPECT_EQ(cmp.added, 4);
+  ASSERT_EQ(cmp.changes.size(), 1u);
+  EXPECT_THAT(cmp.changes[0], HasSubstr("steps: 30 -> 40 (4 runs, e.g. duffing node-rk2 small "
+                                        "n_train=25 none seed=0)"));
+  EXPECT_TRUE(cmp.removed_result_rows.empty());  // changed, not removed
+}
+
+TEST(CompareRunSetsTest, ARemovedRunWithAResultIsRefusedAPendingOneDropped) {
+  const Grid grid = grid_of(kSweep);
+  const Grid node_only = grid_of(edited(kSweep, R"("node-rk2", "phnn-s-dg")", R"("node-rk2")"));
+  const RunSetComparison pending =
+      compare_run_sets(canonical_of(grid), statuses({kDone, kDone, kPending, kPending}),
+                       node_only.runs);
+  EXPECT_FALSE(pending.refused());
+  EXPECT_THAT(pending.dropped_pending_rows, ElementsAre(2, 3));
+  const RunSetComparison finished =
+      compare_run_sets(canonical_of(grid), statuses({kDone, kDone, kPending, RunStatus::kFailed}),
+                       node_only.runs);
+  EXPECT_TRUE(finished.refused());
+  EXPECT_THAT(finished.removed_result_rows, ElementsAre(3));
+  EXPECT_THAT(finished.dropped_pending_rows, ElementsAre(2));
+}
+
+class WriteGrownResultsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = ::testing::TempDir() + "phnn_grow_" + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::system(("rm -rf " + dir_ + " && mkdir -p " + dir_).c_str());
+    out_ = dir_ + "/out.h5";
+  }
+  void TearDown() override { std::system(("rm -rf " + dir_).c_str()); }
+
+  // The file of kSweep with results in rows 0 (done), 1 (diverged), 3 (done).
+  void create_original() {
+    const SweepSpec spec = parse_sweep_text(kSweep, "sweep.toml");
+    const Grid grid = expand_grid(spec);
+    ResultsFile file = ResultsFile::create(out_, MPI_COMM_NULL, grid.runs,
+                                           {"grid", "grid", "grid", "grid"}, spec.name, spec.text,
+                                           spec.text_hash, "v1", ResultsLayout::for_runs(grid.runs));
+    file.begin_session({{"command_line", "phnn sweep a"}, {"started", "t0"}});
+    file.end_session("t1");
+    for (int row : {0, 1, 3}) {
+      original_[grid.runs[row].canonical()] = testing_util::sample_result(row, file.layout());
+      file.write_run_times(row, "s" + std::to_string(row), "f" + std::to_string(row));
+      file.write_run(row, original_[grid.runs[row].canonical()]);
+    }
+    file.close();
+  }
+
+  std::string dir_, out_;
+  std::map<std::string, RunResult> original_;  // canonical -> result written
+};
+
+TEST_F(WriteGrownResultsTest, GrownFileKeepsEveryResultBitwiseInItsNewRow) {
+  create_original();
+  const SweepSpec grown = parse_sweep_text(
+      edited(kSweep, "seeds = [0, 1]", "seeds = [0, 1, 2]  # one more"), "sweep.toml");
+  const Grid grid = expand_grid(grown);
+  const std::string message = write_grown_results(out_, grown, grid, "v2");
+  EXPECT_THAT(message, HasSubstr("grew by 2 runs"));
+  EXPECT_THAT(message, HasSubstr("3 runs with results kept bitwise"));
+  const ResultsFile file = ResultsFile::open_read_only(out_);
+  EXPECT_EQ(file.sweep_text(), grown.text);
+  EXPECT_EQ(file.sweep_hash(), grown.text_hash);
+  ASSERT_EQ(file.num_runs(), 6);
+  const auto status = file.read_statuses();
+  const auto started = file.read_started_utc();
+  int kept = 0;
+  for (int run = 0; run < 6; ++run) {
+    auto it = original_.find(grid.runs[run].canonical());
+    if (it == original_.end()) {
+      EXPECT_EQ(status[run], RunStatus::kPending) << run;
+      continue;
+    }
+    ++kept;
+    testing_util::expect_bit_equal(it->second, file.read_run(run));
+    EXPECT_EQ(started[run][0], 's');
+  }
+  EXPECT_EQ(kept, 3);
+  const auto sessions = file.read_sessions();
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_THAT(sessions[0], ::testing::Contains(std::make_pair(std::string("finished"),
+                                                              std::string("t1"))));
+  EXPECT_THAT(sessions[0], ::testing::Contains(std::make_pair(std::string("command_line"),
+                                                              std::string("phnn sweep a"))));
+}
+
+TEST_F(WriteGrownResultsTest, TextOnlyEditIsSaidSo) {
+  create_original();
+  const SweepSpec commented = parse_sweep_text(std::string("# notes\n") + kSweep, "sweep.toml");
+  const std::string message = write_grown_results(out_, commented, expand_grid(commented), "v2");
+  EXPECT_THAT(message, HasSubstr("text changed, not its runs"));
+  EXPECT_EQ(ResultsFile::open_read_only(out_).sweep_hash(), commented.text_hash);
+}
+
+TEST_F(WriteGrownResultsTest, ChangedRunsAreRefusedAndTheFileIsUntouched) {
+  create_original();
+  const std::string before = ResultsFile::open_read_only(out_).sweep_hash();
+  const SweepSpec changed = parse_sweep_text(edited(kSweep, "steps = 30", "steps = 40"), "s.toml");
+  try {
+    write_grown_results(out_, changed, expand_grid(changed), "v2");
+    FAIL() << "a changed run was accepted";
+  } catch (const RunSetRefused& e) {
+    EXPECT_THAT(e.what(), HasSubstr(out_ + ": this sweep file does not only add runs"));
+    EXPECT_THAT(e.what(), HasSubstr("steps: 30 -> 40 (4 runs"));
+    EXPECT_THAT(e.what(), HasSubstr("--out"));
+  }
+  EXPECT_EQ(ResultsFile::open_read_only(out_).sweep_hash(), before);
+  const SweepSpec fewer = parse_sweep_text(edited(kSweep, "seeds = [0, 1]", "seeds = [0]"), "s");
+  try {
+    write_grown_results(out_, fewer, expand_grid(fewer), "v2");
+    FAIL() << "dropping runs with results was accepted";
+  } catch (const RunSetRefused& e) {
+    EXPECT_THAT(e.what(), HasSubstr("2 runs with results are no longer in it"));
+    EXPECT_THAT(e.what(), HasSubstr("duffing phnn-s-dg small n_train=25 none seed=1"));
+  }
+  EXPECT_EQ(ResultsFile::open_read_only(out_).sweep_hash(), before);
+}
+
+}  // namespace
+}  // namespace phnn
