@@ -5,6 +5,8 @@
 # USR1 once a first run is journaled (what --signal=B:USR1 does before the
 # time limit), lets the job requeue itself, requeues it once more by hand
 # mid-run (scontrol requeue), waits for it to finish and checks the table.
+# Then array mode: the same sweep as a 2-task job array (one shard each) and
+# a merge job that depends on it; the merged runs must equal the first job's.
 #
 #   bash jobs/test-slurm.sh            # from the repository root, after scripts/build.sh
 #
@@ -15,7 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 REPO=$(pwd)
 WORK=${WORK:-/tmp/phnn-test-slurm}
-PHNN=$REPO/build/phnn
+PHNN=${PHNN:-$REPO/build/phnn}
 log() { echo "[test-slurm $(date -u +%T)] $*"; }
 die() { log "FAILED: $*"; exit 1; }
 [[ $(id -u) -eq 0 ]] || die "needs root (installs packages, starts slurmctld/slurmd)"
@@ -130,3 +132,24 @@ grep -q "stopped on a signal" "$WORK/job-$JOB.log" || die "the USR1 stop is not 
 grep "finished before" "$WORK/job-$JOB.log" | tail -1 | grep -qE "; [1-9] finished before" ||
   die "the last start had nothing left to do: scontrol requeue did not interrupt the sweep"
 log "PASSED: submit -> USR1 -> requeue -> scontrol requeue -> finished table"
+
+# --- array mode: 2 shards, then a merge job that depends on them ---------------
+job_state() { scontrol show job "$1" 2>/dev/null | grep -o 'JobState=[A-Z]*' | sort -u | tr '\n' ' '; }
+ARRAY=$(cd "$WORK" && PHNN=$PHNN sbatch --parsable --array=0-1 --ntasks=1 --time=60 \
+        --output="$WORK/array-%j.log" "$REPO/jobs/phnn-sweep.sbatch" "$WORK/sweep.toml" --quiet)
+MERGE=$(cd "$WORK" && sbatch --parsable --dependency=afterok:"$ARRAY" --ntasks=1 --time=10 \
+        --output="$WORK/merge-%j.log" --wrap "$PHNN merge $WORK/merged.h5 \
+        $WORK/results/slurm-test.shard-0-of-2.h5 $WORK/results/slurm-test.shard-1-of-2.h5")
+log "submitted job array $ARRAY (2 shards) and merge job $MERGE (afterok:$ARRAY)"
+wait_for 600 "the merge job" bash -c "[[ \$(scontrol show job $MERGE | grep -o 'JobState=[A-Z]*') == JobState=COMPLETED ]]"
+log "array $ARRAY: $(job_state "$ARRAY"); merge job $MERGE COMPLETED; logs:"
+sed 's/^/    /' "$WORK"/array-*.log "$WORK"/merge-*.log
+grep -q "2 shards merged: 10 of 10 runs with results" "$WORK"/merge-*.log || die "the merge is incomplete"
+mse_column() {  # the run ids and MSEs of a results file, sorted by id
+  "$PHNN" reduce "$1" --format csv --per-run |
+    awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "mse") c = i; next } { print $1, $c }' | sort
+}
+[[ -n $(mse_column "$OUT") && $(mse_column "$WORK/merged.h5") == "$(mse_column "$OUT")" ]] ||
+  die "the merged shards differ from the single job's results"
+"$PHNN" reduce "$WORK/merged.h5" | sed 's/^/    /'
+log "PASSED: job array of 2 shards -> dependent merge job -> the single job's results, run for run"

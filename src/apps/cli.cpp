@@ -28,13 +28,21 @@ void Parser::positional(const std::string& name, const std::string& help) {
   positional_specs_.emplace_back(name, help);
 }
 
+void Parser::positional_rest(const std::string& name, const std::string& help) {
+  rest_spec_ = {name, help};
+}
+
 std::string Parser::help() const {
   std::ostringstream out;
   out << "usage: phnn " << command_;
   for (const auto& p : positional_specs_) out << " " << p.first;
+  if (!rest_spec_.first.empty()) out << " " << rest_spec_.first << "...";
   out << " [options]\n\n" << summary_ << "\n\n";
   for (const auto& p : positional_specs_) {
     out << "  " << p.first << "\n      " << p.second << "\n";
+  }
+  if (!rest_spec_.first.empty()) {
+    out << "  " << rest_spec_.first << "...\n      " << rest_spec_.second << "\n";
   }
   for (const auto& name : order_) {
     const Spec& s = specs_.at(name);
@@ -84,6 +92,8 @@ bool Parser::parse(int argc, char** argv, int first) {
         value = argv[++i];
       }
       values_[name] = value;
+    } else if (next_positional >= positional_specs_.size() && !rest_spec_.first.empty()) {
+      rest_values_.push_back(arg);
     } else {
       if (next_positional >= positional_specs_.size()) {
         throw UsageError{"phnn " + command_ + ": unexpected argument \"" + arg +
@@ -95,6 +105,10 @@ bool Parser::parse(int argc, char** argv, int first) {
   if (next_positional < positional_specs_.size()) {
     throw UsageError{"phnn " + command_ + ": missing argument " +
                      positional_specs_[next_positional].first + "; see `phnn " +
+                     command_ + " --help`"};
+  }
+  if (!rest_spec_.first.empty() && rest_values_.empty()) {
+    throw UsageError{"phnn " + command_ + ": missing argument " + rest_spec_.first + "; see `phnn " +
                      command_ + " --help`"};
   }
   for (const auto& [name, spec] : specs_) {

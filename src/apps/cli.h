@@ -31,6 +31,9 @@ class Parser {
   void flag(const std::string& name, const std::string& help);
   /// Declares positional arguments (by name, in order).
   void positional(const std::string& name, const std::string& help);
+  /// Declares that one or more further positional arguments follow the
+  /// declared ones (e.g. SHARD...); read them with rest().
+  void positional_rest(const std::string& name, const std::string& help);
 
   /// Parses argv[first..]. Returns false if --help was given (help printed).
   bool parse(int argc, char** argv, int first);
@@ -38,6 +41,8 @@ class Parser {
   std::string get(const std::string& name) const;
   bool has(const std::string& name) const;  // given explicitly
   bool flag_set(const std::string& name) const;
+  /// The arguments of positional_rest, in order.
+  const std::vector<std::string>& rest() const { return rest_values_; }
   double get_double(const std::string& name) const;
   std::int64_t get_int(const std::string& name) const;
   std::string help() const;
@@ -54,6 +59,8 @@ class Parser {
   std::vector<std::string> order_;
   std::vector<std::pair<std::string, std::string>> positional_specs_;
   std::map<std::string, std::string> values_;
+  std::pair<std::string, std::string> rest_spec_;  // name, help; name "" = none
+  std::vector<std::string> rest_values_;
 };
 
 /// Longest list parse_int_list accepts: the sweep parser's cap on seeds.

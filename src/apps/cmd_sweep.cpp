@@ -29,6 +29,7 @@
 #include "h5/h5file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/journal.h"
+#include "phnn/sweep/merge.h"
 #include "phnn/sweep/output_check.h"
 #include "phnn/sweep/results_file.h"
 #include "phnn/sweep/scheduler.h"
@@ -138,12 +139,13 @@ std::vector<int> dry_run_ranks(const cli::Parser& parser, int size) {
   return ranks;
 }
 
-// Runs of each cell still to train (pending, or failed with --retry-failed),
-// in the cell's seed order; *done counts the others.
+// Runs of each cell of `shard` still to train (pending, or failed with
+// --retry-failed), in the cell's seed order; *done counts the others.
 std::vector<std::vector<int>> pending_runs(const Grid& grid, const std::vector<int>& status_codes,
-                                           bool retry_failed, int* done) {
+                                           bool retry_failed, const Shard& shard, int* done) {
   std::vector<std::vector<int>> pending(grid.cells.size());
   for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    if (!shard.owns_cell(static_cast<int>(c))) continue;
     for (int row : grid.cells[c].runs) {
       const auto s = static_cast<RunStatus>(status_codes[static_cast<std::size_t>(row)]);
       if (s == RunStatus::kPending || (retry_failed && s == RunStatus::kFailed)) {
@@ -284,6 +286,10 @@ void declare_options(cli::Parser* parser) {
                  "0");
   parser->flag("static", "static round-robin scheduling instead of the MPI-3 shared counter");
   parser->flag("retry-failed", "re-run runs whose status is failed (done/diverged are kept)");
+  parser->option("shard",
+                 "I/N: train only cells c with c % N == I (cells largest first), into "
+                 "<output>.shard-I-of-N.h5 unless --out is given; one shard per Slurm array "
+                 "task, then `phnn merge` (docs/SLURM.md)");
   parser->option("threads", "LibTorch intra-op threads per rank", "1");
   parser->flag("quiet", "no per-item log lines");
 }
@@ -317,7 +323,8 @@ std::vector<int> recover_from_journals(ResultsFile* results, const std::string& 
 }
 
 // Rank 0's summary line(s) after the file is closed.
-void print_summary(const std::string& out, int total_runs, double seconds, bool stopped) {
+void print_summary(const std::string& out, int total_runs, double seconds, bool stopped,
+                   const Shard& shard) {
   const ResultsFile summary = ResultsFile::open_read_only(out);
   int counts[4] = {0, 0, 0, 0};
   for (RunStatus s : summary.read_statuses()) ++counts[static_cast<int>(s)];
@@ -327,6 +334,10 @@ void print_summary(const std::string& out, int total_runs, double seconds, bool 
               counts[3], counts[0], summary.num_runs());
   if (stopped) {
     std::printf("phnn sweep: stopped on a signal; run the same command again to resume\n");
+  } else if (shard.count > 1) {
+    std::printf("phnn sweep: shard %d/%d done (the pending runs are other shards'); when every "
+                "shard is done: phnn merge OUT SHARD...\n",
+                shard.index, shard.count);
   } else if (counts[0] > 0 || counts[3] > 0) {
     std::printf("phnn sweep: runs remain; run the same command again%s\n",
                 counts[3] > 0 ? " with --retry-failed to retry the failed ones" : "");
@@ -378,7 +389,8 @@ class SweepRun {
       return 0;
     }
     torch::set_num_threads(static_cast<int>(parser_.get_int("threads")));
-    out_ = parser_.has("out") ? parser_.get("out") : spec_.output;
+    out_ = parser_.has("out") ? parser_.get("out")
+                              : (shard_.count > 1 ? shard_.output_path(spec_.output) : spec_.output);
     int action = 0;
     if (int status = agreed(world_, root_, [&] {
           action = prepare_output(out_, parser_.get("FILE"), spec_, grid_, &lock_);
@@ -407,6 +419,13 @@ class SweepRun {
     grid_ = expand_grid(spec_);
     if (parser_.get_int("threads") < 1) throw cli::UsageError{"phnn sweep: --threads must be >= 1"};
     split_ = split_options(parser_);
+    if (parser_.has("shard")) {
+      try {
+        shard_ = Shard::parse(parser_.get("shard"));
+      } catch (const std::invalid_argument& e) {
+        throw cli::UsageError{std::string("phnn sweep: ") + e.what()};
+      }
+    }
     ranks_ = dry_run_ranks(parser_, size_);
     return true;
   }
@@ -487,6 +506,7 @@ class SweepRun {
   SweepSpec spec_;
   Grid grid_;
   SplitOptions split_;
+  Shard shard_;  // 0/1: the whole sweep
   std::vector<int> ranks_;
   std::string out_;
   WriterLock lock_;  // rank 0 only; released after the file is closed
@@ -500,16 +520,21 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
   // The same statuses on every rank give the same plan on every rank.
   int runs_done_before = 0;
-  const WorkPlan plan = plan_work(
-      grid_, pending_runs(grid_, status_codes, parser_.flag_set("retry-failed"), &runs_done_before),
-      size_, split_);
+  const auto pending =
+      pending_runs(grid_, status_codes, parser_.flag_set("retry-failed"), shard_, &runs_done_before);
+  const WorkPlan plan = plan_work(grid_, pending, size_, split_);
   const std::vector<WorkItem>& work = plan.items;
-  const int runs_to_do = static_cast<int>(grid_.runs.size()) - runs_done_before;
+  int runs_to_do = 0;
+  for (const auto& runs : pending) runs_to_do += static_cast<int>(runs.size());
   const ScheduleMode mode = parser_.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
   WorkQueue queue(MPI_COMM_WORLD, static_cast<int>(work.size()), mode);
   if (root_) {
     std::cout << "phnn sweep: " << spec_.name << ": " << grid_.runs.size() << " runs in "
-              << grid_.cells.size() << " cells; " << runs_done_before << " finished before, "
+              << grid_.cells.size() << " cells; "
+              << (shard_.count > 1 ? "shard " + std::to_string(shard_.index) + "/" +
+                                         std::to_string(shard_.count) + ": "
+                                   : std::string())
+              << runs_done_before << " finished before, "
               << runs_to_do << " to run in " << work.size() << " items (" << plan.cells
               << " cells, " << plan.split_cells << " split) on " << size_ << " rank"
               << (size_ > 1 ? "s" : "") << " (" << to_string(queue.mode()) << " scheduling) -> "
@@ -584,7 +609,7 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     std::cerr << prefix_ << e.what() << "\n";
     MPI_Abort(MPI_COMM_WORLD, 1);
   }
-  if (root_) print_summary(out_, total_runs, elapsed(), stopped != 0);
+  if (root_) print_summary(out_, total_runs, elapsed(), stopped != 0, shard_);
   if (failed) return failed;
   return stopped ? kExitStopped : 0;
 }

@@ -2,21 +2,13 @@
 // results file whose sweep grew (see include/phnn/sweep/sweep_growth.h).
 #include "phnn/sweep/sweep_growth.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <map>
 #include <set>
 #include <utility>
 
-#include "phnn/sweep/journal.h"
 #include "phnn/sweep/results_file.h"
+#include "results_copy.h"
 
 namespace phnn {
 namespace {
@@ -168,99 +160,28 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
                 "file with --out (or another `output`); the file is unchanged";
 }
 
-std::string errno_text() { return std::strerror(errno); }
-
-void fsync_path(const std::string& path, int flags) {
-  const int fd = ::open(path.c_str(), flags);
-  if (fd < 0) throw std::runtime_error(path + ": cannot open to sync: " + errno_text());
-  const int status = ::fsync(fd);
-  ::close(fd);
-  if (status != 0 && flags != O_RDONLY) {
-    throw std::runtime_error(path + ": fsync failed: " + errno_text());
-  }
-}
-
-std::string parent_directory(const std::string& path) {
-  const std::size_t slash = path.rfind('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
-
-// Our scratch name next to `out`; a leftover of a crash is ours to replace
-// (empty, or an HDF5 file), anything else is refused.
-std::string scratch_path(const std::string& out) {
-  const std::string path = out + ".new-version";
-  struct stat st;
-  if (::stat(path.c_str(), &st) != 0) return path;
-  char head[4] = {};
-  std::ifstream in(path, std::ios::binary);
-  const bool hdf5 = in.read(head, 4) && std::memcmp(head, "\x89HDF", 4) == 0;
-  if (!S_ISREG(st.st_mode) || (st.st_size > 0 && !hdf5)) {
-    throw std::runtime_error(path + ": exists and is not a results file phnn left behind; move "
-                             "it away (phnn writes a results file's new version there)");
-  }
-  if (std::remove(path.c_str()) != 0) {
-    throw std::runtime_error(path + ": cannot remove a leftover new version: " + errno_text());
-  }
-  return path;
-}
-
-ResultsLayout wider_layout(const ResultsLayout& a, const ResultsLayout& b) {
-  ResultsLayout layout;
-  layout.num_inference = std::max(a.num_inference, b.num_inference);
-  layout.trace_points = std::max(a.trace_points, b.trace_points);
-  layout.figure_points = std::max(a.figure_points, b.figure_points);
-  layout.checkpoints = std::max(a.checkpoints, b.checkpoints);
-  return layout;
-}
-
-std::string join_studies(const std::vector<std::string>& studies) {
-  std::string text;
-  for (const std::string& s : studies) text += (text.empty() ? "" : ",") + s;
-  return text;
-}
-
-// The old file's sessions, in order, into the new file.
-void copy_sessions(const ResultsFile& from, ResultsFile* to) {
-  for (Provenance session : from.read_sessions()) {
-    std::string finished;
-    auto it = std::find_if(session.begin(), session.end(),
-                           [](const auto& kv) { return kv.first == "finished"; });
-    if (it != session.end()) {
-      finished = it->second;
-      session.erase(it);
-    }
-    to->begin_session(session);
-    if (!finished.empty()) to->end_session(finished);
-  }
-}
-
 // Copies every row of `from` that holds a result into its row of `to`;
 // returns the (sweep run, file row) pairs copied.
 std::vector<std::pair<int, int>> copy_results(const ResultsFile& from, const RunSetComparison& cmp,
                                               ResultsFile* to) {
   const std::vector<RunStatus> status = from.read_statuses();
-  const bool times = from.has_run_times();
-  const std::vector<std::string> started = times ? from.read_started_utc() : std::vector<std::string>();
-  const std::vector<std::string> finished = times ? from.read_finished_utc() : std::vector<std::string>();
-  std::vector<std::pair<int, int>> copied;
+  std::vector<std::pair<int, int>> copied, rows;  // (run, row), (row, run)
   for (std::size_t run = 0; run < cmp.file_row_of_run.size(); ++run) {
     const int row = cmp.file_row_of_run[run];
     if (row < 0 || status[row] == RunStatus::kPending) continue;
-    if (times) to->write_run_times(static_cast<int>(run), started[row], finished[row]);
-    to->write_run(static_cast<int>(run), from.read_run(row));
     copied.emplace_back(static_cast<int>(run), row);
+    rows.emplace_back(row, static_cast<int>(run));
   }
+  results_copy::copy_rows(from, rows, to);
   return copied;
 }
 
-// Every copied row reads back bit for bit (journal encoding: hex floats).
+// Every copied row reads back bit for bit.
 void verify_copies(const ResultsFile& from, const std::string& written,
                    const std::vector<std::pair<int, int>>& copied) {
   const ResultsFile check = ResultsFile::open_read_only(written);
   for (const auto& [run, row] : copied) {
-    if (internal::encode_journal_record("x", check.read_run(run), 0) !=
-        internal::encode_journal_record("x", from.read_run(row), 0)) {
+    if (!results_copy::same_result(check.read_run(run), from.read_run(row))) {
       throw std::runtime_error(written + ": row " + std::to_string(run) + " does not read back as "
                                "row " + std::to_string(row) + " of the previous version; the "
                                "previous version is left in place");
@@ -280,22 +201,17 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
     const std::vector<std::string> canonical = old.read_canonical();
     cmp = compare_run_sets(canonical, old.read_statuses(), grid.runs);
     if (cmp.refused()) throw RunSetRefused(refusal_message(out, cmp, canonical));
-    std::vector<std::string> studies;
-    for (const auto& s : grid.run_studies) studies.push_back(join_studies(s));
-    scratch = scratch_path(out);
+    const std::vector<std::string> studies = results_copy::joined_studies(grid);
+    scratch = results_copy::scratch_path(out, "new-version");
     ResultsFile fresh = ResultsFile::create(
         scratch, MPI_COMM_NULL, grid.runs, studies, spec.name, spec.text, spec.text_hash,
-        program_version, wider_layout(old.layout(), ResultsLayout::for_runs(grid.runs)));
-    copy_sessions(old, &fresh);
+        program_version, results_copy::wider_layout(old.layout(), ResultsLayout::for_runs(grid.runs)));
+    results_copy::copy_sessions(old, &fresh);
     copied = copy_results(old, cmp, &fresh);
     fresh.close();
     verify_copies(old, scratch, copied);
   }
-  fsync_path(scratch, O_RDWR);
-  if (std::rename(scratch.c_str(), out.c_str()) != 0) {
-    throw std::runtime_error(scratch + ": cannot rename it to " + out + ": " + errno_text());
-  }
-  fsync_path(parent_directory(out), O_RDONLY);
+  results_copy::commit_scratch(scratch, out);
   const std::string kept = std::to_string(copied.size()) + " runs with results kept bitwise";
   const std::size_t dropped = cmp.dropped_pending_rows.size();
   std::string what;

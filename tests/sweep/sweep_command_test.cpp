@@ -342,6 +342,38 @@ TEST(SweepCommandTest, GrownSweepKeepsFinishedRunsAndChangedSweepIsRefused) {
   EXPECT_EQ(ResultsFile::open_read_only(out).sweep_hash(), hash_before);
 }
 
+// Array mode: each shard trains its cells into its own file; `phnn merge`
+// gives bitwise the file of an unsharded run.
+TEST(SweepCommandTest, ShardsMergedEqualAWholeRun) {
+  const std::string dir = temp_dir("shards");
+  const std::string sweep = write_sweep(dir, kSweep);
+  std::string log;
+  ASSERT_EQ(shell(mpiexec(2) + " sweep " + sweep + " --quiet --out " + dir + "/whole.h5", &log), 0)
+      << log;
+  for (const char* shard : {"0/2", "1/2"}) {
+    ASSERT_EQ(shell("cd " + dir + " && " + mpiexec(1) + " sweep " + sweep + " --quiet --shard " +
+                        shard + " --out " + dir + "/part" + std::string(1, shard[0]) + ".h5",
+                    &log),
+              0)
+        << log;
+    EXPECT_THAT(log, HasSubstr("shard " + std::string(shard) + ": 0 finished before"));
+    EXPECT_THAT(log, HasSubstr("phnn merge OUT SHARD..."));
+  }
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " merge " + dir + "/merged.h5 " + dir + "/part0.h5 " +
+                      dir + "/part1.h5",
+                  &log),
+            0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("9 of 9 runs with results"));
+  const ResultsFile whole = ResultsFile::open_read_only(dir + "/whole.h5");
+  const ResultsFile merged = ResultsFile::open_read_only(dir + "/merged.h5");
+  ASSERT_EQ(merged.read_run_ids(), whole.read_run_ids());
+  for (int row = 0; row < whole.num_runs(); ++row) {
+    expect_same_run(merged.read_run(row), whole.read_run(row), row);
+  }
+  EXPECT_EQ(shell(std::string(PHNN_BINARY) + " reduce " + dir + "/merged.h5", &log), 0) << log;
+}
+
 TEST(SweepCommandTest, DryRunPrintsRunsAndCellsOfThePaper) {
   std::string log;
   ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + PHNN_SOURCE_DIR + "/sweeps/paper.toml --dry-run", &log), 0);

@@ -1,0 +1,30 @@
+// src/apps/cmd_merge.cpp — `phnn merge OUT SHARD...`: the shards of one sweep
+// (`phnn sweep --shard I/N`) into one results file (phnn/sweep/merge.h).
+#include <iostream>
+
+#include "apps/cli.h"
+#include "apps/commands.h"
+#include "phnn/sweep/merge.h"
+#include "phnn/sweep/version.h"
+
+namespace phnn {
+namespace apps {
+
+int run_merge(int argc, char** argv, int first) {
+  cli::Parser parser(
+      "merge",
+      "Merges the shard results files of one sweep (phnn sweep FILE --shard I/N, e.g.\n"
+      "one per Slurm array task) into a new results file OUT: every run gets the result\n"
+      "of the shard that trained it (a run finished in two shards must be bitwise equal\n"
+      "in both), the data groups and every shard's provenance. Missing shards leave\n"
+      "their runs pending; `phnn sweep FILE --out OUT` then trains just those.");
+  parser.positional("OUT", "new results file (must not exist)");
+  parser.positional_rest("SHARD", "shard results files of one sweep file");
+  if (!parser.parse(argc, argv, first)) return 0;
+  std::cout << "phnn merge: " << merge_shards(parser.rest(), parser.get("OUT"), program_version())
+            << "\n";
+  return 0;
+}
+
+}  // namespace apps
+}  // namespace phnn

@@ -1,0 +1,173 @@
+// src/sweep/merge.cpp — shards of one sweep into one results file (see
+// include/phnn/sweep/merge.h).
+#include "phnn/sweep/merge.h"
+
+#include <sys/stat.h>
+
+#include <cstdlib>
+#include <memory>
+#include <algorithm>
+#include <stdexcept>
+#include <utility>
+
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/results_file.h"
+#include "phnn/sweep/sweep_file.h"
+#include "results_copy.h"
+
+namespace phnn {
+
+Shard Shard::parse(const std::string& text) {
+  const std::size_t slash = text.find('/');
+  auto number = [&](const std::string& part, long* value) {
+    char* end = nullptr;
+    *value = std::strtol(part.c_str(), &end, 10);
+    return !part.empty() && *end == '\0';
+  };
+  long index = -1, count = 0;
+  if (slash == std::string::npos || !number(text.substr(0, slash), &index) ||
+      !number(text.substr(slash + 1), &count) || count < 1 || count > kMaxShards || index < 0 ||
+      index >= count) {
+    throw std::invalid_argument("--shard \"" + text + "\": expected I/N with 0 <= I < N <= " +
+                                std::to_string(kMaxShards) +
+                                ", e.g. --shard 0/8 (in a Slurm array: "
+                                "$SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT)");
+  }
+  return Shard{static_cast<int>(index), static_cast<int>(count)};
+}
+
+std::string Shard::output_path(const std::string& sweep_output) const {
+  const std::string suffix = ".shard-" + std::to_string(index) + "-of-" + std::to_string(count);
+  const bool h5 = sweep_output.size() >= 3 &&
+                  sweep_output.compare(sweep_output.size() - 3, 3, ".h5") == 0;
+  return h5 ? sweep_output.substr(0, sweep_output.size() - 3) + suffix + ".h5"
+            : sweep_output + suffix + ".h5";
+}
+
+namespace {
+
+bool exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  struct stat sa, sb;
+  return ::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
+         sa.st_ino == sb.st_ino;
+}
+
+std::vector<ResultsFile> open_shards(const std::vector<std::string>& shards,
+                                     const std::string& out) {
+  if (shards.empty()) throw std::invalid_argument("phnn merge: no shard given");
+  if (exists(out)) {
+    throw std::invalid_argument(out + ": exists; phnn merge writes a new file: pass another "
+                                "output path or move it away");
+  }
+  std::vector<ResultsFile> files;
+  for (const std::string& path : shards) {
+    try {
+      files.push_back(ResultsFile::open_read_only(path));
+    } catch (const std::exception& e) {
+      // The reason, without the advice meant for `phnn sweep` (after ';').
+      const std::string why = e.what();
+      throw std::runtime_error(why.substr(0, why.find(';')) +
+                               "; phnn merge reads shard results files written by `phnn sweep "
+                               "--shard I/N`");
+    }
+    if (files.back().sweep_hash() != files.front().sweep_hash()) {
+      throw std::invalid_argument(path + ": results of sweep '" + files.back().sweep_name() +
+                                  "' (hash " + files.back().sweep_hash() + "), but " +
+                                  shards.front() + " has hash " + files.front().sweep_hash() +
+                                  "; merge only shards of one sweep file");
+    }
+  }
+  return files;
+}
+
+// Per row, the shard that gives its result (-1: none); throws if two shards
+// hold different results for a row.
+std::vector<int> result_sources(const std::vector<ResultsFile>& files,
+                                const std::vector<std::string>& shards) {
+  std::vector<int> source(static_cast<std::size_t>(files.front().num_runs()), -1);
+  for (std::size_t s = 0; s < files.size(); ++s) {
+    const std::vector<RunStatus> status = files[s].read_statuses();
+    for (std::size_t row = 0; row < source.size(); ++row) {
+      if (status[row] == RunStatus::kPending) continue;
+      if (source[row] < 0) {
+        source[row] = static_cast<int>(s);
+      } else if (!results_copy::same_result(files[source[row]].read_run(static_cast<int>(row)),
+                                            files[s].read_run(static_cast<int>(row)))) {
+        throw std::runtime_error("run " + std::to_string(row) + " differs between " +
+                                 shards[source[row]] + " and " + shards[s] +
+                                 " (a run's result depends only on its configuration and seed); "
+                                 "were they written by different phnn builds?");
+      }
+    }
+  }
+  return source;
+}
+
+void copy_data_groups(const std::vector<ResultsFile>& files, const Grid& grid, ResultsFile* to) {
+  std::vector<std::string> systems;
+  for (const RunConfig& run : grid.runs) {
+    const std::string name = to_string(run.system);
+    if (std::find(systems.begin(), systems.end(), name) == systems.end()) systems.push_back(name);
+  }
+  for (const std::string& name : systems) {
+    for (const ResultsFile& file : files) {
+      if (!file.has_system_data(name)) continue;
+      to->store_system_data(name, file.read_system_data(name));
+      break;
+    }
+  }
+}
+
+std::string summary(const std::string& out, std::size_t shards,
+                    const std::vector<RunStatus>& status) {
+  int counts[4] = {0, 0, 0, 0};
+  for (RunStatus s : status) ++counts[static_cast<int>(s)];
+  const int finished = counts[1] + counts[2] + counts[3];
+  return out + ": " + std::to_string(shards) + " shard" + (shards == 1 ? "" : "s") +
+         " merged: " + std::to_string(finished) + " of " + std::to_string(status.size()) +
+         " runs with results (" + std::to_string(counts[1]) + " done, " +
+         std::to_string(counts[2]) + " diverged, " + std::to_string(counts[3]) + " failed), " +
+         std::to_string(counts[0]) + " pending";
+}
+
+}  // namespace
+
+std::string merge_shards(const std::vector<std::string>& shards, const std::string& out,
+                         const std::string& program_version) {
+  for (const std::string& shard : shards) {
+    if (shard == out || same_file(shard, out)) {
+      throw std::invalid_argument(out + ": is one of the shards; pass a new output path");
+    }
+  }
+  const std::vector<ResultsFile> files = open_shards(shards, out);
+  const SweepSpec spec = parse_sweep_text(files.front().sweep_text(), shards.front() + "@sweep_text");
+  const Grid grid = expand_grid(spec);
+  ResultsLayout layout = files.front().layout();
+  for (const ResultsFile& file : files) layout = results_copy::wider_layout(layout, file.layout());
+  const std::vector<int> source = result_sources(files, shards);
+  const std::string scratch = results_copy::scratch_path(out, "partial");
+  {
+    ResultsFile merged = ResultsFile::create(scratch, MPI_COMM_NULL, grid.runs,
+                                             results_copy::joined_studies(grid), spec.name,
+                                             spec.text, spec.text_hash, program_version, layout);
+    copy_data_groups(files, grid, &merged);
+    for (std::size_t s = 0; s < files.size(); ++s) {
+      results_copy::copy_sessions(files[s], &merged);
+      std::vector<std::pair<int, int>> rows;
+      for (std::size_t row = 0; row < source.size(); ++row) {
+        if (source[row] == static_cast<int>(s)) rows.emplace_back(row, row);
+      }
+      results_copy::copy_rows(files[s], rows, &merged);
+    }
+    merged.close();
+  }
+  results_copy::commit_scratch(scratch, out);
+  return summary(out, files.size(), ResultsFile::open_read_only(out).read_statuses());
+}
+
+}  // namespace phnn

@@ -1,0 +1,42 @@
+// src/sweep/results_copy.h — internal to src/sweep: copying finished rows,
+// provenance and layouts between results files (new versions of a grown
+// sweep, merged shards), and the bitwise comparison of two results.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/results_file.h"
+
+namespace phnn {
+namespace results_copy {
+
+/// Every field of both equal, doubles bit for bit (their journal encodings).
+bool same_result(const RunResult& a, const RunResult& b);
+
+/// The layout that holds rows of both.
+ResultsLayout wider_layout(const ResultsLayout& a, const ResultsLayout& b);
+
+/// Appends `from`'s provenance sessions, in order, to `to` (serial files).
+void copy_sessions(const ResultsFile& from, ResultsFile* to);
+
+/// Copies each (row of `from`, row of `to`) pair: the run times, then the
+/// result.
+void copy_rows(const ResultsFile& from, const std::vector<std::pair<int, int>>& rows,
+               ResultsFile* to);
+
+/// The studies of each run of `grid`, joined for ResultsFile::create ("I,II").
+std::vector<std::string> joined_studies(const Grid& grid);
+
+/// Our scratch name next to `out` (`<out>.<suffix>`), free: a leftover of a
+/// crash there (empty, or an HDF5 file) is removed; anything else throws
+/// std::runtime_error naming it.
+std::string scratch_path(const std::string& out, const std::string& suffix);
+
+/// fsyncs `scratch`, renames it to `out` (atomic) and fsyncs the directory.
+void commit_scratch(const std::string& scratch, const std::string& out);
+
+}  // namespace results_copy
+}  // namespace phnn

@@ -1,0 +1,129 @@
+// tests/sweep/merge_test.cpp — shards of one sweep merged into one results
+// file: every result kept bitwise, conflicts and foreign files refused.
+#include "phnn/sweep/merge.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/results_file.h"
+#include "phnn/sweep/sweep_file.h"
+#include "sample_results.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(ShardTest, ParsesIndexOverCountAndRefusesEverythingElse) {
+  const Shard shard = Shard::parse("2/8");
+  EXPECT_EQ(shard.index, 2);
+  EXPECT_EQ(shard.count, 8);
+  EXPECT_TRUE(shard.owns_cell(10));
+  EXPECT_FALSE(shard.owns_cell(11));
+  for (const char* bad : {"8/8", "-1/8", "1/0", "1", "a/b", "1/8x", "", "/", "1/100001"}) {
+    EXPECT_THROW(Shard::parse(bad), std::invalid_argument) << bad;
+  }
+  try {
+    Shard::parse("3/2");
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("0 <= I < N"));
+    EXPECT_THAT(e.what(), HasSubstr("SLURM_ARRAY_TASK_ID"));
+  }
+}
+
+TEST(ShardTest, OutputPathNamesTheShard) {
+  EXPECT_EQ(Shard::parse("0/4").output_path("results/paper.h5"), "results/paper.shard-0-of-4.h5");
+  EXPECT_EQ(Shard::parse("3/4").output_path("out"), "out.shard-3-of-4.h5");
+}
+
+const char* kSweep = R"(name = "merge"
+[training]
+steps = 30
+eval_every = 10
+[grid]
+systems = ["duffing"]
+models = ["node-rk2", "phnn-s-dg"]
+n_train = [25]
+seeds = [0, 1]
+)";
+
+class MergeShardsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = ::testing::TempDir() + "phnn_merge_" + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::system(("rm -rf " + dir_ + " && mkdir -p " + dir_).c_str());
+  }
+  void TearDown() override { std::system(("rm -rf " + dir_).c_str()); }
+
+  // A shard file of `text` holding sample results in `rows` (salted by
+  // `salt` so that two shards can disagree).
+  std::string shard(const std::string& name, const std::vector<int>& rows, int salt = 0,
+                    const std::string& text = kSweep) {
+    const SweepSpec spec = parse_sweep_text(text, "sweep.toml");
+    const Grid grid = expand_grid(spec);
+    const std::string path = dir_ + "/" + name;
+    ResultsFile file = ResultsFile::create(path, MPI_COMM_NULL, grid.runs,
+                                           std::vector<std::string>(grid.runs.size(), "grid"),
+                                           spec.name, spec.text, spec.text_hash, "v1",
+                                           ResultsLayout::for_runs(grid.runs));
+    file.begin_session({{"command_line", name}});
+    for (int row : rows) file.write_run(row, testing_util::sample_result(row + salt, file.layout()));
+    file.close();
+    return path;
+  }
+
+  std::string dir_;
+};
+
+TEST_F(MergeShardsTest, EveryShardsResultsLandBitwiseInTheirRows) {
+  const std::string a = shard("a.h5", {0, 3}), b = shard("b.h5", {1, 3});  // row 3 in both
+  const std::string out = dir_ + "/merged.h5";
+  const std::string summary = merge_shards({a, b}, out, "v2");
+  EXPECT_THAT(summary, HasSubstr("2 shards merged: 3 of 4 runs with results"));
+  EXPECT_THAT(summary, HasSubstr("1 pending"));
+  const ResultsFile merged = ResultsFile::open_read_only(out);
+  const ResultsFile fa = ResultsFile::open_read_only(a), fb = ResultsFile::open_read_only(b);
+  testing_util::expect_bit_equal(fa.read_run(0), merged.read_run(0));
+  testing_util::expect_bit_equal(fb.read_run(1), merged.read_run(1));
+  testing_util::expect_bit_equal(fa.read_run(3), merged.read_run(3));
+  EXPECT_EQ(merged.read_statuses()[2], RunStatus::kPending);
+  EXPECT_EQ(merged.sweep_hash(), fa.sweep_hash());
+  EXPECT_EQ(merged.read_sessions().size(), 2u);
+  struct stat st;
+  EXPECT_NE(::stat((out + ".partial").c_str(), &st), 0) << "scratch file left behind";
+}
+
+TEST_F(MergeShardsTest, ConflictingResultsForeignSweepsAndExistingOutputAreRefused) {
+  const std::string a = shard("a.h5", {0}), b = shard("b.h5", {0}, /*salt=*/4);
+  const std::string out = dir_ + "/merged.h5";
+  try {
+    merge_shards({a, b}, out, "v2");
+    FAIL() << "conflicting results were merged";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("run 0 differs between " + a + " and " + b));
+  }
+  struct stat st;
+  EXPECT_NE(::stat(out.c_str(), &st), 0);
+  const std::string other = shard("other.h5", {1}, 0, std::string("# other\n") + kSweep);
+  EXPECT_THROW(merge_shards({a, other}, out, "v2"), std::invalid_argument);
+  EXPECT_THROW(merge_shards({a}, a, "v2"), std::invalid_argument);
+  EXPECT_THROW(merge_shards({}, out, "v2"), std::invalid_argument);
+  merge_shards({a}, out, "v2");
+  try {
+    merge_shards({a}, out, "v2");
+    FAIL() << "an existing output was replaced";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), HasSubstr(out + ": exists"));
+  }
+}
+
+}  // namespace
+}  // namespace phnn
