@@ -112,35 +112,64 @@ void require_new_output(const std::string& path) {
   }
 }
 
-}  // namespace
+void declare_train_options(cli::Parser* parser) {
+  parser->option("system", "harmonic | duffing | self-sustained", "", true);
+  parser->option("model",
+                 "formulation-integrator as in sweep files: node-rk2, node-rk4, phnn-s-rk2, "
+                 "phnn-s-dg, phnn-s-rk4, phnn-s-dg4, phnn-jr-rk2, phnn-jr-dg, phnn-jr-rk4, "
+                 "phnn-jr-dg4 (the older `--model phnn-s --integrator dg` still works)",
+                 "", true);
+  parser->option("integrator", "old spelling: rk2 | dg | rk4 | dg4 with --model node|phnn-s|phnn-jr",
+                 "rk2");
+  parser->option("size", "small | medium | large", "small");
+  parser->option("n-train", "training pairs (1..400)", "25");
+  parser->option("reg", "none | cn | sn | sr", "none");
+  parser->option("seeds", "model seeds, e.g. 0-9 or 0,3,5", "0-9");
+  parser->option("steps", "Adam steps", "50000");
+  parser->option("lr", "learning rate", "1e-3");
+  parser->option("batch", "minibatch size", "64");
+  parser->option("eval-every", "validation cadence in steps", "500");
+  parser->option("data", "read the data set from this file (`phnn data`) instead of generating it");
+  parser->option("data-seed", "data-set seed when generating", "0");
+  parser->option("damping", "c of z(w) = c w [N s/m] when generating", "0.14737");
+  parser->option("threads", "LibTorch intra-op threads", "1");
+  parser->option("out", "also write the runs to this results file (readable by `phnn reduce`)");
+  parser->flag("quiet", "no progress line");
+}
 
-int run_train(int argc, char** argv, int first) {
-  cli::Parser parser("train",
-                     "Trains one cell (all seeds of one configuration) as one stacked model,\n"
-                     "then rolls every member out over the inference set (docs/METHOD.md §3-§5).");
-  parser.option("system", "harmonic | duffing | self-sustained", "", true);
-  parser.option("model", "node | phnn-s | phnn-jr", "", true);
-  parser.option("integrator", "rk2 | dg | rk4 | dg4 (node: rk2 or rk4)", "rk2");
-  parser.option("size", "small | medium | large", "small");
-  parser.option("n-train", "training pairs (1..400)", "25");
-  parser.option("reg", "none | cn | sn | sr", "none");
-  parser.option("seeds", "model seeds, e.g. 0-9 or 0,3,5", "0-9");
-  parser.option("steps", "Adam steps", "50000");
-  parser.option("lr", "learning rate", "1e-3");
-  parser.option("batch", "minibatch size", "64");
-  parser.option("eval-every", "validation cadence in steps", "500");
-  parser.option("data", "read the data set from this file (`phnn data`) instead of generating it");
-  parser.option("data-seed", "data-set seed when generating", "0");
-  parser.option("damping", "c of z(w) = c w [N s/m] when generating", "0.14737");
-  parser.option("threads", "LibTorch intra-op threads", "1");
-  parser.option("out", "also write the runs to this results file (readable by `phnn reduce`)");
-  parser.flag("quiet", "no progress line");
-  if (!parser.parse(argc, argv, first)) return 0;
+// --model phnn-jr-rk2 (one name, as in sweep files), or the older
+// --model phnn-jr [--integrator rk2], accepted with a note.
+void parse_model_option(const cli::Parser& parser, CellSpec* cell) {
+  const std::string name = parser.get("model");
+  for (const char* integrator : {"rk2", "dg", "rk4", "dg4"}) {
+    const std::string suffix = std::string("-") + integrator;
+    if (name.size() <= suffix.size() ||
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
+      continue;
+    }
+    cell->model = parse_model(name.substr(0, name.size() - suffix.size()));
+    cell->integrator = parse_integrator(integrator);
+    if (parser.has("integrator") && parser.get("integrator") != integrator) {
+      throw cli::UsageError{"phnn train: --model " + name + " already names the integrator " +
+                            integrator + "; drop --integrator " + parser.get("integrator")};
+    }
+    return;
+  }
+  try {
+    cell->model = parse_model(name);
+  } catch (const std::invalid_argument&) {
+    throw cli::UsageError{"phnn train: --model \"" + name + "\": expected formulation-integrator "
+                          "as in sweep files, e.g. phnn-jr-rk2 or node-rk4 (see --help)"};
+  }
+  cell->integrator = parse_integrator(parser.get("integrator"));
+  std::cerr << "phnn train: note: --model " << name << " --integrator " << parser.get("integrator")
+            << " is the older spelling of --model " << name << "-" << parser.get("integrator")
+            << "\n";
+}
 
+CellSpec cell_from_options(const cli::Parser& parser) {
   CellSpec cell;
-  const SystemKind system = parse_system(parser.get("system"));
-  cell.model = parse_model(parser.get("model"));
-  cell.integrator = parse_integrator(parser.get("integrator"));
+  parse_model_option(parser, &cell);
   cell.size = parse_size(parser.get("size"));
   cell.regularizer = parse_regularizer(parser.get("reg"));
   cell.n_train = static_cast<int>(parser.get_int("n-train"));
@@ -152,42 +181,37 @@ int run_train(int argc, char** argv, int first) {
   cell.training.learning_rate = parser.get_double("lr");
   cell.training.batch_size = static_cast<int>(parser.get_int("batch"));
   cell.training.eval_every = static_cast<int>(parser.get_int("eval-every"));
-  const auto threads = parser.get_int("threads");
-  if (threads < 1) throw cli::UsageError{"phnn train: --threads must be >= 1"};
-  torch::set_num_threads(static_cast<int>(threads));
+  return cell;
+}
 
-  SystemData data;
+// The data set: read from --data, or generated for the cell's N_train.
+SystemData data_from_options(const cli::Parser& parser, SystemKind system, int n_train) {
   if (parser.has("data")) {
-    data = read_dataset_file(parser.get("data"));
+    SystemData data = read_dataset_file(parser.get("data"));
     if (data.system.kind != system) {
       throw cli::UsageError{"phnn train: --data " + parser.get("data") + " holds system " +
                             to_string(data.system.kind) + ", not " + to_string(system)};
     }
-  } else {
-    OscillatorOptions physics = OscillatorOptions::defaults(system);
-    if (parser.has("damping")) physics.damping = parser.get_double("damping");
-    DatasetOptions options;
-    const auto ds = parser.get_int("data-seed");
-    if (ds < 0) throw cli::UsageError{"phnn train: --data-seed must be >= 0"};
-    options.data_seed = static_cast<std::uint64_t>(ds);
-    if (cell.n_train < 1 || cell.n_train > options.num_train_max) {
-      throw cli::UsageError{"phnn train: --n-train = " + std::to_string(cell.n_train) +
-                            " outside [1, " + std::to_string(options.num_train_max) + "]"};
-    }
-    data = make_system_data(physics, options, cell.n_train);
+    return data;
   }
-  cell.validate(data);
-  std::cout << "phnn train: " << to_string(system) << " " << model_label(cell.model, cell.integrator)
-            << " size=" << to_string(cell.size) << " n_train=" << cell.n_train
-            << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
-            << " steps=" << cell.training.steps << "\n";
-  const bool quiet = parser.flag_set("quiet");
-  const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  if (parser.has("out")) require_new_output(parser.get("out"));
-  // A terminal gets one self-overwriting line; a log file a plain line per
-  // tenth of the run (no carriage returns in logs).
+  OscillatorOptions physics = OscillatorOptions::defaults(system);
+  if (parser.has("damping")) physics.damping = parser.get_double("damping");
+  DatasetOptions options;
+  const auto ds = parser.get_int("data-seed");
+  if (ds < 0) throw cli::UsageError{"phnn train: --data-seed must be >= 0"};
+  options.data_seed = static_cast<std::uint64_t>(ds);
+  if (n_train < 1 || n_train > options.num_train_max) {
+    throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " outside [1, " +
+                          std::to_string(options.num_train_max) + "]"};
+  }
+  return make_system_data(physics, options, n_train);
+}
+
+// Trains the cell; a terminal gets one self-overwriting progress line, a log
+// file a plain line per tenth of the run (no carriage returns in logs).
+std::vector<RunResult> train_with_progress(const CellSpec& cell, const SystemData& data, bool quiet) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
-  const auto results = train_cell(cell, data, [&](const TrainProgress& p) {
+  return train_cell(cell, data, [&](const TrainProgress& p) {
     if (quiet) return;
     const int tenth = std::max(1, p.total_steps / 10);
     if (!terminal && p.step % tenth != 0 && p.step != p.total_steps) return;
@@ -196,6 +220,10 @@ int run_train(int argc, char** argv, int first) {
                  terminal ? "\r" : "", p.step, p.total_steps, p.best_validation_loss, p.elapsed_s,
                  eta, terminal && p.step != p.total_steps ? "" : "\n");
   });
+}
+
+// One line per seed, then the reducer's statistics (numpy linear quartiles).
+void print_cell_results(const CellSpec& cell, const std::vector<RunResult>& results) {
   std::vector<double> mses;
   double wall = 0.0;
   std::printf("%6s  %12s  %11s  %11s  %9s  %s\n", "seed", "MSE", "val(step 0)", "best val",
@@ -208,11 +236,35 @@ int run_train(int argc, char** argv, int first) {
     mses.push_back(r.mse);
     wall += r.wall_time_s;
   }
-  // The reducer's statistics (numpy linear quartiles), so both print the same.
   const double q25 = quantile_linear(mses, 0.25), q50 = quantile_linear(mses, 0.5),
                q75 = quantile_linear(mses, 0.75);
   std::printf("median [IQR]: %.2e [%.2e]   parameters/member: %ld   wall time: %.1f s\n", q50,
               q75 - q25, results.empty() ? 0L : results[0].parameter_count, wall);
+}
+
+}  // namespace
+
+int run_train(int argc, char** argv, int first) {
+  cli::Parser parser("train",
+                     "Trains one cell (all seeds of one configuration) as one stacked model,\n"
+                     "then rolls every member out over the inference set (docs/METHOD.md §3-§5).");
+  declare_train_options(&parser);
+  if (!parser.parse(argc, argv, first)) return 0;
+  const SystemKind system = parse_system(parser.get("system"));
+  const CellSpec cell = cell_from_options(parser);
+  const auto threads = parser.get_int("threads");
+  if (threads < 1) throw cli::UsageError{"phnn train: --threads must be >= 1"};
+  torch::set_num_threads(static_cast<int>(threads));
+  const SystemData data = data_from_options(parser, system, cell.n_train);
+  cell.validate(data);
+  std::cout << "phnn train: " << to_string(system) << " " << model_label(cell.model, cell.integrator)
+            << " size=" << to_string(cell.size) << " n_train=" << cell.n_train
+            << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
+            << " steps=" << cell.training.steps << "\n";
+  const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
+  if (parser.has("out")) require_new_output(parser.get("out"));
+  const auto results = train_with_progress(cell, data, parser.flag_set("quiet"));
+  print_cell_results(cell, results);
   if (parser.has("out")) {
     write_cell_file(parser.get("out"), cell, data, results, provenance,
                     provenance_value(provenance, "started"));

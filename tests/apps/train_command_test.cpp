@@ -28,8 +28,9 @@ TEST(TrainCommandTest, TrainsACellAndWritesAFileTheReducerReads) {
   const std::string out = ::testing::TempDir() + "phnn_train_cell_" + std::to_string(::getpid()) + ".h5";
   std::remove(out.c_str());
   std::string log;
-  ASSERT_EQ(run("train --system harmonic --model phnn-s --integrator dg --n-train 25 --seeds 0-2 "
+  ASSERT_EQ(run("train --system harmonic --model phnn-s-dg --n-train 25 --seeds 0-2 "
                 "--steps 40 --eval-every 20 --quiet --out " + out, &log), 0) << log;
+  EXPECT_THAT(log, Not(HasSubstr("older spelling")));
   EXPECT_THAT(log, HasSubstr("median [IQR]:"));
   EXPECT_THAT(log, HasSubstr("parameters/member: 852"));
   const ResultsFile file = ResultsFile::open_read_only(out);
@@ -57,7 +58,26 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 1,1 --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("seed 1 listed twice"));
   EXPECT_EQ(run("train --system harmonic --model mlp", &log), 2);
-  EXPECT_THAT(log, HasSubstr("unknown model \"mlp\""));
+  EXPECT_THAT(log, HasSubstr("--model \"mlp\": expected formulation-integrator"));
+  EXPECT_EQ(run("train --system harmonic --model node-dg --steps 1", &log), 2);
+  EXPECT_THAT(log, HasSubstr("integrator = dg with model = node"));
+  EXPECT_EQ(run("train --system harmonic --model phnn-jr-rk2 --integrator dg --steps 1", &log), 2);
+  EXPECT_THAT(log, HasSubstr("already names the integrator rk2"));
+}
+
+// One name for a model and its integrator, as in sweep files; the older
+// two-option spelling trains the same cell, with a note.
+TEST(TrainCommandTest, OneModelNameAndTheOlderSpellingTrainTheSameCell) {
+  std::string joined, split;
+  ASSERT_EQ(run("train --system duffing --model phnn-jr-dg --seeds 0 --steps 20 --eval-every 10 "
+                "--quiet", &joined), 0) << joined;
+  ASSERT_EQ(run("train --system duffing --model phnn-jr --integrator dg --seeds 0 --steps 20 "
+                "--eval-every 10 --quiet", &split), 0) << split;
+  EXPECT_THAT(split, HasSubstr("note: --model phnn-jr --integrator dg is the older spelling of "
+                               "--model phnn-jr-dg"));
+  auto table = [](const std::string& log) { return log.substr(log.find("  seed")); };
+  auto without_wall_time = [](std::string t) { return t.substr(0, t.find("wall time")); };
+  EXPECT_EQ(without_wall_time(table(joined)), without_wall_time(table(split)));
 }
 
 // --out into a missing directory is refused before training (it used to
