@@ -82,95 +82,118 @@ struct ColumnAxes {
 
 }  // namespace
 
-Grid expand_grid(const SweepSpec& spec, const CostModel& cost_model) {
-  Grid grid;
-  std::map<std::string, int> index_of;  // canonical() -> index in grid.runs
-  for (const StudySpec& study : spec.studies) {
-    StudyTable table;
-    table.name = study.name;
-    table.title = study.title;
-    table.systems = study.systems;
-    ColumnAxes axes;
-    axes.size = study.sizes.size() > 1;
-    axes.n_train = study.n_train.size() > 1;
-    axes.regularizer = study.regularizers.size() > 1;
-    table.varied_axis = axes.name();
-    for (const auto& [model, integrator] : study.models) {
-      table.rows.push_back(model_label(model, integrator));
-    }
-    for (ModelSize size : study.sizes) {
-      for (int n : study.n_train) {
-        for (Regularizer reg : study.regularizers) {
-          const std::string label = axes.label(size, n, reg);
-          if (std::find(table.columns.begin(), table.columns.end(), label) == table.columns.end()) {
-            table.columns.push_back(label);
-          }
+namespace {
+
+// A study's table without its runs: rows (models), columns (the varied axis).
+StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes) {
+  StudyTable table;
+  table.name = study.name;
+  table.title = study.title;
+  table.systems = study.systems;
+  table.varied_axis = axes.name();
+  for (const auto& [model, integrator] : study.models) {
+    table.rows.push_back(model_label(model, integrator));
+  }
+  for (ModelSize size : study.sizes) {
+    for (int n : study.n_train) {
+      for (Regularizer reg : study.regularizers) {
+        const std::string label = axes.label(size, n, reg);
+        if (std::find(table.columns.begin(), table.columns.end(), label) == table.columns.end()) {
+          table.columns.push_back(label);
         }
       }
     }
+  }
+  return table;
+}
 
-    for (SystemKind system : study.systems) {
-      for (const auto& [model, integrator] : study.models) {
-        for (ModelSize size : study.sizes) {
-          for (int n : study.n_train) {
-            for (Regularizer reg : study.regularizers) {
-              for (int seed : study.seeds) {
-                RunConfig run;
-                run.system = system;
-                run.model = model;
-                run.integrator = integrator;
-                run.size = size;
-                run.n_train = n;
-                run.regularizer = reg;
-                run.seed = seed;
-                run.physics = spec.physics.at(system);
-                run.data = spec.data;
-                run.training = spec.training;
-                const auto [it, inserted] =
-                    index_of.emplace(run.canonical(), static_cast<int>(grid.runs.size()));
-                if (inserted) {
-                  grid.runs.push_back(run);
-                  grid.run_studies.emplace_back();
-                }
-                std::vector<std::string>& studies = grid.run_studies[it->second];
-                if (std::find(studies.begin(), studies.end(), study.name) == studies.end()) {
-                  studies.push_back(study.name);
-                }
-                table.runs.push_back(it->second);
-                table.run_columns.push_back(axes.label(size, n, reg));
-              }
+// Adds `run` to the grid once (index_of: canonical() -> index) and to `table`.
+void add_run(const RunConfig& run, const std::string& column, Grid* grid, StudyTable* table,
+             std::map<std::string, int>* index_of) {
+  const auto [it, inserted] =
+      index_of->emplace(run.canonical(), static_cast<int>(grid->runs.size()));
+  if (inserted) {
+    grid->runs.push_back(run);
+    grid->run_studies.emplace_back();
+  }
+  std::vector<std::string>& studies = grid->run_studies[it->second];
+  if (std::find(studies.begin(), studies.end(), table->name) == studies.end()) {
+    studies.push_back(table->name);
+  }
+  table->runs.push_back(it->second);
+  table->run_columns.push_back(column);
+}
+
+// Every run of `study`, nested system, model, size, n_train, regularizer,
+// seed (seed fastest).
+void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
+                  std::map<std::string, int>* index_of) {
+  ColumnAxes axes;
+  axes.size = study.sizes.size() > 1;
+  axes.n_train = study.n_train.size() > 1;
+  axes.regularizer = study.regularizers.size() > 1;
+  StudyTable table = table_frame(study, axes);
+  RunConfig run;
+  run.data = spec.data;
+  run.training = spec.training;
+  for (SystemKind system : study.systems) {
+    run.system = system;
+    run.physics = spec.physics.at(system);
+    for (const auto& [model, integrator] : study.models) {
+      run.model = model;
+      run.integrator = integrator;
+      for (ModelSize size : study.sizes) {
+        run.size = size;
+        for (int n : study.n_train) {
+          run.n_train = n;
+          for (Regularizer reg : study.regularizers) {
+            run.regularizer = reg;
+            for (int seed : study.seeds) {
+              run.seed = seed;
+              add_run(run, axes.label(size, n, reg), grid, &table, index_of);
             }
           }
         }
       }
     }
-    grid.studies.push_back(std::move(table));
   }
+  grid->studies.push_back(std::move(table));
+}
 
-  // Cells: runs with equal cell_key(), seeds ascending; largest cost first.
+// Cells: runs with equal cell_key(), seeds ascending; largest cost first.
+void form_cells(const CostModel& cost_model, Grid* grid) {
   std::map<std::string, int> cell_of;
-  for (int i = 0; i < static_cast<int>(grid.runs.size()); ++i) {
-    const std::string key = grid.runs[i].cell_key();
-    const auto [it, inserted] = cell_of.emplace(key, static_cast<int>(grid.cells.size()));
+  for (int i = 0; i < static_cast<int>(grid->runs.size()); ++i) {
+    const std::string key = grid->runs[i].cell_key();
+    const auto [it, inserted] = cell_of.emplace(key, static_cast<int>(grid->cells.size()));
     if (inserted) {
-      grid.cells.emplace_back();
-      grid.cells.back().key = key;
+      grid->cells.emplace_back();
+      grid->cells.back().key = key;
     }
-    grid.cells[it->second].runs.push_back(i);
+    grid->cells[it->second].runs.push_back(i);
   }
-  for (Cell& cell : grid.cells) {
+  for (Cell& cell : grid->cells) {
     std::sort(cell.runs.begin(), cell.runs.end(),
-              [&](int a, int b) { return grid.runs[a].seed < grid.runs[b].seed; });
-    const CostParts parts = cost_parts(grid.runs[cell.runs.front()], cost_model);
+              [&](int a, int b) { return grid->runs[a].seed < grid->runs[b].seed; });
+    const CostParts parts = cost_parts(grid->runs[cell.runs.front()], cost_model);
     cell.fixed_cost_s = parts.fixed_s;
     cell.member_cost_s = parts.member_s;
     cell.estimated_cost_s = cell.cost_s(static_cast<int>(cell.runs.size()));
   }
-  std::sort(grid.cells.begin(), grid.cells.end(), [](const Cell& a, const Cell& b) {
+  std::sort(grid->cells.begin(), grid->cells.end(), [](const Cell& a, const Cell& b) {
     if (a.estimated_cost_s != b.estimated_cost_s) return a.estimated_cost_s > b.estimated_cost_s;
     return a.key < b.key;
   });
-  for (const Cell& cell : grid.cells) grid.estimated_cost_s += cell.estimated_cost_s;
+  for (const Cell& cell : grid->cells) grid->estimated_cost_s += cell.estimated_cost_s;
+}
+
+}  // namespace
+
+Grid expand_grid(const SweepSpec& spec, const CostModel& cost_model) {
+  Grid grid;
+  std::map<std::string, int> index_of;  // canonical() -> index in grid.runs
+  for (const StudySpec& study : spec.studies) expand_study(spec, study, &grid, &index_of);
+  form_cells(cost_model, &grid);
   return grid;
 }
 
