@@ -14,6 +14,7 @@ PACKAGES=(
   libopenblas0-pthread               # fast BLAS behind libblas.so.3 (LibTorch uses it)
   libblas-dev                        # libblas.so to link dgemm_ (src/models/stacked_matmul.cpp)
   libjemalloc-dev                    # allocator: glibc malloc costs ~16 % of a step
+  libtomlplusplus-dev                # toml++: the TOML parser of sweep files
   python3-h5py python3-numpy python3-matplotlib  # analysis/ only
   python3-torch                      # bench/pytorch_step.py only
 )

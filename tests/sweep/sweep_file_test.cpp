@@ -183,6 +183,94 @@ systems = ["harmonic", "self-sustained"]
   EXPECT_THAT(spec.studies[1].n_train, ElementsAre(25));
 }
 
+// Everything a sweep file sets, and the grid it expands to.
+void expect_same_spec(const SweepSpec& a, const SweepSpec& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.output, b.output);
+  ASSERT_EQ(a.studies.size(), b.studies.size());
+  for (std::size_t i = 0; i < a.studies.size(); ++i) {
+    SCOPED_TRACE(a.studies[i].name);
+    EXPECT_EQ(a.studies[i].name, b.studies[i].name);
+    EXPECT_EQ(a.studies[i].title, b.studies[i].title);
+    EXPECT_EQ(a.studies[i].systems, b.studies[i].systems);
+    EXPECT_EQ(a.studies[i].models, b.studies[i].models);
+    EXPECT_EQ(a.studies[i].sizes, b.studies[i].sizes);
+    EXPECT_EQ(a.studies[i].n_train, b.studies[i].n_train);
+    EXPECT_EQ(a.studies[i].regularizers, b.studies[i].regularizers);
+    EXPECT_EQ(a.studies[i].seeds, b.studies[i].seeds);
+  }
+  // canonical(): every physics, data and training field of every run.
+  const Grid ga = expand_grid(a), gb = expand_grid(b);
+  ASSERT_EQ(ga.runs.size(), gb.runs.size());
+  for (std::size_t i = 0; i < ga.runs.size(); ++i) {
+    EXPECT_EQ(ga.runs[i].canonical(), gb.runs[i].canonical());
+  }
+}
+
+// toml++ reads all of TOML 1.0: dotted keys, inline tables, literal and
+// multi-line strings, a [study] table holding the studies give the same sweep
+// as the plain one-table-per-header layout.
+TEST(SweepFileTest, FullTomlSyntaxGivesTheSameSpecAsThePlainLayout) {
+  const SweepSpec plain = parse_sweep_text(R"(name = "same"
+[data]
+num_train_max = 100
+[training]
+steps = 200
+learning_rate = 1e-3
+[physics.duffing]
+damping = 0.5
+[study.a]
+title = "A"
+systems = ["duffing"]
+n_train = [25, 50]
+[study.b]
+models = ["phnn-s-dg"]
+seeds = "0-2"
+)",
+                                           "plain.toml");
+  const SweepSpec rich = parse_sweep_text(R"(name = 'same'
+data.num_train_max = 100
+training = { steps = 2_00, learning_rate = 0.001 }
+physics.duffing = { damping = 5e-1 }
+[study]
+a = { title = "A", systems = ["duffing"], n_train = [25, 50] }
+b.models = [
+  'phnn-s-dg',  # the only model
+]
+b.seeds = """0-2"""
+)",
+                                          "rich.toml");
+  EXPECT_EQ(rich.data.num_train_max, 100);
+  EXPECT_EQ(rich.training.steps, 200);
+  expect_same_spec(plain, rich);
+  EXPECT_THAT(error_of("name = \"t\"\ntraining = { steps = 0 }\n").what(),
+              StartsWith("x.toml:2: steps = 0 is out of range"));
+}
+
+// Quoted keys would allow any study name; results files list a run's studies
+// separated by commas, so names stay bare words.
+TEST(SweepFileErrorTest, StudyNamesAreBareWords) {
+  EXPECT_THAT(error_of("name = \"t\"\n[study.\"I,II\"]\nseeds = [0]\n").what(),
+              AllOf(StartsWith("x.toml:2: study name \"I,II\" must be letters, digits"),
+                    HasSubstr("separated by commas")));
+  EXPECT_THAT(error_of("name = \"t\"\n[study]\n").what(),
+              StartsWith("x.toml:2: [study] names no study"));
+}
+
+// toml++ nests a table per dot and recurses over them: a 60 kB [a.a.a...]
+// header would need megabytes of stack, so deep keys are refused first.
+TEST(SweepFileErrorTest, DeeplyDottedKeysAreRefusedBeforeParsing) {
+  std::string deep;
+  for (int i = 0; i < 20000; ++i) deep += ".a";
+  EXPECT_THAT(error_of("name = \"t\"\n[grid" + deep + "]\n").what(),
+              AllOf(StartsWith("x.toml:2: a dotted key or table header nests more than 64 tables"),
+                    HasSubstr("physics.duffing.damping")));
+  EXPECT_THAT(error_of("name = \"t\"\nx" + deep + " = 1\n").what(),
+              StartsWith("x.toml:2: a dotted"));
+  EXPECT_THAT(error_of("name = \"t\"\ngrid.a.a = 1\n").what(),
+              StartsWith("x.toml:2: unknown table [grid.a] in [grid]"));
+}
+
 // --- errors: FILE:LINE, the offending key or value, the allowed values ---
 
 TEST(SweepFileErrorTest, MisspelledKeyListsTheKeysOfItsTable) {

@@ -1,0 +1,367 @@
+// src/sweep/sweep_file_tables.cpp — walks the tables of a parsed sweep file
+// in file order and maps each key onto the defaults of docs/METHOD.md
+// (OscillatorOptions, DatasetOptions, TrainerOptions, the grid axes): unknown
+// tables and keys, whole-struct validation at the key a message names, and the
+// studies' inheritance from [grid] (split from the values: this file knows keys).
+#include "sweep/sweep_file_tables.h"
+
+#include <algorithm>
+#include <functional>
+#include <map>
+#include <optional>
+
+#include "phnn/sweep/output_check.h"
+#include "sweep/sweep_file_values.h"
+
+namespace phnn {
+namespace {
+
+// Axes of [grid] or of one [study.NAME]; unset axes are inherited.
+struct AxisSet {
+  std::string title;
+  std::optional<std::vector<SystemKind>> systems;
+  std::optional<std::vector<std::pair<ModelKind, IntegratorKind>>> models;
+  std::optional<std::vector<ModelSize>> sizes;
+  std::optional<std::vector<int>> n_train;
+  std::vector<int> n_train_lines;  // line of each n_train value
+  std::optional<std::vector<Regularizer>> regularizers;
+  std::optional<std::vector<int>> seeds;
+};
+
+// A key's handler: reads the entry and stores the value.
+using Handler = std::function<void(const Entry&)>;
+using Handlers = std::vector<std::pair<std::string, Handler>>;
+// key -> line of the keys a table set.
+using KeyLines = std::map<std::string, int>;
+
+const char kTableList[] =
+    "[data], [training], [grid], [physics.harmonic], [physics.duffing], "
+    "[physics.self-sustained], [study.NAME]";
+
+std::optional<SystemKind> find_system(const std::string& name) {
+  for (SystemKind kind : all_systems()) {
+    if (to_string(kind) == name) return kind;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> system_names() {
+  std::vector<std::string> names;
+  for (SystemKind kind : all_systems()) names.push_back(to_string(kind));
+  return names;
+}
+
+bool is_word_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+// Position of `field` as a whole word in `message`, or npos.
+std::size_t find_word(const std::string& message, const std::string& field) {
+  for (std::size_t at = message.find(field); at != std::string::npos;
+       at = message.find(field, at + 1)) {
+    const bool left = at == 0 || !is_word_char(message[at - 1]);
+    const std::size_t end = at + field.size();
+    if (left && (end == message.size() || !is_word_char(message[end]))) return at;
+  }
+  return std::string::npos;
+}
+
+class TableWalker {
+ public:
+  explicit TableWalker(const SweepSource& source) : source_(source), values_(source) {}
+
+  SweepSpec resolve(const toml::table& root) {
+    for (SystemKind kind : all_systems()) spec_.physics[kind] = OscillatorOptions::defaults(kind);
+    for (const Entry& e : entries_in_file_order(root)) top_level_entry(e);
+    if (!has_name_) {
+      fail(1, "missing required key \"name\"; add `name = \"...\"` at the top of the file");
+    }
+    if (!has_output_) spec_.output = "results/" + sanitize_file_name(spec_.name) + ".h5";
+    validate_options();
+    if (studies_.empty()) studies_.emplace_back("grid", AxisSet());
+    for (const auto& [name, axes] : studies_) spec_.studies.push_back(study_spec(name, axes));
+    return spec_;
+  }
+
+ private:
+  [[noreturn]] void fail(int line, const std::string& message) const {
+    source_.fail(line, message);
+  }
+
+  void top_level_entry(const Entry& e) {
+    if (e.key == "name") {
+      spec_.name = values_.nonempty_string(e);
+      has_name_ = true;
+    } else if (e.key == "output") {
+      spec_.output = values_.nonempty_string(e);
+      has_output_ = true;
+    } else if (e.key == "data") {
+      data_header_ = e.line;
+      data_lines_ = apply(values_.table(e, "[data]"), "[data]", data_handlers(spec_.data));
+    } else if (e.key == "training") {
+      training_header_ = e.line;
+      training_lines_ =
+          apply(values_.table(e, "[training]"), "[training]", training_handlers(spec_.training));
+    } else if (e.key == "grid") {
+      apply(values_.table(e, "[grid]"), "[grid]", axis_handlers(grid_, /*allow_title=*/false));
+    } else if (e.key == "physics") {
+      physics_tables(values_.table(e, "[physics.SYSTEM]"));
+    } else if (e.key == "study") {
+      study_tables(e, values_.table(e, "[study.NAME]"));
+    } else if (e.value->is_table() || e.value->is_array_of_tables()) {
+      fail(e.line,
+           "unknown table [" + e.key + "]" +
+               did_you_mean(e.key, {"data", "training", "grid", "physics.harmonic",
+                                    "physics.duffing", "physics.self-sustained", "study.NAME"}) +
+               "; expected one of: " + kTableList);
+    } else {
+      fail(e.line, "unknown key " + quoted(e.key) + " in the top level (before any [table])" +
+                       did_you_mean(e.key, {"name", "output"}) + "; expected one of: name, output");
+    }
+  }
+
+  void physics_tables(const toml::table& physics) {
+    for (const Entry& e : entries_in_file_order(physics)) {
+      const std::optional<SystemKind> kind = find_system(e.key);
+      if (!kind && !e.value->is_table()) {
+        fail(e.line, "key " + quoted(e.key) +
+                         " directly in [physics]; physical parameters go "
+                         "in [physics.harmonic], [physics.duffing] or [physics.self-sustained]");
+      }
+      const std::string label = "[physics." + e.key + "]";
+      if (!kind) {
+        fail(e.line, "unknown system " + quoted(e.key) + " in table " + label +
+                         did_you_mean(e.key, system_names()) +
+                         "; expected one of: [physics.harmonic], [physics.duffing], "
+                         "[physics.self-sustained]");
+      }
+      physics_header_[*kind] = e.line;
+      physics_lines_[*kind] =
+          apply(values_.table(e, label), label, physics_handlers(*kind, spec_.physics[*kind]));
+    }
+  }
+
+  void study_tables(const Entry& study, const toml::table& tables) {
+    if (tables.empty()) fail(study.line, "[study] names no study; write [study.NAME] tables");
+    for (const Entry& e : entries_in_file_order(tables)) {
+      const std::string label = "[study." + e.key + "]";
+      const toml::table& table = values_.table(e, label);
+      const bool bare = !e.key.empty() && std::all_of(e.key.begin(), e.key.end(), [](char c) {
+        return is_word_char(c) || c == '-';
+      });
+      if (!bare) {
+        fail(e.line, "study name " + quoted(e.key) +
+                         " must be letters, digits, '_' and '-' "
+                         "(results files list studies separated by commas)");
+      }
+      studies_.emplace_back(e.key, AxisSet());
+      apply(table, label, axis_handlers(studies_.back().second, /*allow_title=*/true));
+    }
+  }
+
+  // Runs the handlers of a table's keys; returns the lines of the keys it set.
+  KeyLines apply(const toml::table& table, const std::string& label, const Handlers& handlers) {
+    KeyLines lines;
+    for (const Entry& e : entries_in_file_order(table)) {
+      lines.emplace(e.key, e.line);  // toml++ refuses duplicate keys
+      const auto handler = std::find_if(handlers.begin(), handlers.end(),
+                                        [&](const auto& h) { return h.first == e.key; });
+      if (handler == handlers.end()) {
+        std::vector<std::string> allowed;
+        for (const auto& h : handlers) allowed.push_back(h.first);
+        const std::string what =
+            e.value->is_table() && !e.value->as_table()->is_inline()
+                ? "table [" + label.substr(1, label.size() - 2) + "." + e.key + "]"
+                : "key " + quoted(e.key);
+        fail(e.line, "unknown " + what + " in " + label + did_you_mean(e.key, allowed) +
+                         "; expected one of: " + join(allowed));
+      }
+      handler->second(e);
+    }
+    return lines;
+  }
+
+  // Whole-struct constraints (e.g. energy_max >= energy_min), reported at
+  // the line of the key the message names.
+  void validate_options() {
+    validate_at([&] { spec_.data.validate(); }, "[data]", data_lines_, data_header_);
+    validate_at([&] { spec_.training.validate(); }, "[training]", training_lines_,
+                training_header_);
+    for (SystemKind kind : all_systems()) {
+      const std::string label = "[physics." + to_string(kind) + "]";
+      const int header = physics_header_.count(kind) ? physics_header_[kind] : 1;
+      validate_at(
+          [&] {
+            spec_.physics[kind].validate();
+            if (kind == SystemKind::kSelfSustained) {
+              (void)Oscillator(spec_.physics[kind]).self_oscillation_interval();
+            }
+          },
+          label, physics_lines_[kind], header);
+    }
+  }
+
+  // Calls `check` (an Options::validate()); on failure rethrows its message at
+  // the line of the key of the table that the message names first.
+  void validate_at(const std::function<void()>& check, const std::string& label,
+                   const KeyLines& key_lines, int header_line) const {
+    try {
+      check();
+    } catch (const std::invalid_argument& error) {
+      const std::string message = error.what();
+      int line = header_line;
+      std::size_t first = std::string::npos;
+      for (const auto& [key, key_line] : key_lines) {
+        const std::size_t at = find_word(message, key == "seed" ? "data_seed" : key);
+        if (at < first) {
+          first = at;
+          line = key_line;
+        }
+      }
+      fail(line, "in " + label + ": " + message);
+    }
+  }
+
+  // One study: its axes, else the grid's, else docs/METHOD.md §6 defaults.
+  StudySpec study_spec(const std::string& name, const AxisSet& axes) const {
+    StudySpec study;
+    study.name = name;
+    study.title = axes.title;
+    study.systems = axes.systems ? *axes.systems : grid_.systems ? *grid_.systems : all_systems();
+    study.models = axes.models ? *axes.models : grid_.models ? *grid_.models : all_model_pairs();
+    study.sizes = axes.sizes    ? *axes.sizes
+                  : grid_.sizes ? *grid_.sizes
+                                : std::vector<ModelSize>{ModelSize::kSmall};
+    study.regularizers = axes.regularizers    ? *axes.regularizers
+                         : grid_.regularizers ? *grid_.regularizers
+                                              : std::vector<Regularizer>{Regularizer::kNone};
+    if (axes.seeds || grid_.seeds) {
+      study.seeds = axes.seeds ? *axes.seeds : *grid_.seeds;
+    } else {
+      for (int s = 0; s < 10; ++s) study.seeds.push_back(s);
+    }
+    const AxisSet* n_train_from = axes.n_train ? &axes : grid_.n_train ? &grid_ : nullptr;
+    study.n_train = n_train_from ? *n_train_from->n_train : std::vector<int>{25};
+    check_n_train(study, n_train_from ? n_train_from->n_train_lines : std::vector<int>());
+    return study;
+  }
+
+  // n_train <= num_train_max: reported at the value's line (`lines` is empty
+  // for the default).
+  void check_n_train(const StudySpec& study, const std::vector<int>& lines) const {
+    const int max = spec_.data.num_train_max;
+    for (std::size_t i = 0; i < study.n_train.size(); ++i) {
+      const int n = study.n_train[i];
+      if (n >= 1 && n <= max) continue;
+      const auto max_line = data_lines_.find("num_train_max");
+      const int line = i < lines.size()                ? lines[i]
+                       : max_line != data_lines_.end() ? max_line->second
+                                                       : 1;
+      fail(line, "n_train value " + std::to_string(n) + (lines.empty() ? " (the default)" : "") +
+                     " of study " + quoted(study.name) + " is outside [1, num_train_max = " +
+                     std::to_string(max) + "]; lower it or raise num_train_max in [data]");
+    }
+  }
+
+  Handlers axis_handlers(AxisSet& axes, bool allow_title) const {
+    Handlers h;
+    if (allow_title) {
+      h.emplace_back("title", [this, &axes](const Entry& e) { axes.title = values_.string(e); });
+    }
+    h.emplace_back("systems", [this, &axes](const Entry& e) { axes.systems = values_.systems(e); });
+    h.emplace_back("models", [this, &axes](const Entry& e) { axes.models = values_.models(e); });
+    h.emplace_back("sizes", [this, &axes](const Entry& e) { axes.sizes = values_.sizes(e); });
+    h.emplace_back("n_train", [this, &axes](const Entry& e) {
+      axes.n_train_lines.clear();
+      axes.n_train = values_.int_axis(e, 1, &axes.n_train_lines);
+    });
+    h.emplace_back("regularizers",
+                   [this, &axes](const Entry& e) { axes.regularizers = values_.regularizers(e); });
+    h.emplace_back("seeds", [this, &axes](const Entry& e) { axes.seeds = values_.seeds(e); });
+    return h;
+  }
+
+  Handler number(double& field) const {
+    return [this, &field](const Entry& e) { field = values_.number(e, *e.value); };
+  }
+  Handler integer(int& field, int min) const {
+    return [this, &field, min](const Entry& e) { field = values_.int_at_least(e, min); };
+  }
+
+  Handlers data_handlers(DatasetOptions& d) const {
+    return {{"seed",
+             [this, &d](const Entry& e) {
+               d.data_seed = static_cast<std::uint64_t>(
+                   values_.integer(e, *e.value, 0, INT64_MAX, "an integer >= 0"));
+             }},
+            {"generation_step", number(d.generation_step)},
+            {"period", number(d.period)},
+            {"alpha", number(d.alpha)},
+            {"beta", number(d.beta)},
+            {"sample_rate", number(d.sample_rate)},
+            {"energy_min", number(d.energy_min)},
+            {"energy_max", number(d.energy_max)},
+            {"equilibrium_energy_min", number(d.equilibrium_energy_min)},
+            {"equilibrium_energy_max", number(d.equilibrium_energy_max)},
+            {"num_trajectories", integer(d.num_trajectories, 1)},
+            {"num_train_max", integer(d.num_train_max, 1)},
+            {"num_validation", integer(d.num_validation, 1)},
+            {"num_inference", integer(d.num_inference, 1)},
+            {"newton_tolerance", number(d.newton.newton_tolerance)}};
+  }
+
+  Handlers training_handlers(TrainerOptions& t) const {
+    return {{"steps", integer(t.steps, 1)},
+            {"learning_rate", number(t.learning_rate)},
+            {"adam_beta1", number(t.adam_beta1)},
+            {"adam_beta2", number(t.adam_beta2)},
+            {"adam_eps", number(t.adam_eps)},
+            {"batch_size", integer(t.batch_size, 1)},
+            {"eval_every", integer(t.eval_every, 1)},
+            {"lambda_cn", number(t.lambda_cn)},
+            {"lambda_sn", number(t.lambda_sn)},
+            {"lambda_sr", number(t.lambda_sr)},
+            {"jacobian_eps", number(t.jacobian_eps)},
+            {"newton_tolerance", number(t.newton_tolerance)},
+            {"newton_max_iterations", integer(t.newton_max_iterations, 1)},
+            {"dg_min_dx_norm", number(t.dg_min_dx_norm)},
+            {"divergence_norm", number(t.divergence_norm)},
+            {"checkpoints", [this, &t](const Entry& e) {
+               t.checkpoints = values_.int_axis(e, 1, nullptr);
+               std::sort(t.checkpoints.begin(), t.checkpoints.end());
+             }}};
+  }
+
+  // Only the parameters the system uses (RunConfig::cell_key() hashes exactly
+  // these), so a key that would be silently ignored is an error instead.
+  Handlers physics_handlers(SystemKind kind, OscillatorOptions& p) const {
+    Handlers h = {{"mass", number(p.mass)}, {"stiffness", number(p.stiffness)}};
+    if (kind == SystemKind::kDuffing) h.emplace_back("cubic_stiffness", number(p.cubic_stiffness));
+    if (kind != SystemKind::kSelfSustained) {
+      h.emplace_back("damping", number(p.damping));
+    } else {
+      h.emplace_back("z_coefficients",
+                     [this, &p](const Entry& e) { p.z_coefficients = values_.three_numbers(e); });
+    }
+    return h;
+  }
+
+  const SweepSource& source_;
+  ValueReader values_;
+  SweepSpec spec_;
+  AxisSet grid_;
+  std::vector<std::pair<std::string, AxisSet>> studies_;  // file order
+  KeyLines data_lines_, training_lines_;
+  std::map<SystemKind, KeyLines> physics_lines_;
+  std::map<SystemKind, int> physics_header_;
+  int data_header_ = 1, training_header_ = 1;
+  bool has_name_ = false, has_output_ = false;
+};
+
+}  // namespace
+
+SweepSpec resolve_sweep_tables(const toml::table& root, const SweepSource& source) {
+  return TableWalker(source).resolve(root);
+}
+
+}  // namespace phnn
