@@ -60,9 +60,9 @@ constexpr std::size_t kMessageLength = 256;
 /// Collective calls (every rank of `comm`, same arguments): create, open,
 /// store_system_data, flush, close (also the destructor). In a parallel file
 /// an exception inside one of them is printed with the rank prefix and ends
-/// the job with MPI_Abort (STYLE.md policy 4); bad arguments and a wrong
-/// file are found before the first collective HDF5 call and throw on every
-/// rank (policy 1). Independent calls: write_run and every read_*; their
+/// the job with MPI_Abort; bad arguments and a wrong file are found before
+/// the first collective HDF5 call and throw on every rank (docs/DECISIONS.md,
+/// "No rank waits forever"). Independent calls: write_run and every read_*; their
 /// errors throw std::runtime_error (h5::Error inside phnn) whose message
 /// starts with "[rank r/n] " in a parallel file.
 /// A file made with comm == MPI_COMM_NULL (or open_read_only) is serial and

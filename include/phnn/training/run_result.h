@@ -7,7 +7,7 @@
 
 namespace phnn {
 
-/// Status of a run: a diverged run is a result, not an error (STYLE.md).
+/// Status of a run: a diverged run is a result, not an error (docs/DECISIONS.md).
 enum class RunStatus { kPending = 0, kDone = 1, kDiverged = 2, kFailed = 3 };
 /// "pending", "done", "diverged", "failed".
 std::string to_string(RunStatus status);

@@ -1,0 +1,217 @@
+// src/sweep/results_file_create.cpp — ResultsFile::create: every dataset of
+// docs/RESULTS_FORMAT.md made up front (allocated and filled, so a row write
+// later touches raw data only) and the configuration columns written.
+#include <unistd.h>
+
+#include <map>
+
+#include "phnn/common/utc_time.h"
+#include "sweep/results_file_internal.h"
+
+namespace phnn {
+
+using namespace results_io;
+
+namespace {
+
+// The config columns of /runs, one entry per run, validated (every
+// rank has the same arguments, so these throw everywhere).
+struct ConfigColumns {
+  std::vector<std::string> ids, canonical, systems, models, integrators, sizes, regularizers;
+  std::vector<std::int64_t> n_train, seeds;
+
+  ConfigColumns(const std::vector<RunConfig>& runs, const std::vector<std::string>& run_studies,
+                const std::string& where) {
+    std::map<std::string, std::size_t> row_of_id;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      const RunConfig& run = runs[i];
+      canonical.push_back(run.canonical());
+      ids.push_back(run.id());
+      require(canonical[i].size() <= kCanonicalLength,
+              where + "run " + std::to_string(i) + " has a canonical config of " +
+                  std::to_string(canonical[i].size()) + " bytes, more than " +
+                  std::to_string(kCanonicalLength) + ": " + canonical[i]);
+      require(run_studies[i].size() <= kStudiesLength,
+              where + "run " + std::to_string(i) + " has studies \"" + run_studies[i] +
+                  "\", longer than " + std::to_string(kStudiesLength) + " bytes");
+      const auto [it, inserted] = row_of_id.emplace(ids[i], i);
+      require(inserted, where + "runs " + std::to_string(it->second) + " and " +
+                            std::to_string(i) + " are the same run (id " + ids[i] +
+                            "); the grid must list each run once");
+      systems.push_back(to_string(run.system));
+      models.push_back(to_string(run.model));
+      integrators.push_back(to_string(run.integrator));
+      sizes.push_back(to_string(run.size));
+      regularizers.push_back(to_string(run.regularizer));
+      n_train.push_back(run.n_train);
+      seeds.push_back(run.seed);
+    }
+  }
+};
+
+// Creates datasets of R rows with their `units` attribute.
+struct DatasetMaker {
+  h5::File& file;
+  std::uint64_t rows;
+
+  void text(const std::string& name, std::size_t length, const std::string& units) const {
+    file.create_dataset(name, h5::Type::kString, {rows}, length);
+    file.set_attribute(name, "units", units);
+  }
+  void ints(const std::string& name, std::vector<std::uint64_t> dims,
+            const std::string& units) const {
+    file.create_dataset(name, h5::Type::kInt64, dims);
+    file.set_attribute(name, "units", units);
+  }
+  // Filled with NaN: a pending row reads as NaN.
+  void floats(const std::string& name, std::vector<std::uint64_t> dims,
+              const std::string& units) const {
+    file.create_dataset(name, h5::Type::kFloat64, dims, /*string_length=*/0, /*fill_value=*/kNaN);
+    file.set_attribute(name, "units", units);
+  }
+};
+
+void create_config_datasets(const DatasetMaker& make) {
+  const std::uint64_t R = make.rows;
+  make.text(kId, kIdLength, "RunConfig::id(): FNV-1a 64 of canonical, 16 hex digits");
+  make.text(kCanonical, kCanonicalLength, "RunConfig::canonical()");
+  make.text(kSystem, kNameLength, "harmonic, duffing or self-sustained");
+  make.text(kModel, kNameLength, "node, phnn-s or phnn-jr");
+  make.text(kIntegrator, kNameLength, "rk2, dg, rk4 or dg4");
+  make.text(kSize, kNameLength, "small, medium or large");
+  make.text(kRegularizer, kNameLength, "none, cn, sn or sr");
+  make.ints(kNTrain, {R}, "training pairs");
+  make.ints(kSeed, {R}, "model initialization seed");
+  make.text(kStudies, kStudiesLength, "comma-separated studies of the run, e.g. I,II,III");
+}
+
+void create_result_datasets(const DatasetMaker& make, const ResultsLayout& layout) {
+  const std::uint64_t R = make.rows;
+  const auto I = static_cast<std::uint64_t>(layout.num_inference);
+  make.ints(kStatus, {R}, "0 pending, 1 done, 2 diverged, 3 failed");
+  make.text(kMessage, kMessageLength, "why a run diverged or failed (truncated)");
+  make.floats(kMse, {R}, kMseUnits);
+  make.floats(kTrajectoryErrors, {R, I}, kMseUnits + "; per inference trajectory");
+  make.ints(kTrajectoryErrorsLength, {R}, "valid entries of trajectory_errors");
+  make.ints(kDivergedRollouts, {R}, "inference rollouts that diverged");
+  make.ints(kBestStep, {R}, "Adam step of the best validation loss");
+  make.floats(kBestValidationLoss, {R}, kLossUnits);
+  make.floats(kWallTime, {R}, "s");
+  make.ints(kSteps, {R}, "Adam steps");
+  make.ints(kParameterCount, {R}, "trainable parameters");
+  make.ints(kNewtonFailures, {R}, "DG inference steps whose Newton did not converge");
+  make.text(kStartedUtc, kUtcLength,
+            "UTC, ISO 8601: when training of the run's work item started; empty if pending "
+            "or recovered from a journal");
+  make.text(kFinishedUtc, kUtcLength, "UTC, ISO 8601: when the run's work item finished");
+}
+
+void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLayout& layout) {
+  const std::uint64_t R = make.rows;
+  const auto T = static_cast<std::uint64_t>(layout.trace_points);
+  const auto F = static_cast<std::uint64_t>(layout.figure_points);
+  make.floats(kTrace, {R, T, kTraceColumns},
+              "step [1], elapsed_s [s], train_loss and validation_loss [" + kLossUnits +
+                  "], kappa [1], sigma_max [1/s], rho [1]; NaN after trace_length");
+  make.file.set_attribute(kTrace, "columns",
+                          std::string("step, elapsed_s, train_loss, validation_loss, kappa, "
+                                      "sigma_max, rho"));
+  make.ints(kTraceLength, {R}, "valid points of trace");
+  const std::string figure = kStateUnits + " per point; NaN after figure/length";
+  make.floats(kPrediction05, {R, F, 2}, figure + "; model rollout from H(x0) = 0.5 J");
+  make.floats(kPrediction075, {R, F, 2}, figure + "; model rollout from H(x0) = 0.75 J");
+  make.floats(kReference05, {R, F, 2}, figure + "; reference from H(x0) = 0.5 J");
+  make.floats(kReference075, {R, F, 2}, figure + "; reference from H(x0) = 0.75 J");
+  make.ints(kFigureLength, {R, 4}, "valid points of each figure trajectory");
+  make.file.set_attribute(kFigureLength, "columns",
+                          std::string("prediction_05, prediction_075, reference_05, "
+                                      "reference_075"));
+  if (layout.checkpoints > 0) {
+    const auto K = static_cast<std::uint64_t>(layout.checkpoints);
+    make.ints(kCheckpointSteps, {R, K}, "step budgets (TrainerOptions::checkpoints); 0 after the "
+                                        "run's own count");
+    make.floats(kCheckpointMse, {R, K},
+                kMseUnits + "; of the best-validation weights up to each budget");
+    make.floats(kCheckpointTrainSeconds, {R, K},
+                "s; training wall time to each budget, this run's share of its stack, inference "
+                "excluded");
+  }
+}
+
+// Independent raw-data writes of rank 0.
+void write_config_columns(h5::File& file, const ConfigColumns& c,
+                          const std::vector<std::string>& run_studies) {
+  const auto R = static_cast<std::uint64_t>(c.ids.size());
+  file.write_string_rows(kId, 0, c.ids);
+  file.write_string_rows(kCanonical, 0, c.canonical);
+  file.write_string_rows(kSystem, 0, c.systems);
+  file.write_string_rows(kModel, 0, c.models);
+  file.write_string_rows(kIntegrator, 0, c.integrators);
+  file.write_string_rows(kSize, 0, c.sizes);
+  file.write_string_rows(kRegularizer, 0, c.regularizers);
+  file.write_string_rows(kStudies, 0, run_studies);
+  file.write_rows(kNTrain, 0, R, c.n_train.data());
+  file.write_rows(kSeed, 0, R, c.seeds.data());
+}
+
+}  // namespace
+
+ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
+                                const std::vector<RunConfig>& runs,
+                                const std::vector<std::string>& run_studies,
+                                const std::string& sweep_name,
+                                const std::string& sweep_text,
+                                const std::string& sweep_hash,
+                                const std::string& program_version,
+                                const ResultsLayout& layout) {
+  // Every rank has the same arguments, so these throw everywhere together.
+  const std::string where = "ResultsFile::create(" + path + "): ";
+  layout.validate();
+  require(!runs.empty(), where + "the run list is empty; a sweep needs at least one run");
+  require(run_studies.size() == runs.size(),
+          where + "got " + std::to_string(run_studies.size()) + " study lists for " +
+              std::to_string(runs.size()) + " runs; pass one per run");
+  require(sweep_text.size() <= kMaxSweepText,
+          where + "sweep_text has " + std::to_string(sweep_text.size()) +
+              " bytes, more than the " + std::to_string(kMaxSweepText) +
+              " an HDF5 attribute can hold; shorten the sweep file");
+  const ConfigColumns columns(runs, run_studies, where);
+
+  // Rank 0 checks the directory; all ranks learn the outcome and the
+  // creation time together.
+  check_on_rank0(comm, [&]() -> std::string {
+    const std::string dir = dirname_of(path);
+    if (::access(dir.c_str(), W_OK) != 0) {
+      return path + ": cannot create the results file: directory " + dir +
+             " does not exist or is not writable";
+    }
+    return "";
+  });
+  const std::string created = broadcast(comm, utc_now());
+
+  std::unique_ptr<Impl> impl;
+  collective_or_abort(comm, [&] {
+    h5::File file = h5::File::create(path, comm);
+    file.set_attribute("/", "format", std::string(kFormat));
+    file.set_attribute("/", "format_version", kFormatVersion);
+    file.set_attribute("/", "sweep_name", sweep_name);
+    file.set_attribute("/", "sweep_text", sweep_text);
+    file.set_attribute("/", "sweep_hash", sweep_hash);
+    file.set_attribute("/", "program_version", program_version);
+    file.set_attribute("/", "units", kFileUnits);
+    file.set_attribute("/", "created", created);
+    // Every dataset now, allocated and filled (pending rows: status 0, NaN
+    // floats, zero lengths): writing a row later touches raw data only.
+    const DatasetMaker make{file, static_cast<std::uint64_t>(runs.size())};
+    create_config_datasets(make);
+    create_result_datasets(make, layout);
+    create_trace_and_figure_datasets(make, layout);
+    if (comm_rank(comm) == 0) write_config_columns(file, columns, run_studies);
+    // Metadata on disk now: from here on a crash can only lose row data.
+    file.flush();
+    impl = std::make_unique<Impl>(std::move(file), comm);
+  });
+  return ResultsFile(std::move(impl));
+}
+
+}  // namespace phnn

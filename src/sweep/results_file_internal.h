@@ -1,0 +1,166 @@
+// src/sweep/results_file_internal.h — shared by the results_file*.cpp files
+// only: the dataset names and units texts of docs/RESULTS_FORMAT.md,
+// ResultsFile::Impl (the open h5::File and the layout read from it), and the
+// helpers that make every rank fail together. Includes HDF5 only through
+// src/h5.
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "h5/h5file.h"
+#include "phnn/sweep/results_file.h"
+
+namespace phnn {
+namespace results_io {
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+inline constexpr std::size_t kIdLength = 16;
+inline constexpr std::size_t kNameLength = 32;
+// The root object header holds each attribute in one message of < 64 KiB.
+inline constexpr std::size_t kMaxSweepText = 60000;
+inline constexpr int kTraceColumns = 7;
+
+// Dataset names (docs/RESULTS_FORMAT.md).
+inline const std::string kRuns = "/runs/";
+inline const std::string kId = "/runs/id";
+inline const std::string kCanonical = "/runs/canonical";
+inline const std::string kSystem = "/runs/system";
+inline const std::string kModel = "/runs/model";
+inline const std::string kIntegrator = "/runs/integrator";
+inline const std::string kSize = "/runs/size";
+inline const std::string kRegularizer = "/runs/regularizer";
+inline const std::string kNTrain = "/runs/n_train";
+inline const std::string kSeed = "/runs/seed";
+inline const std::string kStudies = "/runs/studies";
+inline const std::string kStatus = "/runs/status";
+inline const std::string kMessage = "/runs/message";
+inline const std::string kMse = "/runs/mse";
+inline const std::string kTrajectoryErrors = "/runs/trajectory_errors";
+inline const std::string kTrajectoryErrorsLength = "/runs/trajectory_errors_length";
+inline const std::string kDivergedRollouts = "/runs/diverged_rollouts";
+inline const std::string kBestStep = "/runs/best_step";
+inline const std::string kBestValidationLoss = "/runs/best_validation_loss";
+inline const std::string kWallTime = "/runs/wall_time_s";
+inline const std::string kSteps = "/runs/steps";
+inline const std::string kParameterCount = "/runs/parameter_count";
+inline const std::string kNewtonFailures = "/runs/newton_failures";
+inline const std::string kTrace = "/runs/trace";
+inline const std::string kTraceLength = "/runs/trace_length";
+inline const std::string kPrediction05 = "/runs/figure/prediction_05";
+inline const std::string kPrediction075 = "/runs/figure/prediction_075";
+inline const std::string kReference05 = "/runs/figure/reference_05";
+inline const std::string kReference075 = "/runs/figure/reference_075";
+inline const std::string kFigureLength = "/runs/figure/length";
+inline const std::string kCheckpointSteps = "/runs/checkpoint_steps";
+inline const std::string kCheckpointMse = "/runs/checkpoint_mse";
+inline const std::string kCheckpointTrainSeconds = "/runs/checkpoint_train_seconds";
+// Added with provenance; files written before them have neither.
+inline const std::string kStartedUtc = "/runs/started_utc";
+inline const std::string kFinishedUtc = "/runs/finished_utc";
+inline const std::string kProvenance = "/provenance";
+inline constexpr std::size_t kUtcLength = 20;  // "2024-05-01T12:00:00Z"
+
+inline const std::string kStateUnits = "q [m], p [kg m/s]";
+inline const std::string kMseUnits =
+    "m^2 and (kg m/s)^2 mixed: mean of ||x - x_hat||^2 over the inference "
+    "trajectories and steps (docs/METHOD.md section 5); +inf if a rollout diverged";
+inline const std::string kLossUnits =
+    "m/s and kg m/s^2 mixed: L_d = mean |x_{n+1} - x_hat_{n+1}| / h (+ regularizer)";
+inline const std::string kFileUnits =
+    "SI units. States q [m], p [kg m/s]; time [s]; energy [J]; mse in m^2 and "
+    "(kg m/s)^2 mixed (mean of ||x - x_hat||^2); losses in m/s and kg m/s^2 mixed "
+    "(mean |x_{n+1} - x_hat_{n+1}| / h); kappa and rho dimensionless; sigma_max in "
+    "1/s. Every dataset of /runs has a units attribute.";
+
+
+std::string dirname_of(const std::string& path);
+int comm_rank(MPI_Comm comm);
+int comm_size(MPI_Comm comm);
+/// Rank `root`'s string on every rank (serial: unchanged).
+std::string broadcast(MPI_Comm comm, std::string text, int root = 0);
+/// Rank 0 runs `check` (which returns an error message or ""); every rank
+/// throws the same error, so none is left waiting in a collective call
+/// (docs/DECISIONS.md, "No rank waits forever").
+void check_on_rank0(MPI_Comm comm, const std::function<std::string()>& check);
+/// Message truncated to `length` bytes, ending in "...", not splitting a
+/// UTF-8 character.
+std::string truncate_message(const std::string& text, std::size_t length);
+/// Throws std::invalid_argument(message) unless ok.
+void require(bool ok, const std::string& message);
+/// Runs collective HDF5 code. Serial: exceptions propagate. Parallel: an
+/// exception is printed with the rank prefix and ends the job (docs/DECISIONS.md,
+/// "No rank waits forever"), since the other ranks would wait for this one forever.
+void collective_or_abort(MPI_Comm comm, const std::function<void()>& body);
+
+}  // namespace results_io
+
+struct ResultsFile::Impl {
+  h5::File file;
+  MPI_Comm comm = MPI_COMM_NULL;
+  int rank = 0;
+  int size = 1;
+  bool open = true;
+  int num_runs = 0;
+  ResultsLayout layout;
+  bool has_run_times = false;  // false in files written before provenance
+  std::string session;         // this process's /provenance/session_<k>
+
+  Impl(h5::File f, MPI_Comm c)
+      : file(std::move(f)), comm(c), rank(results_io::comm_rank(c)), size(results_io::comm_size(c)) {
+    read_layout();
+  }
+
+  void read_layout() {
+    num_runs = static_cast<int>(file.dims(results_io::kId).at(0));
+    layout.num_inference = static_cast<int>(file.dims(results_io::kTrajectoryErrors).at(1));
+    layout.trace_points = static_cast<int>(file.dims(results_io::kTrace).at(1));
+    layout.figure_points = static_cast<int>(file.dims(results_io::kPrediction05).at(1));
+    layout.checkpoints =
+        file.exists(results_io::kCheckpointMse) ? static_cast<int>(file.dims(results_io::kCheckpointMse).at(1)) : 0;
+    has_run_times = file.exists(results_io::kStartedUtc) && file.exists(results_io::kFinishedUtc);
+  }
+
+  // "[rank 3/8] " in a parallel file, "" in a serial one.
+  std::string prefix() const {
+    if (comm == MPI_COMM_NULL) return "";
+    return "[rank " + std::to_string(rank) + "/" + std::to_string(size) + "] ";
+  }
+
+  // Independent I/O: h5::Error gets the rank prefix.
+  template <class F>
+  auto independent(F&& body) const -> decltype(body()) {
+    if (!open) throw std::logic_error(prefix() + file.path() + ": used after close()");
+    try {
+      return body();
+    } catch (const h5::Error& e) {
+      if (comm == MPI_COMM_NULL) throw;
+      throw h5::Error(prefix() + e.what());
+    }
+  }
+
+  void collective(const std::function<void()>& body) {
+    if (!open) throw std::logic_error(prefix() + file.path() + ": used after close()");
+    results_io::collective_or_abort(comm, body);
+  }
+
+  std::vector<std::string> strings(const std::string& name) const {
+    return independent([&] { return file.read_strings(name); });
+  }
+  std::vector<std::int64_t> ints(const std::string& name, std::uint64_t row = 0,
+                                 std::uint64_t count = 0) const {
+    return independent([&] { return file.read_ints(name, row, count); });
+  }
+  std::vector<double> doubles(const std::string& name, std::uint64_t row = 0,
+                              std::uint64_t count = 0) const {
+    return independent([&] { return file.read_doubles(name, row, count); });
+  }
+};
+
+}  // namespace phnn
