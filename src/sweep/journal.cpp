@@ -1,235 +1,29 @@
-// src/sweep/journal.cpp
+// src/sweep/journal.cpp — the per-rank journal files: append a record and
+// fsync it, replay the latest record of every run, delete old journals.
+// The record format: journal_record.cpp.
 #include "phnn/sweep/journal.h"
 
 #include <dirent.h>
 #include <fcntl.h>
-#include <locale.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
 
-#include "phnn/sweep/run_config.h"  // fnv1a64, hex64
-
 namespace phnn {
 namespace {
-
-constexpr char kChecksumKey[] = " fnv1a64=";
-constexpr char kFormatVersion[] = "1";
 
 std::string errno_text() { return std::strerror(errno); }
 
 std::string log_path(const std::string& results_path, int rank) {
   return journal_directory(results_path) + "/rank-" + std::to_string(rank) + ".log";
-}
-
-// %a and strtod follow LC_NUMERIC; the journal is always written and read in
-// the "C" locale, whatever the program set with setlocale().
-class CLocaleScope {
- public:
-  CLocaleScope() {
-    static const locale_t c_locale = newlocale(LC_ALL_MASK, "C", locale_t{});
-    previous_ = uselocale(c_locale);
-  }
-  ~CLocaleScope() { uselocale(previous_); }
-  CLocaleScope(const CLocaleScope&) = delete;
-  CLocaleScope& operator=(const CLocaleScope&) = delete;
-
- private:
-  locale_t previous_;
-};
-
-std::uint64_t bits_of(double v) {
-  std::uint64_t b = 0;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
-
-double from_bits(std::uint64_t b) {
-  double v = 0;
-  std::memcpy(&v, &b, sizeof v);
-  return v;
-}
-
-constexpr std::uint64_t kQuietNan = 0x7ff8000000000000ULL;
-constexpr std::uint64_t kNegativeQuietNan = 0xfff8000000000000ULL;
-
-// Hex float (exact). %a cannot carry a NaN's sign and payload, so NaNs other
-// than the two default quiet NaNs are written as nan_<IEEE bits>.
-std::string format_double(double v) {
-  if (std::isnan(v)) {
-    const std::uint64_t b = bits_of(v);
-    if (b == kQuietNan) return "nan";
-    if (b == kNegativeQuietNan) return "-nan";
-    return "nan_" + hex64(b);
-  }
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%a", v);
-  return buf;
-}
-
-bool parse_hex_u64(const std::string& text, std::uint64_t* out) {
-  if (text.size() != 16) return false;
-  std::uint64_t v = 0;
-  for (char c : text) {
-    int d = 0;
-    if (c >= '0' && c <= '9') d = c - '0';
-    else if (c >= 'a' && c <= 'f') d = c - 'a' + 10;
-    else return false;
-    v = (v << 4) | static_cast<std::uint64_t>(d);
-  }
-  *out = v;
-  return true;
-}
-
-bool parse_double(const std::string& text, double* out) {
-  if (text == "nan") {
-    *out = from_bits(kQuietNan);
-    return true;
-  }
-  if (text == "-nan") {
-    *out = from_bits(kNegativeQuietNan);
-    return true;
-  }
-  if (text.compare(0, 4, "nan_") == 0) {
-    std::uint64_t b = 0;
-    if (!parse_hex_u64(text.substr(4), &b)) return false;
-    *out = from_bits(b);
-    return std::isnan(*out);
-  }
-  if (text.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  *out = std::strtod(text.c_str(), &end);
-  // ERANGE is fine for subnormals, which %a writes exactly.
-  return end == text.c_str() + text.size() && !std::isnan(*out);
-}
-
-bool parse_int(const std::string& text, std::int64_t* out) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  const long long v = std::strtoll(text.c_str(), &end, 10);
-  if (errno != 0 || end != text.c_str() + text.size()) return false;
-  *out = v;
-  return true;
-}
-
-// Percent-encoding of every byte outside '!'..'~' and of '%' itself: the
-// encoded text has no spaces (the field separator) and no newlines.
-std::string escape(const std::string& text) {
-  static const char kHex[] = "0123456789ABCDEF";
-  std::string out;
-  out.reserve(text.size());
-  for (const char byte : text) {
-    const auto c = static_cast<unsigned char>(byte);
-    if (c > ' ' && c < 0x7f && c != '%') {
-      out.push_back(static_cast<char>(c));
-    } else {
-      out.push_back('%');
-      out.push_back(kHex[c >> 4]);
-      out.push_back(kHex[c & 15]);
-    }
-  }
-  return out;
-}
-
-bool unescape(const std::string& text, std::string* out) {
-  out->clear();
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    if (text[i] != '%') {
-      out->push_back(text[i]);
-      continue;
-    }
-    if (i + 2 >= text.size()) return false;
-    int value = 0;
-    for (std::size_t k = i + 1; k <= i + 2; ++k) {
-      const char c = text[k];
-      int d = 0;
-      if (c >= '0' && c <= '9') d = c - '0';
-      else if (c >= 'A' && c <= 'F') d = c - 'A' + 10;
-      else return false;
-      value = value * 16 + d;
-    }
-    out->push_back(static_cast<char>(value));
-    i += 2;
-  }
-  return true;
-}
-
-std::vector<std::string> split(const std::string& text, char separator) {
-  std::vector<std::string> parts;
-  if (text.empty()) return parts;
-  std::size_t begin = 0;
-  while (true) {
-    const std::size_t end = text.find(separator, begin);
-    parts.push_back(text.substr(begin, end - begin));
-    if (end == std::string::npos) return parts;
-    begin = end + 1;
-  }
-}
-
-std::string format_doubles(const std::vector<double>& values) {
-  std::string out;
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (i) out.push_back(',');
-    out += format_double(values[i]);
-  }
-  return out;
-}
-
-bool parse_doubles(const std::string& text, std::vector<double>* out) {
-  out->clear();
-  for (const std::string& part : split(text, ',')) {
-    double v = 0;
-    if (!parse_double(part, &v)) return false;
-    out->push_back(v);
-  }
-  return true;
-}
-
-// A trace point is step:elapsed_s:train_loss:validation_loss:kappa:sigma_max:rho.
-std::string format_trace(const std::vector<TracePoint>& trace) {
-  std::string out;
-  for (std::size_t i = 0; i < trace.size(); ++i) {
-    const TracePoint& t = trace[i];
-    if (i) out.push_back(',');
-    out += std::to_string(t.step) + ":" + format_double(t.elapsed_s) + ":" +
-           format_double(t.train_loss) + ":" + format_double(t.validation_loss) + ":" +
-           format_double(t.kappa) + ":" + format_double(t.sigma_max) + ":" +
-           format_double(t.rho);
-  }
-  return out;
-}
-
-bool parse_trace(const std::string& text, std::vector<TracePoint>* out) {
-  out->clear();
-  for (const std::string& point : split(text, ',')) {
-    const std::vector<std::string> f = split(point, ':');
-    if (f.size() != 7) return false;
-    TracePoint t;
-    std::int64_t step = 0;
-    if (!parse_int(f[0], &step) || !parse_double(f[1], &t.elapsed_s) ||
-        !parse_double(f[2], &t.train_loss) || !parse_double(f[3], &t.validation_loss) ||
-        !parse_double(f[4], &t.kappa) || !parse_double(f[5], &t.sigma_max) ||
-        !parse_double(f[6], &t.rho)) {
-      return false;
-    }
-    t.step = static_cast<int>(step);
-    out->push_back(t);
-  }
-  return true;
 }
 
 std::int64_t now_ns() {
@@ -283,9 +77,9 @@ std::vector<std::pair<int, std::string>> list_logs(const std::string& dir) {
         name.compare(name.size() - 4, 4, suffix) != 0) {
       continue;
     }
-    std::int64_t rank = 0;
-    if (!parse_int(name.substr(5, name.size() - 9), &rank) || rank < 0) continue;
-    logs.emplace_back(static_cast<int>(rank), dir + "/" + name);
+    const std::string digits = name.substr(5, name.size() - 9);
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    logs.emplace_back(std::stoi(digits), dir + "/" + name);
   }
   ::closedir(d);
   std::sort(logs.begin(), logs.end());
@@ -297,93 +91,6 @@ std::vector<std::pair<int, std::string>> list_logs(const std::string& dir) {
 std::string journal_directory(const std::string& results_path) {
   return results_path + ".journal";
 }
-
-namespace internal {
-
-std::string encode_journal_record(const std::string& run_id, const RunResult& r,
-                                  std::int64_t time_ns) {
-  const CLocaleScope c_locale;
-  std::ostringstream s;
-  s << "run " << escape(run_id) << " v=" << kFormatVersion << " time=" << time_ns
-    << " status=" << to_string(r.status) << " message=" << escape(r.message)
-    << " mse=" << format_double(r.mse)
-    << " trajectory_errors=" << format_doubles(r.trajectory_errors)
-    << " diverged_rollouts=" << r.diverged_rollouts << " trace=" << format_trace(r.trace)
-    << " best_step=" << r.best_step
-    << " best_validation_loss=" << format_double(r.best_validation_loss)
-    << " wall_time_s=" << format_double(r.wall_time_s) << " steps=" << r.steps
-    << " parameter_count=" << r.parameter_count << " newton_failures=" << r.newton_failures
-    << " figure_prediction_05=" << format_doubles(r.figure_prediction_05)
-    << " figure_prediction_075=" << format_doubles(r.figure_prediction_075)
-    << " figure_reference_05=" << format_doubles(r.figure_reference_05)
-    << " figure_reference_075=" << format_doubles(r.figure_reference_075);
-  const std::string body = s.str();
-  return body + kChecksumKey + hex64(fnv1a64(body));
-}
-
-bool decode_journal_record(const std::string& line_in, std::string* run_id,
-                           RunResult* result, std::int64_t* time_ns) {
-  std::string line = line_in;
-  if (!line.empty() && line.back() == '\n') line.pop_back();
-  const std::size_t mark = line.rfind(kChecksumKey);
-  if (line.compare(0, 4, "run ") != 0 || mark == std::string::npos) return false;
-  std::uint64_t checksum = 0;
-  const std::string body = line.substr(0, mark);
-  if (!parse_hex_u64(line.substr(mark + sizeof(kChecksumKey) - 1), &checksum) ||
-      checksum != fnv1a64(body)) {
-    return false;
-  }
-  const std::vector<std::string> tokens = split(body, ' ');
-  if (tokens.size() < 2 || !unescape(tokens[1], run_id) || run_id->empty()) return false;
-  std::map<std::string, std::string> fields;
-  for (std::size_t i = 2; i < tokens.size(); ++i) {
-    const std::size_t eq = tokens[i].find('=');
-    if (eq == std::string::npos) return false;
-    fields[tokens[i].substr(0, eq)] = tokens[i].substr(eq + 1);
-  }
-  // Every field is required; unknown fields (a later minor version) are
-  // ignored.
-  const char* const kRequired[] = {
-      "v", "time", "status", "message", "mse", "trajectory_errors", "diverged_rollouts",
-      "trace", "best_step", "best_validation_loss", "wall_time_s", "steps",
-      "parameter_count", "newton_failures", "figure_prediction_05", "figure_prediction_075",
-      "figure_reference_05", "figure_reference_075"};
-  for (const char* key : kRequired) {
-    if (fields.count(key) == 0) return false;
-  }
-  if (fields["v"] != kFormatVersion) return false;
-  const CLocaleScope c_locale;
-  RunResult r;
-  std::int64_t diverged = 0, best_step = 0, steps = 0, params = 0;
-  try {
-    r.status = parse_run_status(fields["status"]);
-  } catch (const std::exception&) {
-    return false;
-  }
-  if (!parse_int(fields["time"], time_ns) || !unescape(fields["message"], &r.message) ||
-      !parse_double(fields["mse"], &r.mse) ||
-      !parse_doubles(fields["trajectory_errors"], &r.trajectory_errors) ||
-      !parse_int(fields["diverged_rollouts"], &diverged) ||
-      !parse_trace(fields["trace"], &r.trace) || !parse_int(fields["best_step"], &best_step) ||
-      !parse_double(fields["best_validation_loss"], &r.best_validation_loss) ||
-      !parse_double(fields["wall_time_s"], &r.wall_time_s) ||
-      !parse_int(fields["steps"], &steps) || !parse_int(fields["parameter_count"], &params) ||
-      !parse_int(fields["newton_failures"], &r.newton_failures) ||
-      !parse_doubles(fields["figure_prediction_05"], &r.figure_prediction_05) ||
-      !parse_doubles(fields["figure_prediction_075"], &r.figure_prediction_075) ||
-      !parse_doubles(fields["figure_reference_05"], &r.figure_reference_05) ||
-      !parse_doubles(fields["figure_reference_075"], &r.figure_reference_075)) {
-    return false;
-  }
-  r.diverged_rollouts = static_cast<int>(diverged);
-  r.best_step = static_cast<int>(best_step);
-  r.steps = static_cast<int>(steps);
-  r.parameter_count = static_cast<long>(params);
-  *result = std::move(r);
-  return true;
-}
-
-}  // namespace internal
 
 Journal::Journal(const std::string& results_path, int rank)
     : path_(log_path(results_path, rank)), rank_(rank) {

@@ -79,6 +79,29 @@ TEST_F(JournalTest, WritesOneLineWithHexFloatsEscapedStringsAndAChecksum) {
   EXPECT_FALSE(internal::decode_journal_record(corrupt, &id, &back, &time_ns));
 }
 
+// Checkpoint MSEs survive a crash between the journal record and the row
+// write; a record without checkpoint fields reads as a run without them.
+TEST_F(JournalTest, CheckpointsRoundTripAndAreOptional) {
+  RunResult r = sample_result(0, sample_layout());
+  r.checkpoint_steps = {2500, 5000, 50000};
+  r.checkpoint_mse = {0.125, std::numeric_limits<double>::infinity(), tagged_nan(0x7)};
+  r.checkpoint_train_seconds = {1.0 / 3.0, 2.5, 40.0};
+  const std::string line = internal::encode_journal_record("0a", r, /*time_ns=*/7);
+  EXPECT_THAT(line, HasSubstr(" checkpoint_steps=2500,5000,50000 "));
+  std::string id;
+  RunResult back;
+  std::int64_t time_ns = 0;
+  ASSERT_TRUE(internal::decode_journal_record(line, &id, &back, &time_ns));
+  expect_bit_equal(r, back);
+
+  const RunResult plain = sample_result(1, sample_layout());
+  const std::string plain_line = internal::encode_journal_record("0b", plain, /*time_ns=*/8);
+  EXPECT_EQ(plain_line.find("checkpoint"), std::string::npos);
+  ASSERT_TRUE(internal::decode_journal_record(plain_line, &id, &back, &time_ns));
+  EXPECT_TRUE(back.checkpoint_steps.empty());
+  expect_bit_equal(plain, back);
+}
+
 TEST_F(JournalTest, SkipsAndCountsATornLastLine) {
   Journal(results_path_, 0).append(id(0), sample_result(0, sample_layout()));
   Journal(results_path_, 0).append(id(1), sample_result(1, sample_layout()));
