@@ -1,0 +1,189 @@
+// src/h5/h5file_datasets.cpp — h5::File datasets: creation (contiguous,
+// allocated and filled early), dimensions, and row reads and writes of
+// doubles, int64 and fixed-length strings.
+#include <cstring>
+#include <numeric>
+#include <sstream>
+
+#include "h5/h5_handle.h"
+
+namespace phnn {
+namespace h5 {
+
+using namespace detail;
+
+namespace {
+Handle string_type(std::size_t length) {
+  Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.get(), std::max<std::size_t>(length, 1));
+  H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
+  return type;
+}
+}  // namespace
+
+void File::create_dataset(const std::string& path, Type type,
+                          const std::vector<std::uint64_t>& dims,
+                          std::size_t string_length, double fill_value) {
+  const auto slash = path.rfind('/');
+  if (slash != std::string::npos && slash > 0) create_group(path.substr(0, slash));
+  std::vector<hsize_t> hdims(dims.begin(), dims.end());
+  Handle space(H5Screate_simple(static_cast<int>(hdims.size()), hdims.data(), nullptr),
+               H5Sclose);
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS);
+  // Allocate at creation so independent writes never change file metadata.
+  H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY);
+  H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_ALLOC);
+  hid_t h5type = H5T_NATIVE_DOUBLE;
+  Handle stype = string_type(string_length);
+  if (type == Type::kInt64) h5type = H5T_NATIVE_INT64;
+  if (type == Type::kString) h5type = stype.get();
+  if (type == Type::kFloat64) {
+    H5Pset_fill_value(dcpl.get(), H5T_NATIVE_DOUBLE, &fill_value);
+  }
+  Handle dset(H5Dcreate2(id_, path.c_str(), h5type, space.get(), H5P_DEFAULT,
+                         dcpl.get(), H5P_DEFAULT),
+              H5Dclose);
+  if (!dset.ok()) fail(path_, "cannot create dataset " + path);
+}
+
+std::vector<std::uint64_t> File::dims(const std::string& path) const {
+  Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!dset.ok()) fail(path_, "no dataset " + path);
+  const auto d = dataset_dims(dset.get());
+  return std::vector<std::uint64_t>(d.begin(), d.end());
+}
+
+namespace {
+void rows_io(hid_t file, const std::string& fname, const std::string& path,
+             std::uint64_t row, std::uint64_t count, hid_t memtype, void* data,
+             bool write, std::uint64_t* count_out = nullptr) {
+  Handle dset(H5Dopen2(file, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!dset.ok()) fail(fname, "no dataset " + path);
+  std::vector<hsize_t> dims = dataset_dims(dset.get());
+  if (dims.empty()) dims = {1};
+  if (count == 0 && !write) count = dims[0] - std::min<hsize_t>(row, dims[0]);
+  if (row + count > dims[0]) {
+    std::ostringstream msg;
+    msg << "rows [" << row << ", " << row + count << ") outside dataset " << path
+        << " with " << dims[0] << " rows";
+    fail(fname, msg.str());
+  }
+  if (count_out) *count_out = count;
+  if (count == 0 || data == nullptr) return;
+  Handle fspace(H5Dget_space(dset.get()), H5Sclose);
+  std::vector<hsize_t> start(dims.size(), 0), extent = dims;
+  start[0] = row;
+  extent[0] = count;
+  H5Sselect_hyperslab(fspace.get(), H5S_SELECT_SET, start.data(), nullptr,
+                      extent.data(), nullptr);
+  Handle mspace(H5Screate_simple(static_cast<int>(extent.size()), extent.data(), nullptr),
+                H5Sclose);
+  Handle dxpl(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
+  const herr_t status =
+      write ? H5Dwrite(dset.get(), memtype, mspace.get(), fspace.get(), dxpl.get(), data)
+            : H5Dread(dset.get(), memtype, mspace.get(), fspace.get(), dxpl.get(), data);
+  if (status < 0) {
+    std::ostringstream msg;
+    msg << (write ? "H5Dwrite" : "H5Dread") << " failed for " << path << " rows ["
+        << row << ", " << row + count << ")";
+    fail(fname, msg.str());
+  }
+}
+}  // namespace
+
+void File::write_rows(const std::string& path, std::uint64_t row,
+                      std::uint64_t count, const double* data) {
+  rows_io(id_, path_, path, row, count, H5T_NATIVE_DOUBLE, const_cast<double*>(data), true);
+}
+
+void File::write_rows(const std::string& path, std::uint64_t row,
+                      std::uint64_t count, const std::int64_t* data) {
+  rows_io(id_, path_, path, row, count, H5T_NATIVE_INT64,
+          const_cast<std::int64_t*>(data), true);
+}
+
+void File::write_string_rows(const std::string& path, std::uint64_t row,
+                             const std::vector<std::string>& values) {
+  Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!dset.ok()) fail(path_, "no dataset " + path);
+  Handle type(H5Dget_type(dset.get()), H5Tclose);
+  const std::size_t length = H5Tget_size(type.get());
+  std::vector<char> buffer(values.size() * length, '\0');
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    std::memcpy(buffer.data() + i * length, values[i].data(),
+                std::min(length, values[i].size()));
+  }
+  rows_io(id_, path_, path, row, values.size(), type.get(), buffer.data(), true);
+}
+
+void File::write(const std::string& path, const std::vector<std::uint64_t>& dims,
+                 const std::vector<double>& data) {
+  create_dataset(path, Type::kFloat64, dims);
+  int rank = 0;
+  if (comm_ != MPI_COMM_NULL) MPI_Comm_rank(comm_, &rank);
+  if (rank == 0) write_rows(path, 0, dims.empty() ? 1 : dims[0], data.data());
+}
+
+void File::write(const std::string& path, const std::vector<std::uint64_t>& dims,
+                 const std::vector<std::int64_t>& data) {
+  create_dataset(path, Type::kInt64, dims);
+  int rank = 0;
+  if (comm_ != MPI_COMM_NULL) MPI_Comm_rank(comm_, &rank);
+  if (rank == 0) write_rows(path, 0, dims.empty() ? 1 : dims[0], data.data());
+}
+
+std::vector<double> File::read_doubles(const std::string& path, std::uint64_t row,
+                                       std::uint64_t count) const {
+  std::uint64_t n = 0;
+  rows_io(id_, path_, path, row, count, H5T_NATIVE_DOUBLE, nullptr, false, &n);
+  const auto d = dims(path);
+  std::vector<hsize_t> hd(d.begin(), d.end());
+  std::vector<double> out(n * row_size(hd));
+  rows_io(id_, path_, path, row, n, H5T_NATIVE_DOUBLE, out.data(), false);
+  return out;
+}
+
+std::vector<std::int64_t> File::read_ints(const std::string& path, std::uint64_t row,
+                                          std::uint64_t count) const {
+  std::uint64_t n = 0;
+  rows_io(id_, path_, path, row, count, H5T_NATIVE_INT64, nullptr, false, &n);
+  const auto d = dims(path);
+  std::vector<hsize_t> hd(d.begin(), d.end());
+  std::vector<std::int64_t> out(n * row_size(hd));
+  rows_io(id_, path_, path, row, n, H5T_NATIVE_INT64, out.data(), false);
+  return out;
+}
+
+std::vector<std::string> File::read_strings(const std::string& path, std::uint64_t row,
+                                            std::uint64_t count) const {
+  Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!dset.ok()) fail(path_, "no dataset " + path);
+  Handle type(H5Dget_type(dset.get()), H5Tclose);
+  const std::size_t length = H5Tget_size(type.get());
+  const auto d = dataset_dims(dset.get());
+  std::size_t n = d.empty() ? 1 : d[0];
+  std::vector<char> buffer;
+  if (row == 0 && count == 0) {  // the whole dataset (scalar ones too)
+    buffer.assign(n * length, '\0');
+    if (n > 0 && H5Dread(dset.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT,
+                         buffer.data()) < 0) {
+      fail(path_, "cannot read " + path);
+    }
+  } else {
+    std::uint64_t rows = 0;
+    rows_io(id_, path_, path, row, count, type.get(), nullptr, false, &rows);
+    n = rows;
+    buffer.assign(n * length, '\0');
+    rows_io(id_, path_, path, row, n, type.get(), buffer.data(), false);
+  }
+  std::vector<std::string> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const char* s = buffer.data() + i * length;
+    out[i] = std::string(s, strnlen(s, length));
+  }
+  return out;
+}
+
+}  // namespace h5
+}  // namespace phnn
