@@ -516,6 +516,63 @@ class SweepRun {
   Clock::time_point start_ = Clock::now();
 };
 
+// Rank 0's opening line: what is done, what is left, how it is split.
+void print_plan(const SweepSpec& spec, const Grid& grid, const Shard& shard,
+                int runs_done_before, int runs_to_do, const WorkPlan& plan, int size,
+                ScheduleMode mode, const std::string& out) {
+  std::cout << "phnn sweep: " << spec.name << ": " << grid.runs.size() << " runs in "
+            << grid.cells.size() << " cells; "
+            << (shard.count > 1 ? "shard " + std::to_string(shard.index) + "/" +
+                                      std::to_string(shard.count) + ": "
+                                : std::string())
+            << runs_done_before << " finished before, " << runs_to_do << " to run in "
+            << plan.items.size() << " items (" << plan.cells << " cells, " << plan.split_cells
+            << " split) on " << size << " rank" << (size > 1 ? "s" : "") << " ("
+            << to_string(mode) << " scheduling) -> " << out << std::endl;
+}
+
+// Trains one item's cell. A cell that throws is a result too: every run
+// failed, with the message.
+std::vector<RunResult> train_item(const CellSpec& cell, const SystemData& data,
+                                  const std::function<void()>& tick, const std::string& prefix,
+                                  int item_number) {
+  try {
+    return train_cell(cell, data, [&](const TrainProgress&) { tick(); });
+  } catch (const std::exception& e) {
+    std::vector<RunResult> failed(cell.seeds.size());
+    for (auto& r : failed) {
+      r.status = RunStatus::kFailed;
+      r.message = e.what();
+    }
+    std::fprintf(stderr, "%sitem %d failed: %s\n", prefix.c_str(), item_number, e.what());
+    return failed;
+  }
+}
+
+// Journal record first (the source of truth), then the run times and the
+// row, for each run of the item. Returns "" or the I/O error.
+std::string record_item(const Grid& grid, const WorkItem& item,
+                        const std::vector<RunResult>& cell_results, const std::string& started,
+                        const std::string& finished, Journal* journal, ResultsFile* results) {
+  try {
+    for (std::size_t k = 0; k < item.runs.size(); ++k) {
+      const int row = item.runs[k];
+      journal->append(grid.runs[static_cast<std::size_t>(row)].id(), cell_results[k]);
+      results->write_run_times(row, started, finished);
+      results->write_run(row, cell_results[k]);
+    }
+  } catch (const std::exception& e) {
+    return std::string("phnn sweep: ") + e.what();
+  }
+  return "";
+}
+
+void print_item(const char* format, const std::string& prefix, int item_number,
+                std::size_t items, const std::string& what) {
+  std::printf(format, prefix.c_str(), item_number, items, what.c_str());
+  std::fflush(stdout);
+}
+
 int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
   // The same statuses on every rank give the same plan on every rank.
@@ -529,16 +586,7 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   const ScheduleMode mode = parser_.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
   WorkQueue queue(MPI_COMM_WORLD, static_cast<int>(work.size()), mode);
   if (root_) {
-    std::cout << "phnn sweep: " << spec_.name << ": " << grid_.runs.size() << " runs in "
-              << grid_.cells.size() << " cells; "
-              << (shard_.count > 1 ? "shard " + std::to_string(shard_.index) + "/" +
-                                         std::to_string(shard_.count) + ": "
-                                   : std::string())
-              << runs_done_before << " finished before, "
-              << runs_to_do << " to run in " << work.size() << " items (" << plan.cells
-              << " cells, " << plan.split_cells << " split) on " << size_ << " rank"
-              << (size_ > 1 ? "s" : "") << " (" << to_string(queue.mode()) << " scheduling) -> "
-              << out_ << std::endl;
+    print_plan(spec_, grid_, shard_, runs_done_before, runs_to_do, plan, size_, queue.mode(), out_);
   }
   const bool quiet = parser_.flag_set("quiet");
   int my_runs = 0;
@@ -557,44 +605,21 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
     const CellSpec cell = cell_of(grid_, item);
     if (!quiet) {
-      std::printf("%sitem %d/%zu: %s, %zu seed%s\n", prefix_.c_str(), i + 1, work.size(),
-                  describe(head).c_str(), cell.seeds.size(), cell.seeds.size() > 1 ? "s" : "");
-      std::fflush(stdout);
+      print_item("%sitem %d/%zu: %s\n", prefix_, i + 1, work.size(),
+                 describe(head) + ", " + std::to_string(cell.seeds.size()) + " seed" +
+                     (cell.seeds.size() > 1 ? "s" : ""));
     }
     const auto cell_start = Clock::now();
     const std::string started = utc_now();
-    std::vector<RunResult> cell_results;
-    try {
-      cell_results = train_cell(cell, data_for(head.system), [&](const TrainProgress&) {
-        report_progress(false);
-      });
-    } catch (const std::exception& e) {
-      // A run that throws is a result too: status failed, with the message.
-      cell_results.assign(cell.seeds.size(), RunResult{});
-      for (auto& r : cell_results) {
-        r.status = RunStatus::kFailed;
-        r.message = e.what();
-      }
-      std::fprintf(stderr, "%sitem %d failed: %s\n", prefix_.c_str(), i + 1, e.what());
-    }
-    const std::string finished = utc_now();
-    try {
-      for (std::size_t k = 0; k < item.runs.size(); ++k) {
-        const int row = item.runs[k];
-        journal_->append(grid_.runs[static_cast<std::size_t>(row)].id(), cell_results[k]);
-        results_->write_run_times(row, started, finished);
-        results_->write_run(row, cell_results[k]);
-      }
-    } catch (const std::exception& e) {
-      io_error = std::string("phnn sweep: ") + e.what();
-      break;
-    }
+    const std::vector<RunResult> cell_results = train_item(
+        cell, data_for(head.system), [&] { report_progress(false); }, prefix_, i + 1);
+    io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
+    if (!io_error.empty()) break;
     my_runs += static_cast<int>(item.runs.size());
     queue.mark_done();
     if (!quiet) {
-      std::printf("%sitem %d/%zu done in %s\n", prefix_.c_str(), i + 1, work.size(),
-                  format_duration(std::chrono::duration<double>(Clock::now() - cell_start).count()).c_str());
-      std::fflush(stdout);
+      print_item("%sitem %d/%zu done in %s\n", prefix_, i + 1, work.size(),
+                 format_duration(std::chrono::duration<double>(Clock::now() - cell_start).count()));
     }
     report_progress(true);
   }
