@@ -1,0 +1,53 @@
+// src/models/fused_heads_common.h — shared by fused_heads.cpp and
+// fused_heads_hamiltonian.cpp only: softplus/sigmoid from one exp, and the
+// structure matrices a head saves for its backward.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <torch/torch.h>
+
+namespace phnn {
+namespace internal {
+namespace heads {
+
+using torch::Tensor;
+using torch::autograd::AutogradContext;
+using torch::autograd::variable_list;
+
+// softplus(x) and sigmoid(x) from one exp(-|x|); above x = 20 softplus is x
+// and its slope 1, as in LibTorch's softplus (threshold 20).
+struct SoftplusSigmoid {
+  double softplus, sigmoid, slope;
+  explicit SoftplusSigmoid(double x) {
+    const double z = std::exp(-std::fabs(x));
+    sigmoid = x >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z);
+    softplus = x > 20.0 ? x : std::fmax(x, 0.0) + std::log1p(z);
+    slope = x > 20.0 ? 1.0 : sigmoid;
+  }
+};
+
+inline Tensor dense(const Tensor& t) { return t.contiguous(); }
+
+// A head's constant structure matrix (J or S), kept for its backward as one
+// list entry of the context.
+template <std::size_t R, std::size_t C>
+void save_matrix(AutogradContext* ctx, const std::array<std::array<double, C>, R>& m) {
+  std::vector<double> flat;
+  for (const auto& row : m) flat.insert(flat.end(), row.begin(), row.end());
+  ctx->saved_data["matrix"] = flat;
+}
+template <std::size_t R, std::size_t C>
+std::array<std::array<double, C>, R> load_matrix(AutogradContext* ctx) {
+  const std::vector<double> flat = ctx->saved_data["matrix"].toDoubleVector();
+  std::array<std::array<double, C>, R> m;
+  for (std::size_t i = 0; i < R; ++i)
+    for (std::size_t j = 0; j < C; ++j) m[i][j] = flat[i * C + j];
+  return m;
+}
+
+}  // namespace heads
+}  // namespace internal
+}  // namespace phnn
