@@ -1,5 +1,7 @@
 // src/models/fused_mlp.cpp — forward and hand-written backward of a stacked
 // tanh MLP's jet (docs/DECISIONS.md "Fused networks").
+// Size: one autograd node; its layout, plan, forward and backward share the
+// derivation written below and are read together.
 //
 // Layout. A jet of a layer's activations is stored per member as C channels
 // of [B, n] row-major blocks, tensor [E, C, B, n]:

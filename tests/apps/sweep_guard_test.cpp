@@ -3,6 +3,7 @@
 // one writer per results file, no rank waiting forever, nothing that is not
 // ours destroyed, damaged files rebuilt, provenance stored. Also the guards
 // of `phnn data --out` and `phnn train --seeds`.
+// Size: one scenario per hostile input, each with its own setup and timeout.
 #include <dirent.h>
 #include <sys/stat.h>
 #include <unistd.h>

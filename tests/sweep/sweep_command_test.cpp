@@ -1,5 +1,6 @@
 // tests/sweep/sweep_command_test.cpp — `phnn sweep` end to end under mpiexec:
 // rank-count independence, kill-and-resume, rejection of bad sweep files.
+// Size: one test file per command; each end-to-end scenario needs its setup.
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>

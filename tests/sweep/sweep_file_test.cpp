@@ -1,4 +1,6 @@
-// tests/sweep/sweep_file_test.cpp
+// tests/sweep/sweep_file_test.cpp — the sweep-file format: accepted files,
+// defaults, and the catalogue of hostile inputs rejected with FILE:LINE.
+// Size: one test file per module; the catalogue is the format's contract.
 #include "phnn/sweep/sweep_file.h"
 
 #include <gmock/gmock.h>
