@@ -11,6 +11,7 @@ int run_train(int argc, char** argv, int first);
 int run_sweep(int argc, char** argv, int first);
 int run_reduce(int argc, char** argv, int first);
 int run_merge(int argc, char** argv, int first);
+int run_eval(int argc, char** argv, int first);
 
 }  // namespace apps
 }  // namespace phnn

@@ -20,7 +20,8 @@ const char* kUsage =
     "  train    train one cell (all seeds of one configuration)\n"
     "  sweep    run a sweep file over MPI ranks into one HDF5 results file\n"
     "  reduce   print the paper's median [IQR] tables from a results file\n"
-    "  merge    merge the shard results files of one sweep into one\n\n"
+    "  merge    merge the shard results files of one sweep into one\n"
+    "  eval     reload one run from its stored weights and evaluate it again\n\n"
     "`phnn <command> --help` lists each command's options; `phnn --version` prints\n"
     "the version, git commit and library versions.\n";
 
@@ -45,9 +46,10 @@ int main(int argc, char** argv) {
     if (command == "sweep") return phnn::apps::run_sweep(argc, argv, 2);
     if (command == "reduce") return phnn::apps::run_reduce(argc, argv, 2);
     if (command == "merge") return phnn::apps::run_merge(argc, argv, 2);
+    if (command == "eval") return phnn::apps::run_eval(argc, argv, 2);
 #endif
     std::cerr << "phnn: unknown command \"" << command
-              << "\"; expected one of: data, train, sweep, reduce, merge\n";
+              << "\"; expected one of: data, train, sweep, reduce, merge, eval\n";
     return phnn::cli::kUsageError;
   } catch (const phnn::cli::UsageError& e) {
     std::cerr << e.message << "\n";

@@ -280,6 +280,7 @@ std::string encode_journal_record(const std::string& run_id, const RunResult& r,
     << " figure_reference_05=" << format_doubles(r.figure_reference_05)
     << " figure_reference_075=" << format_doubles(r.figure_reference_075);
   write_checkpoints(s, r);
+  if (!r.weights.empty()) s << " weights=" << format_doubles(r.weights);
   const std::string body = s.str();
   return body + kChecksumKey + hex64(fnv1a64(body));
 }
@@ -336,7 +337,8 @@ bool decode_journal_record(const std::string& line_in, std::string* run_id,
       !parse_doubles(fields["figure_prediction_075"], &r.figure_prediction_075) ||
       !parse_doubles(fields["figure_reference_05"], &r.figure_reference_05) ||
       !parse_doubles(fields["figure_reference_075"], &r.figure_reference_075) ||
-      !read_checkpoints(fields, &r)) {
+      !read_checkpoints(fields, &r) ||
+      (fields.count("weights") != 0 && !parse_doubles(fields["weights"], &r.weights))) {
     return false;
   }
   r.diverged_rollouts = static_cast<int>(diverged);

@@ -48,6 +48,7 @@ ResultsLayout wider_layout(const ResultsLayout& a, const ResultsLayout& b) {
   layout.trace_points = std::max(a.trace_points, b.trace_points);
   layout.figure_points = std::max(a.figure_points, b.figure_points);
   layout.checkpoints = std::max(a.checkpoints, b.checkpoints);
+  layout.weights = a.weights || b.weights;
   return layout;
 }
 

@@ -154,6 +154,7 @@ ResultsLayout ResultsLayout::for_runs(const std::vector<RunConfig>& runs) {
     layout.checkpoints =
         std::max(layout.checkpoints, static_cast<int>(run.training.checkpoints.size()));
   }
+  layout.weights = true;
   return layout;
 }
 

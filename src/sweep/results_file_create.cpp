@@ -3,9 +3,11 @@
 // later touches raw data only) and the configuration columns written.
 #include <unistd.h>
 
+#include <algorithm>
 #include <map>
 
 #include "phnn/common/utc_time.h"
+#include "phnn/models/model_config.h"
 #include "sweep/results_file_internal.h"
 
 namespace phnn {
@@ -19,6 +21,9 @@ namespace {
 struct ConfigColumns {
   std::vector<std::string> ids, canonical, systems, models, integrators, sizes, regularizers;
   std::vector<std::int64_t> n_train, seeds;
+  // Where each run's weights start in /weights, and their total count.
+  std::vector<std::int64_t> weights_offset;
+  std::int64_t weights_total = 0;
 
   ConfigColumns(const std::vector<RunConfig>& runs, const std::vector<std::string>& run_studies,
                 const std::string& where) {
@@ -45,6 +50,8 @@ struct ConfigColumns {
       regularizers.push_back(to_string(run.regularizer));
       n_train.push_back(run.n_train);
       seeds.push_back(run.seed);
+      weights_offset.push_back(weights_total);
+      weights_total += parameter_count(run.model, run.size);
     }
   }
 };
@@ -138,6 +145,19 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
   }
 }
 
+// /weights holds every run's best-validation weights back to back (a run's
+// parameter count is known from its model and size), so a file of large
+// models is not padded to their size in every row.
+void create_weight_datasets(const DatasetMaker& make, std::int64_t total) {
+  const std::uint64_t R = make.rows;
+  make.ints(kWeightsOffset, {R}, "index in /weights of the run's first weight");
+  make.ints(kWeightsLength, {R}, "weights stored for the run (0: none, e.g. pending or failed)");
+  const auto n = static_cast<std::uint64_t>(std::max<std::int64_t>(total, 1));
+  make.floats(kWeights, {n},
+              "best-validation weights of every run, back to back: DynamicsModel::parameters() "
+              "order, each tensor row-major without its member axis; NaN where none stored");
+}
+
 // Independent raw-data writes of rank 0.
 void write_config_columns(h5::File& file, const ConfigColumns& c,
                           const std::vector<std::string>& run_studies) {
@@ -152,6 +172,7 @@ void write_config_columns(h5::File& file, const ConfigColumns& c,
   file.write_string_rows(kStudies, 0, run_studies);
   file.write_rows(kNTrain, 0, R, c.n_train.data());
   file.write_rows(kSeed, 0, R, c.seeds.data());
+  if (file.exists(kWeightsOffset)) file.write_rows(kWeightsOffset, 0, R, c.weights_offset.data());
 }
 
 }  // namespace
@@ -206,6 +227,7 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
     create_config_datasets(make);
     create_result_datasets(make, layout);
     create_trace_and_figure_datasets(make, layout);
+    if (layout.weights) create_weight_datasets(make, columns.weights_total);
     if (comm_rank(comm) == 0) write_config_columns(file, columns, run_studies);
     // Metadata on disk now: from here on a crash can only lose row data.
     file.flush();

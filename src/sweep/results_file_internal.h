@@ -60,6 +60,10 @@ inline const std::string kReference075 = "/runs/figure/reference_075";
 inline const std::string kFigureLength = "/runs/figure/length";
 inline const std::string kCheckpointSteps = "/runs/checkpoint_steps";
 inline const std::string kCheckpointMse = "/runs/checkpoint_mse";
+// Added with the stored weights; files written before them have none.
+inline const std::string kWeights = "/weights";
+inline const std::string kWeightsOffset = "/runs/weights_offset";
+inline const std::string kWeightsLength = "/runs/weights_length";
 inline const std::string kCheckpointTrainSeconds = "/runs/checkpoint_train_seconds";
 // Added with provenance; files written before them have neither.
 inline const std::string kStartedUtc = "/runs/started_utc";
@@ -125,6 +129,7 @@ struct ResultsFile::Impl {
     layout.checkpoints =
         file.exists(results_io::kCheckpointMse) ? static_cast<int>(file.dims(results_io::kCheckpointMse).at(1)) : 0;
     has_run_times = file.exists(results_io::kStartedUtc) && file.exists(results_io::kFinishedUtc);
+    layout.weights = file.exists(results_io::kWeights);
   }
 
   // "[rank 3/8] " in a parallel file, "" in a serial one.

@@ -98,6 +98,17 @@ void write_figures_and_checkpoints(h5::File& f, std::uint64_t at, const RunResul
   }
 }
 
+// Offset of row `at`'s weights in /weights and the room it has there (its
+// model's parameter count).
+std::pair<std::int64_t, std::int64_t> weights_slot(const h5::File& f, std::uint64_t at,
+                                                   int num_runs) {
+  const std::int64_t offset = f.read_ints(kWeightsOffset, at, 1).at(0);
+  const std::int64_t end = at + 1 < static_cast<std::uint64_t>(num_runs)
+                               ? f.read_ints(kWeightsOffset, at + 1, 1).at(0)
+                               : static_cast<std::int64_t>(f.dims(kWeights).at(0));
+  return {offset, end - offset};
+}
+
 }  // namespace
 
 void ResultsFile::write_run(int row, const RunResult& r) {
@@ -108,6 +119,17 @@ void ResultsFile::write_run(int row, const RunResult& r) {
   require(row >= 0 && row < impl.num_runs,
           where + "row outside [0, " + std::to_string(impl.num_runs) + ")");
   require_fits(r, L, where);
+  // A file written before weights were stored drops them.
+  std::int64_t weights_offset = 0;
+  const bool store_weights = L.weights && !r.weights.empty();
+  if (store_weights) {
+    const auto [offset, room] = impl.independent(
+        [&] { return weights_slot(impl.file, static_cast<std::uint64_t>(row), impl.num_runs); });
+    require(static_cast<std::int64_t>(r.weights.size()) <= room,
+            where + "has " + std::to_string(r.weights.size()) + " weights, the file holds " +
+                std::to_string(room) + " for this run (its model's parameter count)");
+    weights_offset = offset;
+  }
   const std::vector<double> trace = trace_row(r.trace, L.trace_points);
 
   impl.independent([&] {
@@ -132,6 +154,11 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     put_int(kTraceLength, static_cast<std::int64_t>(r.trace.size()));
     write_figures_and_checkpoints(f, at, r, L);
     f.write_string_rows(kMessage, at, {truncate_message(r.message, kMessageLength)});
+    if (store_weights) {
+      f.write_rows(kWeights, static_cast<std::uint64_t>(weights_offset), r.weights.size(),
+                   r.weights.data());
+    }
+    if (L.weights) put_int(kWeightsLength, static_cast<std::int64_t>(store_weights ? r.weights.size() : 0));
     // Last: until this lands the row reads as pending.
     put_int(kStatus, static_cast<std::int64_t>(r.status));
   });
@@ -207,6 +234,13 @@ RunResult ResultsFile::read_run(int row) const {
     const auto count = static_cast<std::int64_t>(r.checkpoint_steps.size());
     r.checkpoint_mse = unpadded(impl.doubles(kCheckpointMse, at, 1), count);
     r.checkpoint_train_seconds = unpadded(impl.doubles(kCheckpointTrainSeconds, at, 1), count);
+  }
+  if (impl.layout.weights) {
+    const std::int64_t length = one_int(kWeightsLength);
+    if (length > 0) {
+      const auto offset = static_cast<std::uint64_t>(one_int(kWeightsOffset));
+      r.weights = impl.doubles(kWeights, offset, static_cast<std::uint64_t>(length));
+    }
   }
   return r;
 }

@@ -139,6 +139,21 @@ std::vector<double> member_mse(const Rollouts& r) {
   return out;
 }
 
+void fill_inference(const Rollouts& rollouts, int64_t e, double mse, RunResult* r) {
+  const int64_t B_inf = rollouts.sq_err.size(1);
+  r->newton_failures = rollouts.newton_failures[e].item<int64_t>();
+  r->trajectory_errors.resize(static_cast<std::size_t>(B_inf));
+  r->diverged_rollouts = 0;
+  for (int64_t i = 0; i < B_inf; ++i) {
+    const bool div = rollouts.diverged[e][i].item<bool>();
+    r->trajectory_errors[static_cast<std::size_t>(i)] =
+        div ? std::numeric_limits<double>::infinity()
+            : rollouts.sq_err[e][i].item<double>() / rollouts.steps;
+    r->diverged_rollouts += div;
+  }
+  r->mse = mse;
+}
+
 FigureReferences figure_references(const SystemData& data) {
   const FigureSetup fig = figure_setup(data.system);
   return {reference_trajectory(data.system, data.options, fig.x0_05, fig.u),

@@ -31,6 +31,11 @@ Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const System
 // trajectories of their mean squared error, +inf if any diverged.
 std::vector<double> member_mse(const Rollouts& rollouts);
 
+// Member e's inference results into r: Eq. 31 (`mse`), the per-trajectory
+// errors (+inf for a diverged rollout), the diverged count and the Newton
+// failures.
+void fill_inference(const Rollouts& rollouts, int64_t e, double mse, RunResult* r);
+
 // The reference trajectories of the figures (paper Figures 7 and 9), made
 // once per cell, and member e's predicted ones, into r.
 struct FigureReferences {

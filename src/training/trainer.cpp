@@ -320,17 +320,7 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
   r.parameter_count = model_->parameter_count();
   r.best_validation_loss = best_val_[static_cast<std::size_t>(e)];
   r.wall_time_s = wall / static_cast<double>(E_);
-  r.newton_failures = rollouts.newton_failures[e].item<int64_t>();
-  r.trajectory_errors.resize(static_cast<std::size_t>(B_inf));
-  r.diverged_rollouts = 0;
-  for (int64_t i = 0; i < B_inf; ++i) {
-    const bool div = rollouts.diverged[e][i].item<bool>();
-    r.trajectory_errors[static_cast<std::size_t>(i)] =
-        div ? std::numeric_limits<double>::infinity()
-            : rollouts.sq_err[e][i].item<double>() / rollouts.steps;
-    r.diverged_rollouts += div;
-  }
-  r.mse = mse;
+  fill_inference(rollouts, e, mse, &r);
   // Budgets not reached in the loop (the last step, or every member
   // diverged earlier): the final best weights are the best up to them.
   while (r.checkpoint_steps.size() < opt_.checkpoints.size()) {
@@ -339,6 +329,10 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
     r.checkpoint_train_seconds.push_back(train_s);
   }
   fill_figures(rollouts, e, references, &r);
+  for (const torch::Tensor& best : best_) {
+    const torch::Tensor w = best[e].contiguous();
+    r.weights.insert(r.weights.end(), w.data_ptr<double>(), w.data_ptr<double>() + w.numel());
+  }
   r.status = RunStatus::kDone;
   std::ostringstream msg;
   if (diverged_at_[static_cast<std::size_t>(e)] >= 0) {

@@ -79,13 +79,14 @@ TEST_F(JournalTest, WritesOneLineWithHexFloatsEscapedStringsAndAChecksum) {
   EXPECT_FALSE(internal::decode_journal_record(corrupt, &id, &back, &time_ns));
 }
 
-// Checkpoint MSEs survive a crash between the journal record and the row
-// write; a record without checkpoint fields reads as a run without them.
-TEST_F(JournalTest, CheckpointsRoundTripAndAreOptional) {
+// Checkpoint MSEs and weights survive a crash between the journal record
+// and the row write; a record without those fields reads as a run without.
+TEST_F(JournalTest, CheckpointsAndWeightsRoundTripAndAreOptional) {
   RunResult r = sample_result(0, sample_layout());
   r.checkpoint_steps = {2500, 5000, 50000};
   r.checkpoint_mse = {0.125, std::numeric_limits<double>::infinity(), tagged_nan(0x7)};
   r.checkpoint_train_seconds = {1.0 / 3.0, 2.5, 40.0};
+  r.weights = {0.1, -2.0, tagged_nan(0x9), 1e-300};
   const std::string line = internal::encode_journal_record("0a", r, /*time_ns=*/7);
   EXPECT_THAT(line, HasSubstr(" checkpoint_steps=2500,5000,50000 "));
   std::string id;
@@ -97,6 +98,7 @@ TEST_F(JournalTest, CheckpointsRoundTripAndAreOptional) {
   const RunResult plain = sample_result(1, sample_layout());
   const std::string plain_line = internal::encode_journal_record("0b", plain, /*time_ns=*/8);
   EXPECT_EQ(plain_line.find("checkpoint"), std::string::npos);
+  EXPECT_EQ(plain_line.find("weights"), std::string::npos);
   ASSERT_TRUE(internal::decode_journal_record(plain_line, &id, &back, &time_ns));
   EXPECT_TRUE(back.checkpoint_steps.empty());
   expect_bit_equal(plain, back);

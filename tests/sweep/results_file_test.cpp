@@ -2,6 +2,8 @@
 // MPI_Init); tests/mpi/results_file_mpi_test.cpp covers the parallel one.
 #include "phnn/sweep/results_file.h"
 
+#include "phnn/models/model_config.h"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -128,6 +130,48 @@ TEST_F(ResultsFileTest, RoundTripsCheckpointsWhenTheLayoutHasThem) {
   expect_bit_equal(three, file.read_run(3));
   EXPECT_TRUE(file.read_run(2).checkpoint_steps.empty());  // pending
   create_plain_and_check_no_checkpoints();
+}
+
+// Weights are stored back to back at offsets given by each run's parameter
+// count (the last run's room ends with /weights), round-trip bit-exactly,
+// and a run with more weights than its model has is refused.
+TEST_F(ResultsFileTest, RoundTripsWeightsAtTheirOffsets) {
+  ResultsLayout layout = sample_layout();
+  layout.weights = true;
+  const std::vector<RunConfig> runs = sample_runs(kNumRuns);
+  auto weights_of = [&](int row) {
+    std::vector<double> w(static_cast<std::size_t>(
+        parameter_count(runs[static_cast<std::size_t>(row)].model,
+                        runs[static_cast<std::size_t>(row)].size)));
+    for (std::size_t i = 0; i < w.size(); ++i) w[i] = row + 1.0 / (3.0 + static_cast<double>(i));
+    return w;
+  };
+  RunResult first = sample_result(0, layout), last = sample_result(kNumRuns - 1, layout);
+  first.weights = weights_of(0);
+  last.weights = weights_of(kNumRuns - 1);
+  last.weights.back() = -std::numeric_limits<double>::infinity();
+  {
+    ResultsFile file = ResultsFile::create(path_, MPI_COMM_NULL, runs, sample_studies(kNumRuns),
+                                           "demo", "x", kSweepHash, "phnn-sweep 0.1.0", layout);
+    file.write_run(0, first);
+    file.write_run(kNumRuns - 1, last);
+    RunResult too_many = sample_result(1, layout);
+    too_many.weights = weights_of(1);
+    too_many.weights.push_back(1.0);
+    EXPECT_THROW(file.write_run(1, too_many), std::invalid_argument);
+    file.close();
+  }
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  EXPECT_TRUE(file.layout().weights);
+  expect_bit_equal(first, file.read_run(0));
+  expect_bit_equal(last, file.read_run(kNumRuns - 1));
+  EXPECT_TRUE(file.read_run(1).weights.empty());  // refused: still pending
+  const std::vector<std::int64_t> offsets = file.read_int_column("weights_offset");
+  std::int64_t expected = 0;
+  for (int row = 0; row < kNumRuns; ++row) {
+    EXPECT_EQ(offsets[static_cast<std::size_t>(row)], expected);
+    expected += static_cast<std::int64_t>(weights_of(row).size());
+  }
 }
 
 TEST_F(ResultsFileTest, StoresConfigColumnsAndFileAttributes) {

@@ -164,6 +164,7 @@ inline void expect_bit_equal(const RunResult& expected, const RunResult& actual)
   EXPECT_EQ(expected.checkpoint_steps, actual.checkpoint_steps);
   EXPECT_EQ(bits(expected.checkpoint_mse), bits(actual.checkpoint_mse));
   EXPECT_EQ(bits(expected.checkpoint_train_seconds), bits(actual.checkpoint_train_seconds));
+  EXPECT_EQ(bits(expected.weights), bits(actual.weights));
 }
 
 }  // namespace testing_util

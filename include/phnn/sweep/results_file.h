@@ -29,6 +29,10 @@ struct ResultsLayout {
   /// Columns of /runs/checkpoint_* (the most TrainerOptions::checkpoints of
   /// any run); 0: those datasets are not created (files before them have none).
   int checkpoints = 0;
+  /// Whether the file stores each run's best-validation weights (/weights,
+  /// /runs/weights_offset, /runs/weights_length); for_runs sets it, files
+  /// written before weights were stored have none.
+  bool weights = false;
 
   /// The smallest layout that holds every run of `runs`: max num_inference,
   /// max steps / eval_every + 2, max num_inference_steps() + 1.

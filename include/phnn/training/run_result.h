@@ -51,6 +51,10 @@ struct RunResult {
   /// (self-sustained); with the reference trajectories.
   std::vector<double> figure_prediction_05, figure_prediction_075;
   std::vector<double> figure_reference_05, figure_reference_075;
+  /// The best-validation weights used for inference (DynamicsModel::
+  /// parameters() order, each tensor flattened row-major without its member
+  /// axis): `phnn eval` reloads them. Empty for a run that failed.
+  std::vector<double> weights;
 };
 
 }  // namespace phnn

@@ -1,0 +1,49 @@
+// include/phnn/training/evaluate.h — one run reloaded from its stored
+// best-validation weights (RunResult::weights) and evaluated again with the
+// trainer's own inference code: the same rollouts, Eq. 31 and figure
+// trajectories, plus the true and the learned energy along the figure
+// trajectories. Touches no file.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "phnn/data/dataset_file.h"
+#include "phnn/models/dynamics_model.h"
+#include "phnn/training/run_result.h"
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+
+/// The model of `cell` (one seed) with `weights` loaded: DynamicsModel::
+/// parameters() order, each tensor row-major without its member axis.
+/// Throws std::invalid_argument if the cell has not exactly one seed or the
+/// weight count is not the model's parameter count.
+std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemData& data,
+                                           const std::vector<double>& weights);
+
+/// Energies along one figure trajectory (paper Figures 7, 9), one row per
+/// point: t [s], q, p (model rollout), q_ref, p_ref (true system),
+/// H(x), H(x_ref) (true Hamiltonian) [J], H_theta(x), H_theta(x_ref)
+/// (learned; NaN for NODE, which has none) [J].
+struct EnergyTrace {
+  static constexpr const char* kColumns =
+      "t,q,p,q_ref,p_ref,H_true,H_true_ref,H_model,H_model_ref";
+  std::vector<std::array<double, 9>> rows;
+};
+
+struct Evaluation {
+  /// status, mse, trajectory_errors, diverged_rollouts, newton_failures and
+  /// the figure trajectories, as the trainer computes them (bitwise, since
+  /// stacking members is exact).
+  RunResult result;
+  /// From H(x0) = 0.5 J and 0.75 J.
+  EnergyTrace energy_05, energy_075;
+};
+
+/// Evaluates the run of `cell` (one seed) with its stored weights.
+Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
+                               const std::vector<double>& weights);
+
+}  // namespace phnn

@@ -1,0 +1,130 @@
+// src/apps/cmd_eval.cpp — `phnn eval RESULTS --run ID`: one finished run of
+// a results file reloaded from its stored best-validation weights and
+// evaluated again (phnn/training/evaluate.h), checked against the stored
+// MSE, with the true and learned energy along the figure trajectories.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <stdexcept>
+
+#include "apps/cli.h"
+#include "apps/commands.h"
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/results_file.h"
+#include "phnn/sweep/sweep_file.h"
+#include "phnn/training/evaluate.h"
+
+namespace phnn {
+namespace apps {
+namespace {
+
+// The row of the run whose id is `id` or starts with it (unique).
+int find_row(const ResultsFile& results, const std::string& id) {
+  const std::vector<std::string> ids = results.read_run_ids();
+  int row = -1;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (ids[i].compare(0, id.size(), id) != 0) continue;
+    if (row >= 0) {
+      throw cli::UsageError{"phnn eval: --run " + id + " matches several runs (" +
+                            ids[static_cast<std::size_t>(row)] + ", " + ids[i] +
+                            ", ...); give more digits"};
+    }
+    row = static_cast<int>(i);
+  }
+  if (row < 0 || id.empty()) {
+    throw cli::UsageError{"phnn eval: no run with id " + id + " in " + results.path() +
+                          "; `phnn reduce " + results.path() +
+                          " --format csv --per-run` lists the ids"};
+  }
+  return row;
+}
+
+// The run's configuration, rebuilt from the sweep text stored in the file.
+RunConfig stored_config(const ResultsFile& results, const std::string& id) {
+  const SweepSpec spec = parse_sweep_text(results.sweep_text(), results.path() + " (sweep_text)");
+  for (const RunConfig& run : expand_grid(spec).runs) {
+    if (run.id() == id) return run;
+  }
+  throw std::runtime_error(results.path() + ": run " + id +
+                           " is not in the sweep text stored in the file; it was written by "
+                           "another program version (" + results.program_version() + ")");
+}
+
+CellSpec single_seed_cell(const RunConfig& run) {
+  CellSpec cell;
+  cell.model = run.model;
+  cell.integrator = run.integrator;
+  cell.size = run.size;
+  cell.n_train = run.n_train;
+  cell.regularizer = run.regularizer;
+  cell.training = run.training;
+  cell.seeds = {run.seed};
+  return cell;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void write_energy_csv(const std::string& path, const Evaluation& e) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write the CSV; is the directory writable?");
+  out << "h0," << EnergyTrace::kColumns << "\n";
+  char buf[32];
+  for (const auto& [h0, trace] : {std::make_pair("0.5", &e.energy_05),
+                                  std::make_pair("0.75", &e.energy_075)}) {
+    for (const auto& row : trace->rows) {
+      out << h0;
+      for (double v : row) {
+        std::snprintf(buf, sizeof buf, "%.17g", v);
+        out << "," << buf;
+      }
+      out << "\n";
+    }
+  }
+  if (!out.flush()) throw std::runtime_error(path + ": write failed; is the disk full?");
+}
+
+}  // namespace
+
+int run_eval(int argc, char** argv, int first) {
+  cli::Parser parser(
+      "eval",
+      "Reloads one finished run of a results file from its stored best-validation\n"
+      "weights, evaluates it again on the stored data (the inference MSE of Eq. 31 and\n"
+      "the figure trajectories from H(x0) = 0.5 J and 0.75 J), checks the MSE against\n"
+      "the stored one (exit 1 if it differs), and writes the true and learned energy\n"
+      "along the figure trajectories to --out (CSV).");
+  parser.positional("RESULTS", "results file of `phnn sweep` or `phnn train --out`");
+  parser.option("run", "run id (or a unique prefix of it), as in `phnn reduce --per-run`", "");
+  parser.option("out", "CSV of t, states and energies along the figure trajectories", "");
+  if (!parser.parse(argc, argv, first)) return 0;
+  if (parser.get("run").empty()) throw cli::UsageError{"phnn eval: --run ID is required"};
+  const ResultsFile results = ResultsFile::open_read_only(parser.get("RESULTS"));
+  const int row = find_row(results, parser.get("run"));
+  const std::string id = results.read_run_ids()[static_cast<std::size_t>(row)];
+  const RunResult stored = results.read_run(row);
+  if (stored.weights.empty()) {
+    throw std::runtime_error(results.path() + ": run " + id + " has no stored weights (" +
+                             (results.layout().weights ? "status " + to_string(stored.status)
+                                                       : std::string("the file predates them")) +
+                             "); only finished runs of files written since weights are "
+                             "stored can be evaluated");
+  }
+  const RunConfig run = stored_config(results, id);
+  const SystemData data = results.read_system_data(to_string(run.system));
+  const Evaluation e = evaluate_stored_run(single_seed_cell(run), data, stored.weights);
+  const bool same = same_bits(e.result.mse, stored.mse);
+  std::printf("phnn eval: run %s (%s): mse %.6e, stored %.6e: %s\n", id.c_str(),
+              run.canonical().substr(0, run.canonical().find(";mass=")).c_str(), e.result.mse,
+              stored.mse, same ? "bitwise equal" : "DIFFERENT");
+  if (!parser.get("out").empty()) {
+    write_energy_csv(parser.get("out"), e);
+    std::printf("phnn eval: energies along the figure trajectories -> %s\n",
+                parser.get("out").c_str());
+  }
+  return same ? 0 : 1;
+}
+
+}  // namespace apps
+}  // namespace phnn

@@ -1,0 +1,122 @@
+// tests/apps/eval_command_test.cpp — `phnn eval`: runs reloaded from their
+// stored weights reproduce their stored MSE bitwise, and the energy CSV.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+#include "phnn/sweep/results_file.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+
+int run(const std::string& args, std::string* output) {
+  return testing_util::run_shell(std::string(PHNN_BINARY) + " " + args, output);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  for (std::string item; std::getline(s, item, ',');) out.push_back(item);
+  return out;
+}
+
+class EvalCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    out_ = ::testing::TempDir() + "phnn_eval_" + std::to_string(::getpid()) + "_" +
+           ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".h5";
+    std::remove(out_.c_str());
+  }
+  void TearDown() override { std::remove(out_.c_str()); }
+
+  // Trains `model` on `system` (2 seeds, 40 steps) into out_; the run ids.
+  std::vector<std::string> train(const std::string& system, const std::string& model) {
+    std::string log;
+    EXPECT_EQ(run("train --system " + system + " --model " + model +
+                      " --n-train 25 --seeds 0-1 --steps 40 --eval-every 20 --quiet --out " + out_,
+                  &log),
+              0)
+        << log;
+    return ResultsFile::open_read_only(out_).read_run_ids();
+  }
+
+  std::string out_;
+};
+
+// The stored weights are the inference weights: evaluating them again gives
+// the stored MSE bitwise, for explicit, DG (Newton) and fourth-order steps.
+TEST_F(EvalCommandTest, ReloadedRunsReproduceTheirStoredMseBitwise) {
+  for (const auto& [system, model] :
+       std::vector<std::pair<std::string, std::string>>{{"duffing", "phnn-jr-dg"},
+                                                        {"self-sustained", "phnn-s-rk4"},
+                                                        {"harmonic", "node-rk2"}}) {
+    SCOPED_TRACE(system + " " + model);
+    std::remove(out_.c_str());
+    const std::vector<std::string> ids = train(system, model);
+    ASSERT_EQ(ids.size(), 2u);
+    const ResultsFile file = ResultsFile::open_read_only(out_);
+    EXPECT_TRUE(file.layout().weights);
+    for (int row = 0; row < 2; ++row) {
+      EXPECT_EQ(static_cast<long>(file.read_run(row).weights.size()),
+                file.read_run(row).parameter_count);
+      std::string log;
+      EXPECT_EQ(run("eval " + out_ + " --run " + ids[static_cast<std::size_t>(row)], &log), 0)
+          << log;
+      EXPECT_THAT(log, HasSubstr("bitwise equal"));
+    }
+  }
+}
+
+// The CSV: both figure trajectories from t = 0, the true H(x0) of each
+// (0.5 J and 0.75 J by construction), and no learned energy for NODE.
+TEST_F(EvalCommandTest, EnergyCsvStartsAtTheFigureEnergies) {
+  for (const std::string model : {"phnn-s-dg", "node-rk2"}) {
+    SCOPED_TRACE(model);
+    std::remove(out_.c_str());
+    const std::vector<std::string> ids = train("harmonic", model);
+    const std::string csv = out_ + ".csv";
+    std::string log;
+    ASSERT_EQ(run("eval " + out_ + " --run " + ids[0].substr(0, 10) + " --out " + csv, &log), 0)
+        << log;
+    std::ifstream in(csv);
+    std::string line;
+    ASSERT_TRUE(std::getline(in, line));
+    EXPECT_EQ(line, "h0,t,q,p,q_ref,p_ref,H_true,H_true_ref,H_model,H_model_ref");
+    int rows_05 = 0, rows_075 = 0;
+    while (std::getline(in, line)) {
+      const std::vector<std::string> f = split(line);
+      ASSERT_EQ(f.size(), 10u) << line;
+      const double t = std::stod(f[1]), h_true_ref = std::stod(f[7]), h_model = std::stod(f[8]);
+      if (t == 0.0) EXPECT_NEAR(h_true_ref, std::stod(f[0]), 1e-12) << line;
+      EXPECT_EQ(std::isnan(h_model), model == "node-rk2") << line;
+      (f[0] == "0.5" ? rows_05 : rows_075) += 1;
+    }
+    EXPECT_EQ(rows_05, 501);  // x_0 ... x_500 of the inference duration
+    EXPECT_EQ(rows_075, 501);
+    std::remove(csv.c_str());
+  }
+}
+
+TEST_F(EvalCommandTest, UnknownOrMissingRunIsAUsageError) {
+  train("harmonic", "phnn-jr-rk2");
+  std::string log;
+  EXPECT_EQ(run("eval " + out_ + " --run ffffffffffffffff", &log), 2);
+  EXPECT_THAT(log, HasSubstr("--per-run"));
+  EXPECT_EQ(run("eval " + out_, &log), 2);
+  EXPECT_THAT(log, HasSubstr("--run ID is required"));
+}
+
+}  // namespace
+}  // namespace phnn
