@@ -39,12 +39,19 @@ finished run is not written, and the script says so.
 Tests: tests/analysis/plot_results_smoke.sh (synthetic file with every status) and
 tests/analysis/test_plot_results.py.
 
-NOT made, because the file cannot support them: the learned energy H_theta along a rollout against
-the true H needs the trained weights, which format_version 1 does not store (issue 12 item 5 asks
-for them and for `phnn eval RESULTS --run ID`).  The integrator work-precision figure comes
-from bench/ via analysis/plot_work_precision.py, not from a results file.
+  energy_<sys>.png            the learned energy H_theta against the true H [J] along the figure
+                              trajectories from H(x0) = 0.5 J and 0.75 J, for the best PHNN of the
+                              trajectories_<sys>.png cell at its median-MSE seed: H and H_theta
+                              along the model's rollout and along the reference.  Made by
+                              `phnn eval RESULTS --run ID --out CSV` from the run's stored weights
+                              (the binary: $PHNN, else build/phnn next to analysis/); files
+                              written before weights were stored get none, and the script says so.
+
+The integrator work-precision figure comes from bench/ via analysis/plot_work_precision.py, not
+from a results file.
 """
 import os
+import subprocess
 import sys
 import textwrap
 import warnings
@@ -108,6 +115,8 @@ def load(path):
             sys.exit(f"{path}: not a phnn results file (no format = phnn-results attribute)")
         r = f["runs"]
         runs = {k: text(r[k][()]) for k in ("system", "size", "regularizer", "studies", "canonical")}
+        runs["id"] = text(r["id"][()]) if "id" in r else [""] * len(runs["system"])
+        runs["has_weights"] = "weights" in f and "id" in r
         runs["model"] = [model_label(m, i) for m, i in zip(text(r["model"][()]),
                                                            text(r["integrator"][()]))]
         for k in ("n_train", "seed", "status", "mse", "wall_time_s", "trace", "trace_length"):
@@ -415,6 +424,68 @@ def draw_prediction(runs, axes, i, energy, model, median):
                      transform=axes[0].transAxes, fontsize=7, color=colour(model))
 
 
+# ------------------------------------------------------------------ learned energy (phnn eval)
+def phnn_binary():
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    return os.environ.get("PHNN", os.path.join(here, "build", "phnn"))
+
+
+def eval_energies(path, run_id, out):
+    """`phnn eval` of one run into a CSV; its rows as a numpy record array, or None."""
+    csv = os.path.join(out, f".energy_{run_id}.csv")
+    done = subprocess.run([phnn_binary(), "eval", path, "--run", run_id, "--out", csv],
+                          capture_output=True, text=True)
+    if done.returncode != 0 or not os.path.exists(csv):
+        print(f"  phnn eval {run_id} failed ({done.returncode}): {done.stderr.strip()}")
+        return None
+    data = np.genfromtxt(csv, delimiter=",", names=True)
+    os.remove(csv)
+    return data
+
+
+def energies(runs, path, name, out):
+    """energy_<sys>.png; see the module docstring."""
+    if not runs["has_weights"]:
+        print("  skipped energy_*.png: this file stores no weights (written before they were)")
+        return []
+    written = []
+    for system in ordered_systems(runs, runs["rows"]):
+        cell, n_train, _ = trajectory_cell(runs, system)
+        picks = [m for m in chosen_models(runs, cell)[0] if m.startswith("PHNN")]
+        if not picks:
+            continue
+        i = median_seed_row(runs, [j for j in cell if runs["model"][j] == picks[0]])
+        data = eval_energies(path, runs["id"][i], out)
+        if data is None:
+            continue
+        fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=False)
+        for ax, h0 in zip(axes, (0.5, 0.75)):
+            rows = data[np.isclose(data["h0"], h0)]
+            c = colour(picks[0])
+            ax.plot(rows["t"], rows["H_true_ref"], color="black", lw=2.2,
+                    label="H along the reference")
+            ax.plot(rows["t"], rows["H_model_ref"], color="grey", lw=1.3, ls=":",
+                    label="H_theta along the reference")
+            ax.plot(rows["t"], rows["H_true"], color=c, lw=1.3, ls="--",
+                    label=f"H along the {picks[0]} rollout")
+            ax.plot(rows["t"], rows["H_model"], color=c, lw=1.3, ls=":",
+                    label=f"H_theta along the {picks[0]} rollout")
+            ax.set_title(f"H(x0) = {h0} J")
+            ax.set_xlabel("t [s]")
+            ax.set_ylabel("energy [J]")
+            ax.grid(alpha=0.3)
+        axes[1].legend(fontsize=7)
+        suptitle(fig, f"{name}: {system}, N_train = {n_train}: learned vs true energy",
+                 f"{picks[0]}, seed {int(runs['seed'][i])} (median-MSE seed, MSE "
+                 f"{runs['mse'][i]:.2g}), reloaded from its stored weights by phnn eval")
+        fig.tight_layout()
+        p = os.path.join(out, f"energy_{system}.png")
+        fig.savefig(p, dpi=DPI)
+        plt.close(fig)
+        written.append(p)
+    return written
+
+
 # ------------------------------------------------------------- Jacobian (10/12) and loss traces
 def trace_runs(runs, system):
     """Small-size runs of a system at the N_train the regularized runs use: {regularizer: rows}."""
@@ -561,6 +632,7 @@ def main():
         written += make(runs, name, sweep, out)
     for make in (trajectories, jacobian_traces, loss_curves, time_vs_error):
         written += make(runs, name, out)
+    written += energies(runs, path, name, out)
     c = Counter(int(s) for s in runs["status"])
     print(f"{len(written)} figures written to {out}/ ({c[DONE]} done, {c[DIVERGED]} diverged, "
           f"{c[FAILED]} failed, {c[PENDING]} pending of {len(runs['status'])} runs)")

@@ -4,7 +4,8 @@
 # first the unit tests of the script's choices (tests/analysis/test_plot_results.py).
 # ctest: add_test(NAME plot_results_smoke COMMAND sh ${CMAKE_SOURCE_DIR}/tests/analysis/plot_results_smoke.sh)
 #        set_tests_properties(plot_results_smoke PROPERTIES SKIP_RETURN_CODE 77)
-#   tests/analysis/plot_results_smoke.sh [PYTHON]     (default /usr/bin/python3, Debian h5py+mpl)
+# Then, with a phnn binary, a real results file with stored weights: the energy figure (phnn eval).
+#   tests/analysis/plot_results_smoke.sh [PYTHON [PHNN]]   (default /usr/bin/python3, Debian h5py+mpl)
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -20,4 +21,10 @@ for f in mse_I_harmonic mse_III_duffing trajectories_harmonic jacobian_duffing l
          time_vs_error_duffing; do
     test -s "$out/fig/$f.png" || { echo "missing $f.png" >&2; exit 1; }
 done
+if [ $# -ge 2 ]; then
+    "$2" train --system duffing --model phnn-s-dg --n-train 25 --seeds 0-2 --steps 20 \
+        --eval-every 10 --quiet --out "$out/trained.h5" > /dev/null
+    PHNN="$2" "$py" "$root/analysis/plot_results.py" "$out/trained.h5" "$out/fig2"
+    test -s "$out/fig2/energy_duffing.png" || { echo "missing energy_duffing.png" >&2; exit 1; }
+fi
 echo "plot_results smoke test passed"
