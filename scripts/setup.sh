@@ -15,6 +15,7 @@ PACKAGES=(
   libblas-dev                        # libblas.so to link dgemm_ (src/models/stacked_matmul.cpp)
   libjemalloc-dev                    # allocator: glibc malloc costs ~16 % of a step
   libtomlplusplus-dev                # toml++: the TOML parser of sweep files
+  libcli11-dev                       # CLI11: the command-line parser of `phnn`
   python3-h5py python3-numpy python3-matplotlib  # analysis/ only
   python3-torch                      # bench/pytorch_step.py only
 )

@@ -1,13 +1,20 @@
-// src/apps/cli.h — a small, strict command-line parser for the subcommands:
-// every option is declared with its help; unknown options, missing values and
-// bad numbers exit with status 2 and a message naming the option.
+// src/apps/cli.h — the subcommands' command lines, parsed by CLI11 (tokens,
+// --name VALUE and --name=VALUE, positionals, --help). Kept on top: every
+// usage error is a UsageError (exit status 2), one line naming the option and
+// the fix, with "did you mean" for a misspelled option; numbers are read
+// strictly (base 10, finite), ranges of integers by parse_int_list.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
+
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace phnn {
 namespace cli {
@@ -20,47 +27,53 @@ struct UsageError {
   std::string message;
 };
 
+/// One subcommand's options; values are read back as text by name.
+///
+///   cli::Parser parser("reduce", "Prints the tables of a results file.");
+///   parser.positional("FILE", "results file written by `phnn sweep`");
+///   parser.option("format", "markdown | latex | csv", "markdown");
+///   if (!parser.parse(argc, argv, /*first=*/2)) return 0;  // --help printed
+///   print_tables(parser.get("FILE"), parser.get("format"));
 class Parser {
  public:
   Parser(std::string command, std::string summary);
+  ~Parser();
+  Parser(const Parser&) = delete;  // CLI11 holds references to values_ and rest_
+  Parser& operator=(const Parser&) = delete;
 
-  /// Declares --name VALUE with a default ("" = required if `required`).
+  /// Declares --name VALUE with a default (shown in --help).
   void option(const std::string& name, const std::string& help,
               const std::string& default_value = "", bool required = false);
-  /// Declares a boolean --name.
+  /// Declares a boolean --name (no value: --name=1 is an error).
   void flag(const std::string& name, const std::string& help);
-  /// Declares positional arguments (by name, in order).
+  /// Declares a required positional argument (by name, in order).
   void positional(const std::string& name, const std::string& help);
   /// Declares that one or more further positional arguments follow the
   /// declared ones (e.g. SHARD...); read them with rest().
   void positional_rest(const std::string& name, const std::string& help);
 
-  /// Parses argv[first..]. Returns false if --help was given (help printed).
+  /// Parses argv[first..]. Returns false if --help was given (help printed);
+  /// throws UsageError for anything else that is wrong.
   bool parse(int argc, char** argv, int first);
 
+  /// The value given, else the default ("" if none).
   std::string get(const std::string& name) const;
   bool has(const std::string& name) const;  // given explicitly
-  bool flag_set(const std::string& name) const;
+  bool flag_set(const std::string& name) const { return has(name); }
   /// The arguments of positional_rest, in order.
-  const std::vector<std::string>& rest() const { return rest_values_; }
-  double get_double(const std::string& name) const;
-  std::int64_t get_int(const std::string& name) const;
-  std::string help() const;
+  const std::vector<std::string>& rest() const { return rest_; }
+  double get_double(const std::string& name) const;     // finite
+  std::int64_t get_int(const std::string& name) const;  // base 10
 
  private:
-  struct Spec {
-    std::string help;
-    std::string default_value;
-    bool required = false;
-    bool is_flag = false;
-  };
-  std::string command_, summary_;
-  std::map<std::string, Spec> specs_;
-  std::vector<std::string> order_;
-  std::vector<std::pair<std::string, std::string>> positional_specs_;
-  std::map<std::string, std::string> values_;
-  std::pair<std::string, std::string> rest_spec_;  // name, help; name "" = none
-  std::vector<std::string> rest_values_;
+  UsageError usage(const std::string& what) const;  // "phnn COMMAND: what"
+  std::string see_help() const;                     // "; see `phnn COMMAND --help`"
+  void check_parsed() const;  // unknown options, missing arguments, flags' values
+
+  std::string command_;
+  std::unique_ptr<CLI::App> app_;
+  std::map<std::string, std::string> values_;  // CLI11 writes the values here
+  std::vector<std::string> rest_;
 };
 
 /// Longest list parse_int_list accepts: the sweep parser's cap on seeds.
@@ -70,8 +83,7 @@ constexpr long long kMaxListValue = 2147483647;
 
 /// Parses "0-9", "0,3,5" or "0-2,7" into a list of non-negative integers;
 /// throws UsageError for more than kMaxListLength values (before expanding).
-std::vector<std::int64_t> parse_int_list(const std::string& option,
-                                         const std::string& text);
+std::vector<std::int64_t> parse_int_list(const std::string& option, const std::string& text);
 
 }  // namespace cli
 }  // namespace phnn

@@ -3,12 +3,44 @@
 #include <exception>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/provenance.h"
+#include "phnn/common/closest_name.h"
 
 namespace {
+
+struct Command {
+  const char* name;
+  int (*run)(int argc, char** argv, int first);
+};
+
+// Each parses its own options (apps/cli.h) from argv[2] on.
+const Command kCommands[] = {
+    {"data", phnn::apps::run_data},
+#ifdef PHNN_HAVE_TRAIN
+    {"train", phnn::apps::run_train},
+#endif
+#ifdef PHNN_HAVE_SWEEP
+    {"sweep", phnn::apps::run_sweep}, {"reduce", phnn::apps::run_reduce},
+    {"merge", phnn::apps::run_merge}, {"eval", phnn::apps::run_eval},
+#endif
+};
+
+// "phnn: unknown command "trian" (did you mean train?); expected one of: ..."
+std::string unknown_command(const std::string& command) {
+  std::vector<std::string> names = {"--help", "--version"};
+  std::string list;
+  for (const Command& c : kCommands) {
+    names.push_back(c.name);
+    list += (list.empty() ? "" : ", ") + std::string(c.name);
+  }
+  const std::string best = phnn::closest_name(command, names);
+  return "phnn: unknown command \"" + command + "\"" +
+         (best.empty() ? "" : " (did you mean " + best + "?)") + "; expected one of: " + list;
+}
 
 const char* kUsage =
     "usage: phnn <command> [options]\n\n"
@@ -38,18 +70,10 @@ int main(int argc, char** argv) {
   }
   const std::string command = argv[1];
   try {
-    if (command == "data") return phnn::apps::run_data(argc, argv, 2);
-#ifdef PHNN_HAVE_TRAIN
-    if (command == "train") return phnn::apps::run_train(argc, argv, 2);
-#endif
-#ifdef PHNN_HAVE_SWEEP
-    if (command == "sweep") return phnn::apps::run_sweep(argc, argv, 2);
-    if (command == "reduce") return phnn::apps::run_reduce(argc, argv, 2);
-    if (command == "merge") return phnn::apps::run_merge(argc, argv, 2);
-    if (command == "eval") return phnn::apps::run_eval(argc, argv, 2);
-#endif
-    std::cerr << "phnn: unknown command \"" << command
-              << "\"; expected one of: data, train, sweep, reduce, merge, eval\n";
+    for (const Command& c : kCommands) {
+      if (command == c.name) return c.run(argc, argv, 2);
+    }
+    std::cerr << unknown_command(command) << "\n";
     return phnn::cli::kUsageError;
   } catch (const phnn::cli::UsageError& e) {
     std::cerr << e.message << "\n";

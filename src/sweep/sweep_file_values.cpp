@@ -5,11 +5,11 @@
 #include "sweep/sweep_file_values.h"
 
 #include <algorithm>
-#include <cctype>
 #include <climits>
 #include <cmath>
 #include <set>
 
+#include "phnn/common/closest_name.h"
 #include "phnn/sweep/sweep_file.h"
 
 namespace phnn {
@@ -41,22 +41,6 @@ std::string join(const std::vector<std::string>& items) {
 
 namespace {
 
-// Levenshtein distance, for "did you mean" hints.
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
 std::string type_name(const toml::node& v) {
   switch (v.type()) {
     case toml::node_type::integer:
@@ -85,22 +69,8 @@ std::string type_name(const toml::node& v) {
 }  // namespace
 
 std::string did_you_mean(const std::string& value, const std::vector<std::string>& allowed) {
-  std::string lower = value;
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  for (const std::string& name : allowed) {
-    if (name == lower) return " (did you mean " + quoted(name) + "?)";  // "PHNN-JR-DG"
-  }
-  std::size_t best = 3;
-  std::string best_name;
-  for (const std::string& name : allowed) {
-    const std::size_t d = edit_distance(value, name);
-    if (d < best) {
-      best = d;
-      best_name = name;
-    }
-  }
-  return best_name.empty() ? std::string() : " (did you mean " + quoted(best_name) + "?)";
+  const std::string name = closest_name(value, allowed);
+  return name.empty() ? std::string() : " (did you mean " + quoted(name) + "?)";
 }
 
 std::string ValueReader::describe(const toml::node& v) const {
