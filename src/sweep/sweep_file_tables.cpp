@@ -25,6 +25,8 @@ struct AxisSet {
   std::optional<std::vector<int>> n_train;
   std::vector<int> n_train_lines;  // line of each n_train value
   std::optional<std::vector<Regularizer>> regularizers;
+  std::optional<std::vector<double>> lambdas;
+  int lambdas_line = 0;
   std::optional<std::vector<int>> seeds;
 };
 
@@ -80,6 +82,7 @@ class TableWalker {
     validate_options();
     if (studies_.empty()) studies_.emplace_back("grid", AxisSet());
     for (const auto& [name, axes] : studies_) spec_.studies.push_back(study_spec(name, axes));
+    check_lambdas();
     return spec_;
   }
 
@@ -235,6 +238,9 @@ class TableWalker {
     study.regularizers = axes.regularizers    ? *axes.regularizers
                          : grid_.regularizers ? *grid_.regularizers
                                               : std::vector<Regularizer>{Regularizer::kNone};
+    study.lambdas = axes.lambdas    ? *axes.lambdas
+                    : grid_.lambdas ? *grid_.lambdas
+                                    : std::vector<double>();
     if (axes.seeds || grid_.seeds) {
       study.seeds = axes.seeds ? *axes.seeds : *grid_.seeds;
     } else {
@@ -263,6 +269,26 @@ class TableWalker {
     }
   }
 
+  // A `lambdas` that multiplies no run would be silently ignored: an error at
+  // its line when no study that takes it has a regularizer other than none.
+  void check_lambdas() const {
+    const auto no_run = [](const std::string& where) {
+      return "lambdas of " + where + " multiplies no run: every run it would apply to has "
+             "regularizer \"none\" (lambdas multiplies cn, sn and sr runs); add one of them to "
+             "regularizers, or remove lambdas";
+    };
+    bool grid_used = false;
+    for (std::size_t i = 0; i < studies_.size(); ++i) {
+      const StudySpec& s = spec_.studies[i];
+      const bool used = std::any_of(s.regularizers.begin(), s.regularizers.end(),
+                                    [](Regularizer r) { return r != Regularizer::kNone; });
+      const AxisSet& own = studies_[i].second;
+      if (own.lambdas && !used) fail(own.lambdas_line, no_run("study " + quoted(s.name)));
+      grid_used = grid_used || (!own.lambdas && used);
+    }
+    if (grid_.lambdas && !grid_used) fail(grid_.lambdas_line, no_run("[grid]"));
+  }
+
   Handlers axis_handlers(AxisSet& axes, bool allow_title) const {
     Handlers h;
     if (allow_title) {
@@ -277,6 +303,10 @@ class TableWalker {
     });
     h.emplace_back("regularizers",
                    [this, &axes](const Entry& e) { axes.regularizers = values_.regularizers(e); });
+    h.emplace_back("lambdas", [this, &axes](const Entry& e) {
+      axes.lambdas = values_.number_axis(e);
+      axes.lambdas_line = e.line;
+    });
     h.emplace_back("seeds", [this, &axes](const Entry& e) { axes.seeds = values_.seeds(e); });
     return h;
   }

@@ -1,7 +1,8 @@
 // src/sweep/sweep_file_values.cpp — one sweep-file value as the type and
-// range its key expects: numbers, strings, the grid axes (systems, models,
-// sizes, n_train, regularizers, seeds), with the line and the allowed values
-// in every error (split from the table walk: this file knows values, not keys).
+// range its key expects: numbers, strings, fixed-choice strings, the grid
+// axes (systems, models, sizes, n_train, regularizers, seeds, lambdas), with
+// the line and the allowed values in every error (split from the table walk:
+// this file knows values, not keys).
 #include "sweep/sweep_file_values.h"
 
 #include <algorithm>
@@ -182,6 +183,31 @@ std::vector<int> ValueReader::int_axis(const Entry& e, int min, std::vector<int>
     if (lines) lines->push_back(line_of(v));
   }
   return out;
+}
+
+std::vector<double> ValueReader::number_axis(const Entry& e) const {
+  std::vector<double> out;
+  for (const toml::node& v : axis_items(e, "an array of numbers")) {
+    const double x = number(e, v);
+    if (!(x >= 0.0)) {
+      fail(line_of(v), e.key + " value " + source_.raw(v) +
+                           " is out of range; expected an array of numbers >= 0");
+    }
+    if (std::find(out.begin(), out.end(), x) != out.end()) {
+      fail(line_of(v), e.key + " lists " + source_.raw(v) + " twice; list each value once");
+    }
+    out.push_back(x);
+  }
+  return out;
+}
+
+std::string ValueReader::choice(const Entry& e, const std::vector<std::string>& allowed) const {
+  const std::string s = string(e);
+  if (std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
+    fail(e.line, "unknown " + e.key + " " + source_.raw(*e.value) + did_you_mean(s, allowed) +
+                     "; expected one of: " + join(allowed));
+  }
+  return s;
 }
 
 std::vector<int> ValueReader::seeds(const Entry& e) const {

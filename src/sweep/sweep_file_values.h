@@ -58,6 +58,11 @@ class ValueReader {
 
   /// Non-empty, duplicate-free axes; `lines` (optional) gets each value's line.
   std::vector<int> int_axis(const Entry& e, int min, std::vector<int>* lines) const;
+  /// lambdas = [1e-6, 1e-5]: finite numbers >= 0 (integers accepted).
+  std::vector<double> number_axis(const Entry& e) const;
+  /// A string that must be one of `allowed` (loss_norm = "mse"); the error
+  /// lists them with a "did you mean" hint.
+  std::string choice(const Entry& e, const std::vector<std::string>& allowed) const;
   /// seeds = [0, 1, 2] or seeds = "0-9".
   std::vector<int> seeds(const Entry& e) const;
   std::vector<SystemKind> systems(const Entry& e) const;

@@ -347,6 +347,45 @@ checkpoints = [1000, 500]
 
 // The fourth-order explicit variants are sweep-file models like the others
 // (not in the default list, which is the paper's five).
+// [grid] / [study.NAME] lambdas: numbers >= 0, each once, inherited from
+// [grid] like the other axes; one that would multiply no run is refused.
+TEST(SweepFileTest, LambdasAreAnAxisOfNonNegativeNumbers) {
+  const SweepSpec spec = parse_sweep_text(R"(name = "t"
+[grid]
+regularizers = ["none", "cn"]
+lambdas = [1e-6, 0, 1]
+[study.a]
+[study.b]
+lambdas = [2e-6]
+)", "x.toml");
+  EXPECT_THAT(spec.studies[0].lambdas, ElementsAre(1e-6, 0.0, 1.0));
+  EXPECT_THAT(spec.studies[1].lambdas, ElementsAre(2e-6));
+  EXPECT_TRUE(parse_sweep_file(kSweeps + "paper.toml").studies[2].lambdas.empty());
+}
+
+TEST(SweepFileErrorTest, BadLambdasPointAtTheirLine) {
+  const std::string head = "name = \"t\"\n[grid]\nregularizers = [\"sr\"]\n";
+  EXPECT_THAT(error_of(head + "lambdas = [1e-4, -1e-4]\n").what(),
+              StartsWith("x.toml:4: lambdas value -1e-4 is out of range; expected an array of "
+                         "numbers >= 0"));
+  EXPECT_THAT(error_of(head + "lambdas = [\n  1e-4,\n  1e-4,\n]\n").what(),
+              StartsWith("x.toml:6: lambdas lists 1e-4 twice"));
+  EXPECT_THAT(error_of(head + "lambdas = 1e-4\n").what(),
+              StartsWith("x.toml:4: lambdas expects an array of numbers, got the float 1e-4"));
+  EXPECT_THAT(error_of(head + "lambdas = [\"1e-4\"]\n").what(),
+              StartsWith("x.toml:4: lambdas expects a number"));
+  EXPECT_THAT(error_of(head + "lambdas = [nan]\n").what(),
+              StartsWith("x.toml:4: lambdas expects a finite number"));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nlambdas = [1e-4]\n").what(),
+              StartsWith("x.toml:3: lambdas of [grid] multiplies no run: every run it would "
+                         "apply to has regularizer \"none\""));
+  EXPECT_THAT(error_of(head + "[study.I]\nregularizers = [\"none\"]\nlambdas = [1]\n").what(),
+              StartsWith("x.toml:6: lambdas of study \"I\" multiplies no run"));
+  // [grid] lambdas used by one study of two is fine.
+  EXPECT_NO_THROW(parse_sweep_text(head + "lambdas = [1]\n[study.I]\n[study.II]\n"
+                                          "regularizers = [\"none\"]\n", "x.toml"));
+}
+
 TEST(SweepFileTest, AcceptsRk4Models) {
   const SweepSpec spec = parse_sweep_text(R"(name = "t"
 [grid]
