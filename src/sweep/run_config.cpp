@@ -57,6 +57,9 @@ std::string RunConfig::cell_key() const {
   if (regularizer == Regularizer::kCn) s << ";lambda=" << num(t.lambda_cn);
   if (regularizer == Regularizer::kSn) s << ";lambda=" << num(t.lambda_sn);
   if (regularizer == Regularizer::kSr) s << ";lambda=" << num(t.lambda_sr);
+  // Knobs below are printed only away from their defaults, so the identity
+  // of every run made before they existed is unchanged.
+  if (t.loss_norm != LossNorm::kMeanL1) s << ";loss_norm=" << to_string(t.loss_norm);
   s << ";jac_eps=" << num(t.jacobian_eps);
   if (is_discrete_gradient(integrator)) {
     s << ";newton=" << num(t.newton_tolerance) << "," << t.newton_max_iterations

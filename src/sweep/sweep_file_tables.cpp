@@ -351,6 +351,8 @@ class TableWalker {
             {"lambda_cn", number(t.lambda_cn)},
             {"lambda_sn", number(t.lambda_sn)},
             {"lambda_sr", number(t.lambda_sr)},
+            {"loss_norm",
+             [this, &t](const Entry& e) { t.loss_norm = values_.choice(e, all_loss_norms()); }},
             {"jacobian_eps", number(t.jacobian_eps)},
             {"newton_tolerance", number(t.newton_tolerance)},
             {"newton_max_iterations", integer(t.newton_max_iterations, 1)},

@@ -201,13 +201,15 @@ std::vector<double> ValueReader::number_axis(const Entry& e) const {
   return out;
 }
 
-std::string ValueReader::choice(const Entry& e, const std::vector<std::string>& allowed) const {
+std::size_t ValueReader::choice_index(const Entry& e,
+                                      const std::vector<std::string>& allowed) const {
   const std::string s = string(e);
-  if (std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
+  const auto it = std::find(allowed.begin(), allowed.end(), s);
+  if (it == allowed.end()) {
     fail(e.line, "unknown " + e.key + " " + source_.raw(*e.value) + did_you_mean(s, allowed) +
                      "; expected one of: " + join(allowed));
   }
-  return s;
+  return static_cast<std::size_t>(it - allowed.begin());
 }
 
 std::vector<int> ValueReader::seeds(const Entry& e) const {

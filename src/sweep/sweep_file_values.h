@@ -60,9 +60,16 @@ class ValueReader {
   std::vector<int> int_axis(const Entry& e, int min, std::vector<int>* lines) const;
   /// lambdas = [1e-6, 1e-5]: finite numbers >= 0 (integers accepted).
   std::vector<double> number_axis(const Entry& e) const;
-  /// A string that must be one of `allowed` (loss_norm = "mse"); the error
-  /// lists them with a "did you mean" hint.
-  std::string choice(const Entry& e, const std::vector<std::string>& allowed) const;
+  /// A string that must be to_string() of one of `values` (loss_norm =
+  /// "mse"); the error lists them with a "did you mean" hint.
+  template <typename T>
+  T choice(const Entry& e, const std::vector<T>& values) const {
+    std::vector<std::string> names;
+    for (const T& v : values) names.push_back(to_string(v));
+    return values[choice_index(e, names)];
+  }
+  /// Index of the string value of `e` in `allowed`; fails if it is not there.
+  std::size_t choice_index(const Entry& e, const std::vector<std::string>& allowed) const;
   /// seeds = [0, 1, 2] or seeds = "0-9".
   std::vector<int> seeds(const Entry& e) const;
   std::vector<SystemKind> systems(const Entry& e) const;

@@ -76,7 +76,8 @@ class CellTrainer {
   double elapsed() const {
     return std::chrono::duration<double>(Clock::now() - start_).count();
   }
-  // L_d (Eq. 30) per member: mean over batch and components of |x_{n+1} - x_hat| / h.
+  // L_d (Eq. 30) per member in opt_.loss_norm (discrete_loss): by default the
+  // mean over batch and components of |x_{n+1} - x_hat| / h.
   torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn,
                           const torch::Tensor& u) const;
   void step(int step, BatchSampler& sampler);
@@ -157,7 +158,7 @@ torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor
       cell_.integrator == IntegratorKind::kDg    ? dg_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
       : cell_.integrator == IntegratorKind::kDg4 ? dg4_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
                                                  : explicit_step(m, cell_.integrator, x, u, h_);
-  return ((xn - x_hat).abs() / h_).mean({1, 2});
+  return discrete_loss(xn, x_hat, h_, opt_.loss_norm);
 }
 
 void CellTrainer::train() {

@@ -386,6 +386,23 @@ TEST(SweepFileErrorTest, BadLambdasPointAtTheirLine) {
                                           "regularizers = [\"none\"]\n", "x.toml"));
 }
 
+// [training] loss_norm: one of three spellings; part of a run's identity
+// only away from the default.
+TEST(SweepFileTest, LossNormIsATrainingOption) {
+  const std::string head = "name = \"t\"\n[grid]\nseeds = [0]\n[training]\n";
+  const SweepSpec spec = parse_sweep_text(head + "loss_norm = \"mse\"\n", "x.toml");
+  EXPECT_EQ(spec.training.loss_norm, LossNorm::kMse);
+  EXPECT_THAT(expand_grid(spec).runs[0].cell_key(), HasSubstr(";loss_norm=mse;"));
+  const Grid plain = expand_grid(parse_sweep_text(head + "loss_norm = \"mean-l1\"\n", "x.toml"));
+  EXPECT_EQ(plain.runs[0].id(), expand_grid(parse_sweep_text(head, "x.toml")).runs[0].id());
+  EXPECT_THAT(plain.runs[0].cell_key(), Not(HasSubstr("loss_norm")));
+  EXPECT_STREQ(error_of(head + "steps = 5\nloss_norm = \"sum-L1\"\n").what(),
+               "x.toml:6: unknown loss_norm \"sum-L1\" (did you mean \"sum-l1\"?); expected "
+               "one of: mean-l1, sum-l1, mse");
+  EXPECT_THAT(error_of(head + "loss_norm = 2\n").what(),
+              StartsWith("x.toml:5: loss_norm expects a \"string\", got the integer 2"));
+}
+
 TEST(SweepFileTest, AcceptsRk4Models) {
   const SweepSpec spec = parse_sweep_text(R"(name = "t"
 [grid]

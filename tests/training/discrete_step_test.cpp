@@ -247,6 +247,28 @@ TEST(DiscreteStepTest, Rk2RolloutCanIncreaseLearnedEnergy) {
   EXPECT_TRUE(ok.all().item<bool>());
 }
 
+// L_d in its three norms on a fixed error e = x_next - x_hat = h E with
+// E = [[1, -2], [3, -4], [0, 5]] (one member): mean-l1 = 15 / 6,
+// sum-l1 = 15 / 3 = 2 mean-l1, mse = (1 + 4 + 9 + 16 + 0 + 25) / 6.
+TEST(DiscreteStepTest, DiscreteLossNormsFollowTheirDefinitions) {
+  const double h = 0.01;
+  const auto E = torch::tensor({1.0, -2.0, 3.0, -4.0, 0.0, 5.0}, torch::kFloat64).view({1, 3, 2});
+  const auto x_next = states(1, 3, 6);
+  const auto x_hat = x_next - h * E;
+  constexpr double kRoundOff = 1e-13;  // e / h recovers E to a few ulps
+  EXPECT_NEAR(discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1).item<double>(), 2.5, kRoundOff);
+  EXPECT_NEAR(discrete_loss(x_next, x_hat, h, LossNorm::kSumL1).item<double>(), 5.0, kRoundOff);
+  EXPECT_NEAR(discrete_loss(x_next, x_hat, h, LossNorm::kMse).item<double>(), 55.0 / 6.0,
+              kRoundOff);
+  // Per member, and the default is today's formula bit for bit.
+  const auto a = states(3, 7, 7), b = states(3, 7, 8);
+  const auto mean_l1 = discrete_loss(a, b, h, LossNorm::kMeanL1);
+  EXPECT_EQ(mean_l1.sizes(), (std::vector<int64_t>{3}));
+  EXPECT_TRUE(torch::equal(mean_l1, ((a - b).abs() / h).mean({1, 2})));
+  EXPECT_TRUE(torch::allclose(discrete_loss(a, b, h, LossNorm::kSumL1), 2.0 * mean_l1,
+                              /*rtol=*/1e-15, /*atol=*/0.0));
+}
+
 TEST(DiscreteStepTest, NodeRejectsDiscreteGradient) {
   const auto model = DynamicsModel::create(ModelOptions{ModelKind::kNode, ModelSize::kSmall, SystemKind::kHarmonic}, {0});
   const auto x = states(1, 4, 7);

@@ -219,6 +219,29 @@ TEST(TrainerTest, DivergedMemberIsFrozenWhileOthersTrain) {
   }
 }
 
+// loss_norm applies to the logged training loss and to the validation loss
+// (which picks the best weights): at step 0 (same weights) sum-l1 is twice
+// mean-l1 and mse is the mean of squares, on every model.
+TEST(TrainerTest, LossNormAppliesToTrainingAndValidationLoss) {
+  for (ModelKind model : {ModelKind::kNode, ModelKind::kPhnnS}) {
+    CellSpec cell;
+    cell.model = model;
+    cell.integrator = IntegratorKind::kRk2;
+    cell.training.steps = 0;
+    cell.seeds = {3};
+    std::map<LossNorm, TracePoint> first;
+    for (LossNorm norm : all_loss_norms()) {
+      cell.training.loss_norm = norm;
+      first[norm] = train_cell(cell, small_data(SystemKind::kHarmonic))[0].trace.at(0);
+    }
+    const TracePoint& l1 = first[LossNorm::kMeanL1];
+    EXPECT_LE(rel(first[LossNorm::kSumL1].validation_loss, 2.0 * l1.validation_loss), 1e-14);
+    EXPECT_LE(rel(first[LossNorm::kSumL1].train_loss, 2.0 * l1.train_loss), 1e-14);
+    // Jensen: mean(e^2) >= mean(|e|)^2, with equality only for constant |e|.
+    EXPECT_GT(first[LossNorm::kMse].validation_loss, l1.validation_loss * l1.validation_loss);
+  }
+}
+
 TEST(CellSpecTest, RejectsNodeWithDgAndBadCounts) {
   CellSpec cell;
   cell.model = ModelKind::kNode;
