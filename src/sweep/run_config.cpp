@@ -65,6 +65,11 @@ std::string RunConfig::cell_key() const {
     s << ";newton=" << num(t.newton_tolerance) << "," << t.newton_max_iterations
       << ";tau=" << num(t.dg_min_dx_norm);
   }
+  // Only PHNN-JR's DG step has a state-dependent structure (R_theta).
+  if (model == ModelKind::kPhnnJr && integrator == IntegratorKind::kDg &&
+      t.dg_structure_point != DgStructurePoint::kMidpoint) {
+    s << ";dg_structure_point=" << to_string(t.dg_structure_point);
+  }
   s << ";divergence=" << num(t.divergence_norm);
   // Only when set, so the identity of every run without checkpoints is
   // unchanged from before they existed.

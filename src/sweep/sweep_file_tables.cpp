@@ -53,21 +53,6 @@ std::vector<std::string> system_names() {
   return names;
 }
 
-bool is_word_char(char c) {
-  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-}
-
-// Position of `field` as a whole word in `message`, or npos.
-std::size_t find_word(const std::string& message, const std::string& field) {
-  for (std::size_t at = message.find(field); at != std::string::npos;
-       at = message.find(field, at + 1)) {
-    const bool left = at == 0 || !is_word_char(message[at - 1]);
-    const std::size_t end = at + field.size();
-    if (left && (end == message.size() || !is_word_char(message[end]))) return at;
-  }
-  return std::string::npos;
-}
-
 class TableWalker {
  public:
   explicit TableWalker(const SweepSource& source) : source_(source), values_(source) {}
@@ -311,6 +296,11 @@ class TableWalker {
     return h;
   }
 
+  // A fixed-choice key: `all` lists its values, default first.
+  template <typename T>
+  Handler choice(T& field, std::vector<T> (*all)()) const {
+    return [this, &field, all](const Entry& e) { field = values_.choice(e, all()); };
+  }
   Handler number(double& field) const {
     return [this, &field](const Entry& e) { field = values_.number(e, *e.value); };
   }
@@ -351,11 +341,11 @@ class TableWalker {
             {"lambda_cn", number(t.lambda_cn)},
             {"lambda_sn", number(t.lambda_sn)},
             {"lambda_sr", number(t.lambda_sr)},
-            {"loss_norm",
-             [this, &t](const Entry& e) { t.loss_norm = values_.choice(e, all_loss_norms()); }},
+            {"loss_norm", choice(t.loss_norm, &all_loss_norms)},
             {"jacobian_eps", number(t.jacobian_eps)},
             {"newton_tolerance", number(t.newton_tolerance)},
             {"newton_max_iterations", integer(t.newton_max_iterations, 1)},
+            {"dg_structure_point", choice(t.dg_structure_point, &all_dg_structure_points)},
             {"dg_min_dx_norm", number(t.dg_min_dx_norm)},
             {"divergence_norm", number(t.divergence_norm)},
             {"checkpoints", [this, &t](const Entry& e) {

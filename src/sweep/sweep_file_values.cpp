@@ -85,6 +85,21 @@ std::string type_name(const toml::node& v) {
 
 }  // namespace
 
+bool is_word_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+// Position of `field` as a whole word in `message`, or npos.
+std::size_t find_word(const std::string& message, const std::string& field) {
+  for (std::size_t at = message.find(field); at != std::string::npos;
+       at = message.find(field, at + 1)) {
+    const bool left = at == 0 || !is_word_char(message[at - 1]);
+    const std::size_t end = at + field.size();
+    if (left && (end == message.size() || !is_word_char(message[end]))) return at;
+  }
+  return std::string::npos;
+}
+
 std::string did_you_mean(const std::string& value, const std::vector<std::string>& allowed) {
   std::string lower = value;
   std::transform(lower.begin(), lower.end(), lower.begin(),

@@ -30,6 +30,10 @@ std::vector<Entry> entries_in_file_order(const toml::table& table);
 int line_of(const toml::node& node);
 
 std::string join(const std::vector<std::string>& items);
+/// A letter, digit or '_'.
+bool is_word_char(char c);
+/// Position of `field` as a whole word in `message`, or npos.
+std::size_t find_word(const std::string& message, const std::string& field);
 /// " (did you mean "steps"?)" for the allowed value closest to `value`
 /// (equal up to case, or within 2 edits), else "".
 std::string did_you_mean(const std::string& value, const std::vector<std::string>& allowed);

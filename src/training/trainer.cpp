@@ -117,7 +117,9 @@ CellTrainer::CellTrainer(const CellSpec& cell, const SystemData& data,
       E_(static_cast<int64_t>(cell.seeds.size())), h_(data.train.step) {
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   model_ = DynamicsModel::create(
-      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks}, seeds);
+      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks,
+                   cell.training.dg_structure_point},
+      seeds);
   // One contiguous leaf for the whole stack: Adam in a handful of ops.
   flat_ = model_->flatten_parameters();
   params_ = model_->parameters();

@@ -403,6 +403,28 @@ TEST(SweepFileTest, LossNormIsATrainingOption) {
               StartsWith("x.toml:5: loss_norm expects a \"string\", got the integer 2"));
 }
 
+// [training] dg_structure_point: part of the identity of PHNN-JR-DG runs
+// only (the only DG step with a state-dependent structure), away from the
+// default.
+TEST(SweepFileTest, DgStructurePointChangesOnlyPhnnJrDgRuns) {
+  const std::string head = "name = \"t\"\n[grid]\nsystems = [\"duffing\"]\nseeds = [0]\n"
+                           "models = [\"phnn-jr-dg\", \"phnn-jr-rk2\", \"phnn-s-dg\", "
+                           "\"phnn-jr-dg4\"]\n[training]\n";
+  const Grid plain = expand_grid(parse_sweep_text(head, "x.toml"));
+  const SweepSpec spec = parse_sweep_text(head + "dg_structure_point = \"start\"\n", "x.toml");
+  EXPECT_EQ(spec.training.dg_structure_point, DgStructurePoint::kStart);
+  const Grid start = expand_grid(spec);
+  ASSERT_EQ(start.runs.size(), 4u);
+  EXPECT_THAT(start.runs[0].cell_key(), HasSubstr(";dg_structure_point=start;"));
+  EXPECT_NE(start.runs[0].id(), plain.runs[0].id());
+  for (std::size_t i = 1; i < 4; ++i) EXPECT_EQ(start.runs[i].id(), plain.runs[i].id()) << i;
+  EXPECT_EQ(expand_grid(parse_sweep_text(head + "dg_structure_point = \"midpoint\"\n", "x.toml"))
+                .runs[0].id(),
+            plain.runs[0].id());
+  EXPECT_STREQ(error_of(head + "dg_structure_point = \"end\"\n").what(),
+               "x.toml:7: unknown dg_structure_point \"end\"; expected one of: midpoint, start");
+}
+
 TEST(SweepFileTest, AcceptsRk4Models) {
   const SweepSpec spec = parse_sweep_text(R"(name = "t"
 [grid]

@@ -242,6 +242,23 @@ TEST(TrainerTest, LossNormAppliesToTrainingAndValidationLoss) {
   }
 }
 
+// dg_structure_point reaches the model of a PHNN-JR-DG cell: with the same
+// initial weights, R at the start changes both the validation loss
+// (training's DG step) and the inference MSE (the Newton rollouts).
+TEST(TrainerTest, DgStructurePointAppliesToTrainingAndInference) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnJr;
+  cell.integrator = IntegratorKind::kDg;
+  cell.training.steps = 0;
+  cell.seeds = {2};
+  const auto midpoint = train_cell(cell, small_data(SystemKind::kDuffing))[0];
+  cell.training.dg_structure_point = DgStructurePoint::kStart;
+  const auto start = train_cell(cell, small_data(SystemKind::kDuffing))[0];
+  EXPECT_GT(rel(start.trace.at(0).validation_loss, midpoint.trace.at(0).validation_loss), 1e-9);
+  EXPECT_GT(rel(start.mse, midpoint.mse), 1e-9);
+  EXPECT_EQ(start.trace.at(0).kappa, midpoint.trace.at(0).kappa);  // continuous field: unchanged
+}
+
 TEST(CellSpecTest, RejectsNodeWithDgAndBadCounts) {
   CellSpec cell;
   cell.model = ModelKind::kNode;

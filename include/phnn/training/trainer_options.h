@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "phnn/models/model_config.h"
+
 namespace phnn {
 
 /// Jacobian regularizer (eq:condition-number-loss, eq:spectral-norm-loss,
@@ -54,6 +56,9 @@ struct TrainerOptions {
   /// newton_max_iterations updates.
   double newton_tolerance = 1e-12;
   int newton_max_iterations = 20;
+  /// Where the DG step evaluates PHNN-JR's R_theta(x, u), in training and at
+  /// inference alike (ModelOptions::dg_structure_point).
+  DgStructurePoint dg_structure_point = DgStructurePoint::kMidpoint;
   /// DG training fallback threshold tau on ||dx||.
   double dg_min_dx_norm = 6e-6;
   /// Divergence: a rollout state with ||x|| > divergence_norm (or non-finite).
