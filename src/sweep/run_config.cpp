@@ -50,6 +50,10 @@ std::string RunConfig::cell_key() const {
     << num(data.equilibrium_energy_max) << ";n_traj=" << data.num_trajectories
     << ";splits=" << data.num_train_max << "," << data.num_validation << ","
     << data.num_inference << ";gen_tol=" << num(data.newton.newton_tolerance);
+  // Algorithm 1 only (harmonic, self-sustained); only away from the default.
+  if (system != SystemKind::kDuffing && data.energy_sampling != EnergySampling::kAlgorithm1) {
+    s << ";energy_sampling=" << to_string(data.energy_sampling);
+  }
   const TrainerOptions& t = training;
   s << ";steps=" << t.steps << ";lr=" << num(t.learning_rate) << ";adam=" << num(t.adam_beta1)
     << "," << num(t.adam_beta2) << "," << num(t.adam_eps) << ";batch=" << t.batch_size

@@ -40,19 +40,6 @@ const char kTableList[] =
     "[data], [training], [grid], [physics.harmonic], [physics.duffing], "
     "[physics.self-sustained], [study.NAME]";
 
-std::optional<SystemKind> find_system(const std::string& name) {
-  for (SystemKind kind : all_systems()) {
-    if (to_string(kind) == name) return kind;
-  }
-  return std::nullopt;
-}
-
-std::vector<std::string> system_names() {
-  std::vector<std::string> names;
-  for (SystemKind kind : all_systems()) names.push_back(to_string(kind));
-  return names;
-}
-
 class TableWalker {
  public:
   explicit TableWalker(const SweepSource& source) : source_(source), values_(source) {}
@@ -68,6 +55,7 @@ class TableWalker {
     if (studies_.empty()) studies_.emplace_back("grid", AxisSet());
     for (const auto& [name, axes] : studies_) spec_.studies.push_back(study_spec(name, axes));
     check_lambdas();
+    check_knobs_change_runs();
     return spec_;
   }
 
@@ -254,8 +242,7 @@ class TableWalker {
     }
   }
 
-  // A `lambdas` that multiplies no run would be silently ignored: an error at
-  // its line when no study that takes it has a regularizer other than none.
+  // A `lambdas` that multiplies no run (only "none" runs take it): an error.
   void check_lambdas() const {
     const auto no_run = [](const std::string& where) {
       return "lambdas of " + where + " multiplies no run: every run it would apply to has "
@@ -272,6 +259,28 @@ class TableWalker {
       grid_used = grid_used || (!own.lambdas && used);
     }
     if (grid_.lambdas && !grid_used) fail(grid_.lambdas_line, no_run("[grid]"));
+  }
+
+  // A knob away from its default that no run of the file uses would be
+  // silently ignored (no run id names it): an error at its line.
+  void check_knobs_change_runs() const {
+    bool algorithm1 = false, jr_dg = false;
+    for (const StudySpec& s : spec_.studies) {
+      for (SystemKind k : s.systems) algorithm1 = algorithm1 || k != SystemKind::kDuffing;
+      for (const auto& m : s.models) {
+        jr_dg = jr_dg || m == std::make_pair(ModelKind::kPhnnJr, IntegratorKind::kDg);
+      }
+    }
+    if (spec_.data.energy_sampling != EnergySampling::kAlgorithm1 && !algorithm1) {
+      fail(data_lines_.at("energy_sampling"),
+           "energy_sampling = \"direct\" changes no run: it replaces Algorithm 1 (harmonic, "
+           "self-sustained) and every study is duffing only (Algorithm 2); remove it");
+    }
+    if (spec_.training.dg_structure_point != DgStructurePoint::kMidpoint && !jr_dg) {
+      fail(training_lines_.at("dg_structure_point"),
+           "dg_structure_point = \"start\" changes no run: it moves R_theta of phnn-jr-dg, "
+           "which no study has; remove it");
+    }
   }
 
   Handlers axis_handlers(AxisSet& axes, bool allow_title) const {
@@ -321,6 +330,7 @@ class TableWalker {
             {"sample_rate", number(d.sample_rate)},
             {"energy_min", number(d.energy_min)},
             {"energy_max", number(d.energy_max)},
+            {"energy_sampling", choice(d.energy_sampling, &all_energy_samplings)},
             {"equilibrium_energy_min", number(d.equilibrium_energy_min)},
             {"equilibrium_energy_max", number(d.equilibrium_energy_max)},
             {"num_trajectories", integer(d.num_trajectories, 1)},

@@ -100,6 +100,19 @@ std::size_t find_word(const std::string& message, const std::string& field) {
   return std::string::npos;
 }
 
+std::optional<SystemKind> find_system(const std::string& name) {
+  for (SystemKind kind : all_systems()) {
+    if (to_string(kind) == name) return kind;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> system_names() {
+  std::vector<std::string> names;
+  for (SystemKind kind : all_systems()) names.push_back(to_string(kind));
+  return names;
+}
+
 std::string did_you_mean(const std::string& value, const std::vector<std::string>& allowed) {
   std::string lower = value;
   std::transform(lower.begin(), lower.end(), lower.begin(),

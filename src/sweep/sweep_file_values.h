@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +31,10 @@ std::vector<Entry> entries_in_file_order(const toml::table& table);
 int line_of(const toml::node& node);
 
 std::string join(const std::vector<std::string>& items);
+/// The system named `name` ("duffing"), if any.
+std::optional<SystemKind> find_system(const std::string& name);
+/// "harmonic", "duffing", "self-sustained".
+std::vector<std::string> system_names();
 /// A letter, digit or '_'.
 bool is_word_char(char c);
 /// Position of `field` as a whole word in `message`, or npos.

@@ -425,6 +425,33 @@ TEST(SweepFileTest, DgStructurePointChangesOnlyPhnnJrDgRuns) {
                "x.toml:7: unknown dg_structure_point \"end\"; expected one of: midpoint, start");
 }
 
+// [data] energy_sampling: part of the identity of harmonic and self-sustained
+// runs only (Algorithm 1), away from the default; refused where no run uses
+// it, like a dg_structure_point without phnn-jr-dg.
+TEST(SweepFileTest, EnergySamplingChangesOnlyAlgorithmOneRuns) {
+  const std::string head = "name = \"t\"\n[grid]\nmodels = [\"node-rk2\"]\nseeds = [0]\n[data]\n";
+  const Grid plain = expand_grid(parse_sweep_text(head, "x.toml"));
+  const SweepSpec spec = parse_sweep_text(head + "energy_sampling = \"direct\"\n", "x.toml");
+  EXPECT_EQ(spec.data.energy_sampling, EnergySampling::kDirect);
+  const Grid direct = expand_grid(spec);
+  ASSERT_EQ(direct.runs.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const bool algorithm1 = direct.runs[i].system != SystemKind::kDuffing;
+    EXPECT_EQ(direct.runs[i].id() != plain.runs[i].id(), algorithm1) << i;
+    EXPECT_EQ(direct.runs[i].cell_key().find(";energy_sampling=direct;") != std::string::npos,
+              algorithm1);
+  }
+  EXPECT_THAT(error_of(head + "energy_sampling = \"sqrt\"\n").what(),
+              StartsWith("x.toml:6: unknown energy_sampling \"sqrt\"; expected one of: "
+                         "algorithm1, direct"));
+  const std::string duffing = "name = \"t\"\n[grid]\nsystems = [\"duffing\"]\n";
+  EXPECT_THAT(error_of(duffing + "[data]\nenergy_sampling = \"direct\"\n").what(),
+              StartsWith("x.toml:5: energy_sampling = \"direct\" changes no run"));
+  EXPECT_THAT(error_of(duffing + "models = [\"phnn-s-dg\", \"phnn-jr-rk2\"]\n[training]\n"
+                                 "dg_structure_point = \"start\"\n").what(),
+              StartsWith("x.toml:6: dg_structure_point = \"start\" changes no run"));
+}
+
 TEST(SweepFileTest, AcceptsRk4Models) {
   const SweepSpec spec = parse_sweep_text(R"(name = "t"
 [grid]
