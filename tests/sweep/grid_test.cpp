@@ -330,6 +330,29 @@ TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
               ElementsAre("lambda=1e-06", "lambda=1.0000001e-06", "lambda=0"));
 }
 
+// sweeps/ablation-duffing.toml changes one knob: without its loss_norm line
+// its runs are the default runs (seeds 0-9 are paper.toml's own), and with
+// it each cell key differs by exactly ";loss_norm=mse".
+TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-duffing.toml");
+  std::string text = spec.text;
+  const std::string line = "loss_norm = \"mse\"\n";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.erase(text.find(line), line.size());
+  const Grid ablation = expand_grid(spec);
+  const Grid baseline = expand_grid(parse_sweep_text(text, "baseline.toml"));
+  ASSERT_EQ(ablation.runs.size(), 60u);
+  ASSERT_EQ(baseline.runs.size(), 60u);
+  std::set<std::string> paper_ids;
+  for (const RunConfig& run : paper_grid().runs) paper_ids.insert(run.id());
+  for (std::size_t i = 0; i < 60; ++i) {
+    std::string key = ablation.runs[i].cell_key();
+    key.erase(key.find(";loss_norm=mse"), std::string(";loss_norm=mse").size());
+    EXPECT_EQ(key, baseline.runs[i].cell_key());
+    EXPECT_EQ(paper_ids.count(baseline.runs[i].id()), baseline.runs[i].seed < 10 ? 1u : 0u) << i;
+  }
+}
+
 TEST(GridTest, SeveralVariedAxesGiveProductColumns) {
   const Grid grid = expand_grid(parse_sweep_text(R"(name = "two"
 [grid]
