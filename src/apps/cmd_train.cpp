@@ -40,8 +40,11 @@ std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
   const std::string system = to_string(data.system.kind);
   s << "# written by `phnn train --out`\n"
     << "name = \"train-" << system << "-" << to_string(cell.model) << "-"
-    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed
-    << "\n\n[training]\nsteps = " << cell.training.steps
+    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed;
+  if (data.options.energy_sampling != EnergySampling::kAlgorithm1) {  // a --data file's
+    s << "\nenergy_sampling = \"" << to_string(data.options.energy_sampling) << "\"";
+  }
+  s << "\n\n[training]\nsteps = " << cell.training.steps
     << "\nlearning_rate = " << g17(cell.training.learning_rate)
     << "\nbatch_size = " << cell.training.batch_size
     << "\neval_every = " << cell.training.eval_every << "\n\n[physics." << system << "]\n"

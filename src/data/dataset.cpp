@@ -24,6 +24,18 @@ long integer_ratio(double a, double b) {
 
 }  // namespace
 
+std::string to_string(EnergySampling sampling) {
+  switch (sampling) {
+    case EnergySampling::kAlgorithm1: return "algorithm1";
+    case EnergySampling::kDirect: return "direct";
+  }
+  return "unknown";
+}
+
+std::vector<EnergySampling> all_energy_samplings() {
+  return {EnergySampling::kAlgorithm1, EnergySampling::kDirect};
+}
+
 int DatasetOptions::stride() const {
   const long s = integer_ratio(1.0 / generation_step, sample_rate);
   PHNN_REQUIRE(s >= 1, "Invalid DatasetOptions: sr_gen / sample_rate = "
@@ -117,10 +129,11 @@ TrajectorySpec trajectory_spec(const Oscillator& system,
     }
   } else {
     // Algorithm 1, as written: theta ~ U(0, 2 pi), r ~ U(E_min, E_max),
-    // E0 = sqrt(r), q = sqrt(2 E0 / k) sin(theta), p = sqrt(2 m E0) cos(theta).
+    // E0 = sqrt(r) (kDirect: E0 = r), q = sqrt(2 E0 / k) sin(theta),
+    // p = sqrt(2 m E0) cos(theta).
     const double theta = ic.uniform(0.0, kTwoPi);
     const double r = ic.uniform(options.energy_min, options.energy_max);
-    const double e0 = std::sqrt(r);
+    const double e0 = options.energy_sampling == EnergySampling::kDirect ? r : std::sqrt(r);
     spec.x0 = Vec2(std::sqrt(2.0 * e0 / p.stiffness) * std::sin(theta),
                    std::sqrt(2.0 * p.mass * e0) * std::cos(theta));
   }

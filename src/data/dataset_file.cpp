@@ -100,6 +100,7 @@ void write_system_data(h5::File& file, const std::string& group,
   file.set_attribute(group, "sample_rate_Hz", o.sample_rate);
   file.set_attribute(group, "energy_min_J", o.energy_min);
   file.set_attribute(group, "energy_max_J", o.energy_max);
+  file.set_attribute(group, "energy_sampling", to_string(o.energy_sampling));
   file.set_attribute(group, "equilibrium_energy_min_J", o.equilibrium_energy_min);
   file.set_attribute(group, "equilibrium_energy_max_J", o.equilibrium_energy_max);
   file.set_attribute(group, "num_trajectories", static_cast<std::int64_t>(o.num_trajectories));
@@ -130,6 +131,21 @@ void write_system_data(h5::File& file, const std::string& group,
   file.set_attribute(inf + "/states", "units", std::string("q [m], p [kg m/s]"));
 }
 
+namespace {
+
+// Files written before the attribute existed used Algorithm 1 as written.
+EnergySampling read_energy_sampling(const h5::File& file, const std::string& group) {
+  if (!file.has_attribute(group, "energy_sampling")) return EnergySampling::kAlgorithm1;
+  const std::string name = file.string_attribute(group, "energy_sampling");
+  for (EnergySampling s : all_energy_samplings()) {
+    if (to_string(s) == name) return s;
+  }
+  throw std::runtime_error(file.path() + ": " + group + " has energy_sampling = \"" + name +
+                           "\"; expected algorithm1 or direct");
+}
+
+}  // namespace
+
 SystemData read_system_data(const h5::File& file, const std::string& group) {
   if (!file.has_attribute(group, "format") ||
       file.string_attribute(group, "format") != "phnn-dataset") {
@@ -156,6 +172,7 @@ SystemData read_system_data(const h5::File& file, const std::string& group) {
   o.sample_rate = file.double_attribute(group, "sample_rate_Hz");
   o.energy_min = file.double_attribute(group, "energy_min_J");
   o.energy_max = file.double_attribute(group, "energy_max_J");
+  o.energy_sampling = read_energy_sampling(file, group);
   o.equilibrium_energy_min = file.double_attribute(group, "equilibrium_energy_min_J");
   o.equilibrium_energy_max = file.double_attribute(group, "equilibrium_energy_max_J");
   o.num_trajectories = static_cast<int>(file.int_attribute(group, "num_trajectories"));

@@ -34,6 +34,18 @@ std::string to_string(ModelSize size) {
   return "unknown";
 }
 
+std::string to_string(DgStructurePoint point) {
+  switch (point) {
+    case DgStructurePoint::kMidpoint: return "midpoint";
+    case DgStructurePoint::kStart: return "start";
+  }
+  return "unknown";
+}
+
+std::vector<DgStructurePoint> all_dg_structure_points() {
+  return {DgStructurePoint::kMidpoint, DgStructurePoint::kStart};
+}
+
 ModelKind parse_model(const std::string& name) {
   for (ModelKind k : {ModelKind::kNode, ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
     if (name == to_string(k)) return k;

@@ -95,12 +95,12 @@ FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tenso
   if (!with_jacobian) {
     Jet effort;
     effort.v = hamiltonian_and_gradient(l_h(), x).grad;
-    out.f = field_from_effort(effort, x, u, /*order=*/0).v;
+    out.f = field_from_effort(effort, x, u, /*order=*/0, /*dissipation_fixed=*/false).v;
     return out;
   }
   const int order = 1;
   const Jet grad = curvature_jet(x);
-  const Jet f = field_from_effort(grad, x, u, order);
+  const Jet f = field_from_effort(grad, x, u, order, /*dissipation_fixed=*/false);
   out.f = f.v;
   if (with_jacobian) out.dfdx = f.g.transpose(-1, -2);
   return out;
@@ -139,7 +139,14 @@ torch::Tensor PortHamiltonianModel::discrete_gradient_field(const torch::Tensor&
                                                             double min_dx_norm) const {
   Jet effort;
   effort.v = discrete_gradient(x, dx, min_dx_norm);
-  return field_from_effort(effort, x + 0.5 * dx, u, /*order=*/0).v;
+  // R_theta at x_n + dx/2 (default) or x_n (docs/METHOD.md §4, dg_structure_point).
+  const auto x_dissipation = dissipation_at_start() ? x : x + 0.5 * dx;
+  return field_from_effort(effort, x_dissipation, u, /*order=*/0, /*dissipation_fixed=*/false).v;
+}
+
+bool PortHamiltonianModel::dissipation_at_start() const {
+  return options().kind == ModelKind::kPhnnJr &&
+         options().dg_structure_point == DgStructurePoint::kStart;
 }
 
 // Jacobian of the DG field w.r.t. dx. With m = x + dx/2, g = gradH(m),
@@ -151,6 +158,8 @@ torch::Tensor PortHamiltonianModel::discrete_gradient_field(const torch::Tensor&
 // else in f_bar depends on dx through m only (R(m, u), z(w(dg))), so the
 // field is differentiated as a jet in the directions of m with the effort's
 // tangent d dg / d m = 2 d dg / d dx, and d f_bar / d dx = (d f_bar / d m) / 2.
+// With R at the start x_n only the effort moves: the jet's directions are dx
+// itself, the effort's tangent is d dg / d dx and R's is zero.
 FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
     const torch::Tensor& x, const torch::Tensor& dx, const torch::Tensor& u,
     double min_dx_norm) const {
@@ -172,9 +181,16 @@ FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
   const auto j_dg = 0.5 * hess + dx.unsqueeze(-1) * dk.unsqueeze(-2) + k.unsqueeze(-1) * eye;
   Jet effort;
   effort.v = grad_m.v + k * dx;
-  effort.g = 2.0 * j_dg.transpose(-1, -2);  // [E, B, i (direction m_i), a]
-  const Jet f = field_from_effort(effort, m, u, /*order=*/1);
   FieldEval out;
+  if (dissipation_at_start()) {
+    effort.g = j_dg.transpose(-1, -2);  // [E, B, i (direction dx_i), a]
+    const Jet f = field_from_effort(effort, x, u, /*order=*/1, /*dissipation_fixed=*/true);
+    out.f = f.v;
+    out.dfdx = f.g.transpose(-1, -2);  // [E, B, component, dx_i]
+    return out;
+  }
+  effort.g = 2.0 * j_dg.transpose(-1, -2);  // [E, B, i (direction m_i), a]
+  const Jet f = field_from_effort(effort, m, u, /*order=*/1, /*dissipation_fixed=*/false);
   out.f = f.v;
   out.dfdx = 0.5 * f.g.transpose(-1, -2);  // [E, B, component, dx_i]
   return out;
@@ -206,7 +222,8 @@ PhnnS::PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds)
 }
 
 Jet PhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_dissipation*/,
-                             const torch::Tensor& u, int order) const {
+                             const torch::Tensor& u, int order,
+                             bool /*dissipation_fixed*/) const {
   if (order == 0 && nets_[1]->options().fused) {
     const auto w = internal::phnn_s_w_head(effort.v, u, {S_[2][0], S_[2][1], S_[2][3]});
     return Jet{internal::phnn_s_field_head(effort.v, u, nets_[1]->forward(w), w, S_), {}, {}};
@@ -252,7 +269,7 @@ torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x, const torch::Te
 }
 
 Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
-                              const torch::Tensor& u, int order) const {
+                              const torch::Tensor& u, int order, bool dissipation_fixed) const {
   if (order == 0 && nets_[1]->options().fused) {
     const auto o = nets_[1]->forward(torch::cat({x_dissipation, u}, -1));  // [E, B, 6]
     return Jet{internal::jr_field_head(effort.v, o, u, J_), {}, {}};
@@ -267,8 +284,11 @@ Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipat
     const auto je = torch::matmul(j_matrix_, e);
     return Jet{(je - re).squeeze(-1).narrow(-1, 0, 2), {}, {}};
   }
-  // L_R(x, u): lower triangular 3 x 3 from 6 outputs, row by row.
-  const Jet o = nets_[1]->forward_input(torch::cat({x_dissipation, u}, -1), 2, order);
+  // L_R(x, u): lower triangular 3 x 3 from 6 outputs, row by row (constant
+  // along the jet's directions when the dissipation is fixed).
+  const auto input = torch::cat({x_dissipation, u}, -1);
+  const Jet o = dissipation_fixed ? Jet::constant(nets_[1]->forward(input), 2, order)
+                                  : nets_[1]->forward_input(input, 2, order);
   if (order == 1 && nets_[1]->options().fused && effort.g.defined()) {
     const auto jet = internal::jr_field_jet_head(effort.v, effort.g, o.v, o.g, u, J_);
     return Jet{jet.f, jet.g, {}};
@@ -359,7 +379,7 @@ FieldEval PortHamiltonianModel::discrete_gradient4_field(const torch::Tensor& x,
   effort.v = average_vector_field_gradient(x, dx, min_dx_norm);
   effort.g = curvature_jet(m).g;  // Q [E, B, 2 (direction), 2]
   effort.h = torch::zeros({x.size(0), x.size(1), 2, 2, 2}, x.options());
-  const Jet phi = field_from_effort(effort, m, u, /*order=*/2);
+  const Jet phi = field_from_effort(effort, m, u, /*order=*/2, /*dissipation_fixed=*/false);
   const auto v = phi.v;                               // [E, B, 2]
   const auto A = phi.g.transpose(-1, -2);             // [E, B, component, direction]
   const auto vv = v.unsqueeze(-1) * v.unsqueeze(-2);  // [E, B, i, j]

@@ -2,6 +2,8 @@
 #include "phnn/sweep/grid.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <queue>
@@ -54,25 +56,41 @@ double estimate_group_cost_s(const RunConfig& run, int members, const CostModel&
 
 namespace {
 
+// Shortest "%g" spelling that reads back as `value` (1e-05, 0.0001, 2.5e-06):
+// distinct weights never share a column label.
+std::string shortest_number(double value) {
+  char buf[32];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+    if (std::strtod(buf, nullptr) == value) break;
+  }
+  return buf;
+}
+
 // Varied axes of a study, in nesting order, and the label of a run's column.
+// The regularizer weight is a column part of regularized runs only
+// ("cn/lambda=1e-05"; the "none" column has no weight), so runs of different
+// weights never share a table cell.
 struct ColumnAxes {
-  bool size = false, n_train = false, regularizer = false;
+  bool size = false, n_train = false, regularizer = false, lambda = false;
 
   std::string name() const {
     std::vector<std::string> names;
     if (size) names.push_back("size");
     if (n_train) names.push_back("n_train");
     if (regularizer) names.push_back("regularizer");
+    if (lambda) names.push_back("lambda");
     std::string out;
     for (const std::string& n : names) out += (out.empty() ? "" : "/") + n;
     return out;
   }
 
-  std::string label(ModelSize s, int n, Regularizer r) const {
+  std::string label(ModelSize s, int n, Regularizer r, double weight) const {
     std::vector<std::string> parts;
     if (size) parts.push_back(to_string(s));
     if (n_train) parts.push_back(std::to_string(n));
     if (regularizer) parts.push_back(to_string(r));
+    if (lambda && r != Regularizer::kNone) parts.push_back("lambda=" + shortest_number(weight));
     if (parts.empty()) return "MSE";
     std::string out;
     for (const std::string& p : parts) out += (out.empty() ? "" : "/") + p;
@@ -80,12 +98,34 @@ struct ColumnAxes {
   }
 };
 
+// The weights a run with `reg` is made with: the study's lambdas for a
+// regularized run when it has any, else the [training] weight (one run).
+std::vector<double> weights_of(const StudySpec& study, Regularizer reg,
+                               const TrainerOptions& training) {
+  if (reg == Regularizer::kNone || study.lambdas.empty()) {
+    return {reg == Regularizer::kCn   ? training.lambda_cn
+            : reg == Regularizer::kSn ? training.lambda_sn
+            : reg == Regularizer::kSr ? training.lambda_sr
+                                      : 0.0};
+  }
+  return study.lambdas;
+}
+
+// Sets the weight of `reg` (eq:condition-number-loss, eq:spectral-norm-loss,
+// eq:stiffness-ratio-loss) in `training`; nothing for kNone.
+void set_weight(Regularizer reg, double weight, TrainerOptions* training) {
+  if (reg == Regularizer::kCn) training->lambda_cn = weight;
+  if (reg == Regularizer::kSn) training->lambda_sn = weight;
+  if (reg == Regularizer::kSr) training->lambda_sr = weight;
+}
+
 }  // namespace
 
 namespace {
 
 // A study's table without its runs: rows (models), columns (the varied axis).
-StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes) {
+StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes,
+                       const TrainerOptions& training) {
   StudyTable table;
   table.name = study.name;
   table.title = study.title;
@@ -97,9 +137,11 @@ StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes) {
   for (ModelSize size : study.sizes) {
     for (int n : study.n_train) {
       for (Regularizer reg : study.regularizers) {
-        const std::string label = axes.label(size, n, reg);
-        if (std::find(table.columns.begin(), table.columns.end(), label) == table.columns.end()) {
-          table.columns.push_back(label);
+        for (double weight : weights_of(study, reg, training)) {
+          const std::string label = axes.label(size, n, reg, weight);
+          if (std::find(table.columns.begin(), table.columns.end(), label) == table.columns.end()) {
+            table.columns.push_back(label);
+          }
         }
       }
     }
@@ -125,14 +167,15 @@ void add_run(const RunConfig& run, const std::string& column, Grid* grid, StudyT
 }
 
 // Every run of `study`, nested system, model, size, n_train, regularizer,
-// seed (seed fastest).
+// lambda (regularized runs only), seed (seed fastest).
 void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
                   std::map<std::string, int>* index_of) {
   ColumnAxes axes;
   axes.size = study.sizes.size() > 1;
   axes.n_train = study.n_train.size() > 1;
   axes.regularizer = study.regularizers.size() > 1;
-  StudyTable table = table_frame(study, axes);
+  axes.lambda = study.lambdas.size() > 1;
+  StudyTable table = table_frame(study, axes, spec.training);
   RunConfig run;
   run.data = spec.data;
   run.training = spec.training;
@@ -148,9 +191,13 @@ void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
           run.n_train = n;
           for (Regularizer reg : study.regularizers) {
             run.regularizer = reg;
-            for (int seed : study.seeds) {
-              run.seed = seed;
-              add_run(run, axes.label(size, n, reg), grid, &table, index_of);
+            for (double weight : weights_of(study, reg, spec.training)) {
+              run.training = spec.training;
+              set_weight(reg, weight, &run.training);
+              for (int seed : study.seeds) {
+                run.seed = seed;
+                add_run(run, axes.label(size, n, reg, weight), grid, &table, index_of);
+              }
             }
           }
         }

@@ -50,6 +50,10 @@ std::string RunConfig::cell_key() const {
     << num(data.equilibrium_energy_max) << ";n_traj=" << data.num_trajectories
     << ";splits=" << data.num_train_max << "," << data.num_validation << ","
     << data.num_inference << ";gen_tol=" << num(data.newton.newton_tolerance);
+  // Algorithm 1 only (harmonic, self-sustained); only away from the default.
+  if (system != SystemKind::kDuffing && data.energy_sampling != EnergySampling::kAlgorithm1) {
+    s << ";energy_sampling=" << to_string(data.energy_sampling);
+  }
   const TrainerOptions& t = training;
   s << ";steps=" << t.steps << ";lr=" << num(t.learning_rate) << ";adam=" << num(t.adam_beta1)
     << "," << num(t.adam_beta2) << "," << num(t.adam_eps) << ";batch=" << t.batch_size
@@ -57,10 +61,18 @@ std::string RunConfig::cell_key() const {
   if (regularizer == Regularizer::kCn) s << ";lambda=" << num(t.lambda_cn);
   if (regularizer == Regularizer::kSn) s << ";lambda=" << num(t.lambda_sn);
   if (regularizer == Regularizer::kSr) s << ";lambda=" << num(t.lambda_sr);
+  // Knobs below are printed only away from their defaults, so the identity
+  // of every run made before they existed is unchanged.
+  if (t.loss_norm != LossNorm::kMeanL1) s << ";loss_norm=" << to_string(t.loss_norm);
   s << ";jac_eps=" << num(t.jacobian_eps);
   if (is_discrete_gradient(integrator)) {
     s << ";newton=" << num(t.newton_tolerance) << "," << t.newton_max_iterations
       << ";tau=" << num(t.dg_min_dx_norm);
+  }
+  // Only PHNN-JR's DG step has a state-dependent structure (R_theta).
+  if (model == ModelKind::kPhnnJr && integrator == IntegratorKind::kDg &&
+      t.dg_structure_point != DgStructurePoint::kMidpoint) {
+    s << ";dg_structure_point=" << to_string(t.dg_structure_point);
   }
   s << ";divergence=" << num(t.divergence_norm);
   // Only when set, so the identity of every run without checkpoints is

@@ -25,6 +25,8 @@ struct AxisSet {
   std::optional<std::vector<int>> n_train;
   std::vector<int> n_train_lines;  // line of each n_train value
   std::optional<std::vector<Regularizer>> regularizers;
+  std::optional<std::vector<double>> lambdas;
+  int lambdas_line = 0;
   std::optional<std::vector<int>> seeds;
 };
 
@@ -37,34 +39,6 @@ using KeyLines = std::map<std::string, int>;
 const char kTableList[] =
     "[data], [training], [grid], [physics.harmonic], [physics.duffing], "
     "[physics.self-sustained], [study.NAME]";
-
-std::optional<SystemKind> find_system(const std::string& name) {
-  for (SystemKind kind : all_systems()) {
-    if (to_string(kind) == name) return kind;
-  }
-  return std::nullopt;
-}
-
-std::vector<std::string> system_names() {
-  std::vector<std::string> names;
-  for (SystemKind kind : all_systems()) names.push_back(to_string(kind));
-  return names;
-}
-
-bool is_word_char(char c) {
-  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-}
-
-// Position of `field` as a whole word in `message`, or npos.
-std::size_t find_word(const std::string& message, const std::string& field) {
-  for (std::size_t at = message.find(field); at != std::string::npos;
-       at = message.find(field, at + 1)) {
-    const bool left = at == 0 || !is_word_char(message[at - 1]);
-    const std::size_t end = at + field.size();
-    if (left && (end == message.size() || !is_word_char(message[end]))) return at;
-  }
-  return std::string::npos;
-}
 
 class TableWalker {
  public:
@@ -80,6 +54,8 @@ class TableWalker {
     validate_options();
     if (studies_.empty()) studies_.emplace_back("grid", AxisSet());
     for (const auto& [name, axes] : studies_) spec_.studies.push_back(study_spec(name, axes));
+    check_lambdas();
+    check_knobs_change_runs();
     return spec_;
   }
 
@@ -235,6 +211,9 @@ class TableWalker {
     study.regularizers = axes.regularizers    ? *axes.regularizers
                          : grid_.regularizers ? *grid_.regularizers
                                               : std::vector<Regularizer>{Regularizer::kNone};
+    study.lambdas = axes.lambdas    ? *axes.lambdas
+                    : grid_.lambdas ? *grid_.lambdas
+                                    : std::vector<double>();
     if (axes.seeds || grid_.seeds) {
       study.seeds = axes.seeds ? *axes.seeds : *grid_.seeds;
     } else {
@@ -263,6 +242,47 @@ class TableWalker {
     }
   }
 
+  // A `lambdas` that multiplies no run (only "none" runs take it): an error.
+  void check_lambdas() const {
+    const auto no_run = [](const std::string& where) {
+      return "lambdas of " + where + " multiplies no run: every run it would apply to has "
+             "regularizer \"none\" (lambdas multiplies cn, sn and sr runs); add one of them to "
+             "regularizers, or remove lambdas";
+    };
+    bool grid_used = false;
+    for (std::size_t i = 0; i < studies_.size(); ++i) {
+      const StudySpec& s = spec_.studies[i];
+      const bool used = std::any_of(s.regularizers.begin(), s.regularizers.end(),
+                                    [](Regularizer r) { return r != Regularizer::kNone; });
+      const AxisSet& own = studies_[i].second;
+      if (own.lambdas && !used) fail(own.lambdas_line, no_run("study " + quoted(s.name)));
+      grid_used = grid_used || (!own.lambdas && used);
+    }
+    if (grid_.lambdas && !grid_used) fail(grid_.lambdas_line, no_run("[grid]"));
+  }
+
+  // A knob away from its default that no run of the file uses would be
+  // silently ignored (no run id names it): an error at its line.
+  void check_knobs_change_runs() const {
+    bool algorithm1 = false, jr_dg = false;
+    for (const StudySpec& s : spec_.studies) {
+      for (SystemKind k : s.systems) algorithm1 = algorithm1 || k != SystemKind::kDuffing;
+      for (const auto& m : s.models) {
+        jr_dg = jr_dg || m == std::make_pair(ModelKind::kPhnnJr, IntegratorKind::kDg);
+      }
+    }
+    if (spec_.data.energy_sampling != EnergySampling::kAlgorithm1 && !algorithm1) {
+      fail(data_lines_.at("energy_sampling"),
+           "energy_sampling = \"direct\" changes no run: it replaces Algorithm 1 (harmonic, "
+           "self-sustained) and every study is duffing only (Algorithm 2); remove it");
+    }
+    if (spec_.training.dg_structure_point != DgStructurePoint::kMidpoint && !jr_dg) {
+      fail(training_lines_.at("dg_structure_point"),
+           "dg_structure_point = \"start\" changes no run: it moves R_theta of phnn-jr-dg, "
+           "which no study has; remove it");
+    }
+  }
+
   Handlers axis_handlers(AxisSet& axes, bool allow_title) const {
     Handlers h;
     if (allow_title) {
@@ -277,10 +297,19 @@ class TableWalker {
     });
     h.emplace_back("regularizers",
                    [this, &axes](const Entry& e) { axes.regularizers = values_.regularizers(e); });
+    h.emplace_back("lambdas", [this, &axes](const Entry& e) {
+      axes.lambdas = values_.number_axis(e);
+      axes.lambdas_line = e.line;
+    });
     h.emplace_back("seeds", [this, &axes](const Entry& e) { axes.seeds = values_.seeds(e); });
     return h;
   }
 
+  // A fixed-choice key: `all` lists its values, default first.
+  template <typename T>
+  Handler choice(T& field, std::vector<T> (*all)()) const {
+    return [this, &field, all](const Entry& e) { field = values_.choice(e, all()); };
+  }
   Handler number(double& field) const {
     return [this, &field](const Entry& e) { field = values_.number(e, *e.value); };
   }
@@ -301,6 +330,7 @@ class TableWalker {
             {"sample_rate", number(d.sample_rate)},
             {"energy_min", number(d.energy_min)},
             {"energy_max", number(d.energy_max)},
+            {"energy_sampling", choice(d.energy_sampling, &all_energy_samplings)},
             {"equilibrium_energy_min", number(d.equilibrium_energy_min)},
             {"equilibrium_energy_max", number(d.equilibrium_energy_max)},
             {"num_trajectories", integer(d.num_trajectories, 1)},
@@ -321,9 +351,11 @@ class TableWalker {
             {"lambda_cn", number(t.lambda_cn)},
             {"lambda_sn", number(t.lambda_sn)},
             {"lambda_sr", number(t.lambda_sr)},
+            {"loss_norm", choice(t.loss_norm, &all_loss_norms)},
             {"jacobian_eps", number(t.jacobian_eps)},
             {"newton_tolerance", number(t.newton_tolerance)},
             {"newton_max_iterations", integer(t.newton_max_iterations, 1)},
+            {"dg_structure_point", choice(t.dg_structure_point, &all_dg_structure_points)},
             {"dg_min_dx_norm", number(t.dg_min_dx_norm)},
             {"divergence_norm", number(t.divergence_norm)},
             {"checkpoints", [this, &t](const Entry& e) {

@@ -1,7 +1,8 @@
 // src/sweep/sweep_file_values.cpp — one sweep-file value as the type and
-// range its key expects: numbers, strings, the grid axes (systems, models,
-// sizes, n_train, regularizers, seeds), with the line and the allowed values
-// in every error (split from the table walk: this file knows values, not keys).
+// range its key expects: numbers, strings, fixed-choice strings, the grid
+// axes (systems, models, sizes, n_train, regularizers, seeds, lambdas), with
+// the line and the allowed values in every error (split from the table walk:
+// this file knows values, not keys).
 #include "sweep/sweep_file_values.h"
 
 #include <algorithm>
@@ -67,6 +68,34 @@ std::string type_name(const toml::node& v) {
 }
 
 }  // namespace
+
+bool is_word_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+// Position of `field` as a whole word in `message`, or npos.
+std::size_t find_word(const std::string& message, const std::string& field) {
+  for (std::size_t at = message.find(field); at != std::string::npos;
+       at = message.find(field, at + 1)) {
+    const bool left = at == 0 || !is_word_char(message[at - 1]);
+    const std::size_t end = at + field.size();
+    if (left && (end == message.size() || !is_word_char(message[end]))) return at;
+  }
+  return std::string::npos;
+}
+
+std::optional<SystemKind> find_system(const std::string& name) {
+  for (SystemKind kind : all_systems()) {
+    if (to_string(kind) == name) return kind;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> system_names() {
+  std::vector<std::string> names;
+  for (SystemKind kind : all_systems()) names.push_back(to_string(kind));
+  return names;
+}
 
 std::string did_you_mean(const std::string& value, const std::vector<std::string>& allowed) {
   const std::string name = closest_name(value, allowed);
@@ -152,6 +181,33 @@ std::vector<int> ValueReader::int_axis(const Entry& e, int min, std::vector<int>
     if (lines) lines->push_back(line_of(v));
   }
   return out;
+}
+
+std::vector<double> ValueReader::number_axis(const Entry& e) const {
+  std::vector<double> out;
+  for (const toml::node& v : axis_items(e, "an array of numbers")) {
+    const double x = number(e, v);
+    if (!(x >= 0.0)) {
+      fail(line_of(v), e.key + " value " + source_.raw(v) +
+                           " is out of range; expected an array of numbers >= 0");
+    }
+    if (std::find(out.begin(), out.end(), x) != out.end()) {
+      fail(line_of(v), e.key + " lists " + source_.raw(v) + " twice; list each value once");
+    }
+    out.push_back(x);
+  }
+  return out;
+}
+
+std::size_t ValueReader::choice_index(const Entry& e,
+                                      const std::vector<std::string>& allowed) const {
+  const std::string s = string(e);
+  const auto it = std::find(allowed.begin(), allowed.end(), s);
+  if (it == allowed.end()) {
+    fail(e.line, "unknown " + e.key + " " + source_.raw(*e.value) + did_you_mean(s, allowed) +
+                     "; expected one of: " + join(allowed));
+  }
+  return static_cast<std::size_t>(it - allowed.begin());
 }
 
 std::vector<int> ValueReader::seeds(const Entry& e) const {

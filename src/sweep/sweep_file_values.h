@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +31,14 @@ std::vector<Entry> entries_in_file_order(const toml::table& table);
 int line_of(const toml::node& node);
 
 std::string join(const std::vector<std::string>& items);
+/// The system named `name` ("duffing"), if any.
+std::optional<SystemKind> find_system(const std::string& name);
+/// "harmonic", "duffing", "self-sustained".
+std::vector<std::string> system_names();
+/// A letter, digit or '_'.
+bool is_word_char(char c);
+/// Position of `field` as a whole word in `message`, or npos.
+std::size_t find_word(const std::string& message, const std::string& field);
 /// " (did you mean "steps"?)" for the allowed value closest to `value`
 /// (equal up to case, or within 2 edits), else "".
 std::string did_you_mean(const std::string& value, const std::vector<std::string>& allowed);
@@ -58,6 +67,18 @@ class ValueReader {
 
   /// Non-empty, duplicate-free axes; `lines` (optional) gets each value's line.
   std::vector<int> int_axis(const Entry& e, int min, std::vector<int>* lines) const;
+  /// lambdas = [1e-6, 1e-5]: finite numbers >= 0 (integers accepted).
+  std::vector<double> number_axis(const Entry& e) const;
+  /// A string that must be to_string() of one of `values` (loss_norm =
+  /// "mse"); the error lists them with a "did you mean" hint.
+  template <typename T>
+  T choice(const Entry& e, const std::vector<T>& values) const {
+    std::vector<std::string> names;
+    for (const T& v : values) names.push_back(to_string(v));
+    return values[choice_index(e, names)];
+  }
+  /// Index of the string value of `e` in `allowed`; fails if it is not there.
+  std::size_t choice_index(const Entry& e, const std::vector<std::string>& allowed) const;
   /// seeds = [0, 1, 2] or seeds = "0-9".
   std::vector<int> seeds(const Entry& e) const;
   std::vector<SystemKind> systems(const Entry& e) const;

@@ -38,6 +38,18 @@ torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& 
   return x + h * model.discrete_gradient_field(x, x_next - x, u, min_dx_norm);
 }
 
+torch::Tensor discrete_loss(const torch::Tensor& x_next, const torch::Tensor& x_hat, double h,
+                            LossNorm norm) {
+  const auto scaled = (x_next - x_hat) / h;  // [E, B, 2]
+  switch (norm) {
+    case LossNorm::kMeanL1: return scaled.abs().mean({1, 2});
+    case LossNorm::kSumL1: return scaled.abs().sum(2).mean(1);
+    case LossNorm::kMse: return (scaled * scaled).mean({1, 2});
+  }
+  PHNN_CHECK(false, "discrete_loss: unknown LossNorm " << static_cast<int>(norm));
+  return {};
+}
+
 namespace {
 
 // The Newton update delta = -M^{-1} r of every row by Cramer's rule, with

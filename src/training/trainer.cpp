@@ -76,7 +76,8 @@ class CellTrainer {
   double elapsed() const {
     return std::chrono::duration<double>(Clock::now() - start_).count();
   }
-  // L_d (Eq. 30) per member: mean over batch and components of |x_{n+1} - x_hat| / h.
+  // L_d (Eq. 30) per member in opt_.loss_norm (discrete_loss): by default the
+  // mean over batch and components of |x_{n+1} - x_hat| / h.
   torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn,
                           const torch::Tensor& u) const;
   void step(int step, BatchSampler& sampler);
@@ -116,7 +117,9 @@ CellTrainer::CellTrainer(const CellSpec& cell, const SystemData& data,
       E_(static_cast<int64_t>(cell.seeds.size())), h_(data.train.step) {
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   model_ = DynamicsModel::create(
-      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks}, seeds);
+      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks,
+                   cell.training.dg_structure_point},
+      seeds);
   // One contiguous leaf for the whole stack: Adam in a handful of ops.
   flat_ = model_->flatten_parameters();
   params_ = model_->parameters();
@@ -157,7 +160,7 @@ torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor
       cell_.integrator == IntegratorKind::kDg    ? dg_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
       : cell_.integrator == IntegratorKind::kDg4 ? dg4_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
                                                  : explicit_step(m, cell_.integrator, x, u, h_);
-  return ((xn - x_hat).abs() / h_).mean({1, 2});
+  return discrete_loss(xn, x_hat, h_, opt_.loss_norm);
 }
 
 void CellTrainer::train() {

@@ -27,6 +27,19 @@ Regularizer parse_regularizer(const std::string& name) {
                               "\"; expected one of: none, cn, sn, sr");
 }
 
+std::string to_string(LossNorm norm) {
+  switch (norm) {
+    case LossNorm::kMeanL1: return "mean-l1";
+    case LossNorm::kSumL1: return "sum-l1";
+    case LossNorm::kMse: return "mse";
+  }
+  return "unknown";
+}
+
+std::vector<LossNorm> all_loss_norms() {
+  return {LossNorm::kMeanL1, LossNorm::kSumL1, LossNorm::kMse};
+}
+
 std::string to_string(RunStatus status) {
   switch (status) {
     case RunStatus::kPending: return "pending";

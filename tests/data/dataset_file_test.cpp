@@ -44,6 +44,23 @@ TEST(DatasetFileTest, RoundTripsEveryValueAndAttribute) {
   EXPECT_EQ(back.inference.states[1][500], data.inference.states[1][500]);
   const h5::File f = h5::File::open(path, h5::Access::kReadOnly);
   EXPECT_EQ(f.string_attribute("/", "state_units"), "q [m], p [kg m/s]");
+  EXPECT_EQ(f.string_attribute("/", "energy_sampling"), "algorithm1");
+  std::remove(path.c_str());
+}
+
+// The data set records how its initial energies were drawn, and reads it
+// back (a file without the attribute predates it: Algorithm 1).
+TEST(DatasetFileTest, RoundTripsEnergySampling) {
+  DatasetOptions o;
+  o.num_validation = 2;
+  o.num_inference = 1;
+  o.energy_sampling = EnergySampling::kDirect;
+  const SystemData data = make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic), o, 3);
+  const std::string path = temp_path("direct.h5");
+  write_dataset_file(path, data);
+  const SystemData back = read_dataset_file(path);
+  EXPECT_EQ(back.options.energy_sampling, EnergySampling::kDirect);
+  EXPECT_EQ(back.train.x[2], data.train.x[2]);
   std::remove(path.c_str());
 }
 

@@ -1,6 +1,7 @@
 // tests/data/dataset_test.cpp
 #include "phnn/data/dataset.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -35,6 +36,37 @@ TEST(DatasetTest, InitialEnergiesLieInTheSpecifiedInterval) {
         // Algorithm 1 as written: E0 = sqrt(r) >= sqrt(0.1).
         ASSERT_GE(e0, std::sqrt(0.1) - 1e-12);
       }
+    }
+  }
+}
+
+// energy_sampling = direct takes E0 = r instead of sqrt(r) from the same draw
+// r (same stream, same theta): H(x0) is then the square of Algorithm 1's and
+// spans I_E0 = [0.1, 1]; Duffing (Algorithm 2) is unchanged, as are the inputs.
+TEST(DatasetTest, DirectEnergySamplingSquaresAlgorithmOnesInitialEnergy) {
+  DatasetOptions direct;
+  direct.energy_sampling = EnergySampling::kDirect;
+  for (SystemKind kind : all_systems()) {
+    const Oscillator osc(OscillatorOptions::defaults(kind));
+    double lowest = 1.0;
+    for (std::int64_t i = 0; i < 2000; ++i) {
+      const TrajectorySpec a = trajectory_spec(osc, DatasetOptions(), i);
+      const TrajectorySpec d = trajectory_spec(osc, direct, i);
+      EXPECT_EQ(d.u, a.u);
+      const double h_a = osc.hamiltonian(a.x0), h_d = osc.hamiltonian(d.x0);
+      if (kind == SystemKind::kDuffing) {
+        ASSERT_EQ(d.x0, a.x0) << i;
+        continue;
+      }
+      ASSERT_NEAR(h_d, h_a * h_a, 1e-14) << to_string(kind) << " #" << i;
+      ASSERT_GE(h_d, 0.1 - 1e-14);
+      ASSERT_LE(h_d, 1.0 + 1e-14);
+      // Same angle: x0 is scaled by sqrt(E0_direct / E0_alg1) = r^(1/4).
+      EXPECT_NEAR(d.x0(0) * a.x0(1), d.x0(1) * a.x0(0), 1e-14);
+      lowest = std::min(lowest, h_d);
+    }
+    if (kind != SystemKind::kDuffing) {
+      EXPECT_LT(lowest, std::sqrt(0.1)) << to_string(kind);
     }
   }
 }

@@ -153,6 +153,31 @@ TEST(GridTest, RunIdIsStableForAFixedConfig) {
   EXPECT_EQ(hex64(fnv1a64("a")), "af63dc4c8601ec8c");
 }
 
+// Every run id of every sweep file of sweeps/ at the time the ablation knobs
+// (lambdas, loss_norm, dg_structure_point, energy_sampling) were added:
+// their defaults must leave each canonical string byte-identical, or every
+// existing results file would be orphaned. Digest = FNV-1a 64 of the ids of
+// the file, one per line, in grid order.
+TEST(GridTest, RunIdsOfTheShippedSweepsArePinned) {
+  const Grid paper = paper_grid();
+  EXPECT_EQ(paper.runs[0].id(), "fe1820216e4cb749");
+  const std::vector<std::pair<std::string, std::string>> pinned = {
+      {"paper.toml", "980f15989e65ba06"},
+      {"paper-table-damping.toml", "fb94529be8d2ca03"},
+      {"paper-slice.toml", "86a0087e8cbaec74"},
+      {"fourth-order.toml", "82df5d4bc81062db"},
+      {"time-vs-error.toml", "d68043d7c59b2363"},
+      {"demo.toml", "bd0409c560e222b9"},
+      {"tiny.toml", "be8e6b56ff2112e5"}};
+  for (const auto& [file, digest] : pinned) {
+    std::string ids;
+    for (const RunConfig& run : expand_grid(parse_sweep_file(kSweeps + file)).runs) {
+      ids += run.id() + "\n";
+    }
+    EXPECT_EQ(hex64(fnv1a64(ids)), digest) << file;
+  }
+}
+
 TEST(GridTest, CellsAreOrderedByCostLargestFirstThenKey) {
   const Grid grid = paper_grid();
   for (std::size_t c = 1; c < grid.cells.size(); ++c) {
@@ -250,6 +275,82 @@ TEST(GridTest, DemoAndTinySweepsAreSmall) {
   const Grid tiny = expand_grid(parse_sweep_file(kSweeps + "tiny.toml"));
   EXPECT_EQ(first_line(dry_run_summary(tiny, {1})), "6 runs in 2 cells");
   EXPECT_THAT(tiny.studies[0].rows, ElementsAre("PHNN-JR-RK2", "NODE-RK2"));
+}
+
+// `lambdas` multiplies the regularized runs only, sets the weight of their
+// own regularizer, and gives each weight its own column (and cell).
+TEST(GridTest, LambdasMultiplyRegularizedRunsIntoTheirOwnColumns) {
+  const SweepSpec spec = parse_sweep_text(R"(name = "lambdas"
+[grid]
+systems = ["duffing"]
+models = ["phnn-s-dg", "phnn-s-rk2"]
+regularizers = ["none", "cn", "sr"]
+lambdas = [1e-6, 1e-5]
+seeds = [0, 1]
+)",
+                                          "lambdas.toml");
+  const Grid grid = expand_grid(spec);
+  EXPECT_EQ(grid.runs.size(), 2u * (1 + 2 + 2) * 2);
+  EXPECT_EQ(grid.cells.size(), 2u * (1 + 2 + 2));
+  const StudyTable& table = grid.studies[0];
+  EXPECT_EQ(table.varied_axis, "regularizer/lambda");
+  EXPECT_THAT(table.columns, ElementsAre("none", "cn/lambda=1e-06", "cn/lambda=1e-05",
+                                         "sr/lambda=1e-06", "sr/lambda=1e-05"));
+  const TrainerOptions defaults;
+  for (std::size_t i = 0; i < table.runs.size(); ++i) {
+    const RunConfig& run = grid.runs[table.runs[i]];
+    const std::string& column = table.run_columns[i];
+    const double weight = column.find("1e-05") != std::string::npos ? 1e-5 : 1e-6;
+    EXPECT_EQ(run.training.lambda_cn, run.regularizer == Regularizer::kCn ? weight : defaults.lambda_cn);
+    EXPECT_EQ(run.training.lambda_sr, run.regularizer == Regularizer::kSr ? weight : defaults.lambda_sr);
+    EXPECT_EQ(run.training.lambda_sn, defaults.lambda_sn);
+  }
+  // No table cell (system, model, column) holds two runs of one seed.
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < table.runs.size(); ++i) {
+    const RunConfig& run = grid.runs[table.runs[i]];
+    EXPECT_TRUE(seen.insert(model_key(run.model, run.integrator) + "|" + table.run_columns[i] +
+                            "|" + std::to_string(run.seed)).second);
+  }
+}
+
+// One weight is a replacement, not an axis: no column part; and a weight
+// that does not read back from 6 digits still gets a label of its own.
+TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
+  const std::string head = "name = \"l\"\n[grid]\nsystems = [\"harmonic\"]\n"
+                           "models = [\"node-rk2\"]\nregularizers = [\"sn\"]\nseeds = [0]\n";
+  const Grid one = expand_grid(parse_sweep_text(head + "lambdas = [3e-6]\n", "l.toml"));
+  ASSERT_EQ(one.runs.size(), 1u);
+  EXPECT_EQ(one.runs[0].training.lambda_sn, 3e-6);
+  EXPECT_THAT(one.studies[0].columns, ElementsAre("MSE"));
+  EXPECT_THAT(one.runs[0].cell_key(), HasSubstr(";lambda=3.0000000000000001e-06;"));
+  const Grid close =
+      expand_grid(parse_sweep_text(head + "lambdas = [1e-6, 1.0000001e-6, 0]\n", "l.toml"));
+  EXPECT_THAT(close.studies[0].columns,
+              ElementsAre("lambda=1e-06", "lambda=1.0000001e-06", "lambda=0"));
+}
+
+// sweeps/ablation-duffing.toml changes one knob: without its loss_norm line
+// its runs are the default runs (seeds 0-9 are paper.toml's own), and with
+// it each cell key differs by exactly ";loss_norm=mse".
+TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-duffing.toml");
+  std::string text = spec.text;
+  const std::string line = "loss_norm = \"mse\"\n";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.erase(text.find(line), line.size());
+  const Grid ablation = expand_grid(spec);
+  const Grid baseline = expand_grid(parse_sweep_text(text, "baseline.toml"));
+  ASSERT_EQ(ablation.runs.size(), 60u);
+  ASSERT_EQ(baseline.runs.size(), 60u);
+  std::set<std::string> paper_ids;
+  for (const RunConfig& run : paper_grid().runs) paper_ids.insert(run.id());
+  for (std::size_t i = 0; i < 60; ++i) {
+    std::string key = ablation.runs[i].cell_key();
+    key.erase(key.find(";loss_norm=mse"), std::string(";loss_norm=mse").size());
+    EXPECT_EQ(key, baseline.runs[i].cell_key());
+    EXPECT_EQ(paper_ids.count(baseline.runs[i].id()), baseline.runs[i].seed < 10 ? 1u : 0u) << i;
+  }
 }
 
 TEST(GridTest, SeveralVariedAxesGiveProductColumns) {

@@ -349,6 +349,111 @@ checkpoints = [1000, 500]
 
 // The fourth-order explicit variants are sweep-file models like the others
 // (not in the default list, which is the paper's five).
+// [grid] / [study.NAME] lambdas: numbers >= 0, each once, inherited from
+// [grid] like the other axes; one that would multiply no run is refused.
+TEST(SweepFileTest, LambdasAreAnAxisOfNonNegativeNumbers) {
+  const SweepSpec spec = parse_sweep_text(R"(name = "t"
+[grid]
+regularizers = ["none", "cn"]
+lambdas = [1e-6, 0, 1]
+[study.a]
+[study.b]
+lambdas = [2e-6]
+)", "x.toml");
+  EXPECT_THAT(spec.studies[0].lambdas, ElementsAre(1e-6, 0.0, 1.0));
+  EXPECT_THAT(spec.studies[1].lambdas, ElementsAre(2e-6));
+  EXPECT_TRUE(parse_sweep_file(kSweeps + "paper.toml").studies[2].lambdas.empty());
+}
+
+TEST(SweepFileErrorTest, BadLambdasPointAtTheirLine) {
+  const std::string head = "name = \"t\"\n[grid]\nregularizers = [\"sr\"]\n";
+  EXPECT_THAT(error_of(head + "lambdas = [1e-4, -1e-4]\n").what(),
+              StartsWith("x.toml:4: lambdas value -1e-4 is out of range; expected an array of "
+                         "numbers >= 0"));
+  EXPECT_THAT(error_of(head + "lambdas = [\n  1e-4,\n  1e-4,\n]\n").what(),
+              StartsWith("x.toml:6: lambdas lists 1e-4 twice"));
+  EXPECT_THAT(error_of(head + "lambdas = 1e-4\n").what(),
+              StartsWith("x.toml:4: lambdas expects an array of numbers, got the float 1e-4"));
+  EXPECT_THAT(error_of(head + "lambdas = [\"1e-4\"]\n").what(),
+              StartsWith("x.toml:4: lambdas expects a number"));
+  EXPECT_THAT(error_of(head + "lambdas = [nan]\n").what(),
+              StartsWith("x.toml:4: lambdas expects a finite number"));
+  EXPECT_THAT(error_of("name = \"t\"\n[grid]\nlambdas = [1e-4]\n").what(),
+              StartsWith("x.toml:3: lambdas of [grid] multiplies no run: every run it would "
+                         "apply to has regularizer \"none\""));
+  EXPECT_THAT(error_of(head + "[study.I]\nregularizers = [\"none\"]\nlambdas = [1]\n").what(),
+              StartsWith("x.toml:6: lambdas of study \"I\" multiplies no run"));
+  // [grid] lambdas used by one study of two is fine.
+  EXPECT_NO_THROW(parse_sweep_text(head + "lambdas = [1]\n[study.I]\n[study.II]\n"
+                                          "regularizers = [\"none\"]\n", "x.toml"));
+}
+
+// [training] loss_norm: one of three spellings; part of a run's identity
+// only away from the default.
+TEST(SweepFileTest, LossNormIsATrainingOption) {
+  const std::string head = "name = \"t\"\n[grid]\nseeds = [0]\n[training]\n";
+  const SweepSpec spec = parse_sweep_text(head + "loss_norm = \"mse\"\n", "x.toml");
+  EXPECT_EQ(spec.training.loss_norm, LossNorm::kMse);
+  EXPECT_THAT(expand_grid(spec).runs[0].cell_key(), HasSubstr(";loss_norm=mse;"));
+  const Grid plain = expand_grid(parse_sweep_text(head + "loss_norm = \"mean-l1\"\n", "x.toml"));
+  EXPECT_EQ(plain.runs[0].id(), expand_grid(parse_sweep_text(head, "x.toml")).runs[0].id());
+  EXPECT_THAT(plain.runs[0].cell_key(), Not(HasSubstr("loss_norm")));
+  EXPECT_STREQ(error_of(head + "steps = 5\nloss_norm = \"sum-L1\"\n").what(),
+               "x.toml:6: unknown loss_norm \"sum-L1\" (did you mean \"sum-l1\"?); expected "
+               "one of: mean-l1, sum-l1, mse");
+  EXPECT_THAT(error_of(head + "loss_norm = 2\n").what(),
+              StartsWith("x.toml:5: loss_norm expects a \"string\", got the integer 2"));
+}
+
+// [training] dg_structure_point: part of the identity of PHNN-JR-DG runs
+// only (the only DG step with a state-dependent structure), away from the
+// default.
+TEST(SweepFileTest, DgStructurePointChangesOnlyPhnnJrDgRuns) {
+  const std::string head = "name = \"t\"\n[grid]\nsystems = [\"duffing\"]\nseeds = [0]\n"
+                           "models = [\"phnn-jr-dg\", \"phnn-jr-rk2\", \"phnn-s-dg\", "
+                           "\"phnn-jr-dg4\"]\n[training]\n";
+  const Grid plain = expand_grid(parse_sweep_text(head, "x.toml"));
+  const SweepSpec spec = parse_sweep_text(head + "dg_structure_point = \"start\"\n", "x.toml");
+  EXPECT_EQ(spec.training.dg_structure_point, DgStructurePoint::kStart);
+  const Grid start = expand_grid(spec);
+  ASSERT_EQ(start.runs.size(), 4u);
+  EXPECT_THAT(start.runs[0].cell_key(), HasSubstr(";dg_structure_point=start;"));
+  EXPECT_NE(start.runs[0].id(), plain.runs[0].id());
+  for (std::size_t i = 1; i < 4; ++i) EXPECT_EQ(start.runs[i].id(), plain.runs[i].id()) << i;
+  EXPECT_EQ(expand_grid(parse_sweep_text(head + "dg_structure_point = \"midpoint\"\n", "x.toml"))
+                .runs[0].id(),
+            plain.runs[0].id());
+  EXPECT_STREQ(error_of(head + "dg_structure_point = \"end\"\n").what(),
+               "x.toml:7: unknown dg_structure_point \"end\"; expected one of: midpoint, start");
+}
+
+// [data] energy_sampling: part of the identity of harmonic and self-sustained
+// runs only (Algorithm 1), away from the default; refused where no run uses
+// it, like a dg_structure_point without phnn-jr-dg.
+TEST(SweepFileTest, EnergySamplingChangesOnlyAlgorithmOneRuns) {
+  const std::string head = "name = \"t\"\n[grid]\nmodels = [\"node-rk2\"]\nseeds = [0]\n[data]\n";
+  const Grid plain = expand_grid(parse_sweep_text(head, "x.toml"));
+  const SweepSpec spec = parse_sweep_text(head + "energy_sampling = \"direct\"\n", "x.toml");
+  EXPECT_EQ(spec.data.energy_sampling, EnergySampling::kDirect);
+  const Grid direct = expand_grid(spec);
+  ASSERT_EQ(direct.runs.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const bool algorithm1 = direct.runs[i].system != SystemKind::kDuffing;
+    EXPECT_EQ(direct.runs[i].id() != plain.runs[i].id(), algorithm1) << i;
+    EXPECT_EQ(direct.runs[i].cell_key().find(";energy_sampling=direct;") != std::string::npos,
+              algorithm1);
+  }
+  EXPECT_THAT(error_of(head + "energy_sampling = \"sqrt\"\n").what(),
+              StartsWith("x.toml:6: unknown energy_sampling \"sqrt\"; expected one of: "
+                         "algorithm1, direct"));
+  const std::string duffing = "name = \"t\"\n[grid]\nsystems = [\"duffing\"]\n";
+  EXPECT_THAT(error_of(duffing + "[data]\nenergy_sampling = \"direct\"\n").what(),
+              StartsWith("x.toml:5: energy_sampling = \"direct\" changes no run"));
+  EXPECT_THAT(error_of(duffing + "models = [\"phnn-s-dg\", \"phnn-jr-rk2\"]\n[training]\n"
+                                 "dg_structure_point = \"start\"\n").what(),
+              StartsWith("x.toml:6: dg_structure_point = \"start\" changes no run"));
+}
+
 TEST(SweepFileTest, AcceptsRk4Models) {
   const SweepSpec spec = parse_sweep_text(R"(name = "t"
 [grid]

@@ -79,6 +79,56 @@ TEST(DiscreteStepTest, DgInferenceMeetsResidualTolerance) {
   }
 }
 
+// PHNN-JR's DG step with R_theta at the midpoint (default) or at the start
+// x_n: with e = (dg, u), dg the Gonzalez gradient along the Newton solution
+// dx and R = R_theta at that point, skew J gives the discrete power balance
+//   H(x_{n+1}) - H(x_n) = dg^T dx = h dg^T f_bar = -h (e^T R e + u [(J - R) e]_3)
+// for any PSD R wherever it is evaluated (up to dg^T r, |r| <= 1e-12). Both
+// points satisfy it; they give different steps; each point's training step
+// reproduces its own inference step; its Newton Jacobian is exact.
+TEST(DiscreteStepTest, DgStructurePointKeepsThePowerBalanceAndChangesTheStep) {
+  const double h = 0.01;
+  std::vector<torch::Tensor> next;
+  for (DgStructurePoint point : all_dg_structure_points()) {
+    const auto model = DynamicsModel::create(
+        ModelOptions{ModelKind::kPhnnJr, ModelSize::kSmall, SystemKind::kDuffing, true, point},
+        {0, 1});
+    const auto& jr = dynamic_cast<const PhnnJr&>(*model);
+    torch::NoGradGuard no_grad;
+    const auto x = 2.0 * states(2, 64, 11);
+    const auto u = states(2, 64, 12).narrow(-1, 0, 1);
+    const auto s = dg_inference_step(*model, x, u, h);
+    ASSERT_TRUE(s.converged.all().item<bool>()) << to_string(point);
+    const auto dx = s.x_next - x;
+    const auto e = torch::cat({jr.discrete_gradient(x, dx, 6e-6), u}, -1).unsqueeze(-1);
+    const auto R = jr.dissipation_matrix(point == DgStructurePoint::kStart ? x : x + 0.5 * dx, u);
+    const Eigen::Matrix3d Jm = Oscillator(OscillatorOptions::defaults(SystemKind::kDuffing)).J();
+    auto J = torch::empty({3, 3}, torch::kFloat64);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) J[r][c] = Jm(r, c);
+    const auto ere = torch::matmul(e.transpose(-1, -2), torch::matmul(R, e)).squeeze(-1).squeeze(-1);
+    const auto y = torch::matmul(J - R, e).squeeze(-1).select(-1, 2);
+    const auto supplied = -h * (ere + u.squeeze(-1) * y);
+    const auto stored = jr.hamiltonian(s.x_next) - jr.hamiltonian(x);
+    EXPECT_LE((stored - supplied).abs().max().item<double>(), 1e-12) << to_string(point);
+    EXPECT_GT(ere.min().item<double>(), -1e-15) << "R is PSD";
+    const auto x_hat = dg_training_step(*model, x, s.x_next, u, h, 6e-6);
+    EXPECT_LE((x_hat - s.x_next).abs().max().item<double>(), 1e-10) << to_string(point);
+    const FieldEval fj = model->discrete_gradient_field_with_jacobian(x, dx, u, 6e-6);
+    const double eps = 1e-6;
+    for (int i = 0; i < 2; ++i) {
+      auto step = torch::zeros({2}, torch::kFloat64);
+      step[i] = eps;
+      const auto column = (model->discrete_gradient_field(x, dx + step, u, 6e-6) -
+                           model->discrete_gradient_field(x, dx - step, u, 6e-6)) / (2 * eps);
+      EXPECT_LE((fj.dfdx.select(-1, i) - column).abs().max().item<double>(), 1e-7)
+          << to_string(point) << " column " << i;
+    }
+    next.push_back(s.x_next);
+  }
+  EXPECT_GT((next[0] - next[1]).abs().max().item<double>(), 1e-8);
+}
+
 TEST(DiscreteStepTest, Rk2IsExplicitMidpointOfTheField) {
   const auto model = DynamicsModel::create(ModelOptions{ModelKind::kNode, ModelSize::kSmall, SystemKind::kHarmonic}, {0});
   torch::NoGradGuard no_grad;
@@ -245,6 +295,28 @@ TEST(DiscreteStepTest, Rk2RolloutCanIncreaseLearnedEnergy) {
   const auto dg_gain = (model->hamiltonian(s.x_next) - H0) / H0;
   const auto ok = s.converged.logical_not() | (dg_gain <= 1e-10);
   EXPECT_TRUE(ok.all().item<bool>());
+}
+
+// L_d in its three norms on a fixed error e = x_next - x_hat = h E with
+// E = [[1, -2], [3, -4], [0, 5]] (one member): mean-l1 = 15 / 6,
+// sum-l1 = 15 / 3 = 2 mean-l1, mse = (1 + 4 + 9 + 16 + 0 + 25) / 6.
+TEST(DiscreteStepTest, DiscreteLossNormsFollowTheirDefinitions) {
+  const double h = 0.01;
+  const auto E = torch::tensor({1.0, -2.0, 3.0, -4.0, 0.0, 5.0}, torch::kFloat64).view({1, 3, 2});
+  const auto x_next = states(1, 3, 6);
+  const auto x_hat = x_next - h * E;
+  constexpr double kRoundOff = 1e-13;  // e / h recovers E to a few ulps
+  EXPECT_NEAR(discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1).item<double>(), 2.5, kRoundOff);
+  EXPECT_NEAR(discrete_loss(x_next, x_hat, h, LossNorm::kSumL1).item<double>(), 5.0, kRoundOff);
+  EXPECT_NEAR(discrete_loss(x_next, x_hat, h, LossNorm::kMse).item<double>(), 55.0 / 6.0,
+              kRoundOff);
+  // Per member, and the default is today's formula bit for bit.
+  const auto a = states(3, 7, 7), b = states(3, 7, 8);
+  const auto mean_l1 = discrete_loss(a, b, h, LossNorm::kMeanL1);
+  EXPECT_EQ(mean_l1.sizes(), (std::vector<int64_t>{3}));
+  EXPECT_TRUE(torch::equal(mean_l1, ((a - b).abs() / h).mean({1, 2})));
+  EXPECT_TRUE(torch::allclose(discrete_loss(a, b, h, LossNorm::kSumL1), 2.0 * mean_l1,
+                              /*rtol=*/1e-15, /*atol=*/0.0));
 }
 
 TEST(DiscreteStepTest, NodeRejectsDiscreteGradient) {

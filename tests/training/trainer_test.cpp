@@ -219,6 +219,46 @@ TEST(TrainerTest, DivergedMemberIsFrozenWhileOthersTrain) {
   }
 }
 
+// loss_norm applies to the logged training loss and to the validation loss
+// (which picks the best weights): at step 0 (same weights) sum-l1 is twice
+// mean-l1 and mse is the mean of squares, on every model.
+TEST(TrainerTest, LossNormAppliesToTrainingAndValidationLoss) {
+  for (ModelKind model : {ModelKind::kNode, ModelKind::kPhnnS}) {
+    CellSpec cell;
+    cell.model = model;
+    cell.integrator = IntegratorKind::kRk2;
+    cell.training.steps = 0;
+    cell.seeds = {3};
+    std::map<LossNorm, TracePoint> first;
+    for (LossNorm norm : all_loss_norms()) {
+      cell.training.loss_norm = norm;
+      first[norm] = train_cell(cell, small_data(SystemKind::kHarmonic))[0].trace.at(0);
+    }
+    const TracePoint& l1 = first[LossNorm::kMeanL1];
+    EXPECT_LE(rel(first[LossNorm::kSumL1].validation_loss, 2.0 * l1.validation_loss), 1e-14);
+    EXPECT_LE(rel(first[LossNorm::kSumL1].train_loss, 2.0 * l1.train_loss), 1e-14);
+    // Jensen: mean(e^2) >= mean(|e|)^2, with equality only for constant |e|.
+    EXPECT_GT(first[LossNorm::kMse].validation_loss, l1.validation_loss * l1.validation_loss);
+  }
+}
+
+// dg_structure_point reaches the model of a PHNN-JR-DG cell: with the same
+// initial weights, R at the start changes both the validation loss
+// (training's DG step) and the inference MSE (the Newton rollouts).
+TEST(TrainerTest, DgStructurePointAppliesToTrainingAndInference) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnJr;
+  cell.integrator = IntegratorKind::kDg;
+  cell.training.steps = 0;
+  cell.seeds = {2};
+  const auto midpoint = train_cell(cell, small_data(SystemKind::kDuffing))[0];
+  cell.training.dg_structure_point = DgStructurePoint::kStart;
+  const auto start = train_cell(cell, small_data(SystemKind::kDuffing))[0];
+  EXPECT_GT(rel(start.trace.at(0).validation_loss, midpoint.trace.at(0).validation_loss), 1e-9);
+  EXPECT_GT(rel(start.mse, midpoint.mse), 1e-9);
+  EXPECT_EQ(start.trace.at(0).kappa, midpoint.trace.at(0).kappa);  // continuous field: unchanged
+}
+
 TEST(CellSpecTest, RejectsNodeWithDgAndBadCounts) {
   CellSpec cell;
   cell.model = ModelKind::kNode;

@@ -10,6 +10,19 @@
 
 namespace phnn {
 
+/// Initial energy E0 of Algorithm 1 (harmonic and self-sustained initial
+/// conditions; docs/METHOD.md §2), from r ~ U(E_min, E_max):
+///   kAlgorithm1 (default): E0 = sqrt(r), as the paper's Algorithm 1 prints it
+///                          (so H(x0) lies in [sqrt(E_min), sqrt(E_max)]);
+///   kDirect:               E0 = r (H(x0) in I_E0 = [E_min, E_max], as the
+///                          paper's text asks).
+/// Duffing's Algorithm 2 samples H(x0) in I_E0 by rejection and ignores it.
+enum class EnergySampling { kAlgorithm1 = 0, kDirect = 1 };
+/// "algorithm1", "direct".
+std::string to_string(EnergySampling sampling);
+/// Every EnergySampling, default first.
+std::vector<EnergySampling> all_energy_samplings();
+
 /// Data-set options (paper §5.2, Appendix E; docs/METHOD.md §2). Defaults: docs/METHOD.md.
 struct DatasetOptions {
   /// Keys every random stream with (data_seed, system, trajectory, purpose).
@@ -27,6 +40,8 @@ struct DatasetOptions {
   /// I_E0 = [energy_min, energy_max] [J] of the initial conditions.
   double energy_min = 0.1;
   double energy_max = 1.0;
+  /// E0 from r in Algorithm 1 (harmonic, self-sustained).
+  EnergySampling energy_sampling = EnergySampling::kAlgorithm1;
   /// I_Eeq [J] of the controlled equilibria (harmonic, Duffing).
   double equilibrium_energy_min = 0.1;
   double equilibrium_energy_max = 1.0;
@@ -60,7 +75,8 @@ struct TrajectorySpec {
 };
 
 /// Initial state by Algorithm 1 (harmonic, self-sustained; *as written*:
-/// r ~ U(E_min, E_max), E0 = sqrt(r)) or Algorithm 2 (Duffing: rejection in
+/// r ~ U(E_min, E_max), E0 = sqrt(r), or E0 = r with EnergySampling::kDirect)
+/// or Algorithm 2 (Duffing: rejection in
 /// the box |q| <= q_max, |p| <= sqrt(2 m E_max), H(q_max, 0) = E_max), and
 /// input by Algorithm 3 (harmonic, Duffing: E_eq ~ U(I_Eeq), sign of q* +-1)
 /// or Algorithm 4 (self-sustained: w ~ U(I_w), u = -w). Depends only on

@@ -30,6 +30,9 @@ struct ModelOptions {
   /// Networks through the fused autograd node (StackedMlpOptions::fused);
   /// false selects the op-by-op reference path (tests, benchmarks).
   bool fused_networks = true;
+  /// Where the DG field evaluates PHNN-JR's R_theta (the other models and
+  /// DG4 ignore it): x + dx/2 (default) or x.
+  DgStructurePoint dg_structure_point = DgStructurePoint::kMidpoint;
 };
 
 /// Base of NODE, PHNN-S and PHNN-JR. Every method is batched over members.
@@ -43,7 +46,8 @@ class DynamicsModel {
   /// True for PHNN-S and PHNN-JR (they have H_theta and support DG).
   virtual bool is_port_hamiltonian() const { return false; }
   /// Inverse-explicit DG field (docs/METHOD.md §4): gradH replaced by the Gonzalez
-  /// discrete gradient dg_theta(x, dx); R_theta at x + dx/2.
+  /// discrete gradient dg_theta(x, dx); R_theta at x + dx/2, or at x with
+  /// ModelOptions::dg_structure_point = kStart.
   virtual torch::Tensor discrete_gradient_field(const torch::Tensor& x, const torch::Tensor& dx,
                                                 const torch::Tensor& u,
                                                 double min_dx_norm) const;

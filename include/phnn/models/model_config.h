@@ -20,12 +20,22 @@ inline bool is_discrete_gradient(IntegratorKind kind) {
 /// Network size (paper Tables 10-12, docs/METHOD.md §3).
 enum class ModelSize { kSmall = 0, kMedium = 1, kLarge = 2 };
 
+/// Where the DG step (docs/METHOD.md §4) evaluates PHNN-JR's state-dependent
+/// dissipation R_theta(x, u): at the midpoint x_n + dx/2 (the default) or at
+/// the start x_n. J and the structure S of PHNN-S are constant, so PHNN-S,
+/// RK2/RK4 and DG4 (always the midpoint) do not depend on it.
+enum class DgStructurePoint { kMidpoint = 0, kStart = 1 };
+
 /// "node", "phnn-s", "phnn-jr".
 std::string to_string(ModelKind kind);
 /// "rk2", "dg", "rk4", "dg4".
 std::string to_string(IntegratorKind kind);
 /// "small", "medium", "large".
 std::string to_string(ModelSize size);
+/// "midpoint", "start".
+std::string to_string(DgStructurePoint point);
+/// Every DgStructurePoint, default first.
+std::vector<DgStructurePoint> all_dg_structure_points();
 
 /// Parsers: throw std::invalid_argument naming the value and listing the
 /// allowed values.

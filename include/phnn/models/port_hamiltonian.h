@@ -65,9 +65,16 @@ class PortHamiltonianModel : public DynamicsModel {
   PortHamiltonianModel(ModelOptions options, int64_t members)
       : DynamicsModel(options, members) {}
   /// f from an effort jet e ([E,B,2], directions x) evaluated with the
-  /// dissipation network at `x_dissipation` (PHNN-JR: R(x, u)).
+  /// dissipation network at `x_dissipation` (PHNN-JR: R(x, u)); with
+  /// `dissipation_fixed`, R does not move along the jet's directions (its
+  /// derivatives are zero: the DG field with R at the start x_n, where only
+  /// the effort depends on dx).
   virtual Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
-                                const torch::Tensor& u, int order) const = 0;
+                                const torch::Tensor& u, int order,
+                                bool dissipation_fixed) const = 0;
+  /// True when the DG field evaluates R_theta at x_n (PHNN-JR with
+  /// ModelOptions::dg_structure_point = kStart).
+  bool dissipation_at_start() const;
   const StackedMlp& l_h() const { return *nets_[0]; }
   /// Jet whose value is gradH(x) [E, B, 2] and whose g is the Hessian
   /// [E, B, 2, 2].
@@ -83,7 +90,7 @@ class PhnnS : public PortHamiltonianModel {
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
-                        const torch::Tensor& u, int order) const override;
+                        const torch::Tensor& u, int order, bool dissipation_fixed) const override;
 
  private:
   std::array<std::array<double, 4>, 4> S_;
@@ -99,7 +106,7 @@ class PhnnJr : public PortHamiltonianModel {
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
-                        const torch::Tensor& u, int order) const override;
+                        const torch::Tensor& u, int order, bool dissipation_fixed) const override;
 
  private:
   std::array<std::array<double, 3>, 3> J_;

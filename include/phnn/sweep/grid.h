@@ -119,12 +119,16 @@ struct StudyTable {
   /// StudySpec::name and title.
   std::string name, title;
   /// The axis with more than one value, other than seeds, systems and
-  /// models: "size", "n_train" or "regularizer"; "" if none varies (then
-  /// there is one column, "MSE"). If several vary, their names joined by "/"
-  /// in nesting order (e.g. "size/n_train") and columns are their product.
+  /// models: "size", "n_train", "regularizer" or "lambda"; "" if none varies
+  /// (then there is one column, "MSE"). If several vary, their names joined
+  /// by "/" in nesting order (e.g. "size/n_train") and columns are their
+  /// product.
   std::string varied_axis;
   /// Column labels in file order: "25", "100"; "small"; "none", "cn" (the
-  /// sweep-file spelling of the values).
+  /// sweep-file spelling of the values). When `lambdas` varies, regularized
+  /// runs carry their weight ("cn/lambda=1e-05", the shortest spelling that
+  /// reads back exactly) and unregularized ones do not ("none"), so runs of
+  /// different weights never share a cell.
   std::vector<std::string> columns;
   /// Model labels in file order, e.g. "NODE-RK2", "PHNN-JR-DG".
   std::vector<std::string> rows;
@@ -144,7 +148,7 @@ struct StudyTable {
 struct Grid {
   /// Distinct runs (by RunConfig::canonical()), in order of first appearance:
   /// studies in file order, then axes nested system, model, size, n_train,
-  /// regularizer, seed (seed fastest).
+  /// regularizer, lambda (regularized runs only), seed (seed fastest).
   std::vector<RunConfig> runs;
   /// Names of the studies containing runs[i], in study order.
   std::vector<std::vector<std::string>> run_studies;

@@ -53,6 +53,11 @@ struct StudySpec {
   /// N_train values, each in [1, DatasetOptions::num_train_max].
   std::vector<int> n_train;
   std::vector<Regularizer> regularizers;
+  /// Regularizer weights λ (`lambdas`, each >= 0, docs/METHOD.md §4): a run
+  /// with regularizer cn, sn or sr is made once per value, which replaces its
+  /// lambda_cn, lambda_sn or lambda_sr; runs without a regularizer are not
+  /// multiplied. Empty (the default): the single weight of [training].
+  std::vector<double> lambdas;
   /// Model-initialization seeds, each >= 0.
   std::vector<int> seeds;
 };

@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include "phnn/models/dynamics_model.h"
+#include "phnn/training/trainer_options.h"
 
 namespace phnn {
 
@@ -33,6 +34,15 @@ torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& 
 torch::Tensor dg4_training_step(const DynamicsModel& model, const torch::Tensor& x,
                                 const torch::Tensor& x_next, const torch::Tensor& u, double h,
                                 double min_dx_norm);
+
+/// The discrete loss L_d per member [E] of predictions x_hat for data x_next
+/// ([E, B, 2] both) at step h, in `norm` (docs/METHOD.md §4, "Loss"); with
+/// e = x_next - x_hat:
+///   mean-l1: mean_{b, i} |e_bi| / h          (the default)
+///   sum-l1:  mean_b (|e_b0| + |e_b1|) / h   (= 2 mean-l1 for 2 components)
+///   mse:     mean_{b, i} e_bi^2 / h^2
+torch::Tensor discrete_loss(const torch::Tensor& x_next, const torch::Tensor& x_hat, double h,
+                            LossNorm norm);
 
 /// Options of the implicit DG inference step.
 struct DgInferenceOptions {

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "phnn/models/model_config.h"
+
 namespace phnn {
 
 /// Jacobian regularizer (eq:condition-number-loss, eq:spectral-norm-loss,
@@ -14,6 +16,18 @@ enum class Regularizer { kNone = 0, kCn = 1, kSn = 2, kSr = 3 };
 std::string to_string(Regularizer reg);
 /// Throws std::invalid_argument naming the value and the allowed values.
 Regularizer parse_regularizer(const std::string& name);
+
+/// Norm of the discrete loss L_d (docs/METHOD.md §4, "Loss"), with e the
+/// error x_{n+1} - x_hat_{n+1} of a pair and h the step:
+///   kMeanL1 (the default): mean over pairs and both components of |e_i| / h;
+///   kSumL1: mean over pairs of (|e_q| + |e_p|) / h, i.e. 2 x kMeanL1, the
+///           paper's 1-norm of the scaled error;
+///   kMse:   mean over pairs and both components of e_i^2 / h^2.
+enum class LossNorm { kMeanL1 = 0, kSumL1 = 1, kMse = 2 };
+/// "mean-l1", "sum-l1", "mse".
+std::string to_string(LossNorm norm);
+/// Every LossNorm, default first.
+std::vector<LossNorm> all_loss_norms();
 
 /// Optimizer and schedule of one run (docs/METHOD.md §4). Defaults: docs/METHOD.md.
 struct TrainerOptions {
@@ -32,6 +46,9 @@ struct TrainerOptions {
   double lambda_cn = 1e-6;
   double lambda_sn = 1e-6;
   double lambda_sr = 1e-4;
+  /// Norm of L_d, in training and validation alike (best weights are those
+  /// of the lowest validation loss in this norm).
+  LossNorm loss_norm = LossNorm::kMeanL1;
   /// Eps in kappa = s_max / (s_min + eps) and rho = max|Re l| / (min|Re l| + eps).
   double jacobian_eps = 1e-6;
   /// DG/DG4 inference Newton (docs/METHOD.md §4): a row has converged when its
@@ -39,6 +56,9 @@ struct TrainerOptions {
   /// newton_max_iterations updates.
   double newton_tolerance = 1e-12;
   int newton_max_iterations = 20;
+  /// Where the DG step evaluates PHNN-JR's R_theta(x, u), in training and at
+  /// inference alike (ModelOptions::dg_structure_point).
+  DgStructurePoint dg_structure_point = DgStructurePoint::kMidpoint;
   /// DG training fallback threshold tau on ||dx||.
   double dg_min_dx_norm = 6e-6;
   /// Divergence: a rollout state with ||x|| > divergence_norm (or non-finite).
