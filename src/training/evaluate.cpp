@@ -55,7 +55,8 @@ std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemDat
                                 std::to_string(cell.seeds.size()));
   }
   auto model = DynamicsModel::create(
-      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks},
+      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks,
+                   cell.training.dg_structure_point},
       {static_cast<std::uint64_t>(cell.seeds[0])});
   if (static_cast<long>(weights.size()) != model->parameter_count()) {
     throw std::invalid_argument("load_member: " + std::to_string(weights.size()) +

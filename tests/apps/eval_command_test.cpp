@@ -111,6 +111,26 @@ TEST_F(EvalCommandTest, EnergyCsvStartsAtTheFigureEnergies) {
   }
 }
 
+// Settings of the sweep file reach the reloaded model: a PHNN-JR-DG run
+// whose DG step evaluates R at x_n (not the default midpoint) reproduces.
+TEST_F(EvalCommandTest, SweepFileSettingsReachTheReloadedModel) {
+  const std::string sweep = out_ + ".toml";
+  {
+    std::ofstream s(sweep);
+    s << "name = \"eval-start\"\n[data]\nnum_validation = 50\nnum_inference = 5\n"
+         "[training]\nsteps = 20\neval_every = 10\ndg_structure_point = \"start\"\n"
+         "[grid]\nsystems = [\"duffing\"]\nmodels = [\"phnn-jr-dg\"]\nseeds = [0, 1]\n";
+  }
+  std::string log;
+  ASSERT_EQ(run("sweep " + sweep + " --out " + out_ + " --quiet", &log), 0) << log;
+  for (const std::string& id : ResultsFile::open_read_only(out_).read_run_ids()) {
+    EXPECT_EQ(run("eval " + out_ + " --run " + id, &log), 0) << log;
+    EXPECT_THAT(log, HasSubstr("bitwise equal"));
+  }
+  std::remove(sweep.c_str());
+  testing_util::run_shell("rm -rf " + out_ + ".journal " + out_ + ".lock", &log);
+}
+
 TEST_F(EvalCommandTest, UnknownOrMissingRunIsAUsageError) {
   train("harmonic", "phnn-jr-rk2");
   std::string log;
