@@ -52,18 +52,6 @@ RunConfig stored_config(const ResultsFile& results, const std::string& id) {
                            "another program version (" + results.program_version() + ")");
 }
 
-CellSpec single_seed_cell(const RunConfig& run) {
-  CellSpec cell;
-  cell.model = run.model;
-  cell.integrator = run.integrator;
-  cell.size = run.size;
-  cell.n_train = run.n_train;
-  cell.regularizer = run.regularizer;
-  cell.training = run.training;
-  cell.seeds = {run.seed};
-  return cell;
-}
-
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 void write_energy_csv(const std::string& path, const Evaluation& e) {
@@ -113,7 +101,7 @@ int run_eval(int argc, char** argv, int first) {
   }
   const RunConfig run = stored_config(results, id);
   const SystemData data = results.read_system_data(to_string(run.system));
-  const Evaluation e = evaluate_stored_run(single_seed_cell(run), data, stored.weights);
+  const Evaluation e = evaluate_stored_run(cell_spec_for(run, {run.seed}), data, stored.weights);
   const bool same = same_bits(e.result.mse, stored.mse);
   std::printf("phnn eval: run %s (%s): mse %.6e, stored %.6e: %s\n", id.c_str(),
               run.canonical().substr(0, run.canonical().find(";mass=")).c_str(), e.result.mse,

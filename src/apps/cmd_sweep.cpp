@@ -1,7 +1,8 @@
 // src/apps/cmd_sweep.cpp — `phnn sweep FILE`: every rank trains work items
 // (cells, or member groups of a cell) taken from a shared queue; every result
 // lands in one parallel HDF5 file, each run first in this rank's journal
-// (fsync), then in its row of the file.
+// (fsync), then in its row of the file. The phases that can fail on some
+// ranks: sweep_phases.cpp; what rank 0 prints: sweep_report.cpp.
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -26,6 +27,8 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/provenance.h"
+#include "apps/sweep_phases.h"
+#include "apps/sweep_report.h"
 #include "h5/h5file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/journal.h"
@@ -56,65 +59,6 @@ extern "C" void request_stop(int signal) { g_stop_signal = signal; }
 // Slurm job script requeues on it.
 constexpr int kExitStopped = 75;
 
-void make_parent_directories(const std::string& path) {
-  for (std::size_t pos = path.find('/', 1); pos != std::string::npos; pos = path.find('/', pos + 1)) {
-    ::mkdir(path.substr(0, pos).c_str(), 0775);
-  }
-}
-
-std::string join(const std::vector<std::string>& parts, const char* sep) {
-  std::string out;
-  for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? sep : "") + parts[i];
-  return out;
-}
-
-std::string format_duration(double seconds) {
-  char buf[64];
-  if (seconds < 120) std::snprintf(buf, sizeof buf, "%.0f s", seconds);
-  else if (seconds < 7200) std::snprintf(buf, sizeof buf, "%.1f min", seconds / 60);
-  else std::snprintf(buf, sizeof buf, "%.1f h", seconds / 3600);
-  return buf;
-}
-
-// Rank 0's [progress] line: items done, runs per minute, elapsed time, an ETA
-// from the cost model (the estimated cost still to do over the estimated
-// cost done per elapsed second: items are handed out largest first, so a
-// count of items would overestimate), and the UTC time. Under static
-// scheduling rank 0 sees only its own items (every size-th): the line counts
-// that share and says so.
-class ProgressLine {
- public:
-  ProgressLine(const std::vector<WorkItem>& work, int ranks, bool static_share)
-      : static_share_(static_share) {
-    cost_.push_back(0.0);
-    runs_.push_back(0);
-    for (std::size_t i = 0; i < work.size(); i += static_share ? static_cast<std::size_t>(ranks) : 1) {
-      cost_.push_back(cost_.back() + work[i].estimated_cost_s);
-      runs_.push_back(runs_.back() + static_cast<long>(work[i].runs.size()));
-    }
-  }
-
-  void print(int items_done, double elapsed_s) const {
-    const std::size_t n = cost_.size() - 1;
-    const std::size_t done = std::min<std::size_t>(static_cast<std::size_t>(items_done), n);
-    const double minutes = elapsed_s / 60.0;
-    std::string eta = "--";
-    if (done > 0 && done < n && cost_[done] > 0.0) {
-      eta = format_duration(elapsed_s * (cost_[n] - cost_[done]) / cost_[done]);
-    }
-    std::printf("[progress] items %zu/%zu%s  %.1f runs/min  elapsed %s  ETA %s  (%s)\n", done, n,
-                static_share_ ? " (rank 0's share, static scheduling)" : "",
-                minutes > 0 ? static_cast<double>(runs_[done]) / minutes : 0.0,
-                format_duration(elapsed_s).c_str(), eta.c_str(), utc_now().c_str());
-    std::fflush(stdout);
-  }
-
- private:
-  bool static_share_;
-  std::vector<double> cost_;  // cumulative estimated cost of the items rank 0 counts
-  std::vector<long> runs_;    // cumulative runs of the same items
-};
-
 // --split and --max-group-size; throws cli::UsageError.
 SplitOptions split_options(const cli::Parser& parser) {
   SplitOptions options;
@@ -137,134 +81,6 @@ std::vector<int> dry_run_ranks(const cli::Parser& parser, int size) {
     ranks.push_back(static_cast<int>(r));
   }
   return ranks;
-}
-
-// Runs of each cell of `shard` still to train (pending, or failed with
-// --retry-failed), in the cell's seed order; *done counts the others.
-std::vector<std::vector<int>> pending_runs(const Grid& grid, const std::vector<int>& status_codes,
-                                           bool retry_failed, const Shard& shard, int* done) {
-  std::vector<std::vector<int>> pending(grid.cells.size());
-  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
-    if (!shard.owns_cell(static_cast<int>(c))) continue;
-    for (int row : grid.cells[c].runs) {
-      const auto s = static_cast<RunStatus>(status_codes[static_cast<std::size_t>(row)]);
-      if (s == RunStatus::kPending || (retry_failed && s == RunStatus::kFailed)) {
-        pending[c].push_back(row);
-      } else {
-        ++*done;
-      }
-    }
-  }
-  return pending;
-}
-
-std::string describe(const RunConfig& run) {
-  std::ostringstream s;
-  s << to_string(run.system) << " " << model_label(run.model, run.integrator) << " "
-    << to_string(run.size) << " n_train=" << run.n_train << " reg=" << to_string(run.regularizer);
-  return s.str();
-}
-
-// Exit status of a sweep that failed at run time (usage errors: 2).
-constexpr int kExitFailed = 1;
-
-// Every rank passes its own (code, message); returns the largest code on
-// every rank, and rank 0 prints each distinct non-empty message once. A
-// collective call: every rank must reach it, which is the point — an error
-// found on one rank reaches all of them instead of leaving them waiting.
-int agree(const mpi::communicator& world, int code, const std::string& message) {
-  const int worst = mpi::all_reduce(world, code, mpi::maximum<int>());
-  if (worst == 0) return 0;
-  std::vector<std::string> messages;
-  mpi::gather(world, message, messages, 0);
-  if (world.rank() == 0) {
-    std::set<std::string> printed;
-    for (std::size_t r = 0; r < messages.size(); ++r) {
-      if (messages[r].empty() || !printed.insert(messages[r]).second) continue;
-      if (r > 0) std::cerr << "[rank " << r << "/" << world.size() << "] ";
-      std::cerr << messages[r] << "\n";
-    }
-    std::cerr.flush();
-  }
-  return worst;
-}
-
-// Runs `body` on the ranks where `here` is true, catching what it throws
-// (usage errors and std::invalid_argument: status 2; others: 1), then
-// agree(). `body` must not make collective calls.
-template <class Body>
-int agreed(const mpi::communicator& world, bool here, Body&& body) {
-  int code = 0;
-  std::string message;
-  if (here) {
-    try {
-      body();
-    } catch (const cli::UsageError& e) {
-      code = cli::kUsageError;
-      message = e.message;
-    } catch (const std::invalid_argument& e) {
-      code = cli::kUsageError;
-      message = std::string("phnn sweep: ") + e.what();
-    } catch (const std::exception& e) {
-      code = kExitFailed;
-      message = std::string("phnn sweep: ") + e.what();
-    }
-  }
-  return agree(world, code, message);
-}
-
-// srun without PMI starts every task as rank 0 of 1: each would train the
-// whole sweep. "" if this launch looks right.
-std::string launch_problem(int size) {
-  const char* step = std::getenv("SLURM_STEP_NUM_TASKS");
-  const char* job = std::getenv("SLURM_NTASKS");
-  const char* tasks = step != nullptr ? step : job;
-  if (size != 1 || tasks == nullptr || std::atol(tasks) <= 1) return "";
-  return std::string("phnn sweep: Slurm started ") + tasks +
-         " tasks but MPI sees 1 rank here: every task would run the whole sweep. srun "
-         "needs the PMI plugin of your MPI: `srun --mpi=pmix phnn sweep ...` (see `srun "
-         "--mpi=list`), or start the ranks with `mpirun` inside the allocation";
-}
-
-// Rank 0, holding nothing yet: takes the writer lock of `out`, then decides
-// what to do with what is there; a results file of another sweep text is
-// replaced by its new version first (sweep_growth.h). Returns 0 = create,
-// 1 = resume; throws (UsageError: refusal, status 2; runtime_error: lock
-// held, I/O, status 1).
-int prepare_output(const std::string& out, const std::string& sweep_path, const SweepSpec& spec,
-                   const Grid& grid, WriterLock* lock) {
-  make_parent_directories(out);
-  const LockOutcome outcome = lock->acquire(out, spec.text_hash);
-  if (!outcome.acquired) throw std::runtime_error(outcome.message);
-  if (!outcome.message.empty()) std::cerr << outcome.message << "\n";
-  const OutputCheck check = inspect_output(out, sweep_path, spec.text_hash);
-  switch (check.state) {
-    case OutputState::kMissing:
-      return 0;
-    case OutputState::kResumable:
-      return 1;
-    case OutputState::kOtherText:
-      try {
-        std::cout << "phnn sweep: " << write_grown_results(out, spec, grid, program_version())
-                  << "\n";
-      } catch (const RunSetRefused& e) {
-        throw cli::UsageError{std::string("phnn sweep: ") + e.what()};
-      }
-      return 1;
-    case OutputState::kEmpty:
-    case OutputState::kDamaged: {
-      const bool empty = check.state == OutputState::kEmpty;
-      const std::string aside = move_aside(out, empty ? "empty" : "damaged");
-      std::cerr << "phnn sweep: " << out << ": " << (empty ? "an empty file" : "damaged: ")
-                << (empty ? "" : check.message) << "; moved to " << aside
-                << "; rebuilding the results file from the journals in "
-                << journal_directory(out) << "\n";
-      return 0;
-    }
-    case OutputState::kRefused:
-      break;
-  }
-  throw cli::UsageError{"phnn sweep: " + check.message};
 }
 
 void declare_options(cli::Parser* parser) {
@@ -292,70 +108,6 @@ void declare_options(cli::Parser* parser) {
                  "task, then `phnn merge` (docs/SLURM.md)");
   parser->option("threads", "LibTorch intra-op threads per rank", "1");
   parser->flag("quiet", "no per-item log lines");
-}
-
-// Rank 0: replays the journals (the source of truth) into the file and
-// returns every row's status code.
-std::vector<int> recover_from_journals(ResultsFile* results, const std::string& out,
-                                       bool created) {
-  int skipped = 0;
-  const auto journal = replay_journals(out, &skipped);
-  std::vector<RunStatus> statuses = results->read_statuses();
-  const auto ids = results->read_run_ids();
-  int recovered = 0;
-  for (std::size_t row = 0; row < ids.size(); ++row) {
-    auto it = journal.find(ids[row]);
-    if (it != journal.end() && statuses[row] != it->second.status) {
-      results->write_run(static_cast<int>(row), it->second);
-      statuses[row] = it->second.status;
-      ++recovered;
-    }
-  }
-  if (recovered || skipped) {
-    std::cout << "phnn sweep: recovered " << recovered << " finished runs from the journals in "
-              << journal_directory(out)
-              << (skipped ? " (" + std::to_string(skipped) + " torn records skipped)" : "")
-              << (created ? "; delete that directory with the file to start afresh" : "") << "\n";
-  }
-  std::vector<int> codes;
-  for (RunStatus s : statuses) codes.push_back(static_cast<int>(s));
-  return codes;
-}
-
-// Rank 0's summary line(s) after the file is closed.
-void print_summary(const std::string& out, int total_runs, double seconds, bool stopped,
-                   const Shard& shard) {
-  const ResultsFile summary = ResultsFile::open_read_only(out);
-  int counts[4] = {0, 0, 0, 0};
-  for (RunStatus s : summary.read_statuses()) ++counts[static_cast<int>(s)];
-  std::printf("phnn sweep: %d runs trained in %s; %s now holds %d done, %d diverged, %d failed, "
-              "%d pending of %d\n",
-              total_runs, format_duration(seconds).c_str(), out.c_str(), counts[1], counts[2],
-              counts[3], counts[0], summary.num_runs());
-  if (stopped) {
-    std::printf("phnn sweep: stopped on a signal; run the same command again to resume\n");
-  } else if (shard.count > 1) {
-    std::printf("phnn sweep: shard %d/%d done (the pending runs are other shards'); when every "
-                "shard is done: phnn merge OUT SHARD...\n",
-                shard.index, shard.count);
-  } else if (counts[0] > 0 || counts[3] > 0) {
-    std::printf("phnn sweep: runs remain; run the same command again%s\n",
-                counts[3] > 0 ? " with --retry-failed to retry the failed ones" : "");
-  }
-}
-
-CellSpec cell_of(const Grid& grid, const WorkItem& item) {
-  const RunConfig& head = grid.runs[static_cast<std::size_t>(item.runs.front())];
-  CellSpec cell;
-  cell.model = head.model;
-  cell.integrator = head.integrator;
-  cell.size = head.size;
-  cell.n_train = head.n_train;
-  cell.regularizer = head.regularizer;
-  cell.training = head.training;
-  cell.seeds.clear();
-  for (int row : item.runs) cell.seeds.push_back(grid.runs[static_cast<std::size_t>(row)].seed);
-  return cell;
 }
 
 // One `phnn sweep` on this rank: each phase that can fail on some ranks ends
@@ -516,21 +268,6 @@ class SweepRun {
   Clock::time_point start_ = Clock::now();
 };
 
-// Rank 0's opening line: what is done, what is left, how it is split.
-void print_plan(const SweepSpec& spec, const Grid& grid, const Shard& shard,
-                int runs_done_before, int runs_to_do, const WorkPlan& plan, int size,
-                ScheduleMode mode, const std::string& out) {
-  std::cout << "phnn sweep: " << spec.name << ": " << grid.runs.size() << " runs in "
-            << grid.cells.size() << " cells; "
-            << (shard.count > 1 ? "shard " + std::to_string(shard.index) + "/" +
-                                      std::to_string(shard.count) + ": "
-                                : std::string())
-            << runs_done_before << " finished before, " << runs_to_do << " to run in "
-            << plan.items.size() << " items (" << plan.cells << " cells, " << plan.split_cells
-            << " split) on " << size << " rank" << (size > 1 ? "s" : "") << " ("
-            << to_string(mode) << " scheduling) -> " << out << std::endl;
-}
-
 // Trains one item's cell. A cell that throws is a result too: every run
 // failed, with the message.
 std::vector<RunResult> train_item(const CellSpec& cell, const SystemData& data,
@@ -567,12 +304,6 @@ std::string record_item(const Grid& grid, const WorkItem& item,
   return "";
 }
 
-void print_item(const char* format, const std::string& prefix, int item_number,
-                std::size_t items, const std::string& what) {
-  std::printf(format, prefix.c_str(), item_number, items, what.c_str());
-  std::fflush(stdout);
-}
-
 int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
   // The same statuses on every rank give the same plan on every rank.
@@ -603,7 +334,9 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   for (int i = g_stop_signal ? -1 : queue.next(); i >= 0; i = g_stop_signal ? -1 : queue.next()) {
     const WorkItem& item = work[static_cast<std::size_t>(i)];
     const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
-    const CellSpec cell = cell_of(grid_, item);
+    std::vector<int> seeds;
+    for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
+    const CellSpec cell = cell_spec_for(head, seeds);
     if (!quiet) {
       print_item("%sitem %d/%zu: %s\n", prefix_, i + 1, work.size(),
                  describe(head) + ", " + std::to_string(cell.seeds.size()) + " seed" +

@@ -64,4 +64,16 @@ void CellSpec::validate(const SystemData& data) const {
   require_finite_data(data, n_train);
 }
 
+CellSpec cell_spec_for(const RunConfig& run, const std::vector<int>& seeds) {
+  CellSpec cell;
+  cell.model = run.model;
+  cell.integrator = run.integrator;
+  cell.size = run.size;
+  cell.n_train = run.n_train;
+  cell.regularizer = run.regularizer;
+  cell.training = run.training;
+  cell.seeds = seeds;
+  return cell;
+}
+
 }  // namespace phnn

@@ -8,6 +8,7 @@
 
 #include "phnn/data/dataset_file.h"
 #include "phnn/models/model_config.h"
+#include "phnn/sweep/run_config.h"
 #include "phnn/training/run_result.h"
 #include "phnn/training/trainer_options.h"
 
@@ -32,6 +33,11 @@ struct CellSpec {
   /// Throws std::invalid_argument naming the field (e.g. NODE with DG).
   void validate(const SystemData& data) const;
 };
+
+/// The cell of `run` (its model, size, N_train, regularizer and training
+/// settings) with the given member seeds: a whole cell, a member group of
+/// it, or one run (`phnn eval`).
+CellSpec cell_spec_for(const RunConfig& run, const std::vector<int>& seeds);
 
 /// Called at every validation point and at the end of evaluation.
 struct TrainProgress {

@@ -1,0 +1,152 @@
+// src/apps/sweep_phases.cpp — see sweep_phases.h.
+#include "apps/sweep_phases.h"
+
+#include <sys/stat.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <set>
+
+#include <boost/mpi/collectives.hpp>
+#include <boost/serialization/string.hpp>
+#include <boost/serialization/vector.hpp>
+
+#include "phnn/sweep/journal.h"
+#include "phnn/sweep/output_check.h"
+#include "phnn/sweep/sweep_growth.h"
+#include "phnn/sweep/version.h"
+
+namespace phnn {
+namespace apps {
+
+namespace mpi = boost::mpi;
+
+namespace {
+
+void make_parent_directories(const std::string& path) {
+  for (std::size_t pos = path.find('/', 1); pos != std::string::npos; pos = path.find('/', pos + 1)) {
+    ::mkdir(path.substr(0, pos).c_str(), 0775);
+  }
+}
+
+}  // namespace
+
+std::string join(const std::vector<std::string>& parts, const char* sep) {
+  std::string out;
+  for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? sep : "") + parts[i];
+  return out;
+}
+
+// Every rank passes its own (code, message); returns the largest code on
+// every rank, and rank 0 prints each distinct non-empty message once. A
+// collective call: every rank must reach it, which is the point — an error
+// found on one rank reaches all of them instead of leaving them waiting.
+int agree(const mpi::communicator& world, int code, const std::string& message) {
+  const int worst = mpi::all_reduce(world, code, mpi::maximum<int>());
+  if (worst == 0) return 0;
+  std::vector<std::string> messages;
+  mpi::gather(world, message, messages, 0);
+  if (world.rank() == 0) {
+    std::set<std::string> printed;
+    for (std::size_t r = 0; r < messages.size(); ++r) {
+      if (messages[r].empty() || !printed.insert(messages[r]).second) continue;
+      if (r > 0) std::cerr << "[rank " << r << "/" << world.size() << "] ";
+      std::cerr << messages[r] << "\n";
+    }
+    std::cerr.flush();
+  }
+  return worst;
+}
+
+std::string launch_problem(int size) {
+  const char* step = std::getenv("SLURM_STEP_NUM_TASKS");
+  const char* job = std::getenv("SLURM_NTASKS");
+  const char* tasks = step != nullptr ? step : job;
+  if (size != 1 || tasks == nullptr || std::atol(tasks) <= 1) return "";
+  return std::string("phnn sweep: Slurm started ") + tasks +
+         " tasks but MPI sees 1 rank here: every task would run the whole sweep. srun "
+         "needs the PMI plugin of your MPI: `srun --mpi=pmix phnn sweep ...` (see `srun "
+         "--mpi=list`), or start the ranks with `mpirun` inside the allocation";
+}
+
+int prepare_output(const std::string& out, const std::string& sweep_path, const SweepSpec& spec,
+                   const Grid& grid, WriterLock* lock) {
+  make_parent_directories(out);
+  const LockOutcome outcome = lock->acquire(out, spec.text_hash);
+  if (!outcome.acquired) throw std::runtime_error(outcome.message);
+  if (!outcome.message.empty()) std::cerr << outcome.message << "\n";
+  const OutputCheck check = inspect_output(out, sweep_path, spec.text_hash);
+  switch (check.state) {
+    case OutputState::kMissing:
+      return 0;
+    case OutputState::kResumable:
+      return 1;
+    case OutputState::kOtherText:
+      try {
+        std::cout << "phnn sweep: " << write_grown_results(out, spec, grid, program_version())
+                  << "\n";
+      } catch (const RunSetRefused& e) {
+        throw cli::UsageError{std::string("phnn sweep: ") + e.what()};
+      }
+      return 1;
+    case OutputState::kEmpty:
+    case OutputState::kDamaged: {
+      const bool empty = check.state == OutputState::kEmpty;
+      const std::string aside = move_aside(out, empty ? "empty" : "damaged");
+      std::cerr << "phnn sweep: " << out << ": " << (empty ? "an empty file" : "damaged: ")
+                << (empty ? "" : check.message) << "; moved to " << aside
+                << "; rebuilding the results file from the journals in "
+                << journal_directory(out) << "\n";
+      return 0;
+    }
+    case OutputState::kRefused:
+      break;
+  }
+  throw cli::UsageError{"phnn sweep: " + check.message};
+}
+
+std::vector<int> recover_from_journals(ResultsFile* results, const std::string& out,
+                                       bool created) {
+  int skipped = 0;
+  const auto journal = replay_journals(out, &skipped);
+  std::vector<RunStatus> statuses = results->read_statuses();
+  const auto ids = results->read_run_ids();
+  int recovered = 0;
+  for (std::size_t row = 0; row < ids.size(); ++row) {
+    auto it = journal.find(ids[row]);
+    if (it != journal.end() && statuses[row] != it->second.status) {
+      results->write_run(static_cast<int>(row), it->second);
+      statuses[row] = it->second.status;
+      ++recovered;
+    }
+  }
+  if (recovered || skipped) {
+    std::cout << "phnn sweep: recovered " << recovered << " finished runs from the journals in "
+              << journal_directory(out)
+              << (skipped ? " (" + std::to_string(skipped) + " torn records skipped)" : "")
+              << (created ? "; delete that directory with the file to start afresh" : "") << "\n";
+  }
+  std::vector<int> codes;
+  for (RunStatus s : statuses) codes.push_back(static_cast<int>(s));
+  return codes;
+}
+
+std::vector<std::vector<int>> pending_runs(const Grid& grid, const std::vector<int>& status_codes,
+                                           bool retry_failed, const Shard& shard, int* done) {
+  std::vector<std::vector<int>> pending(grid.cells.size());
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    if (!shard.owns_cell(static_cast<int>(c))) continue;
+    for (int row : grid.cells[c].runs) {
+      const auto s = static_cast<RunStatus>(status_codes[static_cast<std::size_t>(row)]);
+      if (s == RunStatus::kPending || (retry_failed && s == RunStatus::kFailed)) {
+        pending[c].push_back(row);
+      } else {
+        ++*done;
+      }
+    }
+  }
+  return pending;
+}
+
+}  // namespace apps
+}  // namespace phnn

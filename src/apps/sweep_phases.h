@@ -1,0 +1,81 @@
+// src/apps/sweep_phases.h — the phases of `phnn sweep` that can fail on some
+// ranks only, and how every rank then fails together (agree): the launch
+// check, rank 0's output preparation (writer lock, resume, growth, damaged
+// files) and journal recovery, and the plan of what is still to train.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <boost/mpi/communicator.hpp>
+
+#include "apps/cli.h"
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/merge.h"  // Shard
+#include "phnn/sweep/results_file.h"
+#include "phnn/sweep/sweep_file.h"
+#include "phnn/sweep/work_plan.h"
+#include "phnn/sweep/writer_lock.h"
+
+namespace phnn {
+namespace apps {
+
+/// Exit status of a sweep that failed at run time (usage errors: 2).
+constexpr int kExitFailed = 1;
+
+// Every rank passes its own (code, message); returns the largest code on
+// every rank, and rank 0 prints each distinct non-empty message once. A
+// collective call: every rank must reach it, which is the point — an error
+// found on one rank reaches all of them instead of leaving them waiting.
+int agree(const boost::mpi::communicator& world, int code, const std::string& message);
+
+// Runs `body` on the ranks where `here` is true, catching what it throws
+// (usage errors and std::invalid_argument: status 2; others: 1), then
+// agree(). `body` must not make collective calls.
+template <class Body>
+int agreed(const boost::mpi::communicator& world, bool here, Body&& body) {
+  int code = 0;
+  std::string message;
+  if (here) {
+    try {
+      body();
+    } catch (const cli::UsageError& e) {
+      code = cli::kUsageError;
+      message = e.message;
+    } catch (const std::invalid_argument& e) {
+      code = cli::kUsageError;
+      message = std::string("phnn sweep: ") + e.what();
+    } catch (const std::exception& e) {
+      code = kExitFailed;
+      message = std::string("phnn sweep: ") + e.what();
+    }
+  }
+  return agree(world, code, message);
+}
+
+/// srun without PMI starts every task as rank 0 of 1: each would train the
+/// whole sweep. "" if this launch looks right.
+std::string launch_problem(int size);
+
+/// Rank 0, holding nothing yet: takes the writer lock of `out`, then decides
+/// what to do with what is there; a results file of another sweep text is
+/// replaced by its new version first (sweep_growth.h). Returns 0 = create,
+/// 1 = resume; throws (UsageError: refusal, status 2; runtime_error: lock
+/// held, I/O, status 1).
+int prepare_output(const std::string& out, const std::string& sweep_path, const SweepSpec& spec,
+                   const Grid& grid, WriterLock* lock);
+
+/// Rank 0: replays the journals (the source of truth) into the file and
+/// returns every row's status code.
+std::vector<int> recover_from_journals(ResultsFile* results, const std::string& out,
+                                       bool created);
+
+/// Runs of each cell of `shard` still to train (pending, or failed with
+/// --retry-failed), in the cell's seed order; *done counts the others.
+std::vector<std::vector<int>> pending_runs(const Grid& grid, const std::vector<int>& status_codes,
+                                           bool retry_failed, const Shard& shard, int* done);
+
+std::string join(const std::vector<std::string>& parts, const char* sep);
+
+}  // namespace apps
+}  // namespace phnn
