@@ -215,10 +215,7 @@ def mse_boxplots(runs, name, sweep, out):
             suptitle(fig, f"{name}: {system}, study {study}" + (f" ({title})" if title else ""),
                      f"inference MSE per seed (points), box = quartiles of the finite MSEs, "
                      f"n = {seeds_per_cell(runs, sel)} seeds per cell; {status_note(runs, sel)}")
-            fig.tight_layout()
-            path = os.path.join(out, f"mse_{study}_{system}.png")
-            fig.savefig(path, dpi=DPI)
-            plt.close(fig)
+            path = save(fig, out, f"mse_{study}_{system}.png")
             written.append(path)
     return written
 
@@ -229,6 +226,15 @@ def study_names(runs, rows):
     for i in rows:
         names += [n for n in runs["studies"][i].split(",") if n and n not in names]
     return ("studies " if len(names) > 1 else "study ") + ", ".join(names) if names else "no study"
+
+
+def save(fig, out, filename):
+    """Lays out, writes OUTDIR/filename and closes the figure; returns the path."""
+    fig.tight_layout()
+    path = os.path.join(out, filename)
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
 
 
 def suptitle(fig, *lines):
@@ -379,10 +385,7 @@ def trajectories(runs, name, out):
                  f"no regularizer, N_train = {n_train}{note}; n = {seeds} seeds per model",
                  f"reference vs NODE and the best PHNN (lowest median MSE), each at its "
                  f"median-MSE seed (named in the legend); {status_note(runs, cell)}")
-        fig.tight_layout()
-        path = os.path.join(out, f"trajectories_{system}.png")
-        fig.savefig(path, dpi=DPI)
-        plt.close(fig)
+        path = save(fig, out, f"trajectories_{system}.png")
         written.append(path)
     return written
 
@@ -478,10 +481,7 @@ def energies(runs, path, name, out):
         suptitle(fig, f"{name}: {system}, N_train = {n_train}: learned vs true energy",
                  f"{picks[0]}, seed {int(runs['seed'][i])} (median-MSE seed, MSE "
                  f"{runs['mse'][i]:.2g}), reloaded from its stored weights by phnn eval")
-        fig.tight_layout()
-        p = os.path.join(out, f"energy_{system}.png")
-        fig.savefig(p, dpi=DPI)
-        plt.close(fig)
+        p = save(fig, out, f"energy_{system}.png")
         written.append(p)
     return written
 
@@ -553,10 +553,7 @@ def trace_figure(runs, name, system, out, panels, stem, what):
              f"N_train = {n_train}, one row per regularizer: {what}",
              f"median over seeds (n per model in legend), band = interquartile range; "
              f"{status_note(runs, all_rows)}")
-    fig.tight_layout()
-    path = os.path.join(out, f"{stem}_{system}.png")
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    path = save(fig, out, f"{stem}_{system}.png")
     return path
 
 
@@ -610,10 +607,7 @@ def time_vs_error(runs, name, out):
         suptitle(fig, f"{name}: {system}, all studies: wall time vs inference MSE, every run a "
                  f"point, diamonds = a model's medians over all its runs",
                  f"n = {seeds_per_cell(runs, rows)} seeds per cell; {status_note(runs, rows)}")
-        fig.tight_layout()
-        path = os.path.join(out, f"time_vs_error_{system}.png")
-        fig.savefig(path, dpi=DPI)
-        plt.close(fig)
+        path = save(fig, out, f"time_vs_error_{system}.png")
         written.append(path)
     return written
 
