@@ -26,5 +26,10 @@ if [ $# -ge 2 ]; then
         --eval-every 10 --quiet --out "$out/trained.h5" > /dev/null
     PHNN="$2" "$py" "$root/analysis/plot_results.py" "$out/trained.h5" "$out/fig2"
     test -s "$out/fig2/energy_duffing.png" || { echo "missing energy_duffing.png" >&2; exit 1; }
+    # compare_ablation.py: a file against itself is one row per cell, every verdict "~".
+    PHNN="$2" "$py" "$root/analysis/compare_ablation.py" "$out/trained.h5" "self=$out/trained.h5" \
+        > "$out/ablation.md"
+    grep -q '^| duffing | PHNN-S-DG | 25 | .* \[.*/3\] | .* ~ |$' "$out/ablation.md" \
+        || { echo "compare_ablation.py: unexpected table" >&2; cat "$out/ablation.md" >&2; exit 1; }
 fi
 echo "plot_results smoke test passed"
