@@ -331,8 +331,9 @@ TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
 }
 
 // sweeps/ablation-duffing.toml changes one knob: without its loss_norm line
-// its runs are the default runs (seeds 0-9 are paper.toml's own), and with
-// it each cell key differs by exactly ";loss_norm=mse".
+// its runs are the default runs, exactly those of
+// sweeps/ablation-duffing-baseline.toml (whose seeds 0-9 are paper.toml's
+// own), and with it each cell key differs by exactly ";loss_norm=mse".
 TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
   const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-duffing.toml");
   std::string text = spec.text;
@@ -340,15 +341,18 @@ TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
   ASSERT_NE(text.find(line), std::string::npos);
   text.erase(text.find(line), line.size());
   const Grid ablation = expand_grid(spec);
-  const Grid baseline = expand_grid(parse_sweep_text(text, "baseline.toml"));
-  ASSERT_EQ(ablation.runs.size(), 60u);
-  ASSERT_EQ(baseline.runs.size(), 60u);
+  const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
+  const Grid baseline = expand_grid(parse_sweep_file(kSweeps + "ablation-duffing-baseline.toml"));
+  ASSERT_EQ(ablation.runs.size(), 240u);
+  ASSERT_EQ(stripped.runs.size(), 240u);
+  ASSERT_EQ(baseline.runs.size(), 240u);
   std::set<std::string> paper_ids;
   for (const RunConfig& run : paper_grid().runs) paper_ids.insert(run.id());
-  for (std::size_t i = 0; i < 60; ++i) {
+  for (std::size_t i = 0; i < 240; ++i) {
     std::string key = ablation.runs[i].cell_key();
     key.erase(key.find(";loss_norm=mse"), std::string(";loss_norm=mse").size());
-    EXPECT_EQ(key, baseline.runs[i].cell_key());
+    EXPECT_EQ(key, stripped.runs[i].cell_key());
+    EXPECT_EQ(stripped.runs[i].id(), baseline.runs[i].id()) << i;
     EXPECT_EQ(paper_ids.count(baseline.runs[i].id()), baseline.runs[i].seed < 10 ? 1u : 0u) << i;
   }
 }
