@@ -20,9 +20,10 @@ namespace phnn {
 namespace apps {
 namespace {
 
-// The row of the run whose id is `id` or starts with it (unique).
-int find_row(const ResultsFile& results, const std::string& id) {
-  const std::vector<std::string> ids = results.read_run_ids();
+// The row of the run (of `ids`, the file's) whose id is `id` or starts with
+// it (unique).
+int find_row(const ResultsFile& results, const std::vector<std::string>& ids,
+             const std::string& id) {
   int row = -1;
   for (std::size_t i = 0; i < ids.size(); ++i) {
     if (ids[i].compare(0, id.size(), id) != 0) continue;
@@ -89,8 +90,9 @@ int run_eval(int argc, char** argv, int first) {
   if (!parser.parse(argc, argv, first)) return 0;
   if (parser.get("run").empty()) throw cli::UsageError{"phnn eval: --run ID is required"};
   const ResultsFile results = ResultsFile::open_read_only(parser.get("RESULTS"));
-  const int row = find_row(results, parser.get("run"));
-  const std::string id = results.read_run_ids()[static_cast<std::size_t>(row)];
+  const std::vector<std::string> ids = results.read_run_ids();
+  const int row = find_row(results, ids, parser.get("run"));
+  const std::string& id = ids[static_cast<std::size_t>(row)];
   const RunResult stored = results.read_run(row);
   if (stored.weights.empty()) {
     throw std::runtime_error(results.path() + ": run " + id + " has no stored weights (" +

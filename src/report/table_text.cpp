@@ -84,6 +84,7 @@ TableEntries gather_table(const StudyTable& study, SystemKind system, const Cell
   return t;
 }
 
+namespace {
 
 std::string heading(const TextTable& t, const std::string& dash) {
   std::string h = "Study " + t.study->name + " " + dash + " " + to_string(t.system);
@@ -129,6 +130,8 @@ void render_latex(const TextTable& t, std::ostringstream& out) {
   }
   out << "\\end{table}\n\n";
 }
+
+}  // namespace
 
 void render_text(const TextTable& t, TableFormat format, std::ostringstream& out) {
   if (format == TableFormat::kMarkdown) render_markdown(t, out);

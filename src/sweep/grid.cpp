@@ -102,21 +102,8 @@ struct ColumnAxes {
 // regularized run when it has any, else the [training] weight (one run).
 std::vector<double> weights_of(const StudySpec& study, Regularizer reg,
                                const TrainerOptions& training) {
-  if (reg == Regularizer::kNone || study.lambdas.empty()) {
-    return {reg == Regularizer::kCn   ? training.lambda_cn
-            : reg == Regularizer::kSn ? training.lambda_sn
-            : reg == Regularizer::kSr ? training.lambda_sr
-                                      : 0.0};
-  }
+  if (reg == Regularizer::kNone || study.lambdas.empty()) return {training.weight(reg)};
   return study.lambdas;
-}
-
-// Sets the weight of `reg` (eq:condition-number-loss, eq:spectral-norm-loss,
-// eq:stiffness-ratio-loss) in `training`; nothing for kNone.
-void set_weight(Regularizer reg, double weight, TrainerOptions* training) {
-  if (reg == Regularizer::kCn) training->lambda_cn = weight;
-  if (reg == Regularizer::kSn) training->lambda_sn = weight;
-  if (reg == Regularizer::kSr) training->lambda_sr = weight;
 }
 
 }  // namespace
@@ -193,7 +180,7 @@ void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
             run.regularizer = reg;
             for (double weight : weights_of(study, reg, spec.training)) {
               run.training = spec.training;
-              set_weight(reg, weight, &run.training);
+              run.training.set_weight(reg, weight);
               for (int seed : study.seeds) {
                 run.seed = seed;
                 add_run(run, axes.label(size, n, reg, weight), grid, &table, index_of);

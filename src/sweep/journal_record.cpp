@@ -3,6 +3,8 @@
 // checksum, and its parser. The files themselves: journal.cpp.
 #include <locale.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

@@ -58,9 +58,7 @@ std::string RunConfig::cell_key() const {
   s << ";steps=" << t.steps << ";lr=" << num(t.learning_rate) << ";adam=" << num(t.adam_beta1)
     << "," << num(t.adam_beta2) << "," << num(t.adam_eps) << ";batch=" << t.batch_size
     << ";eval_every=" << t.eval_every;
-  if (regularizer == Regularizer::kCn) s << ";lambda=" << num(t.lambda_cn);
-  if (regularizer == Regularizer::kSn) s << ";lambda=" << num(t.lambda_sn);
-  if (regularizer == Regularizer::kSr) s << ";lambda=" << num(t.lambda_sr);
+  if (regularizer != Regularizer::kNone) s << ";lambda=" << num(t.weight(regularizer));
   // Knobs below are printed only away from their defaults, so the identity
   // of every run made before they existed is unchanged.
   if (t.loss_norm != LossNorm::kMeanL1) s << ";loss_norm=" << to_string(t.loss_norm);

@@ -58,6 +58,22 @@ RunStatus parse_run_status(const std::string& name) {
                               "\"; expected one of: pending, done, diverged, failed");
 }
 
+double TrainerOptions::weight(Regularizer reg) const {
+  switch (reg) {
+    case Regularizer::kCn: return lambda_cn;
+    case Regularizer::kSn: return lambda_sn;
+    case Regularizer::kSr: return lambda_sr;
+    case Regularizer::kNone: break;
+  }
+  return 0.0;
+}
+
+void TrainerOptions::set_weight(Regularizer reg, double value) {
+  if (reg == Regularizer::kCn) lambda_cn = value;
+  if (reg == Regularizer::kSn) lambda_sn = value;
+  if (reg == Regularizer::kSr) lambda_sr = value;
+}
+
 void TrainerOptions::validate() const {
   auto fail = [](const char* field, double value, const char* constraint) {
     PHNN_REQUIRE(false, "Invalid TrainerOptions: " << field << " = " << value

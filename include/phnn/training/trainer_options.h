@@ -71,6 +71,11 @@ struct TrainerOptions {
   /// (a multiple of eval_every, or steps itself). Empty: none.
   std::vector<int> checkpoints;
 
+  /// The weight of `reg` (lambda_cn, lambda_sn or lambda_sr); 0 for kNone.
+  double weight(Regularizer reg) const;
+  /// Sets the weight of `reg`; nothing for kNone.
+  void set_weight(Regularizer reg, double value);
+
   /// Throws std::invalid_argument naming the field, value and constraint.
   void validate() const;
 };
