@@ -5,15 +5,22 @@
 
 namespace phnn {
 
+namespace {
+torch::Tensor first_stage(const DynamicsModel& model, const torch::Tensor& x,
+                          const torch::Tensor& u, const torch::Tensor& k1) {
+  return k1.defined() ? k1 : model.field(x, u, false).f;
+}
+}  // namespace
+
 torch::Tensor rk2_step(const DynamicsModel& model, const torch::Tensor& x,
-                       const torch::Tensor& u, double h) {
-  const auto k1 = model.field(x, u, false).f;
+                       const torch::Tensor& u, double h, const torch::Tensor& k1_given) {
+  const auto k1 = first_stage(model, x, u, k1_given);
   return x + h * model.field(x + (0.5 * h) * k1, u, false).f;
 }
 
 torch::Tensor rk4_step(const DynamicsModel& model, const torch::Tensor& x,
-                       const torch::Tensor& u, double h) {
-  const auto k1 = model.field(x, u, false).f;
+                       const torch::Tensor& u, double h, const torch::Tensor& k1_given) {
+  const auto k1 = first_stage(model, x, u, k1_given);
   const auto k2 = model.field(x + (0.5 * h) * k1, u, false).f;
   const auto k3 = model.field(x + (0.5 * h) * k2, u, false).f;
   const auto k4 = model.field(x + h * k3, u, false).f;
@@ -21,10 +28,11 @@ torch::Tensor rk4_step(const DynamicsModel& model, const torch::Tensor& x,
 }
 
 torch::Tensor explicit_step(const DynamicsModel& model, IntegratorKind integrator,
-                            const torch::Tensor& x, const torch::Tensor& u, double h) {
+                            const torch::Tensor& x, const torch::Tensor& u, double h,
+                            const torch::Tensor& k1) {
   switch (integrator) {
-    case IntegratorKind::kRk2: return rk2_step(model, x, u, h);
-    case IntegratorKind::kRk4: return rk4_step(model, x, u, h);
+    case IntegratorKind::kRk2: return rk2_step(model, x, u, h, k1);
+    case IntegratorKind::kRk4: return rk4_step(model, x, u, h, k1);
     case IntegratorKind::kDg:
     case IntegratorKind::kDg4: break;
   }

@@ -78,8 +78,9 @@ class CellTrainer {
   }
   // L_d (Eq. 30) per member in opt_.loss_norm (discrete_loss): by default the
   // mean over batch and components of |x_{n+1} - x_hat| / h.
-  torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn,
-                          const torch::Tensor& u) const;
+  // `f_at_x`, when defined, is f(x, u), reused as an explicit step's first stage.
+  torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u,
+                          const torch::Tensor& f_at_x = {}) const;
   void step(int step, BatchSampler& sampler);
   void freeze_non_finite(const torch::Tensor& loss, int step, std::vector<int64_t>* dead);
   void validate(int step);
@@ -154,12 +155,12 @@ CellTrainer::Tensors CellTrainer::make_tensors() const {
 }
 
 torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor& xn,
-                                     const torch::Tensor& u) const {
+                                     const torch::Tensor& u, const torch::Tensor& f_at_x) const {
   const DynamicsModel& m = *model_;
   const auto x_hat =
       cell_.integrator == IntegratorKind::kDg    ? dg_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
       : cell_.integrator == IntegratorKind::kDg4 ? dg4_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
-                                                 : explicit_step(m, cell_.integrator, x, u, h_);
+                                                 : explicit_step(m, cell_.integrator, x, u, h_, f_at_x);
   return discrete_loss(xn, x_hat, h_, opt_.loss_norm);
 }
 
@@ -185,9 +186,13 @@ void CellTrainer::step(int step, BatchSampler& sampler) {
   const auto x = full_batch ? t_.x_all : t_.x.index({idx});
   const auto xn = full_batch ? t_.x_next_all : t_.x_next.index({idx});
   const auto u = full_batch ? t_.u_all : t_.u.index({idx});
-  auto loss = data_loss(x, xn, u);
-  if (cell_.regularizer != Regularizer::kNone) {
-    const auto stats = jacobian_stats(model_->field(x, u, true).dfdx, opt_.jacobian_eps);
+  // A regularizer needs df/dx at the batch; the same evaluation's f is an
+  // explicit step's first stage, so RK2/RK4 do not evaluate f(x) twice.
+  const bool regularized = cell_.regularizer != Regularizer::kNone;
+  const FieldEval at_x = regularized ? model_->field(x, u, true) : FieldEval{};
+  auto loss = data_loss(x, xn, u, at_x.f);
+  if (regularized) {
+    const auto stats = jacobian_stats(at_x.dfdx, opt_.jacobian_eps);
     loss = loss + regularizer_penalty(cell_.regularizer, stats, opt_);
   }
   adam_->zero_grad();

@@ -140,6 +140,67 @@ TEST(DiscreteStepTest, Rk2IsExplicitMidpointOfTheField) {
   EXPECT_TRUE(torch::allclose(rk2_step(*model, x, u, h), expected, 0.0, 0.0));
 }
 
+
+// A given first stage k1 = f(x, u) is used as is: the step with k1 passed is
+// bitwise the step that computes it; with k1 from the Jacobian (jet) path, as
+// the regularized training step passes it, the steps agree to round-off
+// (the jet path's f equals the order-0 path's to 1e-14, ForwardModeTest).
+TEST(DiscreteStepTest, ExplicitStepsReuseAGivenFirstStage) {
+  for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
+    const auto model = DynamicsModel::create(ModelOptions{kind, ModelSize::kSmall, SystemKind::kDuffing}, {0, 1});
+    torch::NoGradGuard no_grad;
+    const auto x = states(2, 16, 7);
+    const auto u = states(2, 16, 8).narrow(-1, 0, 1);
+    const double h = 0.05;
+    const auto k1 = model->field(x, u, false).f;
+    const auto k1_jet = model->field(x, u, true).f;
+    for (IntegratorKind integrator : {IntegratorKind::kRk2, IntegratorKind::kRk4}) {
+      const auto plain = explicit_step(*model, integrator, x, u, h);
+      EXPECT_TRUE(torch::equal(explicit_step(*model, integrator, x, u, h, k1), plain))
+          << to_string(kind) << " " << to_string(integrator);
+      const auto from_jet = explicit_step(*model, integrator, x, u, h, k1_jet);
+      EXPECT_LE((from_jet - plain).abs().max().item<double>(), 1e-14)
+          << to_string(kind) << " " << to_string(integrator);
+      // A wrong k1 would show: the step is not the one of k1 = 0.
+      EXPECT_GT((explicit_step(*model, integrator, x, u, h, torch::zeros_like(k1)) - plain)
+                    .abs().max().item<double>(), 1e-6);
+    }
+  }
+}
+
+// The regularized training step backpropagates through the jet path's f (the
+// first stage) and df/dx (the penalty) of one evaluation: its parameter
+// gradients equal those of two separate evaluations (order-0 f for the step,
+// the jet for df/dx) to round-off, so the jet node's backward takes the
+// gradient of its value output, not only of its derivatives.
+TEST(DiscreteStepTest, SharedFirstStageKeepsTheParameterGradients) {
+  for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
+    auto model = DynamicsModel::create(ModelOptions{kind, ModelSize::kSmall, SystemKind::kDuffing}, {0, 1});
+    const auto x = states(2, 16, 9);
+    const auto u = states(2, 16, 10).narrow(-1, 0, 1);
+    const auto target = states(2, 16, 11);
+    const double h = 0.05;
+    auto gradients = [&](bool shared) {
+      for (auto& p : model->parameters()) p.mutable_grad() = torch::Tensor();
+      const FieldEval at_x = model->field(x, u, true);
+      const auto k1 = shared ? at_x.f : torch::Tensor();
+      const auto step = explicit_step(*model, IntegratorKind::kRk2, x, u, h, k1);
+      const auto loss = discrete_loss(target, step, h, LossNorm::kMeanL1) +
+                        (at_x.dfdx * at_x.dfdx).sum({1, 2, 3});
+      loss.sum().backward();
+      std::vector<torch::Tensor> g;
+      for (const auto& p : model->parameters()) g.push_back(p.grad().clone());
+      return g;
+    };
+    const auto separate = gradients(false), shared = gradients(true);
+    ASSERT_EQ(separate.size(), shared.size());
+    for (std::size_t k = 0; k < shared.size(); ++k) {
+      const double scale = 1.0 + separate[k].abs().max().item<double>();
+      EXPECT_LE((shared[k] - separate[k]).abs().max().item<double>(), 1e-12 * scale)
+          << to_string(kind) << " parameter " << k;
+    }
+  }
+}
 // One step of each explicit discrete model against 64 RK4 substeps of the
 // same learned field: the local error falls as h^(p+1), so halving h from
 // 0.1 to 0.05 to 0.025 gives log2 ratios 3 (RK2) and 5 (RK4), +-0.3.

@@ -10,18 +10,21 @@ namespace phnn {
 
 /// RK2 (eq: rk2-method with the factor h the paper drops; docs/METHOD.md §4):
 ///   x_hat = x + h f(x + (h/2) f(x, u), u).
+/// `k1`, when defined, is f(x, u) already computed (e.g. with the Jacobian a
+/// regularizer needs): the step then evaluates the field once more, not twice.
 torch::Tensor rk2_step(const DynamicsModel& model, const torch::Tensor& x,
-                       const torch::Tensor& u, double h);
+                       const torch::Tensor& u, double h, const torch::Tensor& k1 = {});
 
 /// Classical RK4 (include/phnn/integrators/runge_kutta4.h has the tableau):
 ///   x_hat = x + h (k1 + 2 k2 + 2 k3 + k4) / 6, four evaluations of f.
 torch::Tensor rk4_step(const DynamicsModel& model, const torch::Tensor& x,
-                       const torch::Tensor& u, double h);
+                       const torch::Tensor& u, double h, const torch::Tensor& k1 = {});
 
 /// The explicit discrete model of `integrator` (rk2 or rk4; throws for dg,
-/// which needs x_next in training and Newton at inference).
+/// which needs x_next in training and Newton at inference); `k1` as in rk2_step.
 torch::Tensor explicit_step(const DynamicsModel& model, IntegratorKind integrator,
-                            const torch::Tensor& x, const torch::Tensor& u, double h);
+                            const torch::Tensor& x, const torch::Tensor& u, double h,
+                            const torch::Tensor& k1 = {});
 
 /// DG in training, inverse-explicit (docs/METHOD.md §4): with the data step
 /// dx = x_next - x, x_hat = x + h f_bar(x, dx, u).
