@@ -1,7 +1,8 @@
 #!/bin/sh
 # Smoke test of analysis/plot_results.py: build a synthetic results file with every run status
 # (tests/analysis/make_fixture.py), plot it, and check that each kind of figure was written;
-# first the unit tests of the script's choices (tests/analysis/test_plot_results.py).
+# first the unit tests of the scripts' choices (tests/analysis/test_plot_results.py,
+# test_paper_claims.py).
 # ctest: add_test(NAME plot_results_smoke COMMAND sh ${CMAKE_SOURCE_DIR}/tests/analysis/plot_results_smoke.sh)
 #        set_tests_properties(plot_results_smoke PROPERTIES SKIP_RETURN_CODE 77)
 # Then, with a phnn binary, a real results file with stored weights: the energy figure (phnn eval).
@@ -15,6 +16,7 @@ py=${1:-/usr/bin/python3}
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 "$py" "$here/test_plot_results.py"
+"$py" "$here/test_paper_claims.py"
 "$py" "$here/make_fixture.py" "$out/fixture.h5"
 "$py" "$root/analysis/plot_results.py" "$out/fixture.h5" "$out/fig"
 for f in mse_I_harmonic mse_III_duffing trajectories_harmonic jacobian_duffing loss_harmonic \
@@ -31,5 +33,10 @@ if [ $# -ge 2 ]; then
         > "$out/ablation.md"
     grep -q '^| duffing | PHNN-S-DG | 25 | .* \[.*/3\] | .* ~ |$' "$out/ablation.md" \
         || { echo "compare_ablation.py: unexpected table" >&2; cat "$out/ablation.md" >&2; exit 1; }
+    # paper_claims.py on one cell without studies: the header, no comparison, the studies skipped.
+    PHNN="$2" "$py" "$root/analysis/paper_claims.py" "$out/trained.h5" > "$out/claims.md"
+    grep -q '^# The paper.s statements checked on trained.h5$' "$out/claims.md" \
+        && grep -q '^Not in the file (statements skipped): Study I, II, III.$' "$out/claims.md" \
+        || { echo "paper_claims.py: unexpected output" >&2; cat "$out/claims.md" >&2; exit 1; }
 fi
 echo "plot_results smoke test passed"

@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""Unit tests of analysis/paper_claims.py: comparisons, verdicts, absence statements, and the
+Study I statements on a synthetic reducer output (no phnn binary needed).
+
+    /usr/bin/python3 tests/analysis/test_paper_claims.py
+"""
+import os
+import sys
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "analysis"))
+import paper_claims as pc  # noqa: E402
+
+
+def cell(median, lo, hi, iqr=1.0):
+    return pc.Cell(median, median - iqr / 2, median + iqr / 2, iqr, lo, hi, 10, 0, 10)
+
+
+def stat_row(study, system, model, axis, column, median, lo, hi, iqr=1.0):
+    return {"study": study, "system": system, "model": model, "axis": axis, "column": column,
+            "median": str(median), "q25": "0", "q75": "0", "iqr": str(iqr),
+            "ci_low": str(lo), "ci_high": str(hi), "done": "10", "diverged": "0",
+            "expected": "10"}
+
+
+class Compare(unittest.TestCase):
+    def test_resolved_only_without_overlap(self):
+        a, b = cell(1.0, 0.5, 1.5), cell(3.0, 2.0, 4.0)
+        self.assertEqual(pc.compare("x", a, b)[1:], (True, True))
+        touching = cell(3.0, 1.5, 4.0)  # a.hi == b.lo: overlap, a tie
+        self.assertEqual(pc.compare("x", a, touching)[1:], (True, False))
+        self.assertEqual(pc.compare("x", b, a)[1:], (False, True))
+        self.assertEqual(pc.compare("x", b, a, paper_says_lower=False)[1:], (True, True))
+
+    def test_absence_counts_only_a_resolved_occurrence(self):
+        a, b = cell(1.0, 0.5, 1.5), cell(3.0, 2.0, 4.0)
+        occurs = pc.absence(pc.compare("x", a, b))         # a resolved lower: happens
+        self.assertEqual(occurs[1:], (False, True))
+        tie = pc.absence(pc.compare("x", a, cell(1.2, 0.4, 2.0)))
+        self.assertEqual(tie[1:], (True, None))
+        reverse = pc.absence(pc.compare("x", b, a))        # resolved, but the other way
+        self.assertEqual(reverse[1:], (True, None))
+
+
+class Verdict(unittest.TestCase):
+    def c(self, ok, resolved):
+        return pc.Comparison("x", ok, resolved)
+
+    def test_each_verdict(self):
+        self.assertEqual(pc.verdict([self.c(True, True)] * 3)[0], "holds")
+        self.assertEqual(pc.verdict([self.c(True, True), self.c(True, False)])[0], "same direction")
+        self.assertEqual(pc.verdict([self.c(True, True), self.c(False, False)])[0], "partly")
+        self.assertEqual(pc.verdict([self.c(True, False), self.c(False, False)])[0], "not supported")
+        self.assertEqual(pc.verdict([self.c(False, True), self.c(True, False)])[0], "contradicted")
+        self.assertEqual(pc.verdict([self.c(False, True), self.c(True, True)])[0], "mixed")
+
+    def test_direction_only(self):
+        self.assertEqual(pc.verdict([self.c(True, None)] * 2)[0], "same direction")
+        self.assertEqual(pc.verdict([self.c(True, None), self.c(False, None)])[0], "partly")
+        self.assertIn("2 by direction only", pc.verdict([self.c(True, None)] * 2)[1])
+
+
+class StudyOne(unittest.TestCase):
+    def results(self, dg_harmonic_25):
+        rows = []
+        for system in pc.SYSTEMS:
+            for model in ("NODE-RK2",) + pc.PHNN_MODELS:
+                for i, col in enumerate(("25", "100", "400")):
+                    m = 10.0 ** (-i)  # every cell drops by 10x per column, resolved
+                    if model == "NODE-RK2":
+                        m *= 5
+                    rows.append(stat_row("I", system, model, "n_train", col, m, 0.8 * m, 1.2 * m))
+        for r in rows:  # harmonic DG models at 25
+            if r["system"] == "harmonic" and r["model"].endswith("-DG") and r["column"] == "25":
+                r.update(median=str(dg_harmonic_25[0]), ci_low=str(dg_harmonic_25[1]),
+                         ci_high=str(dg_harmonic_25[2]))
+        return pc.Results(rows, [])
+
+    def claim(self, res, tag):
+        return next(c for c in pc.study_one(res) if c[0] == tag)
+
+    def test_dg_vs_rk2_on_the_harmonic_oscillator(self):
+        better = self.results((0.5, 0.45, 0.55))  # resolved below RK2's 1.0 (0.8, 1.2)
+        self.assertEqual(pc.verdict(self.claim(better, "I.4")[2])[0], "holds")
+        tie = self.results((0.9, 0.7, 1.1))
+        self.assertEqual(pc.verdict(self.claim(tie, "I.4")[2])[0], "same direction")
+        worse = self.results((2.0, 1.8, 2.2))
+        self.assertEqual(pc.verdict(self.claim(worse, "I.4")[2])[0], "contradicted")
+
+    def test_more_points_and_node(self):
+        res = self.results((1.0, 0.8, 1.2))
+        self.assertEqual(pc.verdict(self.claim(res, "I.1")[2])[0], "holds")
+        self.assertEqual(pc.verdict(self.claim(res, "I.3")[2])[0], "holds")
+        # PHNN-S on the self-sustained oscillator drops resolved here: against "about constant".
+        self.assertEqual(pc.verdict(self.claim(res, "I.2")[2])[0], "contradicted")
+
+    def test_shared_cells_are_counted_once_across_studies(self):
+        rows = [stat_row(st, "duffing", m, axis, col, 1.0, 0.9, 1.1)
+                for st, axis, col in (("I", "n_train", "25"), ("II", "size", "small"))
+                for m in pc.PHNN_MODELS]
+        res = pc.Results(rows, [])
+        self.assertEqual(len(res.by_config), len(pc.PHNN_MODELS))
+
+
+if __name__ == "__main__":
+    unittest.main()
