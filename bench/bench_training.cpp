@@ -20,6 +20,7 @@
 // Debian's defaults (reference BLAS, glibc malloc), side by side.
 #include <algorithm>
 #include <chrono>
+#include <numeric>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -254,14 +255,15 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (mode == "stacked") return stacked(repeats);
-  if (mode == "run" && argc > 5) {  // for perf: run MODEL INTEGRATOR REG STEPS [SIZE]
+  if (mode == "run" && argc > 5) {  // for perf: run MODEL INTEGRATOR REG STEPS [SIZE] [N_TRAIN] [E]
     CellSpec cell;
     cell.model = phnn::parse_model(argv[2]);
     cell.integrator = phnn::parse_integrator(argv[3]);
     cell.regularizer = phnn::parse_regularizer(argv[4]);
     cell.size = phnn::parse_size(argc > 6 ? argv[6] : "small");
     cell.n_train = argc > 7 ? std::atoi(argv[7]) : 64;  // batch = min(n_train, 64)
-    cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+    cell.seeds.resize(argc > 8 ? static_cast<std::size_t>(std::atoi(argv[8])) : 10);
+    std::iota(cell.seeds.begin(), cell.seeds.end(), 0);
     cell.fused_networks = std::getenv("PHNN_REFERENCE_NETWORKS") == nullptr;
     std::printf("%.3f s\n", time_cell(cell, std::atoi(argv[5])));
     return 0;

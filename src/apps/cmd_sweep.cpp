@@ -89,6 +89,10 @@ void declare_options(cli::Parser* parser) {
   parser->flag("dry-run",
                "print `N runs in M cells`, the estimated cost and the simulated schedule "
                "(items, makespan, core-hours, efficiency); train nothing");
+  parser->flag("cell-costs",
+               "with --dry-run: the cost model's estimate of every cell as CSV (cell, "
+               "configuration, members, fixed/member/estimated seconds, run ids) instead of "
+               "the summary");
   parser->option("ranks",
                  "rank counts for --dry-run's schedule, one line each, e.g. 2,16,128 "
                  "(default: this run's)");
@@ -137,7 +141,10 @@ class SweepRun {
     }
     if (int status = check_same_sweep_file()) return status;
     if (parser_.flag_set("dry-run")) {
-      if (root_) std::cout << dry_run_summary(grid_, ranks_, split_);
+      if (root_) {
+        std::cout << (parser_.flag_set("cell-costs") ? cell_costs_csv(grid_)
+                                                     : dry_run_summary(grid_, ranks_, split_));
+      }
       return 0;
     }
     torch::set_num_threads(static_cast<int>(parser_.get_int("threads")));
@@ -170,6 +177,10 @@ class SweepRun {
     spec_ = parse_sweep_file(parser_.get("FILE"));
     grid_ = expand_grid(spec_);
     if (parser_.get_int("threads") < 1) throw cli::UsageError{"phnn sweep: --threads must be >= 1"};
+    if (parser_.flag_set("cell-costs") && !parser_.flag_set("dry-run")) {
+      throw cli::UsageError{"phnn sweep: --cell-costs prints the cost model's estimates and trains "
+                            "nothing: add --dry-run"};
+    }
     split_ = split_options(parser_);
     if (parser_.has("shard")) {
       try {

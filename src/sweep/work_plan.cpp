@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "phnn/models/model_config.h"
+
 namespace phnn {
 
 void SplitOptions::validate() const {
@@ -271,6 +273,26 @@ std::string dry_run_summary(const Grid& grid, const std::vector<int>& ranks,
          "makespan)):\n";
   for (const WorkPlan& plan : plans) out << "  " << schedule_line(plan) << "\n";
   out << study_lines(grid);
+  return out.str();
+}
+
+std::string cell_costs_csv(const Grid& grid) {
+  std::ostringstream out;
+  out.precision(6);
+  out << "cell,system,model,size,n_train,regularizer,members,fixed_s,member_s,estimated_s,"
+         "run_ids\n";
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    const Cell& cell = grid.cells[c];
+    const RunConfig& run = grid.runs[static_cast<std::size_t>(cell.runs.front())];
+    out << c << "," << to_string(run.system) << "," << model_label(run.model, run.integrator)
+        << "," << to_string(run.size) << "," << run.n_train << ","
+        << to_string(run.regularizer) << "," << cell.runs.size() << "," << cell.fixed_cost_s
+        << "," << cell.member_cost_s << "," << cell.estimated_cost_s << ",";
+    for (std::size_t k = 0; k < cell.runs.size(); ++k) {
+      out << (k ? " " : "") << grid.runs[static_cast<std::size_t>(cell.runs[k])].id();
+    }
+    out << "\n";
+  }
   return out.str();
 }
 

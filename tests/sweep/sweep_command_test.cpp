@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -28,6 +29,7 @@ namespace {
 
 using ::testing::HasSubstr;
 using ::testing::Not;
+using ::testing::StartsWith;
 
 std::string temp_dir(const std::string& name) {
   const std::string dir = ::testing::TempDir() + "phnn_sweep_" + name + "_" + std::to_string(::getpid());
@@ -396,6 +398,12 @@ TEST(SweepCommandTest, DryRunPrintsTheScheduleForSeveralRankCounts) {
   EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --ranks 0", &log), 2);
   EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --split off --max-group-size 2", &log), 2);
   EXPECT_THAT(log, HasSubstr("needs mode auto"));
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --cell-costs", &log), 0)
+      << log;
+  EXPECT_THAT(log, StartsWith("cell,system,model,size,n_train,regularizer,members,"));
+  EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 121) << "header + 120 cells";
+  EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --cell-costs", &log), 2);
+  EXPECT_THAT(log, HasSubstr("add --dry-run"));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace phnn {
 namespace {
@@ -207,6 +208,42 @@ TEST(WorkPlanTest, DryRunSummaryPrintsOneScheduleLinePerRankCount) {
   EXPECT_EQ(summary.find("\n  128 ranks: 120 items"), std::string::npos) << "split at 128 ranks";
   EXPECT_THROW(dry_run_summary(grid, {0}), std::invalid_argument);
   EXPECT_THROW(dry_run_summary(grid, {}), std::invalid_argument);
+}
+
+// One CSV line per cell, largest first, whose estimates add up to the grid's
+// and whose run ids are exactly the grid's runs.
+TEST(WorkPlanTest, CellCostsCsvListsEveryCellAndRun) {
+  const Grid grid = paper_grid();
+  std::istringstream csv(cell_costs_csv(grid));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "cell,system,model,size,n_train,regularizer,members,fixed_s,member_s,"
+                  "estimated_s,run_ids");
+  double total = 0.0, previous = 1e300;
+  std::set<std::string> ids;
+  std::size_t cells = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> fields;
+    std::istringstream row(line);
+    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+    ASSERT_EQ(fields.size(), 11u) << line;
+    const double estimated = std::stod(fields[9]);
+    EXPECT_LE(estimated, previous) << "largest first: " << line;
+    EXPECT_NEAR(estimated, std::stod(fields[7]) + std::stoi(fields[6]) * std::stod(fields[8]),
+                1e-5 * estimated);
+    previous = estimated;
+    total += estimated;
+    std::istringstream run_ids(fields[10]);
+    int members = 0;
+    for (std::string id; run_ids >> id; ++members) ids.insert(id);
+    EXPECT_EQ(members, std::stoi(fields[6]));
+    ++cells;
+  }
+  EXPECT_EQ(cells, grid.cells.size());
+  EXPECT_NEAR(total, grid.estimated_cost_s, 1e-5 * grid.estimated_cost_s);
+  std::set<std::string> expected;
+  for (const RunConfig& run : grid.runs) expected.insert(run.id());
+  EXPECT_EQ(ids, expected);
 }
 
 }  // namespace

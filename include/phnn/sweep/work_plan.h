@@ -106,4 +106,12 @@ std::string schedule_line(const WorkPlan& plan);
 std::string dry_run_summary(const Grid& grid, const std::vector<int>& ranks,
                             const SplitOptions& options = SplitOptions());
 
+/// The cost model's estimate of every cell, for `--dry-run --cell-costs`:
+/// CSV, header "cell,system,model,size,n_train,regularizer,members,fixed_s,
+/// member_s,estimated_s,run_ids", one line per cell in Grid::cells order
+/// (largest first), run_ids its runs' RunConfig::id() separated by spaces
+/// (to join with `phnn reduce --format csv --per-run`, e.g.
+/// analysis/cost_model_check.py).
+std::string cell_costs_csv(const Grid& grid);
+
 }  // namespace phnn
