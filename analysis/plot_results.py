@@ -18,6 +18,12 @@ studies has one pseudo-study, e.g. "grid"):
                               the file's most common size (small in paper.toml), no regularizer,
                               N_train 25 / 100 / 25 for harmonic / Duffing / self-sustained (the
                               nearest available N_train otherwise, said in the title).
+  trajectories_sizes_<sys>.png  paper Fig. 9: the same two trajectories for the DG model of the
+                              family the paper finds best on the system (PHNN-S-DG on harmonic and
+                              Duffing, PHNN-JR-DG on self-sustained) at each model size (line
+                              style per size), no regularizer, N_train 25 (nearest with more than
+                              one size), each size at its median-MSE seed; written only when the
+                              file has more than one size (Study II).
   jacobian_<sys>.png          paper Figs. 10/12: kappa [1], sigma_max [1/s], rho [1] of the learned
                               field's Jacobian at each validation point, median over seeds with the
                               interquartile band; one row per regularizer present (Study III),
@@ -85,6 +91,10 @@ STUDY_KEYS = {"n_train": "n_train", "sizes": "size", "regularizers": "regularize
 AXIS_LABEL = {"n_train": "N_train (training pairs)", "size": "model size",
               "regularizer": "Jacobian regularizer"}
 TRAJECTORY_N_TRAIN = {"harmonic": 25, "duffing": 100, "self-sustained": 25}
+# Paper Fig. 9: the DG model of the family that does best on each system, across sizes, N_train 25.
+SIZE_TRAJECTORY_MODEL = {"harmonic": "PHNN-S-DG", "duffing": "PHNN-S-DG",
+                         "self-sustained": "PHNN-JR-DG"}
+SIZE_STYLES = {"small": "--", "medium": "-.", "large": ":"}
 TRACE_COLUMNS = {"kappa": 4, "sigma_max": 5, "rho": 6, "train": 2, "validation": 3}
 DPI = 110
 
@@ -390,6 +400,54 @@ def trajectories(runs, name, out):
     return written
 
 
+def size_trajectory_rows(runs, system):
+    """Paper Fig. 9's runs: {size: rows} of SIZE_TRAJECTORY_MODEL[system], no regularizer, at the
+    N_train nearest 25 that has more than one size; ({}, None) when no size varies."""
+    model = SIZE_TRAJECTORY_MODEL.get(system)
+    rows = [i for i in runs["rows"] if runs["system"][i] == system and runs["model"][i] == model
+            and runs["regularizer"][i] == "none"]
+    by_n = {}
+    for i in rows:
+        by_n.setdefault(int(runs["n_train"][i]), set()).add(runs["size"][i])
+    candidates = [n for n, sizes in by_n.items() if len(sizes) > 1]
+    if not candidates:
+        return {}, None
+    n_train = min(candidates, key=lambda n: (abs(n - 25), n))
+    rows = [i for i in rows if runs["n_train"][i] == n_train]
+    sizes = column_order(runs, "size", rows, {}, "")
+    return {z: [i for i in rows if runs["size"][i] == z] for z in sizes}, n_train
+
+
+def size_trajectories(runs, name, out):
+    """Paper Fig. 9: one model's median-MSE seed at each size, from H(x0) = 0.5 and 0.75 J."""
+    written = []
+    for system in ordered_systems(runs, runs["rows"]):
+        groups, n_train = size_trajectory_rows(runs, system)
+        picks = {z: median_seed_row(runs, rows) for z, rows in groups.items()}
+        picks = {z: i for z, i in picks.items() if i is not None}
+        if len(picks) < 2:
+            continue
+        model = SIZE_TRAJECTORY_MODEL[system]
+        fig, axes = plt.subplots(2, 3, figsize=(13, 7))
+        for r, energy in enumerate(("05", "075")):
+            draw_reference(runs, axes[r], next(iter(picks.values())), energy)
+            for size, i in picks.items():
+                cell = [runs["mse"][j] for j in groups[size]
+                        if runs["status"][j] in (DONE, DIVERGED)]
+                median = float(np.median(np.nan_to_num(cell, nan=np.inf)))
+                draw_prediction(runs, axes[r], i, energy, model, median,
+                                label_prefix=f"{size}: ", linestyle=SIZE_STYLES.get(size, "--"))
+            axes[r, 0].set_ylabel(f"H(x0) = {0.5 if energy == '05' else 0.75} J\nq [m]")
+        axes[0, 2].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+        rows = [i for r in groups.values() for i in r]
+        suptitle(fig, f"{name}: {system}, {model} at each model size, no regularizer, "
+                 f"N_train = {n_train} (paper Fig. 9); n = {seeds_per_cell(runs, rows)} seeds per size",
+                 f"reference vs the model at its median-MSE seed per size (named in the legend); "
+                 f"{status_note(runs, rows)}")
+        written.append(save(fig, out, f"trajectories_sizes_{system}.png"))
+    return written
+
+
 def trajectory(runs, i, key, column):
     length = int(runs["length"][i][column])
     return runs[key][i][:length]
@@ -411,14 +469,14 @@ def draw_reference(runs, axes, i, energy):
         ax.grid(alpha=0.3)
 
 
-def draw_prediction(runs, axes, i, energy, model, median):
+def draw_prediction(runs, axes, i, energy, model, median, label_prefix="", linestyle="--"):
     """Model rollout of row i; a rollout that turns non-finite is drawn up to there and noted."""
     pred = trajectory(runs, i, "prediction_" + energy, 0 if energy == "05" else 1)
     t = np.arange(len(pred)) / float(canonical_value(runs, i, "sample_rate", 100))
     finite = np.all(np.isfinite(pred), axis=1)
-    label = (f"{model}, seed {int(runs['seed'][i])} (MSE {runs['mse'][i]:.2g}; "
+    label = (f"{label_prefix}{model}, seed {int(runs['seed'][i])} (MSE {runs['mse'][i]:.2g}; "
              f"cell median {median:.2g})")
-    style = {"color": colour(model), "lw": 1.3, "ls": "--", "label": label}
+    style = {"color": colour(model), "lw": 1.3, "ls": linestyle, "label": label}
     axes[0].plot(t[finite], pred[finite, 0], **style)
     axes[1].plot(t[finite], pred[finite, 1], **style)
     axes[2].plot(pred[finite, 0], pred[finite, 1], **style)
@@ -624,7 +682,7 @@ def main():
     written = []
     for make in (mse_boxplots,):
         written += make(runs, name, sweep, out)
-    for make in (trajectories, jacobian_traces, loss_curves, time_vs_error):
+    for make in (trajectories, size_trajectories, jacobian_traces, loss_curves, time_vs_error):
         written += make(runs, name, out)
     written += energies(runs, path, name, out)
     c = Counter(int(s) for s in runs["status"])

@@ -4,7 +4,7 @@
     /usr/bin/python3 tests/analysis/make_fixture.py OUT.h5
 
 Two systems, models node-rk2, phnn-s-dg, phnn-jr-rk4, phnn-s-dg4, three seeds, Study I (n_train
-25, 100, 400) and Study III (none, cn), with every status: done, done with MSE = +inf (a diverged
+25, 100, 400), Study II (small, medium) and Study III (none, cn), with every status: done, done with MSE = +inf (a diverged
 rollout), diverged (training), failed and pending.  Numbers are random, not physics.
 """
 import sys
@@ -24,6 +24,9 @@ seeds = [0, 1, 2]
 [study.I]
 title = "Impact of the number of training points"
 n_train = [25, 100, 400]
+[study.II]
+title = "Impact of the model size"
+sizes = ["small", "medium"]
 [study.III]
 title = "Impact of the Jacobian regularization"
 regularizers = ["none", "cn"]
@@ -34,10 +37,13 @@ def run_list():
     runs = []
     for system in SYSTEMS:
         for model, integrator in MODELS:
-            for n_train, reg, studies in ((25, "none", "I,III"), (100, "none", "I"),
-                                          (400, "none", "I"), (25, "cn", "III")):
+            for n_train, reg, studies, size in ((25, "none", "I,II,III", "small"),
+                                                (100, "none", "I", "small"),
+                                                (400, "none", "I", "small"),
+                                                (25, "cn", "III", "small"),
+                                                (25, "none", "II", "medium")):
                 for seed in range(3):
-                    runs.append((system, model, integrator, n_train, reg, studies, seed))
+                    runs.append((system, model, integrator, n_train, reg, studies, seed, size))
     return runs
 
 
@@ -80,8 +86,8 @@ def main(path):
         for k, col in (("system", 0), ("model", 1), ("integrator", 2), ("regularizer", 4),
                        ("studies", 5)):
             g[k] = np.array([r[col].encode() for r in runs], dtype="S32")
-        g["size"] = np.array([b"small"] * R, dtype="S32")
-        g["canonical"] = np.array([f"system={r[0]};sample_rate=100;seed={r[6]}".encode()
+        g["size"] = np.array([r[7].encode() for r in runs], dtype="S32")
+        g["canonical"] = np.array([f"system={r[0]};size={r[7]};sample_rate=100;seed={r[6]}".encode()
                                    for r in runs], dtype="S1024")
         g["n_train"] = np.array([r[3] for r in runs], dtype=np.int64)
         g["seed"] = np.array([r[6] for r in runs], dtype=np.int64)

@@ -20,8 +20,8 @@ trap 'rm -rf "$out"' EXIT
 "$py" "$here/test_cost_model_check.py"
 "$py" "$here/make_fixture.py" "$out/fixture.h5"
 "$py" "$root/analysis/plot_results.py" "$out/fixture.h5" "$out/fig"
-for f in mse_I_harmonic mse_III_duffing trajectories_harmonic jacobian_duffing loss_harmonic \
-         time_vs_error_duffing; do
+for f in mse_I_harmonic mse_II_duffing mse_III_duffing trajectories_harmonic \
+         trajectories_sizes_duffing jacobian_duffing loss_harmonic time_vs_error_duffing; do
     test -s "$out/fig/$f.png" || { echo "missing $f.png" >&2; exit 1; }
 done
 if [ $# -ge 2 ]; then

@@ -63,5 +63,19 @@ class Labels(unittest.TestCase):
                          "(MSE = +inf), 1 failed (not drawn), 2 pending (not drawn)")
 
 
+class SizeTrajectories(unittest.TestCase):
+    def test_the_papers_model_at_each_size_nearest_n_train_25(self):
+        runs = runs_of(system=["duffing"] * 6 + ["self-sustained"] * 2,
+                       model=["PHNN-S-DG"] * 5 + ["PHNN-S-RK2"] + ["PHNN-JR-DG"] * 2,
+                       regularizer=["none"] * 4 + ["cn", "none", "none", "none"],
+                       size=["large", "small", "small", "medium", "medium", "medium",
+                             "small", "small"],
+                       n_train=[100, 100, 400, 100, 100, 100, 25, 25])
+        groups, n_train = pr.size_trajectory_rows(runs, "duffing")
+        self.assertEqual(n_train, 100)  # the only N_train with more than one size
+        self.assertEqual(groups, {"small": [1], "medium": [3], "large": [0]})  # cn, RK2 left out
+        self.assertEqual(pr.size_trajectory_rows(runs, "self-sustained"), ({}, None))
+
+
 if __name__ == "__main__":
     unittest.main()
