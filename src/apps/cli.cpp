@@ -3,6 +3,7 @@
 #include "apps/cli.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -98,6 +99,14 @@ void Parser::check_parsed() const {
     const bool is_flag = o->get_expected_max() == 0;  // CLI11 takes --quiet=abc as a value
     for (const std::string& value : o->results()) {
       if (is_flag && value != "true") throw usage(o->get_name() + " takes no value");
+      // "--out --quiet": CLI11 takes the next option as the value; a value that
+      // names one of this command's options is a forgotten value, not a file.
+      const std::string as_name = value.substr(0, value.find('='));
+      if (!is_flag && !o->get_positional() &&
+          std::find(names.begin(), names.end(), as_name) != names.end()) {
+        throw usage(o->get_name() + " needs a value (got the option " + as_name +
+                    "; a file of that name is ./" + value + ")");
+      }
     }
   }
 }

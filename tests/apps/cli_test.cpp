@@ -163,6 +163,21 @@ TEST(CliTest, FlagsTakeNoValueAndExtraPositionalsAreRefused) {
             "phnn reduce: unexpected argument \"b.h5\"; see `phnn reduce --help`");
 }
 
+// "--out --quiet" forgot the file name: CLI11 would take --quiet as it.
+TEST(CliTest, AnOptionIsNotTakenAsTheValueOfTheOneBefore) {
+  auto parser = train_parser();
+  EXPECT_EQ(usage_error(parser.get(), {"--system", "harmonic", "--out", "--quiet"}),
+            "phnn train: --out needs a value (got the option --quiet; a file of that name is "
+            "./--quiet)");
+  auto steps = train_parser();
+  EXPECT_EQ(usage_error(steps.get(), {"--system", "--steps=10"}),
+            "phnn train: --system needs a value (got the option --steps; a file of that name is "
+            "./--steps=10)");
+  auto fine = train_parser();  // a value that merely starts with dashes is kept
+  parse(fine.get(), {"--system", "harmonic", "--out", "./--quiet"});
+  EXPECT_EQ(fine->get("out"), "./--quiet");
+}
+
 TEST(CliTest, PositionalRestTakesEveryFurtherArgument) {
   auto merge_parser = [] {
     auto parser = std::make_unique<Parser>("merge", "Merges shards.");
