@@ -3,7 +3,8 @@
 
     /usr/bin/python3 analysis/compare_ablation.py results/ablation-duffing-baseline.h5 \\
         "loss_norm = mse=results/ablation-duffing.h5" \\
-        "dg_structure_point = start=results/ablation-duffing-dg-start.h5" [--threshold 1.0]
+        "dg_structure_point = start=results/ablation-duffing-dg-start.h5" \\
+        "precision = float32=results/ablation-duffing-float32.h5" [--threshold 1.0]
 
 For every (system, model, N_train) cell of the baseline, prints a Markdown row: the baseline's
 median MSE with its bootstrap 95 % interval and the seeds above THRESHOLD (the Duffing oscillator's

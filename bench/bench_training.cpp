@@ -6,6 +6,9 @@
 //                                      torch::nn + autograd create_graph for gradH
 //   bench_training compare [repeats] [size]  fused vs reference networks,
 //                                      interleaved, E = 10
+//   bench_training precision [repeats] float32 training (reference networks)
+//                                      vs float64 fused and reference, the
+//                                      four PHNNs of the ablation, E = 10
 //   bench_training run MODEL INTEGRATOR REG STEPS [SIZE] [N_TRAIN]   one cell, E = 10
 //                                      (for perf; PHNN_REFERENCE_NETWORKS=1
 //                                      selects the reference networks)
@@ -104,6 +107,44 @@ int compare(int repeats, phnn::ModelSize size) {
                   fused, ref / fused);
       std::fflush(stdout);
     }
+  }
+  return 0;
+}
+
+// Float32 training (`[training] precision`, always on the reference
+// networks) against float64 on the fused and on the reference networks,
+// interleaved run by run (small, E = 10, batch 64, no regularizer): the
+// cost of the precision ablation, and how much of it is the network path.
+int precision(int repeats) {
+  std::printf("small, E = 10, µs per member-step, median of %d interleaved runs\n", repeats);
+  std::printf("| model | float64 fused | float64 reference | float32 | float32 / float64 fused |\n"
+              "|---|---|---|---|---|\n");
+  const std::pair<phnn::ModelKind, phnn::IntegratorKind> models[] = {
+      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnJr, phnn::IntegratorKind::kDg},
+      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kRk2},
+      {phnn::ModelKind::kPhnnS, phnn::IntegratorKind::kDg}};
+  for (const auto& [model, integrator] : models) {
+    CellSpec cell;
+    cell.model = model;
+    cell.integrator = integrator;
+    cell.n_train = 64;
+    cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+    std::vector<double> samples[3];
+    for (int r = 0; r < repeats; ++r) {
+      for (int variant = 0; variant < 3; ++variant) {
+        cell.fused_networks = variant == 0;
+        cell.training.precision =
+            variant == 2 ? phnn::Precision::kFloat32 : phnn::Precision::kFloat64;
+        const double t_short = time_cell(cell, 200), t_long = time_cell(cell, 1200);
+        samples[variant].push_back((t_long - t_short) / (1000.0 * 10.0) * 1e6);
+      }
+    }
+    const double fused = median(samples[0]), reference = median(samples[1]),
+                 f32 = median(samples[2]);
+    std::printf("| %s | %.0f | %.0f | %.0f | %.2fx |\n",
+                phnn::model_label(model, integrator).c_str(), fused, reference, f32, f32 / fused);
+    std::fflush(stdout);
   }
   return 0;
 }
@@ -272,6 +313,7 @@ int main(int argc, char** argv) {
     return compare(repeats, phnn::parse_size(argc > 3 ? argv[3] : "small"));
   }
   if (mode == "baseline") return baseline(repeats);
+  if (mode == "precision") return precision(repeats);
   if (mode == "cell") return full_cell();
   std::fprintf(stderr, "usage: bench_training stacked|baseline|cell [repeats]\n");
   return 2;

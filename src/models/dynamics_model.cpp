@@ -53,7 +53,7 @@ DynamicsModel::FlatParameters DynamicsModel::flatten_parameters() {
   const std::vector<torch::Tensor> params = parameters();
   int64_t total = 0;
   for (const auto& p : params) total += p.numel();
-  FlatParameters flat{torch::empty({total}, torch::kFloat64), torch::zeros({total}, torch::kFloat64)};
+  FlatParameters flat{torch::empty({total}, options_.dtype), torch::zeros({total}, options_.dtype)};
   {
     torch::NoGradGuard no_grad;
     int64_t offset = 0;

@@ -203,10 +203,11 @@ void add_networks(std::vector<std::unique_ptr<StackedMlp>>* nets, const ModelOpt
                   const std::vector<int>& dissipation_hidden, int dissipation_out,
                   std::uint64_t dissipation_stream) {
   nets->push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{2, network_widths(options.size).l_h, 3, options.fused_networks}, seeds, kStreamLH));
+      StackedMlpOptions{2, network_widths(options.size).l_h, 3, options.fused_networks,
+                        options.dtype}, seeds, kStreamLH));
   nets->push_back(std::make_unique<StackedMlp>(
       StackedMlpOptions{dissipation_in, dissipation_hidden, dissipation_out,
-                        options.fused_networks}, seeds,
+                        options.fused_networks, options.dtype}, seeds,
       dissipation_stream));
 }
 }  // namespace
@@ -249,11 +250,12 @@ PhnnJr::PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds)
   const Eigen::Matrix3d J = structure.J();
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) J_[r][c] = J(r, c);
-  j_matrix_ = torch::zeros({3, 3}, torch::kFloat64);
+  // Entries 0, +-1: exact in either dtype.
+  j_matrix_ = torch::zeros({3, 3}, options.dtype);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) j_matrix_[r][c] = J_[r][c];
   // Output k of L_R goes to row-major lower-triangle entry (row, col).
-  placement_ = torch::zeros({6, 9}, torch::kFloat64);
+  placement_ = torch::zeros({6, 9}, options.dtype);
   int k = 0;
   for (int row = 0; row < 3; ++row)
     for (int col = 0; col <= row; ++col) placement_[k++][3 * row + col] = 1.0;
@@ -320,7 +322,8 @@ Node::Node(ModelOptions options, const std::vector<std::uint64_t>& seeds)
     : DynamicsModel(options, static_cast<int64_t>(seeds.size())) {
   PHNN_REQUIRE(options.kind == ModelKind::kNode, "Node: options.kind must be node");
   nets_.push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{3, network_widths(options.size).node, 2, options.fused_networks}, seeds, kStreamNode));
+      StackedMlpOptions{3, network_widths(options.size).node, 2, options.fused_networks,
+                        options.dtype}, seeds, kStreamNode));
 }
 
 FieldEval Node::field(const torch::Tensor& x, const torch::Tensor& u, bool with_jacobian) const {

@@ -8,18 +8,32 @@ namespace phnn {
 namespace internal {
 namespace {
 
+// dgemm_ / sgemm_ by the element type (float: float32 training).
+void gemm(const char* ta, const char* tb, const int* m, const int* n, const int* k,
+          const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
+          const double* beta, double* c, const int* ldc) {
+  dgemm_(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc);
+}
+void gemm(const char* ta, const char* tb, const int* m, const int* n, const int* k,
+          const float* alpha, const float* a, const int* lda, const float* b, const int* ldb,
+          const float* beta, float* c, const int* ldc) {
+  sgemm_(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc);
+}
+
 // A row-major [rows x cols] matrix inside a 3-D tensor: plain (row stride
 // ld, unit column stride) or the transpose of a plain [cols x rows] matrix.
+template <typename T>
 struct Operand {
   torch::Tensor keep;  // owns the data if a contiguous copy was needed
-  const double* data = nullptr;
+  const T* data = nullptr;
   int64_t member_stride = 0;
   int ld = 0;
   bool transposed = false;
 };
 
-Operand describe(const torch::Tensor& t) {
-  Operand op;
+template <typename T>
+Operand<T> describe(const torch::Tensor& t) {
+  Operand<T> op;
   const int64_t rows = t.size(1), cols = t.size(2);
   if (t.stride(2) == 1 && t.stride(1) >= std::max<int64_t>(cols, 1)) {
     op.keep = t;
@@ -32,9 +46,26 @@ Operand describe(const torch::Tensor& t) {
     op.keep = t.contiguous();
     op.ld = static_cast<int>(std::max<int64_t>(cols, 1));
   }
-  op.data = op.keep.data_ptr<double>();
+  op.data = op.keep.template data_ptr<T>();
   op.member_stride = op.keep.stride(0);
   return op;
+}
+
+// One gemm per member into c [E, R, N] (T = double or float).
+template <typename T>
+void member_products(const torch::Tensor& a, const torch::Tensor& b, torch::Tensor* c) {
+  const int64_t E = a.size(0), R = a.size(1), K = a.size(2), N = b.size(2);
+  const Operand<T> A = describe<T>(a), B = describe<T>(b);
+  // Row-major C = A B is column-major C^T = B^T A^T.
+  const char ta = A.transposed ? 'T' : 'N', tb = B.transposed ? 'T' : 'N';
+  const int m = static_cast<int>(N), n = static_cast<int>(R), k = static_cast<int>(K);
+  const int ldc = static_cast<int>(N);
+  const T one = 1, zero = 0;
+  T* out = c->data_ptr<T>();
+  for (int64_t e = 0; e < E; ++e) {
+    gemm(&tb, &ta, &m, &n, &k, &one, B.data + e * B.member_stride, &B.ld,
+         A.data + e * A.member_stride, &A.ld, &zero, out + e * R * N, &ldc);
+  }
 }
 
 torch::Tensor forward_product(const torch::Tensor& a, const torch::Tensor& b) {
@@ -42,22 +73,18 @@ torch::Tensor forward_product(const torch::Tensor& a, const torch::Tensor& b) {
               a.sizes(), " and ", b.sizes());
   TORCH_CHECK(a.size(0) == b.size(0) && a.size(2) == b.size(1),
               "stacked_matmul: shapes do not match: ", a.sizes(), " @ ", b.sizes());
-  TORCH_CHECK(a.scalar_type() == torch::kFloat64 && b.scalar_type() == torch::kFloat64,
-              "stacked_matmul: expected float64 operands");
+  const bool f64 = a.scalar_type() == torch::kFloat64 && b.scalar_type() == torch::kFloat64;
+  const bool f32 = a.scalar_type() == torch::kFloat32 && b.scalar_type() == torch::kFloat32;
+  TORCH_CHECK(f64 || f32, "stacked_matmul: expected two float64 or two float32 operands, got ",
+              a.scalar_type(), " and ", b.scalar_type());
   const int64_t E = a.size(0), R = a.size(1), K = a.size(2), N = b.size(2);
   auto c = torch::empty({E, R, N}, a.options());
   if (R == 0 || N == 0) return c;
   if (K == 0) return c.zero_();
-  const Operand A = describe(a), B = describe(b);
-  // Row-major C = A B is column-major C^T = B^T A^T.
-  const char ta = A.transposed ? 'T' : 'N', tb = B.transposed ? 'T' : 'N';
-  const int m = static_cast<int>(N), n = static_cast<int>(R), k = static_cast<int>(K);
-  const int ldc = static_cast<int>(N);
-  const double one = 1.0, zero = 0.0;
-  double* out = c.data_ptr<double>();
-  for (int64_t e = 0; e < E; ++e) {
-    dgemm_(&tb, &ta, &m, &n, &k, &one, B.data + e * B.member_stride, &B.ld,
-           A.data + e * A.member_stride, &A.ld, &zero, out + e * R * N, &ldc);
+  if (f64) {
+    member_products<double>(a, b, &c);
+  } else {
+    member_products<float>(a, b, &c);
   }
   return c;
 }

@@ -156,8 +156,16 @@ StackedMlp::StackedMlp(StackedMlpOptions options, const std::vector<std::uint64_
       for (int64_t j = 0; j < b.size(2); ++j) b[e][0][j] = rng.uniform(-bound, bound);
     }
   }
-  for (auto& w : weights_) w.set_requires_grad(true);
-  for (auto& b : biases_) b.set_requires_grad(true);
+  // float32: the float64 draws rounded (a no-op for float64).
+  PHNN_REQUIRE(options_.dtype == torch::kFloat64 ||
+                   (options_.dtype == torch::kFloat32 && !options_.fused),
+               "StackedMlp: the fused networks are float64 only; float32 needs fused = false");
+  for (auto* params : {&weights_, &biases_}) {
+    for (auto& p : *params) {
+      p = p.to(options_.dtype);
+      p.set_requires_grad(true);
+    }
+  }
 }
 
 torch::Tensor StackedMlp::forward(const torch::Tensor& x) const {

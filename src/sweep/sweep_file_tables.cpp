@@ -3,6 +3,7 @@
 // (OscillatorOptions, DatasetOptions, TrainerOptions, the grid axes): unknown
 // tables and keys, whole-struct validation at the key a message names, and the
 // studies' inheritance from [grid] (split from the values: this file knows keys).
+// Size: one handler per key of the format; the keys and their cross-checks stay together.
 #include "sweep/sweep_file_tables.h"
 
 #include <algorithm>
@@ -352,6 +353,7 @@ class TableWalker {
             {"lambda_sn", number(t.lambda_sn)},
             {"lambda_sr", number(t.lambda_sr)},
             {"loss_norm", choice(t.loss_norm, &all_loss_norms)},
+            {"precision", choice(t.precision, &all_precisions)},
             {"jacobian_eps", number(t.jacobian_eps)},
             {"newton_tolerance", number(t.newton_tolerance)},
             {"newton_max_iterations", integer(t.newton_max_iterations, 1)},

@@ -54,10 +54,9 @@ std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemDat
     throw std::invalid_argument("load_member: expected one seed, got " +
                                 std::to_string(cell.seeds.size()));
   }
-  auto model = DynamicsModel::create(
-      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks,
-                   cell.training.dg_structure_point},
-      {static_cast<std::uint64_t>(cell.seeds[0])});
+  // The trainer's inference model (float64 whatever the training precision).
+  auto model = DynamicsModel::create(inference_model_options(cell, data),
+                                     {static_cast<std::uint64_t>(cell.seeds[0])});
   if (static_cast<long>(weights.size()) != model->parameter_count()) {
     throw std::invalid_argument("load_member: " + std::to_string(weights.size()) +
                                 " stored weights, the model has " +

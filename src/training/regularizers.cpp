@@ -1,10 +1,18 @@
 // src/training/regularizers.cpp
 #include "phnn/training/regularizers.h"
 
+#include <limits>
+
 namespace phnn {
 namespace {
 // sqrt with a finite derivative at 0 (the clamped branch has zero slope).
-torch::Tensor safe_sqrt(const torch::Tensor& s) { return torch::sqrt(s.clamp_min(1e-300)); }
+// The floor is a positive normal number of the dtype: 1e-300 would round to 0
+// in float32 (float32 training), where sqrt has an infinite slope.
+torch::Tensor safe_sqrt(const torch::Tensor& s) {
+  const double floor =
+      s.scalar_type() == torch::kFloat32 ? std::numeric_limits<float>::min() : 1e-300;
+  return torch::sqrt(s.clamp_min(floor));
+}
 }  // namespace
 
 JacobianStats jacobian_stats(const torch::Tensor& jacobian, double eps) {

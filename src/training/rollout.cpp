@@ -48,7 +48,14 @@ std::vector<double> reference_trajectory(const OscillatorOptions& system,
   return out;
 }
 
+ModelOptions inference_model_options(const CellSpec& cell, const SystemData& data) {
+  return ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks,
+                      cell.training.dg_structure_point, torch::kFloat64};
+}
+
 Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const SystemData& data) {
+  PHNN_CHECK(model_ref.options().dtype == torch::kFloat64,
+             "roll_out: inference is float64; got a " << model_ref.options().dtype << " model");
   torch::NoGradGuard no_grad;
   const DynamicsModel* model = &model_ref;
   const TrainerOptions& opt = cell.training;

@@ -15,9 +15,15 @@
 
 namespace phnn {
 
+// The model a cell rolls out: float64, on the cell's network path
+// (CellSpec::fused_networks), whatever the training precision (float32
+// training hands over its best weights upcast, docs/DECISIONS.md), so the
+// trainer's inference and `phnn eval` (load_member) build it alike.
+ModelOptions inference_model_options(const CellSpec& cell, const SystemData& data);
+
 // The autoregressive rollouts of Eq. 31 for every member of the stack:
 // the inference trajectories, then the two figure trajectories (rows B_inf,
-// B_inf + 1), from the model's current weights.
+// B_inf + 1), from the model's current weights (a float64 model).
 struct Rollouts {
   torch::Tensor sq_err;           // [E, B_inf]: sum over steps of |x - x_ref|^2
   torch::Tensor diverged;         // [E, B_inf + 2]

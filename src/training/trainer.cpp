@@ -1,6 +1,7 @@
 // src/training/trainer.cpp — train_cell as CellTrainer's phases: prepare,
 // step / validate / checkpoint, finish (the rollouts are in rollout.cpp, the
-// minibatch order in batch_sampler.h, CellSpec's checks in cell_spec.cpp).
+// minibatch order in batch_sampler.h, CellSpec's checks in cell_spec.cpp),
+// in the training precision (float64, or float32 with float64 inference).
 #include "phnn/training/trainer.h"
 
 #include <algorithm>
@@ -27,27 +28,33 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-torch::Tensor to_tensor(const std::vector<Vec2>& v, std::size_t count) {
+// The first `count` values in `dtype` (float32: the float64 data rounded).
+torch::Tensor to_tensor(const std::vector<Vec2>& v, std::size_t count, torch::ScalarType dtype) {
   auto t = torch::empty({static_cast<int64_t>(count), 2}, torch::kFloat64);
   auto a = t.accessor<double, 2>();
   for (std::size_t i = 0; i < count; ++i) {
     a[static_cast<int64_t>(i)][0] = v[i](0);
     a[static_cast<int64_t>(i)][1] = v[i](1);
   }
-  return t;
+  return t.to(dtype);
 }
 
-torch::Tensor to_tensor(const std::vector<double>& v, std::size_t count) {
-  return torch::tensor(std::vector<double>(v.begin(), v.begin() + static_cast<long>(count)),
-                       torch::kFloat64)
+torch::Tensor to_tensor(const std::vector<double>& v, std::size_t count, torch::ScalarType dtype) {
+  return torch::tensor(std::vector<double>(v.begin(), v.begin() + static_cast<long>(count)), dtype)
       .unsqueeze(-1);
 }
 
-
-}  // namespace
-
-
-namespace {
+// The model a cell trains: the inference model (float64) unless training is
+// float32, which runs on the reference networks (the fused kernels are
+// float64 only) with the float64 initialization rounded.
+ModelOptions training_model_options(const CellSpec& cell, const SystemData& data) {
+  ModelOptions options = inference_model_options(cell, data);
+  if (cell.training.precision == Precision::kFloat32) {
+    options.dtype = torch::kFloat32;
+    options.fused_networks = false;
+  }
+  return options;
+}
 
 // One cell's training as named phases (docs: the trainer in one sitting):
 //   CellTrainer trainer(cell, data, progress);   // prepare: model, Adam, tensors
@@ -61,7 +68,10 @@ class CellTrainer {
 
   void train();
   std::vector<RunResult> finish();
-  std::unique_ptr<DynamicsModel> release_model() { return std::move(model_); }
+  // The float64 stack the rollouts used, with the best weights.
+  std::unique_ptr<DynamicsModel> release_model() {
+    return std::move(inference_model_ ? inference_model_ : model_);
+  }
 
  private:
   // The data of the cell as tensors; *_all / validation ones expanded over
@@ -85,6 +95,9 @@ class CellTrainer {
   void freeze_non_finite(const torch::Tensor& loss, int step, std::vector<int64_t>* dead);
   void validate(int step);
   void report_progress(int step, std::vector<double> live_best) const;
+  // Rollouts of the best weights so far, in float64: in the training model (the caller
+  // restores its weights if training goes on) or, after float32 training, inference_model_.
+  Rollouts roll_out_best();
   void checkpoint(int step);
   double train_seconds_per_run() const {
     return (elapsed() - checkpoint_overhead_s_) / static_cast<double>(E_);
@@ -100,6 +113,8 @@ class CellTrainer {
   const int64_t E_;
   const double h_;
   std::unique_ptr<DynamicsModel> model_;
+  // float32 training only: the float64 stack the rollouts use.
+  std::unique_ptr<DynamicsModel> inference_model_;
   DynamicsModel::FlatParameters flat_;
   std::vector<torch::Tensor> params_, grads_;  // alias flat_.values / gradients
   std::unique_ptr<FlatAdam> adam_;
@@ -117,10 +132,10 @@ CellTrainer::CellTrainer(const CellSpec& cell, const SystemData& data,
     : cell_(cell), data_(data), opt_(cell.training), progress_(progress),
       E_(static_cast<int64_t>(cell.seeds.size())), h_(data.train.step) {
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
-  model_ = DynamicsModel::create(
-      ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks,
-                   cell.training.dg_structure_point},
-      seeds);
+  model_ = DynamicsModel::create(training_model_options(cell, data), seeds);
+  if (model_->options().dtype != torch::kFloat64) {
+    inference_model_ = DynamicsModel::create(inference_model_options(cell, data), seeds);
+  }
   // One contiguous leaf for the whole stack: Adam in a handful of ops.
   flat_ = model_->flatten_parameters();
   params_ = model_->parameters();
@@ -141,16 +156,17 @@ CellTrainer::CellTrainer(const CellSpec& cell, const SystemData& data,
 CellTrainer::Tensors CellTrainer::make_tensors() const {
   const auto N = static_cast<std::size_t>(cell_.n_train);
   const std::size_t V = data_.validation.size();
+  const torch::ScalarType dtype = model_->options().dtype;
   Tensors t;
-  t.x = to_tensor(data_.train.x, N);
-  t.x_next = to_tensor(data_.train.x_next, N);
-  t.u = to_tensor(data_.train.u, N);
+  t.x = to_tensor(data_.train.x, N, dtype);
+  t.x_next = to_tensor(data_.train.x_next, N, dtype);
+  t.u = to_tensor(data_.train.u, N, dtype);
   t.x_all = t.x.unsqueeze(0).expand({E_, -1, -1});
   t.x_next_all = t.x_next.unsqueeze(0).expand({E_, -1, -1});
   t.u_all = t.u.unsqueeze(0).expand({E_, -1, -1});
-  t.xv = to_tensor(data_.validation.x, V).unsqueeze(0).expand({E_, -1, -1});
-  t.xv_next = to_tensor(data_.validation.x_next, V).unsqueeze(0).expand({E_, -1, -1});
-  t.uv = to_tensor(data_.validation.u, V).unsqueeze(0).expand({E_, -1, -1});
+  t.xv = to_tensor(data_.validation.x, V, dtype).unsqueeze(0).expand({E_, -1, -1});
+  t.xv_next = to_tensor(data_.validation.x_next, V, dtype).unsqueeze(0).expand({E_, -1, -1});
+  t.uv = to_tensor(data_.validation.u, V, dtype).unsqueeze(0).expand({E_, -1, -1});
   return t;
 }
 
@@ -283,19 +299,27 @@ void CellTrainer::report_progress(int step, std::vector<double> live_best) const
   progress_(p);
 }
 
+Rollouts CellTrainer::roll_out_best() {
+  torch::NoGradGuard no_grad;
+  const std::vector<torch::Tensor> target =
+      inference_model_ ? inference_model_->parameters() : params_;
+  for (std::size_t k = 0; k < target.size(); ++k) target[k].copy_(best_[k]);
+  return roll_out(inference_model_ ? *inference_model_ : *model_, cell_, data_);
+}
+
 // Inference of the best weights so far at a step budget; the training
-// weights are restored bitwise, so training goes on unchanged.
+// weights are restored bitwise (or untouched: float32 training rolls out
+// inference_model_), so training goes on unchanged.
 void CellTrainer::checkpoint(int step) {
   const auto begin = Clock::now();
   const double train_s = train_seconds_per_run();
   torch::NoGradGuard no_grad;
   std::vector<torch::Tensor> current;
-  for (std::size_t k = 0; k < params_.size(); ++k) {
-    current.push_back(params_[k].detach().clone());
-    params_[k].copy_(best_[k]);
+  if (!inference_model_) {
+    for (const torch::Tensor& p : params_) current.push_back(p.detach().clone());
   }
-  const std::vector<double> mse = member_mse(roll_out(*model_, cell_, data_));
-  for (std::size_t k = 0; k < params_.size(); ++k) params_[k].copy_(current[k]);
+  const std::vector<double> mse = member_mse(roll_out_best());
+  for (std::size_t k = 0; k < current.size(); ++k) params_[k].copy_(current[k]);
   for (std::size_t e = 0; e < results_.size(); ++e) {
     results_[e].checkpoint_steps.push_back(step);
     results_[e].checkpoint_mse.push_back(mse[e]);
@@ -308,8 +332,7 @@ void CellTrainer::checkpoint(int step) {
 std::vector<RunResult> CellTrainer::finish() {
   torch::NoGradGuard no_grad;
   const double train_s = train_seconds_per_run();
-  for (std::size_t k = 0; k < params_.size(); ++k) params_[k].copy_(best_[k]);
-  const Rollouts rollouts = roll_out(*model_, cell_, data_);
+  const Rollouts rollouts = roll_out_best();
   const double wall = elapsed();
   const std::vector<double> mse = member_mse(rollouts);
   const FigureReferences references = figure_references(data_);
@@ -337,8 +360,9 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
     r.checkpoint_train_seconds.push_back(train_s);
   }
   fill_figures(rollouts, e, references, &r);
+  // The weights the rollouts used (float32 training: upcast, exactly).
   for (const torch::Tensor& best : best_) {
-    const torch::Tensor w = best[e].contiguous();
+    const torch::Tensor w = best[e].to(torch::kFloat64).contiguous();
     r.weights.insert(r.weights.end(), w.data_ptr<double>(), w.data_ptr<double>() + w.numel());
   }
   r.status = RunStatus::kDone;

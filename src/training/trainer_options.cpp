@@ -40,6 +40,16 @@ std::vector<LossNorm> all_loss_norms() {
   return {LossNorm::kMeanL1, LossNorm::kSumL1, LossNorm::kMse};
 }
 
+std::string to_string(Precision precision) {
+  switch (precision) {
+    case Precision::kFloat64: return "float64";
+    case Precision::kFloat32: return "float32";
+  }
+  return "unknown";
+}
+
+std::vector<Precision> all_precisions() { return {Precision::kFloat64, Precision::kFloat32}; }
+
 std::string to_string(RunStatus status) {
   switch (status) {
     case RunStatus::kPending: return "pending";

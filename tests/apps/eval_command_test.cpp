@@ -131,6 +131,37 @@ TEST_F(EvalCommandTest, SweepFileSettingsReachTheReloadedModel) {
   testing_util::run_shell("rm -rf " + out_ + ".journal " + out_ + ".lock", &log);
 }
 
+// Float32 training: the stored weights are the float32 best weights upcast
+// (each a float32 value), and `phnn eval` rebuilds the same float64
+// inference model from them, so the stored MSE reproduces bitwise (DG
+// Newton, RK2 and the fourth-order DG4).
+TEST_F(EvalCommandTest, Float32RunsReproduceTheirStoredMseBitwise) {
+  const std::string sweep = out_ + ".toml";
+  {
+    std::ofstream s(sweep);
+    s << "name = \"eval-float32\"\n[data]\nnum_validation = 50\nnum_inference = 5\n"
+         "[training]\nsteps = 20\neval_every = 10\nprecision = \"float32\"\n"
+         "[grid]\nsystems = [\"duffing\"]\n"
+         "models = [\"phnn-jr-dg\", \"phnn-s-rk2\", \"phnn-jr-dg4\"]\nseeds = [0, 1]\n";
+  }
+  std::string log;
+  ASSERT_EQ(run("sweep " + sweep + " --out " + out_ + " --quiet", &log), 0) << log;
+  const ResultsFile file = ResultsFile::open_read_only(out_);
+  const std::vector<std::string> ids = file.read_run_ids();
+  ASSERT_EQ(ids.size(), 6u);
+  for (std::size_t row = 0; row < ids.size(); ++row) {
+    const RunResult stored = file.read_run(static_cast<int>(row));
+    ASSERT_FALSE(stored.weights.empty());
+    for (double w : stored.weights) {
+      ASSERT_EQ(static_cast<double>(static_cast<float>(w)), w) << ids[row];
+    }
+    EXPECT_EQ(run("eval " + out_ + " --run " + ids[row], &log), 0) << log;
+    EXPECT_THAT(log, HasSubstr("bitwise equal"));
+  }
+  std::remove(sweep.c_str());
+  testing_util::run_shell("rm -rf " + out_ + ".journal " + out_ + ".lock", &log);
+}
+
 TEST_F(EvalCommandTest, UnknownOrMissingRunIsAUsageError) {
   train("harmonic", "phnn-jr-rk2");
   std::string log;

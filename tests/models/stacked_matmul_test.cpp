@@ -1,5 +1,6 @@
 // tests/models/stacked_matmul_test.cpp — the per-member dgemm product against
-// torch::bmm, values and gradients, for plain, transposed and broadcast operands.
+// torch::bmm, values and gradients, for plain, transposed and broadcast operands;
+// the sgemm product of float32 training.
 #include "models/stacked_matmul.h"
 
 #include <gtest/gtest.h>
@@ -56,8 +57,35 @@ TEST(StackedMatmulTest, RejectsMismatchedShapes) {
   EXPECT_THROW(internal::stacked_matmul(torch::zeros({2, 3, 4}, opts), torch::zeros({2, 5, 1}, opts)),
                c10::Error);
   EXPECT_THROW(internal::stacked_matmul(torch::zeros({2, 3, 4}, torch::kFloat32),
-                                        torch::zeros({2, 4, 1}, torch::kFloat32)),
+                                        torch::zeros({2, 4, 1}, opts)),
                c10::Error);
+  EXPECT_THROW(internal::stacked_matmul(torch::zeros({2, 3, 4}, torch::kInt32),
+                                        torch::zeros({2, 4, 1}, torch::kInt32)),
+               c10::Error);
+}
+
+// float32 operands (float32 training): a float32 product and gradient equal
+// to the float64 product of the same values to float32 round-off (K = 5
+// products of O(1) numbers: ~1e-6), and each member's product bitwise the
+// one it has alone (one sgemm per member), also for a transposed operand.
+TEST(StackedMatmulTest, Float32IsOneSgemmPerMember) {
+  torch::manual_seed(2);
+  const auto a = torch::randn({4, 7, 5}, torch::kFloat32).requires_grad_(true);
+  const auto b = torch::randn({4, 3, 5}, torch::kFloat32).transpose(1, 2);
+  const auto c = internal::stacked_matmul(a, b);
+  ASSERT_EQ(c.scalar_type(), torch::kFloat32);
+  const auto exact = torch::bmm(a.detach().to(torch::kFloat64), b.to(torch::kFloat64));
+  EXPECT_LE(max_abs_diff(c.detach().to(torch::kFloat64), exact), 1e-5);
+  EXPECT_GT(max_abs_diff(c.detach().to(torch::kFloat64), exact), 0.0);
+  for (int64_t e = 0; e < 4; ++e) {
+    const auto alone = internal::stacked_matmul(a.detach().narrow(0, e, 1), b.narrow(0, e, 1));
+    EXPECT_TRUE(torch::equal(alone[0], c.detach()[e])) << e;
+  }
+  const auto g = torch::autograd::grad({c.sum()}, {a})[0];
+  ASSERT_EQ(g.scalar_type(), torch::kFloat32);
+  // d sum(A B) / dA = 1 B^T: each row the column sums of B^T.
+  const auto expected = b.sum(2).unsqueeze(1).expand({4, 7, 5}).to(torch::kFloat64);
+  EXPECT_LE(max_abs_diff(g.to(torch::kFloat64), expected), 1e-5);
 }
 
 }  // namespace

@@ -122,8 +122,9 @@ std::pair<double, double> gonzalez_in(double q, double p, double dq, double dp) 
 // error eps32 |H| / |dx|. At the step sizes of training (|dx| ~ 1e-2 to
 // 1e-4) the discrete gradient is then wrong by 4e-6 to 3e-4 of |gradH| and
 // the step's energy change H(x+dx) - H(x) by as much, where float64 keeps
-// both at ~1e-13 or below (numbers printed). float32 training is therefore
-// not offered (there is no option for it).
+// both at ~1e-13 or below (numbers printed). float64 is therefore the
+// default; float32 training exists only as an ablation
+// (`[training] precision`, docs/DECISIONS.md) to measure what this costs.
 TEST(TrainingStress, Float32DiscreteGradientIsHarmful) {
   std::mt19937_64 gen(11);
   std::uniform_real_distribution<double> c(-0.3, 0.3), angle(0.0, 2.0 * M_PI);

@@ -1,4 +1,5 @@
-// tests/sweep/grid_test.cpp
+// tests/sweep/grid_test.cpp — run ids, cells, costs and columns of expanded grids.
+// Size: one test file per module; the pinned ids and ablation files are its contract.
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/work_plan.h"  // dry_run_summary
 
@@ -354,6 +355,31 @@ TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
     EXPECT_EQ(key, stripped.runs[i].cell_key());
     EXPECT_EQ(stripped.runs[i].id(), baseline.runs[i].id()) << i;
     EXPECT_EQ(paper_ids.count(baseline.runs[i].id()), baseline.runs[i].seed < 10 ? 1u : 0u) << i;
+  }
+}
+
+// sweeps/ablation-duffing-float32.toml likewise: without its precision line
+// its runs are exactly ablation-duffing-baseline.toml's, and with it each
+// cell key differs by exactly ";precision=float32".
+TEST(GridTest, AblationDuffingFloat32SweepChangesOnlyThePrecision) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-duffing-float32.toml");
+  std::string text = spec.text;
+  const std::string line = "precision = \"float32\"\n";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.erase(text.find(line), line.size());
+  const Grid ablation = expand_grid(spec);
+  const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
+  const Grid baseline = expand_grid(parse_sweep_file(kSweeps + "ablation-duffing-baseline.toml"));
+  ASSERT_EQ(ablation.runs.size(), 240u);
+  ASSERT_EQ(stripped.runs.size(), 240u);
+  ASSERT_EQ(baseline.runs.size(), 240u);
+  for (std::size_t i = 0; i < 240; ++i) {
+    std::string key = ablation.runs[i].cell_key();
+    const std::size_t at = key.find(";precision=float32;");
+    ASSERT_NE(at, std::string::npos) << i;
+    key.erase(at, std::string(";precision=float32").size());
+    EXPECT_EQ(key, stripped.runs[i].cell_key()) << i;
+    EXPECT_EQ(stripped.runs[i].id(), baseline.runs[i].id()) << i;
   }
 }
 

@@ -405,6 +405,38 @@ TEST(SweepFileTest, LossNormIsATrainingOption) {
               StartsWith("x.toml:5: loss_norm expects a \"string\", got the integer 2"));
 }
 
+// [training] precision: float64 (default) or float32; it changes every run
+// (every model trains in it), and is part of a run's identity only away from
+// the default, as exactly ";precision=float32".
+TEST(SweepFileTest, PrecisionIsATrainingOption) {
+  const std::string head = "name = \"t\"\n[grid]\nsystems = [\"duffing\"]\nseeds = [0]\n"
+                           "models = [\"phnn-jr-dg\", \"phnn-s-rk2\", \"node-rk4\"]\n"
+                           "[training]\n";
+  const Grid plain = expand_grid(parse_sweep_text(head, "x.toml"));
+  const SweepSpec spec = parse_sweep_text(head + "precision = \"float32\"\n", "x.toml");
+  EXPECT_EQ(spec.training.precision, Precision::kFloat32);
+  const Grid f32 = expand_grid(spec);
+  ASSERT_EQ(f32.runs.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::string key = f32.runs[i].cell_key();
+    const std::size_t at = key.find(";precision=float32;");
+    ASSERT_NE(at, std::string::npos) << key;
+    key.erase(at, std::string(";precision=float32").size());
+    EXPECT_EQ(key, plain.runs[i].cell_key());
+    EXPECT_NE(f32.runs[i].id(), plain.runs[i].id());
+  }
+  const Grid f64 = expand_grid(parse_sweep_text(head + "precision = \"float64\"\n", "x.toml"));
+  EXPECT_EQ(f64.runs[0].id(), plain.runs[0].id());
+  EXPECT_THAT(f64.runs[0].cell_key(), Not(HasSubstr("precision")));
+  EXPECT_STREQ(error_of(head + "steps = 5\nprecision = \"Float32\"\n").what(),
+               "x.toml:8: unknown precision \"Float32\" (did you mean \"float32\"?); expected "
+               "one of: float64, float32");
+  EXPECT_STREQ(error_of(head + "precision = \"double\"\n").what(),
+               "x.toml:7: unknown precision \"double\"; expected one of: float64, float32");
+  EXPECT_THAT(error_of(head + "precision = 32\n").what(),
+              StartsWith("x.toml:7: precision expects a \"string\", got the integer 32"));
+}
+
 // [training] dg_structure_point: part of the identity of PHNN-JR-DG runs
 // only (the only DG step with a state-dependent structure), away from the
 // default.

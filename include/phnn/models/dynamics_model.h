@@ -33,6 +33,12 @@ struct ModelOptions {
   /// Where the DG field evaluates PHNN-JR's R_theta (the other models and
   /// DG4 ignore it): x + dx/2 (default) or x.
   DgStructurePoint dg_structure_point = DgStructurePoint::kMidpoint;
+  /// Type of the parameters and of every computation: kFloat64, or kFloat32
+  /// (float32 training, TrainerOptions::precision) on the reference path
+  /// only (the fused kernels are float64). Parameters are initialized in
+  /// float64 either way and then rounded, so a float32 model starts from the
+  /// float64 model's weights rounded to float32.
+  torch::ScalarType dtype = torch::kFloat64;
 };
 
 /// Base of NODE, PHNN-S and PHNN-JR. Every method is batched over members.

@@ -48,13 +48,16 @@ struct StackedMlpOptions {
   /// one LibTorch op per matmul / tanh / jet product (for tests and
   /// benchmarks; same values to round-off).
   bool fused = true;
+  /// Type of the weights (ModelOptions::dtype): kFloat32 needs fused = false.
+  torch::ScalarType dtype = torch::kFloat64;
 };
 
 /// E tanh MLPs as weights [E, in, out] and biases [E, 1, out]:
 ///   a_{k+1} = tanh(a_k W_k + b_k),  output = a_L W_L + b_L (linear last layer).
 /// Member e is initialized from its own seed with PyTorch's Linear default,
 /// W, b ~ U(-1/sqrt(fan_in), 1/sqrt(fan_in)), so a member's weights do not
-/// depend on which other members share the stack.
+/// depend on which other members share the stack; drawn in float64, then
+/// rounded to options.dtype.
 class StackedMlp {
  public:
   StackedMlp(StackedMlpOptions options, const std::vector<std::uint64_t>& seeds,

@@ -27,7 +27,9 @@ struct CellSpec {
   TrainerOptions training;
   /// Networks through the fused autograd node (default) or the op-by-op
   /// reference path (ModelOptions::fused_networks): same results to
-  /// round-off, for tests and side-by-side benchmarks.
+  /// round-off, for tests and side-by-side benchmarks. Float32 training
+  /// (TrainerOptions::precision) always trains on the reference path; this
+  /// then selects the path of its float64 inference only.
   bool fused_networks = true;
 
   /// Throws std::invalid_argument naming the field (e.g. NODE with DG).
@@ -53,8 +55,12 @@ using ProgressCallback = std::function<void(const TrainProgress&)>;
 /// members out over the inference set (docs/METHOD.md §5) and the two figure
 /// trajectories. Result e belongs to seeds[e] and depends on nothing but the
 /// cell, the data and that seed. A member whose loss turns non-finite is
-/// frozen and reported as diverged; the others go on.
-/// If `trained` is given it receives the model stack with the best weights.
+/// frozen and reported as diverged; the others go on. With
+/// training.precision = kFloat32 training runs in float32 and the rollouts
+/// in float64 from the best weights upcast (docs/DECISIONS.md); the stored
+/// RunResult::weights are those float64 values.
+/// If `trained` is given it receives the (float64) model stack the rollouts
+/// used, with the best weights.
 std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
                                   const ProgressCallback& progress = {},
                                   std::unique_ptr<DynamicsModel>* trained = nullptr);

@@ -29,6 +29,18 @@ std::string to_string(LossNorm norm);
 /// Every LossNorm, default first.
 std::vector<LossNorm> all_loss_norms();
 
+/// Floating-point type of training (docs/DECISIONS.md, "Ablation knobs"):
+///   kFloat64 (the default): everything in float64;
+///   kFloat32: the data pairs, parameters, forward, backward, regularizer,
+///             Adam and the validation losses in float32 (PyTorch's default
+///             dtype), on the op-by-op reference networks; inference stays
+///             float64, from the float32 best weights upcast (exactly).
+enum class Precision { kFloat64 = 0, kFloat32 = 1 };
+/// "float64", "float32".
+std::string to_string(Precision precision);
+/// Every Precision, default first.
+std::vector<Precision> all_precisions();
+
 /// Optimizer and schedule of one run (docs/METHOD.md §4). Defaults: docs/METHOD.md.
 struct TrainerOptions {
   /// Adam steps.
@@ -49,6 +61,8 @@ struct TrainerOptions {
   /// Norm of L_d, in training and validation alike (best weights are those
   /// of the lowest validation loss in this norm).
   LossNorm loss_norm = LossNorm::kMeanL1;
+  /// Floating-point type of training; inference is float64 either way.
+  Precision precision = Precision::kFloat64;
   /// Eps in kappa = s_max / (s_min + eps) and rho = max|Re l| / (min|Re l| + eps).
   double jacobian_eps = 1e-6;
   /// DG/DG4 inference Newton (docs/METHOD.md §4): a row has converged when its
