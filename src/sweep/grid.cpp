@@ -22,7 +22,9 @@ struct CostParts {
 CostParts cost_parts(const RunConfig& run, const CostModel& c) {
   const int m = static_cast<int>(run.model), i = static_cast<int>(run.integrator);
   const int s = static_cast<int>(run.size);
-  const double reg = run.regularizer != Regularizer::kNone ? c.regularizer_factor[m] : 1.0;
+  const double reg = run.regularizer != Regularizer::kNone ? c.regularizer_factor[m][i] : 1.0;
+  const double precision =
+      run.training.precision == Precision::kFloat32 ? c.float32_factor : 1.0;
   const double batch = std::min<double>(run.n_train, c.reference_batch);
   const double batch_scale = 1.0 - c.small_batch_saving * (c.reference_batch - batch) / c.reference_batch;
   const double fixed_us = c.fixed_us[m][i] * c.fixed_size_factor[s] * reg;
@@ -38,8 +40,8 @@ CostParts cost_parts(const RunConfig& run, const CostModel& c) {
                            run.data.num_inference_steps() / c.reference_batch / c.rollout_speedup *
                            (is_discrete_gradient(run.integrator) ? c.dg_newton_factor : 1.0);
   CostParts parts;
-  parts.fixed_s = t.steps * fixed_us * 1e-6;
-  parts.member_s = (t.steps * batch_scale + validation + inference) * member_us * 1e-6;
+  parts.fixed_s = t.steps * fixed_us * precision * 1e-6;
+  parts.member_s = ((t.steps * batch_scale + validation) * precision + inference) * member_us * 1e-6;
   return parts;
 }
 

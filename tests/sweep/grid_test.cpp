@@ -209,7 +209,8 @@ TEST(GridTest, GroupCostFollowsTheDocumentedModel) {
   model.member_us[node][rk2] = 30.0;
   model.fixed_size_factor[static_cast<int>(ModelSize::kLarge)] = 2.0;
   model.member_size_factor[static_cast<int>(ModelSize::kLarge)] = 10.0;
-  model.regularizer_factor[node] = 1.6;
+  model.regularizer_factor[node][rk2] = 1.6;
+  model.float32_factor = 3.0;
   model.small_batch_saving = 0.0;  // the hand computation below is for full batches
   model.rollout_speedup = 20.0;
   model.dg_newton_factor = 4.0;
@@ -231,6 +232,10 @@ TEST(GridTest, GroupCostFollowsTheDocumentedModel) {
   run.training.steps = 1050;  // evaluations at 0, 500, 1000 and 1050
   // 1050 x 128e-6 + 2 x (1050 + 4 x 2500/64 + 39.0625) x 480e-6 = 0.1344 + 1.1955 s.
   EXPECT_NEAR(estimate_group_cost_s(run, 2, model), 1.3299, kCostTolerance);
+  // float32 training: the training steps and validation x 3, the (float64) inference not:
+  // 3 x 0.1344 + 2 x (3 x (1050 + 4 x 2500/64) + 39.0625) x 480e-6 = 0.4032 + 3.5115 s.
+  run.training.precision = Precision::kFloat32;
+  EXPECT_NEAR(estimate_group_cost_s(run, 2, model), 3.9147, kCostTolerance);
   EXPECT_THROW(estimate_group_cost_s(run, 0, model), std::invalid_argument);
 }
 

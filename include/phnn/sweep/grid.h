@@ -71,9 +71,20 @@ struct CostModel {
   double member_size_factor[3] = {1.0, 3.5, 16.0};
   /// Jacobian (second-order jets for the PHNNs), closed-form SVD /
   /// eigenvalues and their backward in every step (CN, SN, SR), on both
-  /// parts, indexed by ModelKind: measured with CN at E = 1 and E = 10:
-  /// 2.1-2.3x (NODE), 2.4-3.9x (PHNN-S), 3.1-5.0x (PHNN-JR).
-  double regularizer_factor[3] = {2.3, 3.0, 3.5};
+  /// parts, indexed [ModelKind][IntegratorKind] like fixed_us: measured with
+  /// CN at E = 1 and E = 10: 2.1-2.3x (NODE), 2.4-3.9x (PHNN-S), 3.1-5.0x
+  /// (PHNN-JR) before the explicit steps took f(x) from the Jacobian's
+  /// evaluation (RK2/RK4 with a regularizer evaluate f once less per step).
+  double regularizer_factor[3][4] = {
+      /*kNode=*/{/*kRk2=*/2.3, /*kDg=*/0.0, /*kRk4=*/2.3, /*kDg4=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/3.0, /*kDg=*/3.0, /*kRk4=*/3.0, /*kDg4=*/3.0},
+      /*kPhnnJr=*/{/*kRk2=*/3.5, /*kDg=*/3.5, /*kRk4=*/3.5, /*kDg4=*/3.5},
+  };
+  /// `[training] precision = "float32"` trains on the op-by-op networks in
+  /// float32: training steps and validation cost this factor more (inference
+  /// is float64 on the fused path, unchanged). bench_training precision, small,
+  /// E = 10: 2.0-3.3x (docs/DECISIONS.md, "Ablation knobs").
+  double float32_factor = 2.7;
   /// A training step on a batch smaller than reference_batch (N_train < 64)
   /// costs member_us x (1 - small_batch_saving x (64 - batch) / 64) per
   /// member (validation and inference are not affected).
