@@ -3,6 +3,7 @@
 # the project's set-up (OpenBLAS behind libblas.so.3, jemalloc preloaded).
 #   bash bench/run_benchmarks.sh            # ~15 min
 #   REPEATS=5 bash bench/run_benchmarks.sh
+#   WORK_PRECISION=0 bash bench/run_benchmarks.sh   # without the integrator work-precision part
 # Every row is a median of REPEATS runs; rows that compare two things
 # interleave them run by run in the same process or loop.
 set -euo pipefail
@@ -53,6 +54,7 @@ echo "## anchor: plain PyTorch eager vs the stacked step"
 
 if [[ ${FULL_CELL:-0} == 1 ]]; then run cell; fi
 
+if [[ ${WORK_PRECISION:-1} == 0 ]]; then exit 0; fi  # WORK_PRECISION=0: training benchmarks only
 echo "## integrator work-precision (true systems; CSV + PNG into docs/figures/)"
 cmake --build build --target work_precision
 build/work_precision --trajectories 10 --repeats 5 > docs/figures/work_precision.csv
