@@ -654,7 +654,10 @@ def time_vs_error(runs, name, out):
             ax.scatter([np.median(t)], [np.median(e[~np.isnan(e)]) if ok.any() else np.nan], s=90,
                        color=colour(m), edgecolor="black", marker="D",
                        label=f"{m}: {len(mine)} runs, {div.sum()} diverged")
-        ax.set_xscale("log")
+        ax.set_xscale("log")  # seconds at 1, 2, 5 x 10^k, in plain numbers
+        ax.xaxis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(ticker.NullFormatter())
         if any(np.isfinite(runs["mse"][i]) for i in sel):
             ax.set_yscale("log")
             label_minor_log_ticks(ax.yaxis)
