@@ -22,12 +22,14 @@ struct CostParts {
 CostParts cost_parts(const RunConfig& run, const CostModel& c) {
   const int m = static_cast<int>(run.model), i = static_cast<int>(run.integrator);
   const int s = static_cast<int>(run.size);
-  const double reg = run.regularizer != Regularizer::kNone ? c.regularizer_factor[m][i] : 1.0;
+  const bool regularized = run.regularizer != Regularizer::kNone;
+  const double reg = regularized ? c.regularizer_factor[m][i] : 1.0;
+  const double reg_fixed = regularized ? c.regularizer_fixed_factor[m][i] : 1.0;
   const double precision =
       run.training.precision == Precision::kFloat32 ? c.float32_factor : 1.0;
   const double batch = std::min<double>(run.n_train, c.reference_batch);
   const double batch_scale = 1.0 - c.small_batch_saving * (c.reference_batch - batch) / c.reference_batch;
-  const double fixed_us = c.fixed_us[m][i] * c.fixed_size_factor[s] * reg;
+  const double fixed_us = c.fixed_us[m][i] * c.fixed_size_factor[s] * reg_fixed;
   const double member_us = c.member_us[m][i] * c.member_size_factor[s] * reg;
   const TrainerOptions& t = run.training;
   const int evaluations = 1 + t.steps / t.eval_every + (t.steps % t.eval_every != 0 ? 1 : 0);

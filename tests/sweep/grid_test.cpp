@@ -210,6 +210,7 @@ TEST(GridTest, GroupCostFollowsTheDocumentedModel) {
   model.fixed_size_factor[static_cast<int>(ModelSize::kLarge)] = 2.0;
   model.member_size_factor[static_cast<int>(ModelSize::kLarge)] = 10.0;
   model.regularizer_factor[node][rk2] = 1.6;
+  model.regularizer_fixed_factor[node][rk2] = 2.0;
   model.float32_factor = 3.0;
   model.small_batch_saving = 0.0;  // the hand computation below is for full batches
   model.rollout_speedup = 20.0;
@@ -226,16 +227,16 @@ TEST(GridTest, GroupCostFollowsTheDocumentedModel) {
   run.integrator = IntegratorKind::kRk2;
   run.size = ModelSize::kLarge;
   run.regularizer = Regularizer::kCn;
-  // fixed  = 50000 x 40 x 2 x 1.6e-6 = 6.4 s;
+  // fixed  = 50000 x 40 x 2 x 2.0e-6 = 8 s (the regularizer's fixed factor);
   // member = (50000 + 3945.3125 + 39.0625) x 30 x 10 x 1.6e-6 = 25.9125 s.
-  EXPECT_NEAR(estimate_group_cost_s(run, 10, model), 6.4 + 259.125, kCostTolerance);
+  EXPECT_NEAR(estimate_group_cost_s(run, 10, model), 8.0 + 259.125, kCostTolerance);
   run.training.steps = 1050;  // evaluations at 0, 500, 1000 and 1050
-  // 1050 x 128e-6 + 2 x (1050 + 4 x 2500/64 + 39.0625) x 480e-6 = 0.1344 + 1.1955 s.
-  EXPECT_NEAR(estimate_group_cost_s(run, 2, model), 1.3299, kCostTolerance);
+  // 1050 x 160e-6 + 2 x (1050 + 4 x 2500/64 + 39.0625) x 480e-6 = 0.168 + 1.1955 s.
+  EXPECT_NEAR(estimate_group_cost_s(run, 2, model), 1.3635, kCostTolerance);
   // float32 training: the training steps and validation x 3, the (float64) inference not:
-  // 3 x 0.1344 + 2 x (3 x (1050 + 4 x 2500/64) + 39.0625) x 480e-6 = 0.4032 + 3.5115 s.
+  // 3 x 0.168 + 2 x (3 x (1050 + 4 x 2500/64) + 39.0625) x 480e-6 = 0.504 + 3.5115 s.
   run.training.precision = Precision::kFloat32;
-  EXPECT_NEAR(estimate_group_cost_s(run, 2, model), 3.9147, kCostTolerance);
+  EXPECT_NEAR(estimate_group_cost_s(run, 2, model), 4.0155, kCostTolerance);
   EXPECT_THROW(estimate_group_cost_s(run, 0, model), std::invalid_argument);
 }
 

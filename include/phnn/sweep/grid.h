@@ -14,19 +14,20 @@ namespace phnn {
 /// time `train_cell` at E = 1 and E = 10 per model-integrator (small, no
 /// regularizer) and per size, and solve the line below for fixed and member.
 ///
-///   step_us(E)     = (fixed_us[model][integrator] * fixed_size_factor[size]
-///                     + E * member_us[model][integrator] * member_size_factor[size])
-///                    * (regularizer != none ? regularizer_factor : 1)
+///   step_us(E)     = fixed_us[model][integrator] * fixed_size_factor[size]
+///                      * (regularizer != none ? regularizer_fixed_factor : 1)
+///                    + E * member_us_all
 ///   member_us_all  = member_us[model][integrator] * member_size_factor[size]
 ///                    * (regularizer != none ? regularizer_factor : 1)
 ///
-///   cost_s(E)      = steps * step_us(E) * 1e-6                       (training)
-///                  + E * eval_steps * member_us_all * 1e-6   (validation, inference)
+///   cost_s(E)      = steps * step_us(E) * prec * 1e-6                (training)
+///                  + E * (validation * prec + inference) * member_us_all * 1e-6
 ///
-///   eval_steps     = evaluations * num_validation / reference_batch
-///                  + num_inference * num_inference_steps
+///   validation     = evaluations * num_validation / reference_batch
+///   inference      = num_inference * num_inference_steps
 ///                      / reference_batch / rollout_speedup
 ///                      * (integrator == DG ? dg_newton_factor : 1)
+///   prec           = precision == float32 ? float32_factor : 1
 ///
 /// with evaluations = 1 + floor(steps / eval_every) (+ 1 when steps is not a
 /// multiple of eval_every): step 0, every eval_every steps and the last step
@@ -40,45 +41,51 @@ namespace phnn {
 struct CostModel {
   /// Per-step cost of a stack that does not depend on its size E [us], small
   /// size, no regularizer, indexed [ModelKind][IntegratorKind] (NODE-DG does
-  /// not exist). Fit to bench/bench_training `stacked` (fused networks,
-  /// docs/BENCHMARKS.md): t(E) = fixed + E member per step from the E = 1
-  /// and E = 10 timings, e.g. small PHNN-JR-RK2 279 and 108 us per
-  /// member-step give fixed 190 and member 89.
+  /// not exist). Fit to bench/bench_training `stacked` (fused networks, one
+  /// quiet core, docs/BENCHMARKS.md, 2026-11-23): t(E) = fixed + E member per
+  /// step from the E = 1 and E = 10 timings, e.g. small PHNN-JR-RK2 152 and
+  /// 78 us per member-step give fixed 82 and member 70.
   /// RK4 and DG4 are scaled from RK2 and DG by their measured ratio at
-  /// E = 10 (bench_training run, one run each on a shared core, small):
-  /// PHNN-JR RK4 246 vs RK2 109 us (2.3x), NODE RK4 98 us (2x NODE-RK2),
-  /// PHNN-JR-DG4 989 vs DG 131 (7.5x: order-2 jets of both networks, H at
-  /// five points), PHNN-S-DG4 560 vs DG 103 (5.4x); the fixed and member
-  /// parts by the same factor.
+  /// E = 10 (bench_training run, one run each on a shared core, small, an
+  /// earlier revision): PHNN-JR RK4 246 vs RK2 109 us (2.3x), NODE RK4 2x
+  /// NODE-RK2, PHNN-JR-DG4 989 vs DG 131 (7.5x: order-2 jets of both
+  /// networks, H at five points), PHNN-S-DG4 560 vs DG 103 (5.4x); the fixed
+  /// and member parts by the same factor.
   double fixed_us[3][4] = {
-      /*kNode=*/{/*kRk2=*/184.0, /*kDg=*/0.0, /*kRk4=*/368.0, /*kDg4=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/190.0, /*kDg=*/145.0, /*kRk4=*/437.0, /*kDg4=*/783.0},
-      /*kPhnnJr=*/{/*kRk2=*/190.0, /*kDg=*/197.0, /*kRk4=*/437.0, /*kDg4=*/1478.0},
+      /*kNode=*/{/*kRk2=*/43.0, /*kDg=*/0.0, /*kRk4=*/86.0, /*kDg4=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/87.0, /*kDg=*/64.0, /*kRk4=*/200.0, /*kDg4=*/346.0},
+      /*kPhnnJr=*/{/*kRk2=*/82.0, /*kDg=*/89.0, /*kRk4=*/189.0, /*kDg4=*/668.0},
   };
   /// Per-step cost of each member of a stack [us], same indexing.
   double member_us[3][4] = {
-      /*kNode=*/{/*kRk2=*/33.0, /*kDg=*/0.0, /*kRk4=*/66.0, /*kDg4=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/103.0, /*kDg=*/80.0, /*kRk4=*/237.0, /*kDg4=*/432.0},
-      /*kPhnnJr=*/{/*kRk2=*/89.0, /*kDg=*/75.0, /*kRk4=*/205.0, /*kDg4=*/563.0},
+      /*kNode=*/{/*kRk2=*/30.0, /*kDg=*/0.0, /*kRk4=*/60.0, /*kDg4=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/71.0, /*kDg=*/64.0, /*kRk4=*/163.0, /*kDg4=*/346.0},
+      /*kPhnnJr=*/{/*kRk2=*/70.0, /*kDg=*/60.0, /*kRk4=*/161.0, /*kDg4=*/450.0},
   };
   /// Indexed by ModelSize: small, medium, large. Assumed independent of the
   /// width (the fixed part is per-operator overhead); not measured.
   double fixed_size_factor[3] = {1.0, 1.0, 1.0};
-  /// Indexed by ModelSize. At E = 10 the fused models cost 2.5-3.8x (medium;
-  /// PHNN-JR-RK2 measured 534-890 us, noisy) and 13-17x (large PHNN-JR-RK2,
-  /// 1497-1819 us) their small cost per member-step: 3.5 and 16 with
-  /// fixed_size_factor 1.
-  double member_size_factor[3] = {1.0, 3.5, 16.0};
+  /// Indexed by ModelSize. At E = 10 the fused medium models cost 3.0-3.9x
+  /// (NODE 104, PHNN 198-244 us per member-step) and the large PHNN-JR-RK2
+  /// 14.7x (1 037 us) their small member cost, with fixed_size_factor 1.
+  double member_size_factor[3] = {1.0, 3.4, 14.7};
   /// Jacobian (second-order jets for the PHNNs), closed-form SVD /
-  /// eigenvalues and their backward in every step (CN, SN, SR), on both
-  /// parts, indexed [ModelKind][IntegratorKind] like fixed_us: measured with
-  /// CN at E = 1 and E = 10: 2.1-2.3x (NODE), 2.4-3.9x (PHNN-S), 3.1-5.0x
-  /// (PHNN-JR) before the explicit steps took f(x) from the Jacobian's
-  /// evaluation (RK2/RK4 with a regularizer evaluate f once less per step).
+  /// eigenvalues and their backward in every step (CN, SN, SR), indexed
+  /// [ModelKind][IntegratorKind], on the member part (regularizer_factor) and
+  /// the fixed part (regularizer_fixed_factor) of a step: from the E = 1 and
+  /// E = 10 timings with CN (bench_training stacked), e.g. PHNN-JR-RK2 368 and
+  /// 135 us: fixed 259 = 3.2 x 82, member 109 = 1.6 x 70. RK4 and DG4 take
+  /// RK2's and DG's (not measured; RK4 shares only one of its four stages with
+  /// the Jacobian's evaluation, so it is underestimated a little).
   double regularizer_factor[3][4] = {
-      /*kNode=*/{/*kRk2=*/2.3, /*kDg=*/0.0, /*kRk4=*/2.3, /*kDg4=*/0.0},
-      /*kPhnnS=*/{/*kRk2=*/3.0, /*kDg=*/3.0, /*kRk4=*/3.0, /*kDg4=*/3.0},
-      /*kPhnnJr=*/{/*kRk2=*/3.5, /*kDg=*/3.5, /*kRk4=*/3.5, /*kDg4=*/3.5},
+      /*kNode=*/{/*kRk2=*/1.7, /*kDg=*/0.0, /*kRk4=*/1.7, /*kDg4=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/1.7, /*kDg=*/2.3, /*kRk4=*/1.7, /*kDg4=*/2.3},
+      /*kPhnnJr=*/{/*kRk2=*/1.6, /*kDg=*/2.2, /*kRk4=*/1.6, /*kDg4=*/2.2},
+  };
+  double regularizer_fixed_factor[3][4] = {
+      /*kNode=*/{/*kRk2=*/4.5, /*kDg=*/0.0, /*kRk4=*/4.5, /*kDg4=*/0.0},
+      /*kPhnnS=*/{/*kRk2=*/4.2, /*kDg=*/6.4, /*kRk4=*/4.2, /*kDg4=*/6.4},
+      /*kPhnnJr=*/{/*kRk2=*/3.2, /*kDg=*/3.5, /*kRk4=*/3.2, /*kDg4=*/3.5},
   };
   /// `[training] precision = "float32"` trains on the op-by-op networks in
   /// float32: training steps and validation cost this factor more (inference
