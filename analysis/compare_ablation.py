@@ -14,22 +14,14 @@ variant that has the cell, marked "better" or "worse" when the two intervals do 
 reducer's own statistics: linear-interpolation quartiles, percentile bootstrap, fixed key); the
 seed counts from `phnn reduce --format csv --per-run`. The phnn binary: $PHNN, else build/phnn.
 """
-import csv
-import io
-import os
-import subprocess
 import sys
 
+from phnn_tool import run_csv
 
-def phnn():
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    return os.environ.get("PHNN", os.path.join(here, "build", "phnn"))
 
 
 def reduce_csv(path, *extra):
-    out = subprocess.run([phnn(), "reduce", path, "--format", "csv", *extra], check=True,
-                         capture_output=True, text=True).stdout
-    return list(csv.DictReader(io.StringIO(out)))
+    return run_csv("reduce", path, "--format", "csv", *extra)
 
 
 def cells(path, threshold):

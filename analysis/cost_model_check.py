@@ -11,22 +11,12 @@ counted.  Prints a Markdown table of measured / estimated per model label, size 
 (the median and range of the per-cell ratios, and the ratio of the sums), then the totals.  The
 phnn binary: $PHNN, else build/phnn.
 """
-import csv
-import io
-import os
 import statistics
-import subprocess
 import sys
 
-
-def phnn():
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    return os.environ.get("PHNN", os.path.join(here, "build", "phnn"))
+from phnn_tool import run_csv
 
 
-def run_csv(*args):
-    out = subprocess.run([phnn(), *args], check=True, capture_output=True, text=True).stdout
-    return list(csv.DictReader(io.StringIO(out)))
 
 
 def measured_cells(estimates, runs):

@@ -24,14 +24,13 @@ Medians, IQRs and intervals come from `phnn reduce --format csv` (the reducer's 
 the per-run Jacobian quantities from `phnn reduce --format csv --per-run`.  The phnn binary: $PHNN,
 else build/phnn.  A study or cell missing from the file is skipped and said so.
 """
-import csv
-import io
 import math
 import os
 import statistics
-import subprocess
 import sys
 from collections import namedtuple
+
+from phnn_tool import run_csv
 
 Cell = namedtuple("Cell", "median q25 q75 iqr lo hi done diverged expected")
 Comparison = namedtuple("Comparison", "label ok resolved")  # ok: the paper's direction
@@ -42,15 +41,9 @@ PHNN_MODELS = FAMILIES["PHNN-S"] + FAMILIES["PHNN-JR"]
 SYSTEMS = ("harmonic", "duffing", "self-sustained")
 
 
-def phnn():
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    return os.environ.get("PHNN", os.path.join(here, "build", "phnn"))
-
 
 def reduce_csv(path, *extra):
-    out = subprocess.run([phnn(), "reduce", path, "--format", "csv", *extra], check=True,
-                         capture_output=True, text=True).stdout
-    return list(csv.DictReader(io.StringIO(out)))
+    return run_csv("reduce", path, "--format", "csv", *extra)
 
 
 # ------------------------------------------------------------------ the file's cells

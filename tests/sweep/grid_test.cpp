@@ -337,15 +337,15 @@ TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
               ElementsAre("lambda=1e-06", "lambda=1.0000001e-06", "lambda=0"));
 }
 
-// sweeps/ablation-duffing.toml changes one knob: without its loss_norm line
-// its runs are the default runs, exactly those of
-// sweeps/ablation-duffing-baseline.toml (whose seeds 0-9 are paper.toml's
-// own), and with it each cell key differs by exactly ";loss_norm=mse".
-TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
-  const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-duffing.toml");
+// An ablation file of sweeps/ changes one knob of ablation-duffing-baseline.toml
+// by one line: without that line its runs are exactly the baseline's (whose
+// seeds 0-9 are paper.toml's own), and with it each cell key differs by
+// exactly `key_part`.
+void expect_one_knob_ablation(const std::string& file, const std::string& line,
+                              const std::string& key_part) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + file);
   std::string text = spec.text;
-  const std::string line = "loss_norm = \"mse\"\n";
-  ASSERT_NE(text.find(line), std::string::npos);
+  ASSERT_NE(text.find(line), std::string::npos) << file;
   text.erase(text.find(line), line.size());
   const Grid ablation = expand_grid(spec);
   const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
@@ -357,36 +357,22 @@ TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
   for (const RunConfig& run : paper_grid().runs) paper_ids.insert(run.id());
   for (std::size_t i = 0; i < 240; ++i) {
     std::string key = ablation.runs[i].cell_key();
-    key.erase(key.find(";loss_norm=mse"), std::string(";loss_norm=mse").size());
-    EXPECT_EQ(key, stripped.runs[i].cell_key());
-    EXPECT_EQ(stripped.runs[i].id(), baseline.runs[i].id()) << i;
+    const std::size_t at = key.find(key_part);
+    ASSERT_NE(at, std::string::npos) << file << " run " << i;
+    key.erase(at, key_part.size());
+    EXPECT_EQ(key, stripped.runs[i].cell_key()) << file << " run " << i;
+    EXPECT_EQ(stripped.runs[i].id(), baseline.runs[i].id()) << file << " run " << i;
     EXPECT_EQ(paper_ids.count(baseline.runs[i].id()), baseline.runs[i].seed < 10 ? 1u : 0u) << i;
   }
 }
 
-// sweeps/ablation-duffing-float32.toml likewise: without its precision line
-// its runs are exactly ablation-duffing-baseline.toml's, and with it each
-// cell key differs by exactly ";precision=float32".
+TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
+  expect_one_knob_ablation("ablation-duffing.toml", "loss_norm = \"mse\"\n", ";loss_norm=mse");
+}
+
 TEST(GridTest, AblationDuffingFloat32SweepChangesOnlyThePrecision) {
-  const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-duffing-float32.toml");
-  std::string text = spec.text;
-  const std::string line = "precision = \"float32\"\n";
-  ASSERT_NE(text.find(line), std::string::npos);
-  text.erase(text.find(line), line.size());
-  const Grid ablation = expand_grid(spec);
-  const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
-  const Grid baseline = expand_grid(parse_sweep_file(kSweeps + "ablation-duffing-baseline.toml"));
-  ASSERT_EQ(ablation.runs.size(), 240u);
-  ASSERT_EQ(stripped.runs.size(), 240u);
-  ASSERT_EQ(baseline.runs.size(), 240u);
-  for (std::size_t i = 0; i < 240; ++i) {
-    std::string key = ablation.runs[i].cell_key();
-    const std::size_t at = key.find(";precision=float32;");
-    ASSERT_NE(at, std::string::npos) << i;
-    key.erase(at, std::string(";precision=float32").size());
-    EXPECT_EQ(key, stripped.runs[i].cell_key()) << i;
-    EXPECT_EQ(stripped.runs[i].id(), baseline.runs[i].id()) << i;
-  }
+  expect_one_knob_ablation("ablation-duffing-float32.toml", "precision = \"float32\"\n",
+                           ";precision=float32");
 }
 
 TEST(GridTest, SeveralVariedAxesGiveProductColumns) {
