@@ -337,19 +337,20 @@ TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
               ElementsAre("lambda=1e-06", "lambda=1.0000001e-06", "lambda=0"));
 }
 
-// An ablation file of sweeps/ changes one knob of ablation-duffing-baseline.toml
-// by one line: without that line its runs are exactly the baseline's (whose
-// seeds 0-9 are paper.toml's own), and with it each cell key differs by
-// exactly `key_part`.
+// An ablation file of sweeps/ changes one knob of its baseline file by one
+// line: without that line its runs are exactly the baseline's (whose seeds
+// 0-9 are paper.toml's own), and with it each cell key differs by exactly
+// `key_part`.
 void expect_one_knob_ablation(const std::string& file, const std::string& line,
-                              const std::string& key_part) {
+                              const std::string& key_part,
+                              const std::string& baseline_file = "ablation-duffing-baseline.toml") {
   const SweepSpec spec = parse_sweep_file(kSweeps + file);
   std::string text = spec.text;
   ASSERT_NE(text.find(line), std::string::npos) << file;
   text.erase(text.find(line), line.size());
   const Grid ablation = expand_grid(spec);
   const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
-  const Grid baseline = expand_grid(parse_sweep_file(kSweeps + "ablation-duffing-baseline.toml"));
+  const Grid baseline = expand_grid(parse_sweep_file(kSweeps + baseline_file));
   ASSERT_EQ(ablation.runs.size(), 240u);
   ASSERT_EQ(stripped.runs.size(), 240u);
   ASSERT_EQ(baseline.runs.size(), 240u);
@@ -368,6 +369,11 @@ void expect_one_knob_ablation(const std::string& file, const std::string& line,
 
 TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
   expect_one_knob_ablation("ablation-duffing.toml", "loss_norm = \"mse\"\n", ";loss_norm=mse");
+}
+
+TEST(GridTest, AblationHarmonicSweepChangesOnlyTheEnergySampling) {
+  expect_one_knob_ablation("ablation-harmonic-direct.toml", "energy_sampling = \"direct\"\n",
+                           ";energy_sampling=direct", "ablation-harmonic-baseline.toml");
 }
 
 TEST(GridTest, AblationDuffingFloat32SweepChangesOnlyThePrecision) {
