@@ -282,18 +282,16 @@ def study_three(res):
         return []
     cols = res.columns("III")  # none, cn, sn, sr
     base, regs = cols[0], cols[1:]
-    out = []
-    for label, systems in (("III.1", ("harmonic", "self-sustained")),):
-        comps = []
-        for system in systems:
-            for model in ("NODE-RK2",) + PHNN_MODELS:
-                b = res.get("III", system, model, base)
-                for reg in regs:
-                    c = res.get("III", system, model, reg)
-                    if finite(b) and finite(c):
-                        comps.append(absence(compare(f"{system} {model} {reg} vs {base}", c, b)))
-        out.append((label, "Regularization does not improve the harmonic and self-sustained "
-                    "oscillators (against = a regularizer resolved better)", comps))
+    comps = []
+    for system in ("harmonic", "self-sustained"):
+        for model in ("NODE-RK2",) + PHNN_MODELS:
+            b = res.get("III", system, model, base)
+            for reg in regs:
+                c = res.get("III", system, model, reg)
+                if finite(b) and finite(c):
+                    comps.append(absence(compare(f"{system} {model} {reg} vs {base}", c, b)))
+    out = [("III.1", "Regularization does not improve the harmonic and self-sustained "
+            "oscillators (against = a regularizer resolved better)", comps)]
     comps = []
     for model in ("NODE-RK2",) + PHNN_MODELS:
         b, c = res.get("III", "duffing", model, base), res.get("III", "duffing", model, "cn")
@@ -323,13 +321,18 @@ def study_three(res):
     return out
 
 
+def run_values(res, key, field):
+    """`field` of the finished runs of the cell `key` (empty and NaN values left out)."""
+    return [float(r[field]) for r in res.runs.get(key, []) if r[field] not in ("", "nan")]
+
+
 def run_median(res, key, field):
-    values = [float(r[field]) for r in res.runs.get(key, []) if r[field] not in ("", "nan")]
+    values = run_values(res, key, field)
     return statistics.median(values) if values else None
 
 
 def run_mean(res, key, field):
-    values = [float(r[field]) for r in res.runs.get(key, []) if r[field] not in ("", "nan")]
+    values = run_values(res, key, field)
     return statistics.fmean(values) if values else None
 
 

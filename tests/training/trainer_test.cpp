@@ -32,19 +32,32 @@ const SystemData& small_data(SystemKind kind) {
 
 double rel(double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); }
 
-// Members trained in a stack of 3 agree with the same seeds trained alone.
-TEST(TrainerTest, StackingIsExact) {
+// A PHNN-JR-DG + CN cell on Duffing (N_train 100 > batch: per-member
+// reshuffling is exercised) in `precision`, trained as a stack of seeds
+// {4, 7, 9} and as seed 7 alone.
+struct StackedAndAlone {
+  std::vector<RunResult> stacked, alone;
+};
+StackedAndAlone train_stacked_and_alone(Precision precision) {
   CellSpec cell;
   cell.model = ModelKind::kPhnnJr;
   cell.integrator = IntegratorKind::kDg;
-  cell.n_train = 100;  // > batch: per-member reshuffling is exercised
+  cell.n_train = 100;
   cell.regularizer = Regularizer::kCn;
+  cell.training.precision = precision;
   cell.training.steps = 200;
   cell.training.eval_every = 100;
   cell.seeds = {4, 7, 9};
-  const auto stacked = train_cell(cell, small_data(SystemKind::kDuffing));
+  StackedAndAlone out;
+  out.stacked = train_cell(cell, small_data(SystemKind::kDuffing));
   cell.seeds = {7};
-  const auto alone = train_cell(cell, small_data(SystemKind::kDuffing));
+  out.alone = train_cell(cell, small_data(SystemKind::kDuffing));
+  return out;
+}
+
+// Members trained in a stack of 3 agree with the same seeds trained alone.
+TEST(TrainerTest, StackingIsExact) {
+  const auto [stacked, alone] = train_stacked_and_alone(Precision::kFloat64);
   ASSERT_EQ(stacked[1].trace.size(), alone[0].trace.size());
   for (std::size_t k = 0; k < alone[0].trace.size(); ++k) {
     EXPECT_LE(rel(stacked[1].trace[k].validation_loss, alone[0].trace[k].validation_loss), 1e-9);
@@ -59,18 +72,7 @@ TEST(TrainerTest, StackingIsExact) {
 // per-member sgemm calls are elementwise or per member; inference is the
 // float64 path above.)
 TEST(TrainerTest, StackingIsExactInFloat32) {
-  CellSpec cell;
-  cell.model = ModelKind::kPhnnJr;
-  cell.integrator = IntegratorKind::kDg;
-  cell.n_train = 100;  // > batch: per-member reshuffling is exercised
-  cell.regularizer = Regularizer::kCn;
-  cell.training.precision = Precision::kFloat32;
-  cell.training.steps = 200;
-  cell.training.eval_every = 100;
-  cell.seeds = {4, 7, 9};
-  const auto stacked = train_cell(cell, small_data(SystemKind::kDuffing));
-  cell.seeds = {7};
-  const auto alone = train_cell(cell, small_data(SystemKind::kDuffing));
+  const auto [stacked, alone] = train_stacked_and_alone(Precision::kFloat32);
   ASSERT_EQ(stacked[1].trace.size(), alone[0].trace.size());
   for (std::size_t k = 0; k < alone[0].trace.size(); ++k) {
     const TracePoint &a = stacked[1].trace[k], &b = alone[0].trace[k];
