@@ -80,24 +80,41 @@ std::vector<std::vector<int>> all_runs(const Grid& grid) {
 }
 
 // Closed form: 2 ranks, cell A = 1 + 2E with 4 runs (9 s), cell B = 1 + E
-// with 2 runs (3 s). Whole: A | B, makespan 9. Split A in two (5 s each):
-// LPT puts 5 | 5, then B on either: makespan 8 (the best; A in four 3-s
-// pieces gives 3,3,3,3,3 -> 9). Efficiency = 12 / (2 x 8).
+// with 2 runs (3 s). Whole: A | B, makespan 9. Any split costs 1 s per extra
+// group, so a makespan of 7 needs exactly 14 s of items split evenly: A in
+// two (5, 5) and B in two (2, 2), LPT 5 + 2 | 5 + 2 = 7, the optimum (A in
+// two with B whole: 8; A in three (5, 3, 3) with B split: 15 s > 2 x 7). A
+// uniform cost target cannot find it (it never cuts B, which fits under
+// any target >= 5); the class-wise refinement does. Efficiency 12 / (2 x 7).
 TEST(WorkPlanTest, SimulatedScheduleMatchesAHandCheckedExample) {
   const Grid grid = hand_grid({{1.0, 2.0, 4}, {1.0, 1.0, 2}});
   const WorkPlan plan = plan_work(grid, /*ranks=*/2);
-  ASSERT_EQ(plan.items.size(), 3u);
+  ASSERT_EQ(plan.items.size(), 4u);
   EXPECT_THAT(plan.items[0].runs, ElementsAre(0, 1));
   EXPECT_THAT(plan.items[1].runs, ElementsAre(2, 3));
-  EXPECT_THAT(plan.items[2].runs, ElementsAre(4, 5));
-  EXPECT_DOUBLE_EQ(plan.makespan_s, 8.0);
+  EXPECT_THAT(plan.items[2].runs, ElementsAre(4));
+  EXPECT_THAT(plan.items[3].runs, ElementsAre(5));
+  EXPECT_DOUBLE_EQ(plan.makespan_s, 7.0);
   EXPECT_DOUBLE_EQ(plan.unsplit_cost_s, 12.0);
-  EXPECT_DOUBLE_EQ(plan.cost_s, 13.0);  // one extra group: + 1 s fixed cost
-  EXPECT_DOUBLE_EQ(plan.efficiency(), 0.75);
-  EXPECT_EQ(plan.split_cells, 1);
+  EXPECT_DOUBLE_EQ(plan.cost_s, 14.0);  // two extra groups: + 2 s fixed cost
+  EXPECT_DOUBLE_EQ(plan.efficiency(), 12.0 / 14.0);
+  EXPECT_EQ(plan.split_cells, 2);
   SplitOptions off;
   off.mode = SplitOptions::Mode::kOff;
   EXPECT_DOUBLE_EQ(plan_work(grid, 2, off).makespan_s, 9.0);
+}
+
+// A split that cannot shorten the schedule is not taken: 2 ranks, a single
+// run of 10 s (cannot be split) and a cell of 4 runs costing 1 + E (5 s).
+// The makespan is 10 however the second cell is cut, so it stays whole (the
+// cheapest of the equally short plans).
+TEST(WorkPlanTest, NoSplitWhereItCannotShortenTheSchedule) {
+  const Grid grid = hand_grid({{0.0, 10.0, 1}, {1.0, 1.0, 4}});
+  const WorkPlan plan = plan_work(grid, /*ranks=*/2);
+  EXPECT_EQ(plan.items.size(), 2u);
+  EXPECT_EQ(plan.split_cells, 0);
+  EXPECT_DOUBLE_EQ(plan.makespan_s, 10.0);
+  EXPECT_DOUBLE_EQ(plan.cost_s, plan.unsplit_cost_s);
 }
 
 // Closed form: one cell of n = 12 runs, cost f + E m, on N = 4 ranks. The
@@ -142,19 +159,17 @@ TEST(WorkPlanTest, PaperGridIsNotSplitOnFewRanks) {
   }
 }
 
-// Efficiency of the simulated schedule under the default cost model (fit
-// to the fused kernels; docs/BENCHMARKS.md gives the numbers). A guard, not
-// the goal: at 128 ranks every extra group pays the per-step fixed cost
-// (~200 us, x6 with a regularizer) for 50 000 steps, which caps the split
-// plans near 0.75; whole cells reach 0.24.
+// Efficiency of the simulated schedule under the default cost model (the
+// refit of docs/BENCHMARKS.md): the speed issue's target is >= 90 % at 128
+// ranks (91.4 % with this model). A refit that moves it below says so here.
 TEST(WorkPlanTest, PaperGridEfficiencyBySimulation) {
   const Grid grid = paper_grid();
   SplitOptions off;
   off.mode = SplitOptions::Mode::kOff;
   EXPECT_GE(plan_work(grid, 16).efficiency(), 0.95);
-  EXPECT_GE(plan_work(grid, 64).efficiency(), 0.88);
+  EXPECT_GE(plan_work(grid, 64).efficiency(), 0.92);
   const WorkPlan plan = plan_work(grid, 128);
-  EXPECT_GE(plan.efficiency(), 0.7);
+  EXPECT_GE(plan.efficiency(), 0.90);
   EXPECT_LT(plan_work(grid, 128, off).efficiency(), 0.3);
 }
 
@@ -217,8 +232,9 @@ TEST(WorkPlanTest, CellCostsCsvListsEveryCellAndRun) {
   std::istringstream csv(cell_costs_csv(grid));
   std::string line;
   std::getline(csv, line);
-  EXPECT_EQ(line, "cell,system,model,size,n_train,regularizer,members,fixed_s,member_s,"
-                  "estimated_s,run_ids");
+  EXPECT_EQ(line,
+            "cell,system,model,size,n_train,regularizer,members,fixed_s,member_s,"
+            "estimated_s,run_ids");
   double total = 0.0, previous = 1e300;
   std::set<std::string> ids;
   std::size_t cells = 0;

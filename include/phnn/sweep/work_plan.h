@@ -25,9 +25,9 @@ struct SplitOptions {
   /// tests, or to bound the memory of a stack). 0 = no cap.
   int max_group_size = 0;
   /// A split costs core-hours (CostModel::fixed_us per extra group and
-  /// step), so kAuto takes the least-split plan whose simulated makespan is
-  /// within (1 + min_gain) of the best plan's. 0.01: splitting has to save
-  /// more than 1 % of the wall time.
+  /// step), so kAuto takes the cheapest plan (fewest core-hours) whose
+  /// simulated makespan is within (1 + min_gain) of the best plan's. 0.01:
+  /// splitting has to save more than 1 % of the wall time.
   double min_gain = 0.01;
 
   /// Throws std::invalid_argument naming the field, value and constraint.
@@ -79,14 +79,17 @@ struct WorkPlan {
 /// ascending; empty = nothing to do). Deterministic: the same arguments give
 /// the same plan on every rank.
 ///
-/// Policy (kAuto; docs/DECISIONS.md "Member groups"): for a target S, each
-/// cell is split into the fewest near-equal contiguous groups whose cost is
-/// <= S (a cell that fits stays whole). Every S at which that split changes
-/// is tried, from the largest cell's cost down to the largest single run's,
-/// and the schedule of each is simulated with greedy_makespan_s(). The plan
-/// taken is the least-split one whose makespan is within (1 + min_gain) of
-/// the shortest. Throws std::invalid_argument if ranks < 1, the options are
-/// invalid, or pending does not match the grid.
+/// Policy (kAuto; docs/DECISIONS.md "Member groups"): candidates are (1)
+/// the uniform cuts: for a target S, each cell in the fewest near-equal
+/// contiguous groups costing <= S (a cell that fits stays whole), at every S
+/// where that changes, from the largest cell down to the largest single
+/// run; (2) a descent on the group counts from the best uniform cut and from
+/// the unsplit plan, moving the count of each class of equal-cost cells by
+/// -2..+3 while the (makespan, core-hours) pair improves. Every candidate's
+/// schedule is simulated with greedy_makespan_s(); the plan taken is the
+/// cheapest whose makespan is within (1 + min_gain) of the shortest. Throws
+/// std::invalid_argument if ranks < 1, the options are invalid, or pending
+/// does not match the grid.
 WorkPlan plan_work(const Grid& grid, const std::vector<std::vector<int>>& pending, int ranks,
                    const SplitOptions& options = SplitOptions());
 
