@@ -1,7 +1,6 @@
 // tests/sweep/grid_test.cpp — run ids, cells, costs and columns of expanded grids.
 // Size: one test file per module; the pinned ids and ablation files are its contract.
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/work_plan.h"  // dry_run_summary
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -10,6 +9,8 @@
 #include <set>
 #include <sstream>
 #include <string>
+
+#include "phnn/sweep/work_plan.h"  // dry_run_summary
 
 namespace phnn {
 namespace {
@@ -163,12 +164,9 @@ TEST(GridTest, RunIdsOfTheShippedSweepsArePinned) {
   const Grid paper = paper_grid();
   EXPECT_EQ(paper.runs[0].id(), "fe1820216e4cb749");
   const std::vector<std::pair<std::string, std::string>> pinned = {
-      {"paper.toml", "980f15989e65ba06"},
-      {"paper-table-damping.toml", "fb94529be8d2ca03"},
-      {"paper-slice.toml", "86a0087e8cbaec74"},
-      {"fourth-order.toml", "82df5d4bc81062db"},
-      {"time-vs-error.toml", "d68043d7c59b2363"},
-      {"demo.toml", "bd0409c560e222b9"},
+      {"paper.toml", "980f15989e65ba06"},         {"paper-table-damping.toml", "fb94529be8d2ca03"},
+      {"paper-slice.toml", "86a0087e8cbaec74"},   {"fourth-order.toml", "82df5d4bc81062db"},
+      {"time-vs-error.toml", "d68043d7c59b2363"}, {"demo.toml", "bd0409c560e222b9"},
       {"tiny.toml", "be8e6b56ff2112e5"}};
   for (const auto& [file, digest] : pinned) {
     std::string ids;
@@ -201,7 +199,8 @@ TEST(GridTest, CellsAreOrderedByCostLargestFirstThenKey) {
 TEST(GridTest, GroupCostFollowsTheDocumentedModel) {
   // The formula, with fixed constants (the defaults are placeholders to refit).
   const int jr = static_cast<int>(ModelKind::kPhnnJr), node = static_cast<int>(ModelKind::kNode);
-  const int dg = static_cast<int>(IntegratorKind::kDg), rk2 = static_cast<int>(IntegratorKind::kRk2);
+  const int dg = static_cast<int>(IntegratorKind::kDg),
+            rk2 = static_cast<int>(IntegratorKind::kRk2);
   CostModel model;
   model.fixed_us[jr][dg] = 500.0;
   model.member_us[jr][dg] = 100.0;
@@ -308,8 +307,10 @@ seeds = [0, 1]
     const RunConfig& run = grid.runs[table.runs[i]];
     const std::string& column = table.run_columns[i];
     const double weight = column.find("1e-05") != std::string::npos ? 1e-5 : 1e-6;
-    EXPECT_EQ(run.training.lambda_cn, run.regularizer == Regularizer::kCn ? weight : defaults.lambda_cn);
-    EXPECT_EQ(run.training.lambda_sr, run.regularizer == Regularizer::kSr ? weight : defaults.lambda_sr);
+    EXPECT_EQ(run.training.lambda_cn,
+              run.regularizer == Regularizer::kCn ? weight : defaults.lambda_cn);
+    EXPECT_EQ(run.training.lambda_sr,
+              run.regularizer == Regularizer::kSr ? weight : defaults.lambda_sr);
     EXPECT_EQ(run.training.lambda_sn, defaults.lambda_sn);
   }
   // No table cell (system, model, column) holds two runs of one seed.
@@ -317,15 +318,17 @@ seeds = [0, 1]
   for (std::size_t i = 0; i < table.runs.size(); ++i) {
     const RunConfig& run = grid.runs[table.runs[i]];
     EXPECT_TRUE(seen.insert(model_key(run.model, run.integrator) + "|" + table.run_columns[i] +
-                            "|" + std::to_string(run.seed)).second);
+                            "|" + std::to_string(run.seed))
+                    .second);
   }
 }
 
 // One weight is a replacement, not an axis: no column part; and a weight
 // that does not read back from 6 digits still gets a label of its own.
 TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
-  const std::string head = "name = \"l\"\n[grid]\nsystems = [\"harmonic\"]\n"
-                           "models = [\"node-rk2\"]\nregularizers = [\"sn\"]\nseeds = [0]\n";
+  const std::string head =
+      "name = \"l\"\n[grid]\nsystems = [\"harmonic\"]\n"
+      "models = [\"node-rk2\"]\nregularizers = [\"sn\"]\nseeds = [0]\n";
   const Grid one = expand_grid(parse_sweep_text(head + "lambdas = [3e-6]\n", "l.toml"));
   ASSERT_EQ(one.runs.size(), 1u);
   EXPECT_EQ(one.runs[0].training.lambda_sn, 3e-6);
@@ -374,6 +377,11 @@ TEST(GridTest, AblationDuffingSweepChangesOnlyTheLossNorm) {
 TEST(GridTest, AblationHarmonicSweepChangesOnlyTheEnergySampling) {
   expect_one_knob_ablation("ablation-harmonic-direct.toml", "energy_sampling = \"direct\"\n",
                            ";energy_sampling=direct", "ablation-harmonic-baseline.toml");
+}
+
+TEST(GridTest, AblationSelfSustainedSweepChangesOnlyTheEnergySampling) {
+  expect_one_knob_ablation("ablation-self-sustained-direct.toml", "energy_sampling = \"direct\"\n",
+                           ";energy_sampling=direct", "ablation-self-sustained-baseline.toml");
 }
 
 TEST(GridTest, AblationDuffingFloat32SweepChangesOnlyThePrecision) {
