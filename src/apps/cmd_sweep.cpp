@@ -93,6 +93,10 @@ void declare_options(cli::Parser* parser) {
                "with --dry-run: the cost model's estimate of every cell as CSV (cell, "
                "configuration, members, fixed/member/estimated seconds, run ids) instead of "
                "the summary");
+  parser->flag("items",
+               "with --dry-run and one --ranks value: the plan's work items as CSV (item, "
+               "cell, runs, estimated seconds, run ids) in the order the ranks take them, "
+               "instead of the summary");
   parser->option("ranks",
                  "rank counts for --dry-run's schedule, one line each, e.g. 2,16,128 "
                  "(default: this run's)");
@@ -142,8 +146,13 @@ class SweepRun {
     if (int status = check_same_sweep_file()) return status;
     if (parser_.flag_set("dry-run")) {
       if (root_) {
-        std::cout << (parser_.flag_set("cell-costs") ? cell_costs_csv(grid_)
-                                                     : dry_run_summary(grid_, ranks_, split_));
+        if (parser_.flag_set("cell-costs")) {
+          std::cout << cell_costs_csv(grid_);
+        } else if (parser_.flag_set("items")) {
+          std::cout << plan_items_csv(grid_, plan_work(grid_, ranks_.front(), split_));
+        } else {
+          std::cout << dry_run_summary(grid_, ranks_, split_);
+        }
       }
       return 0;
     }
@@ -181,6 +190,11 @@ class SweepRun {
       throw cli::UsageError{"phnn sweep: --cell-costs prints the cost model's estimates and trains "
                             "nothing: add --dry-run"};
     }
+    if (parser_.flag_set("items") &&
+        (!parser_.flag_set("dry-run") || parser_.flag_set("cell-costs"))) {
+      throw cli::UsageError{"phnn sweep: --items prints one plan's work items and trains "
+                            "nothing: use it with --dry-run, without --cell-costs"};
+    }
     split_ = split_options(parser_);
     if (parser_.has("shard")) {
       try {
@@ -190,6 +204,10 @@ class SweepRun {
       }
     }
     ranks_ = dry_run_ranks(parser_, size_);
+    if (parser_.flag_set("items") && ranks_.size() != 1) {
+      throw cli::UsageError{"phnn sweep: --items lists the items of one plan: give one rank "
+                            "count, e.g. --ranks 128"};
+    }
     return true;
   }
 

@@ -370,4 +370,19 @@ std::string cell_costs_csv(const Grid& grid) {
   return out.str();
 }
 
+std::string plan_items_csv(const Grid& grid, const WorkPlan& plan) {
+  std::ostringstream out;
+  out.precision(6);
+  out << "item,cell,runs,estimated_s,run_ids\n";
+  for (std::size_t i = 0; i < plan.items.size(); ++i) {
+    const WorkItem& item = plan.items[i];
+    out << i << "," << item.cell << "," << item.runs.size() << "," << item.estimated_cost_s << ",";
+    for (std::size_t k = 0; k < item.runs.size(); ++k) {
+      out << (k ? " " : "") << grid.runs[static_cast<std::size_t>(item.runs[k])].id();
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
 }  // namespace phnn

@@ -2,7 +2,7 @@
 # Smoke test of analysis/plot_results.py: build a synthetic results file with every run status
 # (tests/analysis/make_fixture.py), plot it, and check that each kind of figure was written;
 # first the unit tests of the scripts' choices (tests/analysis/test_plot_results.py,
-# test_paper_claims.py, test_cost_model_check.py).
+# test_paper_claims.py, test_cost_model_check.py, test_schedule_replay.py).
 # ctest: add_test(NAME plot_results_smoke COMMAND sh ${CMAKE_SOURCE_DIR}/tests/analysis/plot_results_smoke.sh)
 #        set_tests_properties(plot_results_smoke PROPERTIES SKIP_RETURN_CODE 77)
 # Then, with a phnn binary, a real results file with stored weights: the energy figure (phnn eval).
@@ -18,6 +18,7 @@ trap 'rm -rf "$out"' EXIT
 "$py" "$here/test_plot_results.py"
 "$py" "$here/test_paper_claims.py"
 "$py" "$here/test_cost_model_check.py"
+"$py" "$here/test_schedule_replay.py"
 "$py" "$here/make_fixture.py" "$out/fixture.h5"
 "$py" "$root/analysis/plot_results.py" "$out/fixture.h5" "$out/fig"
 for f in mse_I_harmonic mse_II_duffing mse_III_duffing trajectories_harmonic \
@@ -39,5 +40,13 @@ if [ $# -ge 2 ]; then
     grep -q '^# The paper.s statements checked on trained.h5$' "$out/claims.md" \
         && grep -q '^Not in the file (statements skipped): Study I, II, III.$' "$out/claims.md" \
         || { echo "paper_claims.py: unexpected output" >&2; cat "$out/claims.md" >&2; exit 1; }
+    # schedule_replay.py on a sweep measured by its own results: one table row per rank count.
+    "$2" sweep "$root/sweeps/tiny.toml" --out "$out/tiny.h5" --quiet > /dev/null 2>&1
+    PHNN="$2" "$py" "$root/analysis/schedule_replay.py" "$root/sweeps/tiny.toml" 1,2 \
+        "$root/sweeps/tiny.toml" "$out/tiny.h5" > "$out/replay.md"
+    grep -q '^measured / estimated from .*tiny.h5: 2 cells (0 left out: runs missing)$' "$out/replay.md" \
+        && grep -q '^| 1 | 2 | 100.0 % | 100.0 % | 100.0 % |$' "$out/replay.md" \
+        && grep -q '^| 2 | ' "$out/replay.md" \
+        || { echo "schedule_replay.py: unexpected output" >&2; cat "$out/replay.md" >&2; exit 1; }
 fi
 echo "plot_results smoke test passed"

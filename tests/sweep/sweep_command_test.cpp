@@ -404,6 +404,14 @@ TEST(SweepCommandTest, DryRunPrintsTheScheduleForSeveralRankCounts) {
   EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 121) << "header + 120 cells";
   EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --cell-costs", &log), 2);
   EXPECT_THAT(log, HasSubstr("add --dry-run"));
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --items --ranks 2", &log), 0)
+      << log;
+  EXPECT_THAT(log, StartsWith("item,cell,runs,estimated_s,run_ids\n0,0,10,"));
+  EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 121) << "header + 120 whole cells on 2 ranks";
+  EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --items --ranks 2,128", &log), 2);
+  EXPECT_THAT(log, HasSubstr("give one rank count"));
+  EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --items", &log), 2);
+  EXPECT_THAT(log, HasSubstr("use it with --dry-run"));
 }
 
 }  // namespace

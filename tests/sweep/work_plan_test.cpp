@@ -225,6 +225,41 @@ TEST(WorkPlanTest, DryRunSummaryPrintsOneScheduleLinePerRankCount) {
   EXPECT_THROW(dry_run_summary(grid, {}), std::invalid_argument);
 }
 
+// One CSV line per item in plan order; the lines list every run once.
+TEST(WorkPlanTest, PlanItemsCsvListsTheItemsInPlanOrder) {
+  const Grid grid = paper_grid();
+  const WorkPlan plan = plan_work(grid, /*ranks=*/128);
+  std::istringstream csv(plan_items_csv(grid, plan));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "item,cell,runs,estimated_s,run_ids");
+  std::multiset<std::string> ids;
+  std::size_t item = 0;
+  for (; std::getline(csv, line); ++item) {
+    std::vector<std::string> fields;
+    std::istringstream row(line);
+    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+    ASSERT_EQ(fields.size(), 5u) << line;
+    ASSERT_LT(item, plan.items.size());
+    EXPECT_EQ(std::stoul(fields[0]), item);
+    EXPECT_EQ(std::stoi(fields[1]), plan.items[item].cell);
+    EXPECT_EQ(std::stoul(fields[2]), plan.items[item].runs.size());
+    EXPECT_NEAR(std::stod(fields[3]), plan.items[item].estimated_cost_s,
+                1e-5 * plan.items[item].estimated_cost_s);
+    std::istringstream run_ids(fields[4]);
+    std::size_t k = 0;
+    for (std::string id; run_ids >> id; ++k) {
+      ASSERT_LT(k, plan.items[item].runs.size());
+      EXPECT_EQ(id, grid.runs[plan.items[item].runs[k]].id());
+      ids.insert(id);
+    }
+    EXPECT_EQ(k, plan.items[item].runs.size());
+  }
+  EXPECT_EQ(item, plan.items.size());
+  EXPECT_EQ(ids.size(), grid.runs.size());
+  for (const RunConfig& run : grid.runs) EXPECT_EQ(ids.count(run.id()), 1u) << run.id();
+}
+
 // One CSV line per cell, largest first, whose estimates add up to the grid's
 // and whose run ids are exactly the grid's runs.
 TEST(WorkPlanTest, CellCostsCsvListsEveryCellAndRun) {

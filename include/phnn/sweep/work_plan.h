@@ -117,4 +117,11 @@ std::string dry_run_summary(const Grid& grid, const std::vector<int>& ranks,
 /// analysis/cost_model_check.py).
 std::string cell_costs_csv(const Grid& grid);
 
+/// The items of `plan`, for `--dry-run --items`: CSV, header
+/// "item,cell,runs,estimated_s,run_ids", one line per item in plan order
+/// (the order the ranks take them), cell its index in Grid::cells (as in
+/// cell_costs_csv()), runs its size, run_ids its runs' RunConfig::id()
+/// separated by spaces (e.g. analysis/schedule_replay.py).
+std::string plan_items_csv(const Grid& grid, const WorkPlan& plan);
+
 }  // namespace phnn
