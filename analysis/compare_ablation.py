@@ -6,13 +6,16 @@
         "dg_structure_point = start=results/ablation-duffing-dg-start.h5" \\
         "precision = float32=results/ablation-duffing-float32.h5" [--threshold 1.0]
 
-For every (system, model, N_train) cell of the baseline, prints a Markdown row: the baseline's
-median MSE with its bootstrap 95 % interval and the seeds above THRESHOLD (the Duffing oscillator's
-bad mode: MSEs near 0.05 or near 10^2-10^3, so 1.0 separates them), then the same for each
-variant that has the cell, marked "better" or "worse" when the two intervals do not overlap
-("resolved"), "~" otherwise. Medians and intervals come from `phnn reduce --format csv` (the
-reducer's own statistics: linear-interpolation quartiles, percentile bootstrap, fixed key); the
-seed counts from `phnn reduce --format csv --per-run`. The phnn binary: $PHNN, else build/phnn.
+For every cell of the baseline that a variant has, prints a Markdown row: the baseline's median
+MSE with its bootstrap 95 % interval and the seeds above THRESHOLD (the Duffing oscillator's bad
+mode: MSEs near 0.05 or near 10^2-10^3, so 1.0 separates them), then the same for each variant
+that has the cell, marked "better" or "worse" when the two intervals do not overlap ("resolved"),
+"~" otherwise. A cell is (system, model, the column of its table): N_train when the tables vary
+it (the third column then shows the number), else the varied axis, e.g. "size=large", so a
+variant of the paper's Study II compares with results/paper.h5's Study II table. Medians and
+intervals come from `phnn reduce --format csv` (the reducer's own statistics: linear-interpolation
+quartiles, percentile bootstrap, fixed key); the seed counts from `phnn reduce --format csv
+--per-run`, over the runs of the row's study. The phnn binary: $PHNN, else build/phnn.
 """
 import sys
 
@@ -24,30 +27,47 @@ def reduce_csv(path, *extra):
     return run_csv("reduce", path, "--format", "csv", *extra)
 
 
+AXES = ("n_train", "size", "regularizer")
+
+
 def cells(path, threshold):
-    """{(system, model, n_train): (median, low, high, above, finished)}"""
+    """{(system, model, axis, column): (median, low, high, above, finished)}"""
     above, finished = {}, {}
     for r in reduce_csv(path, "--per-run"):
         if r["status"] not in ("done", "diverged"):
             continue
-        key = (r["system"], r["model_label"], int(r["n_train"]))
-        finished[key] = finished.get(key, 0) + 1
-        above[key] = above.get(key, 0) + (float(r["mse"]) > threshold)
+        for study in r["studies"].split(","):
+            for axis in AXES:
+                key = (study, r["system"], r["model_label"], axis, r[axis])
+                finished[key] = finished.get(key, 0) + 1
+                above[key] = above.get(key, 0) + (float(r["mse"]) > threshold)
     out = {}
     for r in reduce_csv(path):
         if not r["median"]:
             continue
-        if r["axis"] == "n_train":
-            n_train = int(r["column"])
-        else:  # a table with one column (no varied axis): the model's only N_train
-            ns = {k[2] for k in finished if k[:2] == (r["system"], r["model"])}
-            if r["axis"] or len(ns) != 1:
+        axis, column = r["axis"], r["column"]
+        if not axis:  # a table with one column (no varied axis): the model's only N_train
+            ns = {k[4] for k in finished
+                  if k[:3] == (r["study"], r["system"], r["model"]) and k[3] == "n_train"}
+            if len(ns) != 1:
                 continue
-            n_train = ns.pop()
-        key = (r["system"], r["model"], n_train)
-        out[key] = (float(r["median"]), float(r["ci_low"]), float(r["ci_high"]),
-                    above.get(key, 0), finished.get(key, 0))
+            axis, column = "n_train", ns.pop()
+        if axis not in AXES:
+            continue
+        counted = (r["study"], r["system"], r["model"], axis, column)
+        out[(r["system"], r["model"], axis, column)] = (
+            float(r["median"]), float(r["ci_low"]), float(r["ci_high"]),
+            above.get(counted, 0), finished.get(counted, 0))
     return out
+
+
+def column_text(axis, column):
+    return column if axis == "n_train" else f"{axis}={column}"
+
+
+def sort_key(key):
+    system, model, axis, column = key
+    return (system, model, AXES.index(axis), int(column) if axis == "n_train" else column)
 
 
 def text(cell):
@@ -73,10 +93,13 @@ def main():
         sys.exit(__doc__)
     base = cells(args[0], threshold)
     variants = [(a.rsplit("=", 1)[0], cells(a.rsplit("=", 1)[1], threshold)) for a in args[1:]]
-    print("| system | model | N_train | baseline | " + " | ".join(n for n, _ in variants) + " |")
+    keys = sorted((k for k in base if any(k in v for _, v in variants)), key=sort_key)
+    only_n_train = all(k[2] == "n_train" for k in keys)
+    print(f"| system | model | {'N_train' if only_n_train else 'column'} | baseline | "
+          + " | ".join(n for n, _ in variants) + " |")
     print("|---" * (4 + len(variants)) + "|")
-    for key in sorted(base):
-        row = [key[0], key[1], str(key[2]), text(base[key])]
+    for key in keys:
+        row = [key[0], key[1], column_text(key[2], key[3]), text(base[key])]
         for _, v in variants:
             row.append(text(v[key]) + verdict(base[key], v[key]) if key in v else "")
         print("| " + " | ".join(row) + " |")

@@ -63,6 +63,9 @@ std::string RunConfig::cell_key() const {
   // of every run made before they existed is unchanged.
   if (t.loss_norm != LossNorm::kMeanL1) s << ";loss_norm=" << to_string(t.loss_norm);
   if (t.precision != Precision::kFloat64) s << ";precision=" << to_string(t.precision);
+  if (t.inference_weights != InferenceWeights::kBestValidation) {
+    s << ";inference_weights=" << to_string(t.inference_weights);
+  }
   s << ";jac_eps=" << num(t.jacobian_eps);
   if (is_discrete_gradient(integrator)) {
     s << ";newton=" << num(t.newton_tolerance) << "," << t.newton_max_iterations

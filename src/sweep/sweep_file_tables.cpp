@@ -354,6 +354,7 @@ class TableWalker {
             {"lambda_sr", number(t.lambda_sr)},
             {"loss_norm", choice(t.loss_norm, &all_loss_norms)},
             {"precision", choice(t.precision, &all_precisions)},
+            {"inference_weights", choice(t.inference_weights, &all_inference_weights)},
             {"jacobian_eps", number(t.jacobian_eps)},
             {"newton_tolerance", number(t.newton_tolerance)},
             {"newton_max_iterations", integer(t.newton_max_iterations, 1)},

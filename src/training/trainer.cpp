@@ -269,7 +269,11 @@ void CellTrainer::validate(int step) {
     tp.sigma_max = sigma[e].item<double>();
     tp.rho = rho[e].item<double>();
     results_[ue].trace.push_back(tp);
-    if (std::isfinite(tp.validation_loss) && tp.validation_loss < best_val_[ue]) {
+    // The weights kept for inference: the lowest validation loss so far, or
+    // (inference_weights = final) the latest.
+    const bool keep = opt_.inference_weights == InferenceWeights::kFinal ||
+                      (std::isfinite(tp.validation_loss) && tp.validation_loss < best_val_[ue]);
+    if (keep) {
       best_val_[ue] = tp.validation_loss;
       results_[ue].best_step = step;
       improved.push_back(e);
@@ -328,7 +332,8 @@ void CellTrainer::checkpoint(int step) {
   checkpoint_overhead_s_ += std::chrono::duration<double>(Clock::now() - begin).count();
 }
 
-// Inference with each member's best-validation weights, then the results.
+// Inference with each member's kept weights (best-validation or final), then
+// the results.
 std::vector<RunResult> CellTrainer::finish() {
   torch::NoGradGuard no_grad;
   const double train_s = train_seconds_per_run();
@@ -370,7 +375,10 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
   if (diverged_at_[static_cast<std::size_t>(e)] >= 0) {
     r.status = RunStatus::kDiverged;
     msg << "training loss non-finite at step " << diverged_at_[static_cast<std::size_t>(e)]
-        << "; inference used the best weights (step " << r.best_step << "). ";
+        << "; inference used the "
+        << (opt_.inference_weights == InferenceWeights::kFinal ? "last weights before it"
+                                                               : "best weights")
+        << " (step " << r.best_step << "). ";
   }
   if (r.diverged_rollouts > 0) {
     r.status = RunStatus::kDiverged;

@@ -50,6 +50,18 @@ std::string to_string(Precision precision) {
 
 std::vector<Precision> all_precisions() { return {Precision::kFloat64, Precision::kFloat32}; }
 
+std::string to_string(InferenceWeights weights) {
+  switch (weights) {
+    case InferenceWeights::kBestValidation: return "best-validation";
+    case InferenceWeights::kFinal: return "final";
+  }
+  return "unknown";
+}
+
+std::vector<InferenceWeights> all_inference_weights() {
+  return {InferenceWeights::kBestValidation, InferenceWeights::kFinal};
+}
+
 std::string to_string(RunStatus status) {
   switch (status) {
     case RunStatus::kPending: return "pending";

@@ -384,6 +384,38 @@ TEST(GridTest, AblationSelfSustainedSweepChangesOnlyTheEnergySampling) {
                            ";energy_sampling=direct", "ablation-self-sustained-baseline.toml");
 }
 
+// Without its [training] line, the Study II ablation's runs are exactly the
+// paper grid's Study II runs (results/paper.h5 is its baseline); with it,
+// every cell key carries ";inference_weights=final".
+TEST(GridTest, AblationStudy2SweepIsStudyTwoWithFinalWeights) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-study2-final.toml");
+  const std::string line = "inference_weights = \"final\"\n";
+  std::string text = spec.text;
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.erase(text.find(line), line.size());
+  const Grid ablation = expand_grid(spec);
+  const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
+  const Grid paper = paper_grid();
+  std::set<std::string> study2;
+  for (const StudyTable& study : paper.studies) {
+    if (study.name != "II") continue;
+    for (int r : study.runs) study2.insert(paper.runs[static_cast<std::size_t>(r)].id());
+  }
+  ASSERT_EQ(study2.size(), 450u);
+  ASSERT_EQ(ablation.runs.size(), 450u);
+  ASSERT_EQ(stripped.runs.size(), 450u);
+  std::set<std::string> stripped_ids;
+  for (std::size_t i = 0; i < 450; ++i) {
+    stripped_ids.insert(stripped.runs[i].id());
+    std::string key = ablation.runs[i].cell_key();
+    const std::size_t at = key.find(";inference_weights=final");
+    ASSERT_NE(at, std::string::npos) << i;
+    key.erase(at, std::string(";inference_weights=final").size());
+    EXPECT_EQ(key, stripped.runs[i].cell_key()) << i;
+  }
+  EXPECT_EQ(stripped_ids, study2);
+}
+
 TEST(GridTest, AblationDuffingFloat32SweepChangesOnlyThePrecision) {
   expect_one_knob_ablation("ablation-duffing-float32.toml", "precision = \"float32\"\n",
                            ";precision=float32");

@@ -405,6 +405,29 @@ TEST(SweepFileTest, LossNormIsATrainingOption) {
               StartsWith("x.toml:5: loss_norm expects a \"string\", got the integer 2"));
 }
 
+// [training] inference_weights: best-validation (default) or final; part of
+// a run's identity only away from the default, as ";inference_weights=final".
+TEST(SweepFileTest, InferenceWeightsIsATrainingOption) {
+  const std::string head = "name = \"t\"\n[grid]\nsystems = [\"duffing\"]\nseeds = [0]\n"
+                           "models = [\"phnn-jr-dg\", \"node-rk2\"]\n[training]\n";
+  const Grid plain = expand_grid(parse_sweep_text(head, "x.toml"));
+  const SweepSpec spec = parse_sweep_text(head + "inference_weights = \"final\"\n", "x.toml");
+  EXPECT_EQ(spec.training.inference_weights, InferenceWeights::kFinal);
+  const Grid final = expand_grid(spec);
+  ASSERT_EQ(final.runs.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_THAT(final.runs[i].cell_key(), HasSubstr(";inference_weights=final;"));
+    EXPECT_NE(final.runs[i].id(), plain.runs[i].id());
+  }
+  const Grid best = expand_grid(
+      parse_sweep_text(head + "inference_weights = \"best-validation\"\n", "x.toml"));
+  EXPECT_EQ(best.runs[0].id(), plain.runs[0].id());
+  EXPECT_THAT(best.runs[0].cell_key(), Not(HasSubstr("inference_weights")));
+  EXPECT_STREQ(error_of(head + "inference_weights = \"last\"\n").what(),
+               "x.toml:7: unknown inference_weights \"last\"; expected one of: "
+               "best-validation, final");
+}
+
 // [training] precision: float64 (default) or float32; it changes every run
 // (every model trains in it), and is part of a run's identity only away from
 // the default, as exactly ";precision=float32".

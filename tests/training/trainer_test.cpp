@@ -402,6 +402,48 @@ TEST(TrainerTest, DgStructurePointAppliesToTrainingAndInference) {
   EXPECT_EQ(start.trace.at(0).kappa, midpoint.trace.at(0).kappa);  // continuous field: unchanged
 }
 
+// inference_weights = final rolls out the weights after the last step: the
+// training (trace) is bitwise that of the default, the kept step is the last,
+// and the weights equal those a default run validating only at step 0 and
+// at the last step keeps (its best is its last validation there), bitwise.
+// The learning rate is high enough that some member's best validation point
+// is not the last one, so the two settings differ.
+TEST(TrainerTest, InferenceWeightsFinalRollsOutTheLastWeights) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnS;
+  cell.integrator = IntegratorKind::kRk2;
+  cell.training.steps = 300;
+  cell.training.eval_every = 100;
+  cell.training.learning_rate = 3e-2;
+  cell.seeds = {1, 2, 3};
+  const SystemData& data = small_data(SystemKind::kHarmonic);
+  const auto best = train_cell(cell, data);
+  cell.training.inference_weights = InferenceWeights::kFinal;
+  const auto final = train_cell(cell, data);
+  CellSpec coarse = cell;
+  coarse.training.inference_weights = InferenceWeights::kBestValidation;
+  coarse.training.eval_every = 300;
+  const auto ends = train_cell(coarse, data);
+  int differ = 0;
+  for (std::size_t e = 0; e < 3; ++e) {
+    SCOPED_TRACE("member " + std::to_string(e));
+    ASSERT_EQ(final[e].trace.size(), best[e].trace.size());
+    for (std::size_t i = 0; i < best[e].trace.size(); ++i) {
+      EXPECT_EQ(final[e].trace[i].validation_loss, best[e].trace[i].validation_loss) << i;
+    }
+    EXPECT_EQ(final[e].best_step, 300);
+    EXPECT_EQ(final[e].best_validation_loss, final[e].trace.back().validation_loss);
+    ASSERT_EQ(ends[e].best_step, 300) << "precondition: the last step beats step 0";
+    EXPECT_EQ(final[e].weights, ends[e].weights);
+    EXPECT_EQ(final[e].mse, ends[e].mse);
+    if (best[e].best_step != 300) {
+      ++differ;
+      EXPECT_NE(final[e].weights, best[e].weights);
+    }
+  }
+  EXPECT_GE(differ, 1) << "no member's best validation point came before the last step";
+}
+
 TEST(CellSpecTest, RejectsNodeWithDgAndBadCounts) {
   CellSpec cell;
   cell.model = ModelKind::kNode;

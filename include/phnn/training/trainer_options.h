@@ -41,6 +41,19 @@ std::string to_string(Precision precision);
 /// Every Precision, default first.
 std::vector<Precision> all_precisions();
 
+/// The weights inference uses (docs/DECISIONS.md, "Ablation knobs"):
+///   kBestValidation (the default): each member's weights at its lowest
+///             validation loss (a validation point: step 0, every eval_every
+///             steps, the last step);
+///   kFinal:   the weights at the member's last validation point, i.e. after
+///             the last step (or, for a member whose training diverged, at
+///             the last validation point before).
+enum class InferenceWeights { kBestValidation = 0, kFinal = 1 };
+/// "best-validation", "final".
+std::string to_string(InferenceWeights weights);
+/// Every InferenceWeights, default first.
+std::vector<InferenceWeights> all_inference_weights();
+
 /// Optimizer and schedule of one run (docs/METHOD.md §4). Defaults: docs/METHOD.md.
 struct TrainerOptions {
   /// Adam steps.
@@ -63,6 +76,8 @@ struct TrainerOptions {
   LossNorm loss_norm = LossNorm::kMeanL1;
   /// Floating-point type of training; inference is float64 either way.
   Precision precision = Precision::kFloat64;
+  /// Which weights inference (and every checkpoint) rolls out.
+  InferenceWeights inference_weights = InferenceWeights::kBestValidation;
   /// Eps in kappa = s_max / (s_min + eps) and rho = max|Re l| / (min|Re l| + eps).
   double jacobian_eps = 1e-6;
   /// DG/DG4 inference Newton (docs/METHOD.md §4): a row has converged when its
