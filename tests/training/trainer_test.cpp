@@ -335,31 +335,37 @@ TEST(TrainerTest, ResultsCarryTraceAndFigureTrajectories) {
   EXPECT_NEAR(r[0].mse, sum / 4.0, 1e-15 * sum);
 }
 
-// A member whose loss turns non-finite is frozen and reported; others go on.
-TEST(TrainerTest, DivergedMemberIsFrozenWhileOthersTrain) {
+// Far from the usual regime, stacking stays exact in float64: at lr 1e3 the
+// NODE weights grow large (tanh saturates, so no member's loss becomes
+// non-finite: measured up to lr 1e250, where all diverge at once; the
+// freezing of one diverged member among others is tested in float32,
+// Float32KeepsCheckpointsAndFreezing). Each member of a stack of 4 equals its
+// seed trained alone, bitwise. The final weights are compared (the best
+// validation point at this rate is step 0, whose weights say nothing).
+TEST(TrainerTest, HugeLearningRateKeepsStackingExact) {
   CellSpec cell;
   cell.model = ModelKind::kNode;
   cell.training.steps = 50;
   cell.training.eval_every = 10;
-  cell.training.learning_rate = 1e3;  // blows some members up
-  cell.seeds = {0, 1, 2, 3, 4, 5};
+  cell.training.learning_rate = 1e3;
+  cell.training.inference_weights = InferenceWeights::kFinal;
+  cell.seeds = {0, 1, 2, 3};
   const auto r = train_cell(cell, small_data(SystemKind::kHarmonic));
-  int diverged = 0;
-  for (const auto& run : r) {
-    if (run.status == RunStatus::kDiverged) {
-      ++diverged;
-      EXPECT_THAT(run.message, ::testing::AnyOf(HasSubstr("non-finite"), HasSubstr("diverged")));
-    }
+  for (std::size_t e = 0; e < cell.seeds.size(); ++e) {
+    CellSpec alone = cell;
+    alone.seeds = {cell.seeds[e]};
+    const RunResult a = train_cell(alone, small_data(SystemKind::kHarmonic))[0];
+    EXPECT_EQ(a.status, r[e].status) << e;
+    EXPECT_EQ(a.best_step, r[e].best_step) << e;
+    EXPECT_EQ(a.weights, r[e].weights) << e;
+    EXPECT_EQ(a.mse, r[e].mse) << e;
   }
-  RecordProperty("diverged_members", diverged);
-  // Whatever happened to the others, seed 0 alone gives the same result.
-  CellSpec alone = cell;
-  alone.seeds = {0};
-  const auto a = train_cell(alone, small_data(SystemKind::kHarmonic));
-  EXPECT_EQ(a[0].status, r[0].status);
-  if (std::isfinite(a[0].mse)) {
-    EXPECT_LE(rel(r[0].mse, a[0].mse), 1e-9);
+  // Far from the usual regime: some final weight is > 10 (initial ones are < 1).
+  double largest = 0.0;
+  for (const RunResult& run : r) {
+    for (double w : run.weights) largest = std::max(largest, std::abs(w));
   }
+  EXPECT_GT(largest, 10.0);
 }
 
 // loss_norm applies to the logged training loss and to the validation loss
