@@ -167,9 +167,21 @@ std::vector<std::vector<int>> equal_cost_classes(const Grid& grid, const Pending
   return classes;
 }
 
+// A plan's group counts and what its simulation gives (without its items,
+// so that the hundreds of candidates of a large grid stay small).
+struct Candidate {
+  std::vector<int> counts;
+  double makespan_s = 0.0, cost_s = 0.0;
+};
+
+Candidate simulate(const Grid& grid, const Pending& pending, std::vector<int> counts, int ranks) {
+  const WorkPlan plan = make_plan(grid, pending, counts, ranks);
+  return {std::move(counts), plan.makespan_s, plan.cost_s};
+}
+
 // Plans compare by simulated makespan, then by core-hours (a split that does
 // not shorten the schedule only costs).
-bool better_plan(const WorkPlan& a, const WorkPlan& b) {
+bool better(const Candidate& a, const Candidate& b) {
   constexpr double kRelative = 1e-12;  // sums of <= ~10^4 costs: round-off far below
   if (a.makespan_s < b.makespan_s * (1.0 - kRelative)) return true;
   if (a.makespan_s > b.makespan_s * (1.0 + kRelative)) return false;
@@ -177,34 +189,31 @@ bool better_plan(const WorkPlan& a, const WorkPlan& b) {
 }
 
 // Descent on the group counts, one class of equal cells at a time: change
-// the class's count by -2..+3 and keep the change if better_plan(). A
-// uniform cost target cannot split a cell below the target (two 38-s cells
-// on a 72-s makespan) while cutting a larger one; this can. Stops when no
-// move helps; each kept move strictly improves (makespan, cost), so it ends.
-std::vector<int> refine_group_counts(const Grid& grid, const Pending& pending,
-                                     std::vector<int> counts, int ranks, int cap) {
+// the class's count by -2..+3 and keep the change if better(). A uniform
+// cost target cannot split a cell below the target (two 38-s cells on a
+// 72-s makespan) while cutting a larger one; this can. Stops when no move
+// helps; each kept move strictly improves (makespan, cost), so it ends.
+Candidate refine(const Grid& grid, const Pending& pending, Candidate best, int ranks, int cap) {
   const std::vector<std::vector<int>> classes = equal_cost_classes(grid, pending);
-  WorkPlan best = make_plan(grid, pending, counts, ranks);
   for (bool improved = true; improved;) {
     improved = false;
     for (const std::vector<int>& cells : classes) {
       const int n = static_cast<int>(pending[static_cast<std::size_t>(cells.front())].size());
       const int fewest = cap > 0 ? largest_group(n, cap) : 1;
       for (int step : {-2, -1, 1, 2, 3}) {
-        const int count = counts[static_cast<std::size_t>(cells.front())] + step;
+        const int count = best.counts[static_cast<std::size_t>(cells.front())] + step;
         if (count < fewest || count > n) continue;
-        std::vector<int> trial = counts;
+        std::vector<int> trial = best.counts;
         for (int c : cells) trial[static_cast<std::size_t>(c)] = count;
-        WorkPlan plan = make_plan(grid, pending, trial, ranks);
-        if (better_plan(plan, best)) {
-          best = std::move(plan);
-          counts = std::move(trial);
+        Candidate candidate = simulate(grid, pending, std::move(trial), ranks);
+        if (better(candidate, best)) {
+          best = std::move(candidate);
           improved = true;
         }
       }
     }
   }
-  return counts;
+  return best;
 }
 
 }  // namespace
@@ -225,27 +234,23 @@ WorkPlan plan_work(const Grid& grid, const Pending& pending, int ranks,
   }
   // Candidates: the uniform cut at every target, then the refinement of the
   // best of them and of the unsplit plan.
-  std::vector<std::vector<int>> candidates;
-  std::vector<WorkPlan> plans;
+  std::vector<Candidate> candidates;
   for (double target : targets) {
-    candidates.push_back(group_counts(grid, pending, target, cap));
-    plans.push_back(make_plan(grid, pending, candidates.back(), ranks));
+    candidates.push_back(simulate(grid, pending, group_counts(grid, pending, target, cap), ranks));
   }
-  const std::size_t best_cut = static_cast<std::size_t>(
-      std::min_element(plans.begin(), plans.end(), better_plan) - plans.begin());
-  for (const std::vector<int>& start : {candidates[best_cut], unsplit}) {
-    candidates.push_back(refine_group_counts(grid, pending, start, ranks, cap));
-    plans.push_back(make_plan(grid, pending, candidates.back(), ranks));
-  }
+  const Candidate best_cut = *std::min_element(candidates.begin(), candidates.end(), better);
+  candidates.push_back(refine(grid, pending, best_cut, ranks, cap));
+  candidates.push_back(refine(grid, pending, simulate(grid, pending, unsplit, ranks), ranks, cap));
   // The cheapest plan (fewest core-hours) within (1 + min_gain) of the
   // shortest makespan; the first such on ties.
-  const double shortest = std::min_element(plans.begin(), plans.end(), better_plan)->makespan_s;
-  std::size_t chosen = plans.size();
-  for (std::size_t i = 0; i < plans.size(); ++i) {
-    if (plans[i].makespan_s > shortest * (1.0 + options.min_gain)) continue;
-    if (chosen == plans.size() || plans[i].cost_s < plans[chosen].cost_s) chosen = i;
+  const double shortest =
+      std::min_element(candidates.begin(), candidates.end(), better)->makespan_s;
+  const Candidate* chosen = nullptr;
+  for (const Candidate& c : candidates) {
+    if (c.makespan_s > shortest * (1.0 + options.min_gain)) continue;
+    if (chosen == nullptr || c.cost_s < chosen->cost_s) chosen = &c;
   }
-  return plans[chosen];
+  return make_plan(grid, pending, chosen->counts, ranks);
 }
 
 WorkPlan plan_work(const Grid& grid, int ranks, const SplitOptions& options) {
