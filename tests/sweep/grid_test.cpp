@@ -416,16 +416,17 @@ TEST(GridTest, AblationStudy2SweepIsStudyTwoWithFinalWeights) {
   EXPECT_EQ(stripped_ids, study2);
 }
 
-// The CN-weight study: 4 models x (none + CN at 5 weights) x 30 seeds; its
+// A CN-weight study: `models` x (none + CN at 5 weights) x 30 seeds; its
 // runs at the paper's lambda_CN = 1e-6 (and without regularizer) with seeds
 // 0-9 are paper.toml's own runs, the other weights are new.
-TEST(GridTest, LambdaCnSweepSharesThePapersRunsAtItsWeight) {
-  const Grid grid = expand_grid(parse_sweep_file(kSweeps + "ablation-duffing-lambda-cn.toml"));
-  ASSERT_EQ(grid.runs.size(), 720u);
-  ASSERT_EQ(grid.cells.size(), 24u);
+void expect_lambda_cn_study(const std::string& file, std::size_t models) {
+  SCOPED_TRACE(file);
+  const Grid grid = expand_grid(parse_sweep_file(kSweeps + file));
+  ASSERT_EQ(grid.runs.size(), models * 6 * 30);
+  ASSERT_EQ(grid.cells.size(), models * 6);
   std::set<std::string> paper_ids;
   for (const RunConfig& run : paper_grid().runs) paper_ids.insert(run.id());
-  int shared = 0;
+  std::size_t shared = 0;
   for (const RunConfig& run : grid.runs) {
     const bool papers_weight =
         run.regularizer == Regularizer::kNone || run.training.lambda_cn == 1e-6;
@@ -433,7 +434,12 @@ TEST(GridTest, LambdaCnSweepSharesThePapersRunsAtItsWeight) {
     EXPECT_EQ(paper_ids.count(run.id()) == 1, expected) << run.cell_key() << " seed " << run.seed;
     shared += expected;
   }
-  EXPECT_EQ(shared, 80);  // 4 models x (none, CN 1e-6) x 10 seeds
+  EXPECT_EQ(shared, models * 2 * 10);  // (none, CN 1e-6) x 10 seeds per model
+}
+
+TEST(GridTest, LambdaCnSweepsShareThePapersRunsAtItsWeight) {
+  expect_lambda_cn_study("ablation-duffing-lambda-cn.toml", 4);
+  expect_lambda_cn_study("ablation-harmonic-lambda-cn.toml", 5);
 }
 
 TEST(GridTest, AblationDuffingFloat32SweepChangesOnlyThePrecision) {
