@@ -188,13 +188,14 @@ bool better(const Candidate& a, const Candidate& b) {
   return a.cost_s < b.cost_s * (1.0 - kRelative);
 }
 
-// Descent on the group counts, one class of equal cells at a time: change
-// the class's count by -2..+3 and keep the change if better(). A uniform
-// cost target cannot split a cell below the target (two 38-s cells on a
-// 72-s makespan) while cutting a larger one; this can. Stops when no move
-// helps; each kept move strictly improves (makespan, cost), so it ends.
-Candidate refine(const Grid& grid, const Pending& pending, Candidate best, int ranks, int cap) {
-  const std::vector<std::vector<int>> classes = equal_cost_classes(grid, pending);
+// Descent on the group counts, one class of equal cells (equal_cost_classes)
+// at a time: change the class's count by -2..+3 and keep the change if
+// better(). A uniform cost target cannot split a cell below the target (two
+// 38-s cells on a 72-s makespan) while cutting a larger one; this can. Stops
+// when no move helps; each kept move strictly improves (makespan, cost), so
+// it ends.
+Candidate refine(const Grid& grid, const Pending& pending,
+                 const std::vector<std::vector<int>>& classes, Candidate best, int ranks, int cap) {
   for (bool improved = true; improved;) {
     improved = false;
     for (const std::vector<int>& cells : classes) {
@@ -239,8 +240,10 @@ WorkPlan plan_work(const Grid& grid, const Pending& pending, int ranks,
     candidates.push_back(simulate(grid, pending, group_counts(grid, pending, target, cap), ranks));
   }
   const Candidate best_cut = *std::min_element(candidates.begin(), candidates.end(), better);
-  candidates.push_back(refine(grid, pending, best_cut, ranks, cap));
-  candidates.push_back(refine(grid, pending, simulate(grid, pending, unsplit, ranks), ranks, cap));
+  const std::vector<std::vector<int>> classes = equal_cost_classes(grid, pending);
+  candidates.push_back(refine(grid, pending, classes, best_cut, ranks, cap));
+  candidates.push_back(
+      refine(grid, pending, classes, simulate(grid, pending, unsplit, ranks), ranks, cap));
   // The cheapest plan (fewest core-hours) within (1 + min_gain) of the
   // shortest makespan; the first such on ties.
   const double shortest =
@@ -355,6 +358,20 @@ std::string dry_run_summary(const Grid& grid, const std::vector<int>& ranks,
   return out.str();
 }
 
+namespace {
+
+// RunConfig::id() of `runs` (indices into Grid::runs), separated by spaces.
+std::string run_ids(const Grid& grid, const std::vector<int>& runs) {
+  std::string ids;
+  for (int r : runs) {
+    if (!ids.empty()) ids += ' ';
+    ids += grid.runs[static_cast<std::size_t>(r)].id();
+  }
+  return ids;
+}
+
+}  // namespace
+
 std::string cell_costs_csv(const Grid& grid) {
   std::ostringstream out;
   out.precision(6);
@@ -367,10 +384,7 @@ std::string cell_costs_csv(const Grid& grid) {
         << to_string(run.size) << "," << run.n_train << "," << to_string(run.regularizer) << ","
         << cell.runs.size() << "," << cell.fixed_cost_s << "," << cell.member_cost_s << ","
         << cell.estimated_cost_s << ",";
-    for (std::size_t k = 0; k < cell.runs.size(); ++k) {
-      out << (k ? " " : "") << grid.runs[static_cast<std::size_t>(cell.runs[k])].id();
-    }
-    out << "\n";
+    out << run_ids(grid, cell.runs) << "\n";
   }
   return out.str();
 }
@@ -381,11 +395,8 @@ std::string plan_items_csv(const Grid& grid, const WorkPlan& plan) {
   out << "item,cell,runs,estimated_s,run_ids\n";
   for (std::size_t i = 0; i < plan.items.size(); ++i) {
     const WorkItem& item = plan.items[i];
-    out << i << "," << item.cell << "," << item.runs.size() << "," << item.estimated_cost_s << ",";
-    for (std::size_t k = 0; k < item.runs.size(); ++k) {
-      out << (k ? " " : "") << grid.runs[static_cast<std::size_t>(item.runs[k])].id();
-    }
-    out << "\n";
+    out << i << "," << item.cell << "," << item.runs.size() << "," << item.estimated_cost_s << ","
+        << run_ids(grid, item.runs) << "\n";
   }
   return out.str();
 }
