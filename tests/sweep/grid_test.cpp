@@ -340,6 +340,26 @@ TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
               ElementsAre("lambda=1e-06", "lambda=1.0000001e-06", "lambda=0"));
 }
 
+// Sweep file `file` without its one-knob `line` is `*stripped`: the same
+// runs in the same order, each cell key exactly `key_part` shorter.
+void expect_only_the_knob_differs(const std::string& file, const std::string& line,
+                                  const std::string& key_part, Grid* stripped) {
+  const SweepSpec spec = parse_sweep_file(kSweeps + file);
+  std::string text = spec.text;
+  ASSERT_NE(text.find(line), std::string::npos) << file;
+  text.erase(text.find(line), line.size());
+  const Grid ablation = expand_grid(spec);
+  *stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
+  ASSERT_EQ(ablation.runs.size(), stripped->runs.size()) << file;
+  for (std::size_t i = 0; i < ablation.runs.size(); ++i) {
+    std::string key = ablation.runs[i].cell_key();
+    const std::size_t at = key.find(key_part);
+    ASSERT_NE(at, std::string::npos) << file << " run " << i;
+    key.erase(at, key_part.size());
+    EXPECT_EQ(key, stripped->runs[i].cell_key()) << file << " run " << i;
+  }
+}
+
 // An ablation file of sweeps/ changes one knob of its baseline file by one
 // line: without that line its runs are exactly the baseline's (whose seeds
 // 0-9 are paper.toml's own), and with it each cell key differs by exactly
@@ -347,24 +367,14 @@ TEST(GridTest, OneLambdaReplacesTheWeightAndCloseLambdasKeepDistinctLabels) {
 void expect_one_knob_ablation(const std::string& file, const std::string& line,
                               const std::string& key_part,
                               const std::string& baseline_file = "ablation-duffing-baseline.toml") {
-  const SweepSpec spec = parse_sweep_file(kSweeps + file);
-  std::string text = spec.text;
-  ASSERT_NE(text.find(line), std::string::npos) << file;
-  text.erase(text.find(line), line.size());
-  const Grid ablation = expand_grid(spec);
-  const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
+  Grid stripped;
+  ASSERT_NO_FATAL_FAILURE(expect_only_the_knob_differs(file, line, key_part, &stripped));
   const Grid baseline = expand_grid(parse_sweep_file(kSweeps + baseline_file));
-  ASSERT_EQ(ablation.runs.size(), 240u);
   ASSERT_EQ(stripped.runs.size(), 240u);
   ASSERT_EQ(baseline.runs.size(), 240u);
   std::set<std::string> paper_ids;
   for (const RunConfig& run : paper_grid().runs) paper_ids.insert(run.id());
   for (std::size_t i = 0; i < 240; ++i) {
-    std::string key = ablation.runs[i].cell_key();
-    const std::size_t at = key.find(key_part);
-    ASSERT_NE(at, std::string::npos) << file << " run " << i;
-    key.erase(at, key_part.size());
-    EXPECT_EQ(key, stripped.runs[i].cell_key()) << file << " run " << i;
     EXPECT_EQ(stripped.runs[i].id(), baseline.runs[i].id()) << file << " run " << i;
     EXPECT_EQ(paper_ids.count(baseline.runs[i].id()), baseline.runs[i].seed < 10 ? 1u : 0u) << i;
   }
@@ -388,13 +398,10 @@ TEST(GridTest, AblationSelfSustainedSweepChangesOnlyTheEnergySampling) {
 // paper grid's Study II runs (results/paper.h5 is its baseline); with it,
 // every cell key carries ";inference_weights=final".
 TEST(GridTest, AblationStudy2SweepIsStudyTwoWithFinalWeights) {
-  const SweepSpec spec = parse_sweep_file(kSweeps + "ablation-study2-final.toml");
-  const std::string line = "inference_weights = \"final\"\n";
-  std::string text = spec.text;
-  ASSERT_NE(text.find(line), std::string::npos);
-  text.erase(text.find(line), line.size());
-  const Grid ablation = expand_grid(spec);
-  const Grid stripped = expand_grid(parse_sweep_text(text, "stripped.toml"));
+  Grid stripped;
+  ASSERT_NO_FATAL_FAILURE(expect_only_the_knob_differs("ablation-study2-final.toml",
+                                                       "inference_weights = \"final\"\n",
+                                                       ";inference_weights=final", &stripped));
   const Grid paper = paper_grid();
   std::set<std::string> study2;
   for (const StudyTable& study : paper.studies) {
@@ -402,17 +409,9 @@ TEST(GridTest, AblationStudy2SweepIsStudyTwoWithFinalWeights) {
     for (int r : study.runs) study2.insert(paper.runs[static_cast<std::size_t>(r)].id());
   }
   ASSERT_EQ(study2.size(), 450u);
-  ASSERT_EQ(ablation.runs.size(), 450u);
   ASSERT_EQ(stripped.runs.size(), 450u);
   std::set<std::string> stripped_ids;
-  for (std::size_t i = 0; i < 450; ++i) {
-    stripped_ids.insert(stripped.runs[i].id());
-    std::string key = ablation.runs[i].cell_key();
-    const std::size_t at = key.find(";inference_weights=final");
-    ASSERT_NE(at, std::string::npos) << i;
-    key.erase(at, std::string(";inference_weights=final").size());
-    EXPECT_EQ(key, stripped.runs[i].cell_key()) << i;
-  }
+  for (const RunConfig& run : stripped.runs) stripped_ids.insert(run.id());
   EXPECT_EQ(stripped_ids, study2);
 }
 
