@@ -3,7 +3,11 @@
 // midpoint (RK2), the Gonzalez discrete gradient (DG), classical RK4 and
 // the fourth-order discrete gradient (DG4), over h = 1/12.5 s ... 1/3200 s.
 //
-//   build/work_precision [--trajectories N] [--repeats R] > wp.csv
+//   build/work_precision [--trajectories N] [--repeats R] [--system FILE]... > wp.csv
+//
+// Without --system: the three built-in oscillators (2-state closed forms).
+// With --system FILE (repeatable): those system files instead, through the
+// n-dimensional steps of include/phnn/integrators/ph_steps.h.
 //   python3 analysis/plot_work_precision.py wp.csv docs/figures/
 //
 // Error: RMS over trajectories and the sample times t_k = k / 12.5 s
@@ -34,6 +38,9 @@
 #include "phnn/integrators/discrete_gradient4.h"
 #include "phnn/integrators/explicit_midpoint.h"
 #include "phnn/integrators/runge_kutta4.h"
+#include "phnn/data/ph_dataset.h"
+#include "phnn/integrators/ph_steps.h"
+#include "phnn/systems/system_file.h"
 
 namespace phnn {
 namespace {
@@ -60,17 +67,23 @@ double port_power(const Oscillator& osc, const Vec2& x, double u) {
   return f.z * f.w + u * f.y;
 }
 
+double port_power(const PhSystem& sys, const VecX& x, const VecX& u) {
+  const PhFlows f = sys.flows(sys.grad_hamiltonian(x), u);
+  return f.z.dot(f.w) + u.dot(f.y);
+}
+
+template <class State>
 struct StepResult {
-  Vec2 x_next;
+  State x_next;
   double balance_residual = 0.0;  // relative, see the file header
   bool newton_failed = false;
 };
 
 // One step; with `diagnostics`, also the balance residual (kept out of the
 // timed passes: for RK it costs two more flow evaluations than the step).
-StepResult step(Method m, const Oscillator& osc, const Vec2& x, double u,
-                double h, bool diagnostics) {
-  StepResult r;
+StepResult<Vec2> step(Method m, const Oscillator& osc, const Vec2& x, double u,
+                      double h, bool diagnostics) {
+  StepResult<Vec2> r;
   double power = 0.0;  // h times the discrete port power of the step
   if (m == Method::kDg) {
     const DiscreteGradientStep s = discrete_gradient_step(osc, x, u, h);
@@ -97,21 +110,45 @@ StepResult step(Method m, const Oscillator& osc, const Vec2& x, double u,
   return r;
 }
 
+// The same for a PhSystem (ph_steps.h).
+StepResult<VecX> step(Method m, const PhSystem& sys, const VecX& x, const VecX& u, double h,
+                      bool diagnostics) {
+  StepResult<VecX> r;
+  double power = 0.0;
+  if (m == Method::kDg || m == Method::kDg4) {
+    const PhImplicitStep s = m == Method::kDg ? ph_discrete_gradient_step(sys, x, u, h)
+                                              : ph_discrete_gradient4_step(sys, x, u, h);
+    r.x_next = s.x_next;
+    r.newton_failed = s.status != StepStatus::kConverged;
+    power = -h * (s.flows.z.dot(s.flows.w) + u.dot(s.flows.y)) + h * h * h * s.correction_power;
+  } else {
+    r.x_next = m == Method::kRk2 ? ph_rk2_step(sys, x, u, h) : ph_rk4_step(sys, x, u, h);
+    if (diagnostics) power = -0.5 * h * (port_power(sys, x, u) + port_power(sys, r.x_next, u));
+  }
+  if (!diagnostics) return r;
+  const double H0 = sys.hamiltonian(x);
+  const double dH = sys.hamiltonian(r.x_next) - H0;
+  r.balance_residual = std::abs(dH - power) / (std::abs(H0) + std::abs(power));
+  return r;
+}
+
+template <class State>
 struct Run {
-  std::vector<Vec2> samples;  // x(t_k), k = 1..kSamples
+  std::vector<State> samples;  // x(t_k), k = 1..kSamples
   double worst_balance = 0.0;
   int newton_failures = 0;
   bool diverged = false;
 };
 
-Run integrate(Method m, const Oscillator& osc, const TrajectorySpec& spec,
-              int steps_per_sample, bool diagnostics) {
+template <class System, class Spec>
+auto integrate(Method m, const System& osc, const Spec& spec, int steps_per_sample,
+               bool diagnostics) {
   const double h = kSampleInterval / steps_per_sample;
-  Run run;
-  Vec2 x = spec.x0;
+  Run<std::decay_t<decltype(spec.x0)>> run;
+  auto x = spec.x0;
   for (int k = 0; k < kSamples && !run.diverged; ++k) {
     for (int n = 0; n < steps_per_sample; ++n) {
-      const StepResult s = step(m, osc, x, spec.u, h, diagnostics);
+      const auto s = step(m, osc, x, spec.u, h, diagnostics);
       run.worst_balance = std::max(run.worst_balance, s.balance_residual);
       run.newton_failures += s.newton_failed;
       x = s.x_next;
@@ -134,13 +171,16 @@ double median(std::vector<double> v) {
 struct Options {
   int trajectories = 10;
   int repeats = 5;
+  std::vector<std::string> systems;  // --system FILE
 };
 
 Options parse(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if ((a == "--trajectories" || a == "--repeats") && i + 1 < argc) {
+    if (a == "--system" && i + 1 < argc) {
+      o.systems.push_back(argv[++i]);
+    } else if ((a == "--trajectories" || a == "--repeats") && i + 1 < argc) {
       const int v = std::atoi(argv[++i]);
       if (v < 1) {
         std::fprintf(stderr, "work_precision: %s must be >= 1\n", a.c_str());
@@ -149,22 +189,18 @@ Options parse(int argc, char** argv) {
       (a == "--trajectories" ? o.trajectories : o.repeats) = v;
     } else {
       std::fprintf(stderr,
-                   "usage: work_precision [--trajectories N] [--repeats R]\n");
+                   "usage: work_precision [--trajectories N] [--repeats R] [--system FILE]...\n");
       std::exit(2);
     }
   }
   return o;
 }
 
-void run_system(SystemKind kind, const Options& o) {
-  const Oscillator osc(OscillatorOptions::defaults(kind));
-  const DatasetOptions data;
-  std::vector<TrajectorySpec> specs;
-  for (int i = 0; i < o.trajectories; ++i) {
-    specs.push_back(trajectory_spec(osc, data, data.inference_begin() + i));
-  }
+template <class System, class Spec>
+void run_system(const std::string& name, const System& osc, const std::vector<Spec>& specs,
+                const Options& o) {
   const int ref_steps = (1 << (kLevels - 1)) * 64;
-  std::vector<Run> reference;
+  std::vector<decltype(integrate(Method::kRk4, osc, specs[0], 1, false))> reference;
   for (const auto& s : specs) {
     reference.push_back(integrate(Method::kRk4, osc, s, ref_steps, false));
   }
@@ -174,14 +210,14 @@ void run_system(SystemKind kind, const Options& o) {
       // Timed passes integrate only; one more pass measures errors and balance.
       std::vector<double> seconds;
       for (int r = 0; r < o.repeats; ++r) {
-        std::vector<Run> timed;
+        decltype(reference) timed;
         const auto t0 = std::chrono::steady_clock::now();
         for (const auto& s : specs) timed.push_back(integrate(m, osc, s, per_sample, false));
         const auto t1 = std::chrono::steady_clock::now();
         seconds.push_back(std::chrono::duration<double>(t1 - t0).count() /
                           o.trajectories);
       }
-      std::vector<Run> runs;
+      decltype(reference) runs;
       for (const auto& s : specs) runs.push_back(integrate(m, osc, s, per_sample, true));
       double sum2 = 0.0, worst = 0.0, balance = 0.0;
       int failures = 0, diverged = 0;
@@ -199,7 +235,7 @@ void run_system(SystemKind kind, const Options& o) {
         }
       }
       std::printf("%s,%s,%.10g,%d,%.6e,%.6e,%.6e,%.3e,%d,%d\n",
-                  to_string(kind).c_str(), name_of(m),
+                  name.c_str(), name_of(m),
                   kSampleInterval / per_sample, per_sample * kSamples,
                   std::sqrt(sum2 / (runs.size() * kSamples)), worst,
                   median(seconds), balance, failures, diverged);
@@ -216,6 +252,24 @@ int main(int argc, char** argv) {
   std::printf(
       "system,method,h,steps,rms_error,max_error,seconds_per_trajectory,"
       "worst_balance_residual,newton_failures,diverged_trajectories\n");
-  for (phnn::SystemKind kind : phnn::all_systems()) phnn::run_system(kind, o);
+  const phnn::DatasetOptions data;
+  if (o.systems.empty()) {
+    for (phnn::SystemKind kind : phnn::all_systems()) {
+      const phnn::Oscillator osc(phnn::OscillatorOptions::defaults(kind));
+      std::vector<phnn::TrajectorySpec> specs;
+      for (int i = 0; i < o.trajectories; ++i) {
+        specs.push_back(phnn::trajectory_spec(osc, data, data.inference_begin() + i));
+      }
+      phnn::run_system(phnn::to_string(kind), osc, specs, o);
+    }
+  }
+  for (const std::string& path : o.systems) {
+    const auto sys = phnn::load_system_file(path);
+    std::vector<phnn::PhTrajectorySpec> specs;
+    for (int i = 0; i < o.trajectories; ++i) {
+      specs.push_back(phnn::ph_trajectory_spec(*sys, data, data.inference_begin() + i));
+    }
+    phnn::run_system(sys->name(), *sys, specs, o);
+  }
   return 0;
 }

@@ -7,16 +7,38 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "phnn/data/dataset_file.h"
+#include "phnn/data/ph_dataset_file.h"
+#include "phnn/systems/system_file.h"
 
 namespace phnn {
 namespace apps {
+
+namespace {
+
+int write_file_system_data(const std::string& path, const DatasetOptions& options, int n_train,
+                           const std::string& out, std::chrono::steady_clock::time_point start) {
+  const std::unique_ptr<PhSystem> system = load_system_file(path);
+  const PhSystemData data = make_ph_system_data(*system, options, n_train);
+  write_ph_dataset_file(out, data);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << "phnn data: " << system->name() << " (" << path << ", " << system->n_x()
+            << " states, " << system->n_w() << " ports, " << system->n_u() << " inputs): "
+            << data.train.size() << " train pairs, " << data.validation.size()
+            << " validation pairs, " << data.inference.size() << " inference trajectories x "
+            << (data.inference.size() ? data.inference.states[0].size() : 0) << " samples -> "
+            << out << " (" << seconds << " s)\n";
+  return 0;
+}
+
+}  // namespace
 
 int run_data(int argc, char** argv, int first) {
   cli::Parser parser("data",
                      "Generates the train / validation / inference splits of one "
                      "system (docs/METHOD.md §2)\nwith the Gonzalez discrete gradient and "
                      "writes them to an HDF5 file.");
-  parser.option("system", "harmonic | duffing | self-sustained", "", true);
+  parser.option("system", "harmonic | duffing | self-sustained | a system file (.toml)", "", true);
   parser.option("out", "output HDF5 file", "", true);
   parser.option("n-train", "training pairs to generate (<= 400)", "400");
   parser.option("data-seed", "seed of the counter-based RNG", "0");
@@ -24,10 +46,19 @@ int run_data(int argc, char** argv, int first) {
   parser.option("mass", "m [kg]", "0.16");
   if (!parser.parse(argc, argv, first)) return 0;
 
-  OscillatorOptions system = OscillatorOptions::defaults(parse_system(parser.get("system")));
-  if (parser.has("damping")) system.damping = parser.get_double("damping");
-  system.mass = parser.get_double("mass");
-  system.validate();
+  const std::string system_arg = parser.get("system");
+  const bool from_file = is_system_file_argument(system_arg);
+  if (from_file && (parser.has("damping") || parser.has("mass"))) {
+    throw cli::UsageError{"phnn data: --damping and --mass set the built-in systems' parameters; "
+                          "a system file sets its own under [parameters]: edit " + system_arg};
+  }
+  OscillatorOptions system;
+  if (!from_file) {
+    system = OscillatorOptions::defaults(parse_system(system_arg));
+    if (parser.has("damping")) system.damping = parser.get_double("damping");
+    system.mass = parser.get_double("mass");
+    system.validate();
+  }
   DatasetOptions options;
   const std::int64_t seed = parser.get_int("data-seed");
   if (seed < 0) throw cli::UsageError{"phnn data: --data-seed = " + std::to_string(seed) + " must be >= 0"};
@@ -45,6 +76,7 @@ int run_data(int argc, char** argv, int first) {
                           "data only replaces its own files: pass a new path or move it away"};
   }
   const auto start = std::chrono::steady_clock::now();
+  if (from_file) return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, start);
   const SystemData data = make_system_data(system, options, static_cast<int>(n_train));
   write_dataset_file(parser.get("out"), data);
   const double seconds =

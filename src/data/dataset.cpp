@@ -120,7 +120,12 @@ TrajectorySpec trajectory_spec(const Oscillator& system,
     const double p_max = std::sqrt(2.0 * p.mass * options.energy_max);
     for (int tries = 0;; ++tries) {
       PHNN_CHECK(tries < 1000000, "Algorithm 2 rejected 1e6 draws");
-      const Vec2 x(ic.uniform(-q_max, q_max), ic.uniform(-p_max, p_max));
+      // p is drawn before q: the order GCC gave the two draws when they were
+      // the arguments of one constructor call (unspecified in C++), made
+      // explicit so that no compiler changes the data.
+      const double p_draw = ic.uniform(-p_max, p_max);
+      const double q_draw = ic.uniform(-q_max, q_max);
+      const Vec2 x(q_draw, p_draw);
       const double h0 = system.hamiltonian(x);
       if (h0 >= options.energy_min && h0 <= options.energy_max) {
         spec.x0 = x;

@@ -154,6 +154,14 @@ SystemData read_system_data(const h5::File& file, const std::string& group) {
                              "\"phnn-dataset\" attribute); write one with "
                              "`phnn data`");
   }
+  if (file.has_attribute(group, "format_version") &&
+      file.int_attribute(group, "format_version") != 1) {
+    throw std::runtime_error(
+        file.path() + ": " + group + " is a data set of the system file \"" +
+        file.string_attribute(group, "system") +
+        "\" (format_version " + std::to_string(file.int_attribute(group, "format_version")) +
+        "); read it with read_ph_dataset_file (this reader takes built-in systems' data sets)");
+  }
   SystemData data;
   OscillatorOptions& s = data.system;
   s.kind = parse_system(file.string_attribute(group, "system"));

@@ -1,0 +1,77 @@
+// include/phnn/data/ph_dataset.h — data sets of any PhSystem (n_x states,
+// n_u inputs): initial states and inputs drawn by the system's designs from
+// the counter-based RNG, trajectories by the n-dimensional Gonzalez DG,
+// training / validation pairs and inference trajectories split by index as
+// for the built-in systems (dataset.h, docs/METHOD.md §2). In memory only.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "phnn/data/dataset.h"
+#include "phnn/systems/ph_system.h"
+
+namespace phnn {
+
+/// Initial state and constant input of trajectory `index`.
+struct PhTrajectorySpec {
+  VecX x0, u;
+};
+
+/// Draws x0 by the system's InitialConditionDesign (stream
+/// kInitialCondition) and u by its ControlDesign (stream kControl), keyed by
+/// (data_seed, system.rng_id(), index) only. For the built-in systems'
+/// designs (Algorithms 1-4) the draws are those of trajectory_spec().
+/// Throws std::invalid_argument naming the system file's line when H is
+/// negative or not finite at a drawn state, or when 1e6 draws of the energy
+/// method find no state with H in the interval.
+PhTrajectorySpec ph_trajectory_spec(const PhSystem& system, const DatasetOptions& options,
+                                    std::int64_t index);
+
+struct PhTrajectory {
+  std::int64_t index = 0;
+  VecX u;
+  std::vector<VecX> states;  // at the generation rate, n = 0..steps
+};
+
+/// `num_steps` DG steps at h_gen. Throws std::runtime_error naming system,
+/// trajectory and step if Newton fails.
+PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions& options,
+                                    std::int64_t index, int num_steps);
+
+/// Pairs (x_n, u, x_{n+1}) at sr_train, one per trajectory (PairSet's rules).
+struct PhPairSet {
+  std::vector<VecX> x, x_next, u;
+  std::vector<std::int64_t> trajectory;
+  std::vector<int> position;
+  double step = 0.01;
+  std::size_t size() const { return x.size(); }
+};
+PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options,
+                        std::int64_t first, int count);
+
+struct PhInferenceSet {
+  std::vector<std::int64_t> trajectory;
+  std::vector<VecX> u;
+  std::vector<std::vector<VecX>> states;  // [trajectory][n], n = 0..steps at sr_infer
+  double step = 0.01;
+  std::size_t size() const { return u.size(); }
+};
+PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& options);
+
+/// A system's three splits with what names them.
+struct PhSystemData {
+  std::string system_name, system_text;  // text: the system file ("" built-in)
+  std::vector<std::string> state_names, state_units, input_names;
+  int n_w = 0;
+  DatasetOptions options;
+  PhPairSet train, validation;
+  PhInferenceSet inference;
+};
+
+/// Generates the splits; `num_train` <= options.num_train_max training pairs.
+PhSystemData make_ph_system_data(const PhSystem& system, const DatasetOptions& options,
+                                 int num_train);
+
+}  // namespace phnn

@@ -1,0 +1,161 @@
+// include/phnn/systems/ph_system.h — the n-dimensional port-Hamiltonian
+// system interface (any n_x states, n_w dissipation ports, n_u inputs) that
+// the general integrators and data generator use; built-in oscillators and
+// system files both implement it. Physics only: no files, no Torch.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace phnn {
+
+using VecX = Eigen::VectorXd;
+using MatX = Eigen::MatrixXd;
+
+/// How the initial states x0 of a system's trajectories are drawn
+/// (docs/METHOD.md "System files").
+struct InitialConditionDesign {
+  enum class Method {
+    /// The paper's Algorithm 2 in any dimension: x ~ U(box) until
+    /// H(x) lies in [energy_min, energy_max] (rejection).
+    kEnergy,
+    /// x ~ U(box), no condition on H.
+    kBox,
+    /// The paper's Algorithm 1 (n_x = 2, x = (q, p)): theta ~ U(0, 2 pi),
+    /// r ~ U(energy_min, energy_max), E0 = sqrt(r) (or r with
+    /// EnergySampling::kDirect), q = sqrt(2 E0 / H_qq(0)) sin(theta),
+    /// p = sqrt(2 E0 / H_pp(0)) cos(theta).
+    kAlgorithm1,
+  };
+  Method method = Method::kEnergy;
+  double energy_min = 0.1;
+  double energy_max = 1.0;
+  /// One [lo, hi] per state (kEnergy, kBox). Empty with kEnergy: per state
+  /// i, [-b_i, b_i] with b_i the largest |s| such that H(s e_i) <= energy_max
+  /// (Algorithm 2's box for the Duffing oscillator).
+  std::vector<std::array<double, 2>> box;
+};
+
+/// How the constant input u of a trajectory is drawn.
+struct ControlDesign {
+  enum class Design {
+    /// u_i ~ U(range[i]) per input.
+    kConstant,
+    /// The paper's Algorithm 3 (n_x = 2, n_u = 1): E_eq ~ U(equilibrium
+    /// energies), q* = +-s with H(s, 0) = E_eq (sign +-1 with equal
+    /// probability), u = -dH/dq(q*, 0).
+    kEnergyShaping,
+    /// The paper's Algorithm 4 (n_w = n_u = 1, z polynomial with z'
+    /// quadratic): w ~ U(I_w), I_w = {w : z'(w) < 0}, u = -w.
+    kLimitCycle,
+  };
+  Design design = Design::kConstant;
+  std::vector<std::array<double, 2>> range;  // kConstant: one per input
+  double equilibrium_energy_min = 0.1;       // kEnergyShaping
+  double equilibrium_energy_max = 1.0;
+};
+
+/// The port variables of eq:phs_S at one effort e (in place of gradH):
+///   [x_dot; w; y] = S [e; z(w); u],  S = -S^T,  S_ww = 0 (w explicit).
+struct PhFlows {
+  VecX x_dot, w, z, y;
+};
+
+/// An n-dimensional port-Hamiltonian system (paper §3, eq:phs_S):
+/// state x (n_x), dissipation flows w and efforts z(w) (n_w), inputs u and
+/// outputs y (n_u). Rows and columns of S are ordered (x, w, u/y); S_ww = 0.
+///
+///   std::unique_ptr<PhSystem> sys = make_system("sweeps/systems/pendulum.toml");
+///   VecX f = sys->vector_field(x, u);
+///
+/// Evaluation is not thread-safe for file-defined systems (their compiled
+/// expressions share one variable buffer); use one object per thread.
+class PhSystem {
+ public:
+  virtual ~PhSystem() = default;
+
+  /// Name as given ("harmonic", a system file's `name`).
+  virtual const std::string& name() const = 0;
+  virtual const std::vector<std::string>& state_names() const = 0;
+  virtual const std::vector<std::string>& state_units() const = 0;
+  virtual const std::vector<std::string>& input_names() const = 0;
+  int n_x() const { return static_cast<int>(state_names().size()); }
+  int n_u() const { return static_cast<int>(input_names().size()); }
+  int n_w() const { return static_cast<int>(S().rows()) - n_x() - n_u(); }
+
+  virtual double hamiltonian(const VecX& x) const = 0;
+  virtual VecX grad_hamiltonian(const VecX& x) const = 0;
+  virtual MatX hessian(const VecX& x) const = 0;
+
+  /// z(w) (n_w), dz/dw (n_w x n_w), and z''(w)[s, s] (n_w): the second
+  /// derivative contracted twice with s (DG4's correction).
+  virtual VecX dissipation(const VecX& w) const = 0;
+  virtual MatX dissipation_jacobian(const VecX& w) const = 0;
+  virtual VecX dissipation_second(const VecX& w, const VecX& s) const = 0;
+
+  /// S of eq:phs_S, (n_x + n_w + n_u) square, skew-symmetric, S_ww = 0.
+  virtual const MatX& S() const = 0;
+  /// J of eq:phs_JR, (n_x + n_u) square, rows (x, y), columns (gradH, u).
+  virtual const MatX& J() const = 0;
+
+  /// Gonzalez discrete gradient (eq: gonzalez-discrete-gradient) and its
+  /// Jacobian d dg / d dx (Newton). Default: the generic quotient with the
+  /// min_dx_norm fallback (docs/METHOD.md §4); systems with a
+  /// cancellation-free closed form override it.
+  virtual VecX discrete_gradient(const VecX& x, const VecX& dx) const;
+  virtual MatX discrete_gradient_jacobian(const VecX& x, const VecX& dx) const;
+
+  /// How trajectories' x0 and u are drawn (the system file's [initial] and
+  /// [control] tables; the built-in systems' Algorithms 1-4).
+  virtual const InitialConditionDesign& initial_design() const = 0;
+  virtual const ControlDesign& control_design() const = 0;
+  /// Key of the system's random streams (CounterRng::for_trajectory): 0, 1,
+  /// 2 for the paper's harmonic, duffing and self-sustained systems
+  /// (built-in or file), a hash of the name otherwise.
+  virtual int rng_id() const = 0;
+  /// The system file's text ("" for a built-in system), stored in data and
+  /// results files so a run can be reproduced from them alone.
+  virtual const std::string& source_text() const = 0;
+  /// Where errors about the energy or the designs point ("FILE:LINE" of the
+  /// key, or the built-in's name).
+  virtual std::string energy_location() const { return name(); }
+  virtual std::string initial_location() const { return name(); }
+  /// I_w = {w : z'(w) < 0} of Algorithm 4 (ControlDesign::kLimitCycle);
+  /// throws std::invalid_argument where the system has none.
+  virtual std::array<double, 2> self_oscillation_interval() const;
+  /// Pairs of state indices for phase plots: a system file's [plots] phase,
+  /// else (0,1), (2,3), ... (an odd last state paired with the first).
+  virtual std::vector<std::array<int, 2>> phase_pairs() const;
+
+  /// Flows at effort e (in place of gradH) and input u.
+  PhFlows flows(const VecX& effort, const VecX& u) const;
+  /// dF/de = S_xx + S_xw z'(w) S_wx (n_x x n_x), F = x_dot of flows().
+  MatX flow_jacobian(const VecX& w) const;
+  /// f(x, u) = flows(gradH(x), u).x_dot.
+  VecX vector_field(const VecX& x, const VecX& u) const;
+
+  /// Below this ||dx|| the generic Gonzalez quotient is dropped (tau,
+  /// docs/METHOD.md §4).
+  static constexpr double kMinDxNorm = 6e-6;
+};
+
+/// The rng_id of a system name: 0, 1, 2 for "harmonic", "duffing",
+/// "self-sustained"; else 3 + (FNV-1a 64 of the name mod 2^31 - 3).
+int system_rng_id(const std::string& name);
+
+/// A system by name or by path: "harmonic", "duffing", "self-sustained"
+/// (built-in), or a system file (an argument ending in ".toml" or containing
+/// '/'), relative paths resolved against `base_dir` when it is not empty.
+/// Throws SystemFileError (FILE:LINE and the fix) for a bad file,
+/// std::invalid_argument for an unknown name.
+std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
+                                      const std::string& base_dir = "");
+/// True when make_system would read `name_or_path` as a file.
+bool is_system_file_argument(const std::string& name_or_path);
+
+}  // namespace phnn

@@ -1,0 +1,242 @@
+// src/data/ph_dataset.cpp — data sets of any PhSystem (ph_dataset.h): the
+// sampling designs (the paper's Algorithms 1-4 in their general forms, box
+// and energy-interval draws) and the DG trajectories behind the splits.
+#include "phnn/data/ph_dataset.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "phnn/common/check.h"
+#include "phnn/data/counter_rng.h"
+#include "phnn/integrators/ph_steps.h"
+
+namespace phnn {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+constexpr int kMaxRejections = 1000000;
+
+std::string vec_text(const VecX& x) {
+  std::ostringstream os;
+  os << "(";
+  for (int i = 0; i < x.size(); ++i) os << (i ? ", " : "") << x(i);
+  os << ")";
+  return os.str();
+}
+
+// H(x) at a drawn state: finite and >= 0, else an error at the file's H.
+double checked_energy(const PhSystem& system, const VecX& x) {
+  const double h = system.hamiltonian(x);
+  if (!std::isfinite(h) || h < 0.0) {
+    std::ostringstream os;
+    os << system.energy_location() << ": H = " << h << " at the drawn initial state x = "
+       << vec_text(x) << (std::isfinite(h) ? " is negative" : " is not finite")
+       << "; an energy must be finite and >= 0 where initial states are drawn: fix H or "
+          "shrink initial.box";
+    throw std::invalid_argument(os.str());
+  }
+  return h;
+}
+
+// Components are drawn from the last to the first: the order of the
+// built-in Algorithm 2 (p before q), so the Duffing file reproduces it.
+VecX draw_in_box(const InitialConditionDesign& d, CounterRng* rng) {
+  VecX x(static_cast<int>(d.box.size()));
+  for (int i = static_cast<int>(x.size()) - 1; i >= 0; --i) {
+    x(i) = rng->uniform(d.box[static_cast<std::size_t>(i)][0], d.box[static_cast<std::size_t>(i)][1]);
+  }
+  return x;
+}
+
+// Algorithm 1 with q = sqrt(2 E0 / H_qq(0)) sin(theta), p = sqrt(2 E0 /
+// H_pp(0)) cos(theta) (= the paper's sqrt(2 E0 / k), sqrt(2 m E0)).
+VecX algorithm1(const PhSystem& system, const InitialConditionDesign& d,
+                const DatasetOptions& options, CounterRng* rng) {
+  const double theta = rng->uniform(0.0, kTwoPi);
+  const double r = rng->uniform(d.energy_min, d.energy_max);
+  const double e0 = options.energy_sampling == EnergySampling::kDirect ? r : std::sqrt(r);
+  const MatX h0 = system.hessian(VecX::Zero(2));
+  VecX x(2);
+  x << std::sqrt(2.0 * e0 / h0(0, 0)) * std::sin(theta), std::sqrt(2.0 * e0 / h0(1, 1)) * std::cos(theta);
+  return x;
+}
+
+VecX initial_state(const PhSystem& system, const DatasetOptions& options, CounterRng* rng) {
+  const InitialConditionDesign& d = system.initial_design();
+  switch (d.method) {
+    case InitialConditionDesign::Method::kAlgorithm1:
+      return algorithm1(system, d, options, rng);
+    case InitialConditionDesign::Method::kBox: {
+      const VecX x = draw_in_box(d, rng);
+      checked_energy(system, x);
+      return x;
+    }
+    case InitialConditionDesign::Method::kEnergy:
+      break;
+  }
+  // Algorithm 2: rejection in the box until H(x) lies in [E_min, E_max].
+  for (int tries = 0; tries < kMaxRejections; ++tries) {
+    const VecX x = draw_in_box(d, rng);
+    const double h = checked_energy(system, x);
+    if (h >= d.energy_min && h <= d.energy_max) return x;
+  }
+  std::ostringstream os;
+  os << system.initial_location() << ": no initial state with H in [" << d.energy_min << ", "
+     << d.energy_max << "] in " << kMaxRejections
+     << " draws from the box; widen initial.energy or fit initial.box around that energy shell";
+  throw std::invalid_argument(os.str());
+}
+
+// q* >= 0 with H(q*, 0) = e (H(s, 0) increasing in s >= 0): bisection to
+// the last bit after doubling.
+double equilibrium_offset(const PhSystem& system, double e) {
+  auto energy = [&](double s) {
+    VecX x(2);
+    x << s, 0.0;
+    return system.hamiltonian(x);
+  };
+  double hi = 1e-3;
+  for (int it = 0; energy(hi) < e; ++it) {
+    PHNN_REQUIRE(it < 60, system.initial_location() << ": energy-shaping control: H(q, 0) stays "
+                                                    "below E_eq = " << e << "; lower control.energy");
+    hi *= 2.0;
+  }
+  double lo = 0.0;
+  for (int it = 0; it < 200; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid <= lo || mid >= hi) break;
+    (energy(mid) < e ? lo : hi) = mid;
+  }
+  return energy(hi) - e <= e - energy(lo) ? hi : lo;
+}
+
+VecX control_input(const PhSystem& system, CounterRng* rng) {
+  const ControlDesign& c = system.control_design();
+  VecX u = VecX::Zero(system.n_u());
+  switch (c.design) {
+    case ControlDesign::Design::kConstant:
+      for (int i = 0; i < u.size(); ++i) {
+        u(i) = rng->uniform(c.range[static_cast<std::size_t>(i)][0], c.range[static_cast<std::size_t>(i)][1]);
+      }
+      break;
+    case ControlDesign::Design::kEnergyShaping: {
+      // Algorithm 3: E_eq ~ U(I_Eeq), sign +-1, u = -dH/dq(q*, 0).
+      const double e_eq = rng->uniform(c.equilibrium_energy_min, c.equilibrium_energy_max);
+      const double sign = rng->uniform() < 0.5 ? -1.0 : 1.0;
+      VecX x_star(2);
+      x_star << sign * equilibrium_offset(system, e_eq), 0.0;
+      u(0) = -system.grad_hamiltonian(x_star)(0);
+      break;
+    }
+    case ControlDesign::Design::kLimitCycle: {
+      // Algorithm 4: w ~ U(I_w), u = -w.
+      const auto interval = system.self_oscillation_interval();
+      u(0) = -rng->uniform(interval[0], interval[1]);
+      break;
+    }
+  }
+  return u;
+}
+
+}  // namespace
+
+PhTrajectorySpec ph_trajectory_spec(const PhSystem& system, const DatasetOptions& options,
+                                    std::int64_t index) {
+  PHNN_REQUIRE(index >= 0 && index < options.num_trajectories,
+               "trajectory index " << index << " outside [0, " << options.num_trajectories << ")");
+  CounterRng ic = CounterRng::for_trajectory(options.data_seed, system.rng_id(), index,
+                                             CounterRng::kInitialCondition);
+  CounterRng ctrl =
+      CounterRng::for_trajectory(options.data_seed, system.rng_id(), index, CounterRng::kControl);
+  PhTrajectorySpec spec;
+  spec.x0 = initial_state(system, options, &ic);
+  spec.u = control_input(system, &ctrl);
+  return spec;
+}
+
+PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions& options,
+                                    std::int64_t index, int num_steps) {
+  PHNN_REQUIRE(num_steps >= 0, "ph_generate_trajectory: num_steps = " << num_steps << " must be >= 0");
+  const PhTrajectorySpec spec = ph_trajectory_spec(system, options, index);
+  PhTrajectory traj;
+  traj.index = index;
+  traj.u = spec.u;
+  traj.states.reserve(static_cast<std::size_t>(num_steps) + 1);
+  traj.states.push_back(spec.x0);
+  for (int n = 0; n < num_steps; ++n) {
+    const PhImplicitStep step = ph_discrete_gradient_step(system, traj.states.back(), spec.u,
+                                                          options.generation_step, options.newton);
+    if (step.status != StepStatus::kConverged) {
+      std::ostringstream msg;
+      msg << "data generation: Newton did not converge for system " << system.name()
+          << ", trajectory " << index << ", step " << n << " (" << to_string(step.status)
+          << " after " << step.newton_iterations << " iterations, residual " << step.residual
+          << "); loosen newton.tolerance, shorten generation_step or check the system's parameters";
+      throw std::runtime_error(msg.str());
+    }
+    traj.states.push_back(step.x_next);
+  }
+  return traj;
+}
+
+PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options, std::int64_t first,
+                        int count) {
+  options.validate();
+  const int stride = options.stride();
+  const int positions = options.num_pair_positions();
+  PhPairSet pairs;
+  pairs.step = stride * options.generation_step;
+  for (std::int64_t i = first; i < first + count; ++i) {
+    CounterRng pick = CounterRng::for_trajectory(options.data_seed, system.rng_id(), i,
+                                                 CounterRng::kTrainingPair);
+    const int n = static_cast<int>(pick.below(static_cast<std::uint64_t>(positions)));
+    const PhTrajectory traj = ph_generate_trajectory(system, options, i, (n + 1) * stride);
+    pairs.x.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
+    pairs.x_next.push_back(traj.states.back());
+    pairs.u.push_back(traj.u);
+    pairs.trajectory.push_back(i);
+    pairs.position.push_back(n);
+  }
+  return pairs;
+}
+
+PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& options) {
+  options.validate();
+  const int stride = options.stride();
+  const int steps = options.num_inference_steps();
+  PhInferenceSet set;
+  set.step = stride * options.generation_step;
+  for (int j = 0; j < options.num_inference; ++j) {
+    const std::int64_t i = options.inference_begin() + j;
+    const PhTrajectory traj = ph_generate_trajectory(system, options, i, steps * stride);
+    std::vector<VecX> sub;
+    sub.reserve(static_cast<std::size_t>(steps) + 1);
+    for (int n = 0; n <= steps; ++n) sub.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
+    set.trajectory.push_back(i);
+    set.u.push_back(traj.u);
+    set.states.push_back(std::move(sub));
+  }
+  return set;
+}
+
+PhSystemData make_ph_system_data(const PhSystem& system, const DatasetOptions& options,
+                                 int num_train) {
+  options.validate();
+  PHNN_REQUIRE(num_train >= 1 && num_train <= options.num_train_max,
+               "n_train = " << num_train << " outside [1, " << options.num_train_max << "]");
+  PhSystemData data;
+  data.system_name = system.name();
+  data.system_text = system.source_text();
+  data.state_names = system.state_names();
+  data.state_units = system.state_units();
+  data.input_names = system.input_names();
+  data.n_w = system.n_w();
+  data.options = options;
+  data.train = ph_make_pairs(system, options, 0, num_train);
+  data.validation = ph_make_pairs(system, options, options.validation_begin(), options.num_validation);
+  data.inference = ph_inference_set(system, options);
+  return data;
+}
+
+}  // namespace phnn

@@ -1,0 +1,207 @@
+// src/data/ph_dataset_file.cpp — format_version 2 data-set files
+// (include/phnn/data/ph_dataset_file.h); version 1 (built-in systems) is
+// read through dataset_file.cpp and converted.
+#include "phnn/data/ph_dataset_file.h"
+
+#include <sstream>
+#include <stdexcept>
+
+#include "data/dataset_file_io.h"
+#include "h5/h5file.h"
+
+namespace phnn {
+namespace {
+
+std::string join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) out += (out.empty() ? "" : ",") + s;
+  return out;
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  if (s.empty()) return out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(item);
+  if (!s.empty() && s.back() == ',') out.push_back("");
+  return out;
+}
+
+std::vector<double> flatten(const std::vector<VecX>& rows) {
+  std::vector<double> out;
+  for (const VecX& r : rows) out.insert(out.end(), r.data(), r.data() + r.size());
+  return out;
+}
+
+std::vector<VecX> unflatten(const std::vector<double>& flat, int width, std::size_t count) {
+  std::vector<VecX> out(count, VecX(width));
+  for (std::size_t i = 0; i < count; ++i) {
+    for (int j = 0; j < width; ++j) out[i](j) = flat[i * static_cast<std::size_t>(width) + static_cast<std::size_t>(j)];
+  }
+  return out;
+}
+
+void write_pairs(h5::File& file, const std::string& group, const PhPairSet& p, int nx, int nu) {
+  file.create_group(group);
+  const std::uint64_t n = p.size();
+  file.write(group + "/x", {n, static_cast<std::uint64_t>(nx)}, flatten(p.x));
+  file.write(group + "/x_next", {n, static_cast<std::uint64_t>(nx)}, flatten(p.x_next));
+  if (nu > 0) file.write(group + "/u", {n, static_cast<std::uint64_t>(nu)}, flatten(p.u));
+  file.write(group + "/trajectory", {n}, p.trajectory);
+  file.write(group + "/position", {n}, std::vector<std::int64_t>(p.position.begin(), p.position.end()));
+  file.set_attribute(group, "step_s", p.step);
+}
+
+PhPairSet read_pairs(const h5::File& file, const std::string& group, int nx, int nu) {
+  PhPairSet p;
+  p.trajectory = file.read_ints(group + "/trajectory");
+  const std::size_t n = p.trajectory.size();
+  p.x = unflatten(file.read_doubles(group + "/x"), nx, n);
+  p.x_next = unflatten(file.read_doubles(group + "/x_next"), nx, n);
+  p.u = nu > 0 ? unflatten(file.read_doubles(group + "/u"), nu, n) : std::vector<VecX>(n, VecX(0));
+  for (auto v : file.read_ints(group + "/position")) p.position.push_back(static_cast<int>(v));
+  p.step = file.double_attribute(group, "step_s");
+  return p;
+}
+
+void write_options(h5::File& file, const DatasetOptions& o) {
+  file.set_attribute("/", "data_seed", static_cast<std::int64_t>(o.data_seed));
+  file.set_attribute("/", "generation_step_s", o.generation_step);
+  file.set_attribute("/", "period_s", o.period);
+  file.set_attribute("/", "alpha", o.alpha);
+  file.set_attribute("/", "beta", o.beta);
+  file.set_attribute("/", "sample_rate_Hz", o.sample_rate);
+  file.set_attribute("/", "energy_sampling", to_string(o.energy_sampling));
+  file.set_attribute("/", "num_trajectories", static_cast<std::int64_t>(o.num_trajectories));
+  file.set_attribute("/", "num_train_max", static_cast<std::int64_t>(o.num_train_max));
+  file.set_attribute("/", "num_validation", static_cast<std::int64_t>(o.num_validation));
+  file.set_attribute("/", "num_inference", static_cast<std::int64_t>(o.num_inference));
+  file.set_attribute("/", "newton_tolerance", o.newton.newton_tolerance);
+}
+
+DatasetOptions read_options(const h5::File& file) {
+  DatasetOptions o;
+  o.data_seed = static_cast<std::uint64_t>(file.int_attribute("/", "data_seed"));
+  o.generation_step = file.double_attribute("/", "generation_step_s");
+  o.period = file.double_attribute("/", "period_s");
+  o.alpha = file.double_attribute("/", "alpha");
+  o.beta = file.double_attribute("/", "beta");
+  o.sample_rate = file.double_attribute("/", "sample_rate_Hz");
+  o.energy_sampling = file.string_attribute("/", "energy_sampling") == "direct"
+                          ? EnergySampling::kDirect
+                          : EnergySampling::kAlgorithm1;
+  o.num_trajectories = static_cast<int>(file.int_attribute("/", "num_trajectories"));
+  o.num_train_max = static_cast<int>(file.int_attribute("/", "num_train_max"));
+  o.num_validation = static_cast<int>(file.int_attribute("/", "num_validation"));
+  o.num_inference = static_cast<int>(file.int_attribute("/", "num_inference"));
+  o.newton.newton_tolerance = file.double_attribute("/", "newton_tolerance");
+  return o;
+}
+
+// A version-1 (built-in, 2-state) data set in the n-dimensional form.
+PhSystemData from_version1(const SystemData& v1) {
+  PhSystemData d;
+  d.system_name = to_string(v1.system.kind);
+  d.state_names = {"q", "p"};
+  d.state_units = {"m", "kg m/s"};
+  d.input_names = {"u"};
+  d.n_w = 1;
+  d.options = v1.options;
+  auto pairs = [](const PairSet& p) {
+    PhPairSet out;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      out.x.push_back(p.x[i]);
+      out.x_next.push_back(p.x_next[i]);
+      out.u.push_back(VecX::Constant(1, p.u[i]));
+    }
+    out.trajectory = p.trajectory;
+    out.position = p.position;
+    out.step = p.step;
+    return out;
+  };
+  d.train = pairs(v1.train);
+  d.validation = pairs(v1.validation);
+  d.inference.trajectory = v1.inference.trajectory;
+  d.inference.step = v1.inference.step;
+  for (std::size_t i = 0; i < v1.inference.size(); ++i) {
+    d.inference.u.push_back(VecX::Constant(1, v1.inference.u[i]));
+    std::vector<VecX> traj;
+    for (const Vec2& x : v1.inference.states[i]) traj.push_back(x);
+    d.inference.states.push_back(std::move(traj));
+  }
+  return d;
+}
+
+}  // namespace
+
+void write_ph_dataset_file(const std::string& path, const PhSystemData& data) {
+  h5::File file = h5::File::create(path);
+  const int nx = static_cast<int>(data.state_names.size());
+  const int nu = static_cast<int>(data.input_names.size());
+  file.set_attribute("/", "format", std::string("phnn-dataset"));
+  file.set_attribute("/", "format_version", std::int64_t{2});
+  file.set_attribute("/", "system", data.system_name);
+  file.set_attribute("/", "system_file", data.system_text);
+  file.set_attribute("/", "n_x", static_cast<std::int64_t>(nx));
+  file.set_attribute("/", "n_w", static_cast<std::int64_t>(data.n_w));
+  file.set_attribute("/", "n_u", static_cast<std::int64_t>(nu));
+  file.set_attribute("/", "state_names", join(data.state_names));
+  file.set_attribute("/", "state_units", join(data.state_units));
+  file.set_attribute("/", "input_names", join(data.input_names));
+  file.set_attribute("/", "time_units", std::string("s"));
+  write_options(file, data.options);
+  write_pairs(file, "/train", data.train, nx, nu);
+  write_pairs(file, "/validation", data.validation, nx, nu);
+  file.create_group("/inference");
+  const std::uint64_t m = data.inference.size();
+  const std::uint64_t steps = m ? data.inference.states[0].size() : 0;
+  std::vector<double> states;
+  for (const auto& traj : data.inference.states) {
+    const auto flat = flatten(traj);
+    states.insert(states.end(), flat.begin(), flat.end());
+  }
+  file.write("/inference/states", {m, steps, static_cast<std::uint64_t>(nx)}, states);
+  if (nu > 0) file.write("/inference/u", {m, static_cast<std::uint64_t>(nu)}, flatten(data.inference.u));
+  file.write("/inference/trajectory", {m}, data.inference.trajectory);
+  file.set_attribute("/inference", "step_s", data.inference.step);
+}
+
+PhSystemData read_ph_dataset_file(const std::string& path) {
+  const h5::File file = h5::File::open(path, h5::Access::kReadOnly);
+  if (!file.has_attribute("/", "format") || file.string_attribute("/", "format") != "phnn-dataset") {
+    throw std::runtime_error(path + ": not a phnn data set (no format = \"phnn-dataset\" "
+                                    "attribute); write one with `phnn data`");
+  }
+  if (!file.has_attribute("/", "format_version") || file.int_attribute("/", "format_version") == 1) {
+    return from_version1(internal::read_system_data(file, "/"));
+  }
+  PhSystemData d;
+  d.system_name = file.string_attribute("/", "system");
+  d.system_text = file.string_attribute("/", "system_file");
+  d.state_names = split(file.string_attribute("/", "state_names"));
+  d.state_units = split(file.string_attribute("/", "state_units"));
+  d.input_names = split(file.string_attribute("/", "input_names"));
+  d.n_w = static_cast<int>(file.int_attribute("/", "n_w"));
+  const int nx = static_cast<int>(d.state_names.size());
+  const int nu = static_cast<int>(d.input_names.size());
+  d.options = read_options(file);
+  d.train = read_pairs(file, "/train", nx, nu);
+  d.validation = read_pairs(file, "/validation", nx, nu);
+  d.inference.trajectory = file.read_ints("/inference/trajectory");
+  d.inference.step = file.double_attribute("/inference", "step_s");
+  const std::size_t m = d.inference.trajectory.size();
+  const auto dims = file.dims("/inference/states");
+  const auto flat = file.read_doubles("/inference/states");
+  const std::size_t steps = dims.size() == 3 ? dims[1] : 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::vector<double> part(flat.begin() + static_cast<long>(i * steps * nx),
+                                   flat.begin() + static_cast<long>((i + 1) * steps * nx));
+    d.inference.states.push_back(unflatten(part, nx, steps));
+  }
+  d.inference.u = nu > 0 ? unflatten(file.read_doubles("/inference/u"), nu, m)
+                         : std::vector<VecX>(m, VecX(0));
+  return d;
+}
+
+}  // namespace phnn

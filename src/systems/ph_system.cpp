@@ -1,0 +1,204 @@
+// src/systems/ph_system.cpp — the PhSystem interface's shared parts (flows,
+// the generic Gonzalez discrete gradient), the built-in oscillators behind
+// it, and the registry make_system() (built-in names and system files).
+#include "phnn/systems/ph_system.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "phnn/systems/oscillators.h"
+#include "phnn/systems/system_file.h"
+
+namespace phnn {
+
+// Written as loops over S: these systems are small and S is sparse, and
+// dynamic-size block products would allocate per call.
+PhFlows PhSystem::flows(const VecX& effort, const VecX& u) const {
+  const MatX& s = S();
+  const int nx = n_x(), nw = n_w(), nu = n_u();
+  auto row = [&](int r, const VecX* z) {
+    double acc = 0.0;
+    for (int j = 0; j < nx; ++j) acc += s(r, j) * effort(j);
+    if (z != nullptr) {
+      for (int j = 0; j < nw; ++j) acc += s(r, nx + j) * (*z)(j);
+    }
+    for (int j = 0; j < nu; ++j) acc += s(r, nx + nw + j) * u(j);
+    return acc;
+  };
+  PhFlows out;
+  // S_ww = 0: w depends on the effort and u only.
+  out.w.resize(nw);
+  for (int k = 0; k < nw; ++k) out.w(k) = row(nx + k, nullptr);
+  out.z = dissipation(out.w);
+  out.x_dot.resize(nx);
+  for (int i = 0; i < nx; ++i) out.x_dot(i) = row(i, &out.z);
+  out.y.resize(nu);
+  for (int k = 0; k < nu; ++k) out.y(k) = row(nx + nw + k, &out.z);
+  return out;
+}
+
+MatX PhSystem::flow_jacobian(const VecX& w) const {
+  const MatX& s = S();
+  const int nx = n_x(), nw = n_w();
+  MatX jac = s.topLeftCorner(nx, nx);
+  if (nw == 0) return jac;
+  const MatX dz = dissipation_jacobian(w);
+  for (int i = 0; i < nx; ++i) {
+    for (int k = 0; k < nw; ++k) {
+      if (s(i, nx + k) == 0.0) continue;
+      for (int l = 0; l < nw; ++l) {
+        if (dz(k, l) == 0.0) continue;
+        for (int j = 0; j < nx; ++j) jac(i, j) += s(i, nx + k) * dz(k, l) * s(nx + l, j);
+      }
+    }
+  }
+  return jac;
+}
+
+VecX PhSystem::vector_field(const VecX& x, const VecX& u) const {
+  return flows(grad_hamiltonian(x), u).x_dot;
+}
+
+// dg(x, dx) = gradH(m) + D / |dx|^2 dx,  m = x + dx/2,
+// D = H(x + dx) - H(x) - gradH(m)^T dx  (= gradH(m) below tau).
+VecX PhSystem::discrete_gradient(const VecX& x, const VecX& dx) const {
+  const VecX mid = x + 0.5 * dx;
+  VecX g = grad_hamiltonian(mid);
+  const double n2 = dx.squaredNorm();
+  if (!(std::sqrt(n2) >= kMinDxNorm) || n2 == 0.0) return g;
+  const double defect = hamiltonian(x + dx) - hamiltonian(x) - g.dot(dx);
+  g += (defect / n2) * dx;
+  return g;
+}
+
+// d dg / d dx = H''(m)/2 + (D/n2) I + dx (dD/d dx / n2 - 2 D dx / n2^2)^T,
+// dD/d dx = gradH(x + dx) - gradH(m) - H''(m) dx / 2.
+MatX PhSystem::discrete_gradient_jacobian(const VecX& x, const VecX& dx) const {
+  const VecX mid = x + 0.5 * dx;
+  const MatX hess = hessian(mid);
+  MatX jac = 0.5 * hess;
+  const double n2 = dx.squaredNorm();
+  if (!(std::sqrt(n2) >= kMinDxNorm) || n2 == 0.0) return jac;
+  const VecX g = grad_hamiltonian(mid);
+  const double defect = hamiltonian(x + dx) - hamiltonian(x) - g.dot(dx);
+  const VecX d_defect = grad_hamiltonian(x + dx) - g - 0.5 * (hess * dx);
+  jac.diagonal().array() += defect / n2;
+  jac += dx * (d_defect / n2 - (2.0 * defect / (n2 * n2)) * dx).transpose();
+  return jac;
+}
+
+std::array<double, 2> PhSystem::self_oscillation_interval() const {
+  throw std::invalid_argument(name() + ": no self-oscillation interval I_w = {w : z'(w) < 0}; "
+                              "the limit-cycle design needs one port with a polynomial z(w) "
+                              "whose z' is quadratic and negative between two roots");
+}
+
+std::vector<std::array<int, 2>> PhSystem::phase_pairs() const {
+  std::vector<std::array<int, 2>> pairs;
+  for (int i = 0; i + 1 < n_x(); i += 2) pairs.push_back({i, i + 1});
+  if (n_x() % 2 == 1) pairs.push_back({n_x() - 1, 0});
+  return pairs;
+}
+
+int system_rng_id(const std::string& name) {
+  for (SystemKind kind : all_systems()) {
+    if (name == to_string(kind)) return static_cast<int>(kind);
+  }
+  std::uint64_t hash = 0xcbf29ce484222325ULL;  // FNV-1a 64
+  for (unsigned char c : name) {
+    hash ^= c;
+    hash *= 0x100000001b3ULL;
+  }
+  return 3 + static_cast<int>(hash % 0x7FFFFFFCULL);
+}
+
+namespace {
+
+Eigen::Vector2d as2(const VecX& x) { return Eigen::Vector2d(x(0), x(1)); }
+
+// A built-in oscillator behind PhSystem: its closed forms and the paper's
+// Algorithms 1-4 as designs.
+class BuiltinSystem : public PhSystem {
+ public:
+  explicit BuiltinSystem(const OscillatorOptions& options)
+      : osc_(options), name_(to_string(options.kind)) {
+    states_ = {"q", "p"};
+    units_ = {"m", "kg m/s"};
+    inputs_ = {"u"};
+    S_ = osc_.S();
+    J_ = osc_.J();
+    initial_.method = options.kind == SystemKind::kDuffing
+                          ? InitialConditionDesign::Method::kEnergy
+                          : InitialConditionDesign::Method::kAlgorithm1;
+    control_.design = options.kind == SystemKind::kSelfSustained
+                          ? ControlDesign::Design::kLimitCycle
+                          : ControlDesign::Design::kEnergyShaping;
+  }
+  const std::string& name() const override { return name_; }
+  const std::vector<std::string>& state_names() const override { return states_; }
+  const std::vector<std::string>& state_units() const override { return units_; }
+  const std::vector<std::string>& input_names() const override { return inputs_; }
+  double hamiltonian(const VecX& x) const override { return osc_.hamiltonian(as2(x)); }
+  VecX grad_hamiltonian(const VecX& x) const override {
+    return osc_.grad_hamiltonian(as2(x));
+  }
+  MatX hessian(const VecX& x) const override { return osc_.hessian(as2(x)); }
+  VecX dissipation(const VecX& w) const override {
+    return VecX::Constant(1, osc_.dissipation(w(0)));
+  }
+  MatX dissipation_jacobian(const VecX& w) const override {
+    return MatX::Constant(1, 1, osc_.dissipation_derivative(w(0)));
+  }
+  VecX dissipation_second(const VecX& w, const VecX& s) const override {
+    return VecX::Constant(1, osc_.dissipation_second_derivative(w(0)) * s(0) * s(0));
+  }
+  const MatX& S() const override { return S_; }
+  const MatX& J() const override { return J_; }
+  VecX discrete_gradient(const VecX& x, const VecX& dx) const override {
+    return osc_.discrete_gradient(as2(x), as2(dx));
+  }
+  MatX discrete_gradient_jacobian(const VecX& x, const VecX& dx) const override {
+    return osc_.discrete_gradient_jacobian(as2(x), as2(dx));
+  }
+  const InitialConditionDesign& initial_design() const override { return initial_; }
+  const ControlDesign& control_design() const override { return control_; }
+  int rng_id() const override { return static_cast<int>(osc_.kind()); }
+  const std::string& source_text() const override { return source_; }
+  std::array<double, 2> self_oscillation_interval() const override {
+    return osc_.self_oscillation_interval();
+  }
+
+ private:
+  Oscillator osc_;
+  std::string name_, source_;
+  std::vector<std::string> states_, units_, inputs_;
+  MatX S_, J_;
+  InitialConditionDesign initial_;
+  ControlDesign control_;
+};
+
+}  // namespace
+
+bool is_system_file_argument(const std::string& s) {
+  const std::string ext = ".toml";
+  return s.find('/') != std::string::npos ||
+         (s.size() > ext.size() && s.compare(s.size() - ext.size(), ext.size(), ext) == 0);
+}
+
+std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
+                                      const std::string& base_dir) {
+  if (!is_system_file_argument(name_or_path)) {
+    try {
+      return std::make_unique<BuiltinSystem>(
+          OscillatorOptions::defaults(parse_system(name_or_path)));
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(e.what()) +
+                                  ", or a system file (a path ending in .toml)");
+    }
+  }
+  std::string path = name_or_path;
+  if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
+  return load_system_file(path);
+}
+
+}  // namespace phnn

@@ -1,0 +1,63 @@
+// tests/apps/data_command_test.cpp — `phnn data --system FILE`: a system
+// file's data set written with its names and text; a bad file refused with
+// FILE:LINE and the fix, and no output file left behind.
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/data/ph_dataset_file.h"
+#include "test_util.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+
+int phnn(const std::string& args, std::string* output) {
+  return testing_util::run_shell(std::string(PHNN_BINARY) + " " + args, output);
+}
+
+TEST(DataCommandTest, WritesASystemFilesDataSet) {
+  const std::string out = ::testing::TempDir() + "phnn_data_pendulum.h5";
+  std::remove(out.c_str());
+  std::string log;
+  ASSERT_EQ(phnn("data --system " + std::string(PHNN_SOURCE_DIR) +
+                     "/sweeps/systems/pendulum.toml --n-train 5 --out " + out,
+                 &log),
+            0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("pendulum"));
+  const PhSystemData data = read_ph_dataset_file(out);
+  EXPECT_EQ(data.system_name, "pendulum");
+  EXPECT_EQ(data.state_names, (std::vector<std::string>{"q", "p"}));
+  EXPECT_EQ(data.state_units, (std::vector<std::string>{"rad", "kg m^2/s"}));
+  EXPECT_THAT(data.system_text, HasSubstr("m*g*l*(1 - cos(q))"));
+  EXPECT_EQ(data.train.size(), 5u);
+  EXPECT_EQ(data.validation.size(), 2500u);
+  EXPECT_EQ(data.inference.size(), 100u);
+  EXPECT_EQ(data.inference.states[0].size(), 501u);
+  std::remove(out.c_str());
+}
+
+TEST(DataCommandTest, RefusesAMalformedSystemFileWithItsLine) {
+  const std::string sys = ::testing::TempDir() + "phnn_bad_system.toml";
+  const std::string out = ::testing::TempDir() + "phnn_bad_system.h5";
+  std::remove(out.c_str());
+  std::ofstream(sys) << "name = \"bad\"\nstates = [\"q\", \"p\"]\nH = \"q^2 + p^2 + mass\"\n"
+                        "S = [[0, 1], [-1, 0]]\n[initial]\nmethod = \"energy\"\nenergy = [0.1, 1]\n";
+  std::string log;
+  EXPECT_EQ(phnn("data --system " + sys + " --out " + out, &log), 2);
+  EXPECT_THAT(log, HasSubstr(sys + ":3: unknown symbol \"mass\""));
+  EXPECT_THAT(log, HasSubstr("declare it under [parameters]"));
+  std::ifstream probe(out);
+  EXPECT_FALSE(probe.good()) << "no output file for a refused system";
+  EXPECT_EQ(phnn("data --system " + sys + " --damping 0.2 --out " + out, &log), 2);
+  EXPECT_THAT(log, HasSubstr("a system file sets its own under [parameters]"));
+  std::remove(sys.c_str());
+}
+
+}  // namespace
+}  // namespace phnn

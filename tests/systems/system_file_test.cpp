@@ -1,0 +1,281 @@
+// tests/systems/system_file_test.cpp — system files: the shipped systems'
+// derivatives, structure and discrete gradients against independent
+// computations, and the errors of malformed files (FILE:LINE and the fix).
+#include "phnn/systems/system_file.h"
+
+#include <cmath>
+#include <random>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/systems/oscillators.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+std::string shipped(const std::string& name) {
+  return std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/" + name + ".toml";
+}
+
+const std::vector<std::string> kShipped = {"harmonic", "duffing",         "self-sustained",
+                                           "pendulum", "coupled-duffing", "mass-chain"};
+
+VecX random_state(std::mt19937_64* rng, int n, double scale) {
+  std::uniform_real_distribution<double> u(-scale, scale);
+  VecX x(n);
+  for (int i = 0; i < n; ++i) x(i) = u(*rng);
+  return x;
+}
+
+TEST(SystemFileTest, ShippedSystemsHaveTheirDeclaredDimensions) {
+  struct Dims {
+    const char* name;
+    int nx, nw, nu;
+  };
+  for (const Dims& d : {Dims{"harmonic", 2, 1, 1}, Dims{"pendulum", 2, 1, 1},
+                        Dims{"coupled-duffing", 4, 2, 1}, Dims{"mass-chain", 6, 3, 1}}) {
+    const auto sys = load_system_file(shipped(d.name));
+    EXPECT_EQ(sys->n_x(), d.nx) << d.name;
+    EXPECT_EQ(sys->n_w(), d.nw) << d.name;
+    EXPECT_EQ(sys->n_u(), d.nu) << d.name;
+    EXPECT_EQ(sys->name(), d.name);
+  }
+}
+
+// gradH and the Hessian from GiNaC against central differences of H and
+// gradH (h = 1e-5: truncation ~1e-10 H''', round-off ~1e-11 |H| / h).
+TEST(SystemFileTest, DerivativesMatchCentralDifferences) {
+  std::mt19937_64 rng(7);
+  for (const std::string& name : kShipped) {
+    const auto sys = load_system_file(shipped(name));
+    const int n = sys->n_x();
+    for (int trial = 0; trial < 5; ++trial) {
+      const VecX x = random_state(&rng, n, 0.3);
+      const VecX g = sys->grad_hamiltonian(x);
+      const MatX hess = sys->hessian(x);
+      const double eps = 1e-5;
+      for (int i = 0; i < n; ++i) {
+        VecX e = VecX::Zero(n);
+        e(i) = eps;
+        const double fd = (sys->hamiltonian(x + e) - sys->hamiltonian(x - e)) / (2 * eps);
+        EXPECT_NEAR(g(i), fd, 1e-7 * (1 + std::abs(fd))) << name << " dH/dx" << i;
+        const VecX fd_col = (sys->grad_hamiltonian(x + e) - sys->grad_hamiltonian(x - e)) / (2 * eps);
+        for (int j = 0; j < n; ++j) {
+          EXPECT_NEAR(hess(j, i), fd_col(j), 1e-6 * (1 + std::abs(fd_col(j)))) << name;
+        }
+      }
+      if (sys->n_w() > 0) {
+        const VecX w = random_state(&rng, sys->n_w(), 1.0);
+        const MatX dz = sys->dissipation_jacobian(w);
+        for (int l = 0; l < sys->n_w(); ++l) {
+          VecX e = VecX::Zero(sys->n_w());
+          e(l) = eps;
+          const VecX fd = (sys->dissipation(w + e) - sys->dissipation(w - e)) / (2 * eps);
+          for (int k = 0; k < sys->n_w(); ++k) EXPECT_NEAR(dz(k, l), fd(k), 1e-7) << name;
+        }
+      }
+    }
+  }
+}
+
+// The file versions of the paper's systems evaluate as the built-in ones.
+TEST(SystemFileTest, PaperSystemsMatchTheBuiltInOscillators) {
+  std::mt19937_64 rng(3);
+  for (SystemKind kind : all_systems()) {
+    const auto file = load_system_file(shipped(to_string(kind)));
+    const auto builtin = make_system(to_string(kind));
+    const Oscillator osc(OscillatorOptions::defaults(kind));
+    EXPECT_EQ(file->S(), builtin->S()) << to_string(kind);
+    EXPECT_EQ(file->J(), MatX(osc.J())) << to_string(kind) << ": J derived from S";
+    EXPECT_EQ(file->rng_id(), builtin->rng_id());
+    for (int trial = 0; trial < 10; ++trial) {
+      const VecX x = random_state(&rng, 2, 0.5), dx = random_state(&rng, 2, 0.05);
+      EXPECT_NEAR(file->hamiltonian(x), builtin->hamiltonian(x), 1e-14);
+      EXPECT_LE((file->grad_hamiltonian(x) - builtin->grad_hamiltonian(x)).norm(), 1e-13);
+      EXPECT_LE((file->discrete_gradient(x, dx) - builtin->discrete_gradient(x, dx)).norm(), 1e-12);
+      const VecX w = random_state(&rng, 1, 2.0);
+      EXPECT_NEAR(file->dissipation(w)(0), builtin->dissipation(w)(0), 1e-13);
+    }
+  }
+  EXPECT_EQ(load_system_file(shipped("self-sustained"))->self_oscillation_interval(),
+            Oscillator(OscillatorOptions::defaults(SystemKind::kSelfSustained))
+                .self_oscillation_interval());
+}
+
+// DG property 1 (discrete chain rule) and property 2 (consistency).
+TEST(SystemFileTest, DiscreteGradientSatisfiesTheChainRule) {
+  std::mt19937_64 rng(11);
+  for (const std::string& name : kShipped) {
+    const auto sys = load_system_file(shipped(name));
+    const int n = sys->n_x();
+    for (int trial = 0; trial < 20; ++trial) {
+      const VecX x = random_state(&rng, n, 0.4);
+      const VecX dx = random_state(&rng, n, trial < 10 ? 0.1 : 1e-4);
+      const double lhs = sys->discrete_gradient(x, dx).dot(dx);
+      const double rhs = sys->hamiltonian(x + dx) - sys->hamiltonian(x);
+      EXPECT_NEAR(lhs, rhs, 1e-14 * (1 + std::abs(sys->hamiltonian(x)))) << name;
+    }
+    const VecX x = random_state(&rng, n, 0.4);
+    EXPECT_LE((sys->discrete_gradient(x, VecX::Zero(n)) - sys->grad_hamiltonian(x)).norm(), 1e-15);
+  }
+}
+
+// d dg / d dx against central differences of dg (Newton's matrix).
+TEST(SystemFileTest, DiscreteGradientJacobianMatchesDifferences) {
+  std::mt19937_64 rng(5);
+  for (const std::string& name : kShipped) {
+    const auto sys = load_system_file(shipped(name));
+    const int n = sys->n_x();
+    const VecX x = random_state(&rng, n, 0.4), dx = random_state(&rng, n, 0.05);
+    const MatX jac = sys->discrete_gradient_jacobian(x, dx);
+    const double eps = 1e-6;
+    for (int j = 0; j < n; ++j) {
+      VecX e = VecX::Zero(n);
+      e(j) = eps;
+      const VecX fd = (sys->discrete_gradient(x, dx + e) - sys->discrete_gradient(x, dx - e)) / (2 * eps);
+      EXPECT_LE((jac.col(j) - fd).norm(), 1e-6 * (1 + fd.norm())) << name << " column " << j;
+    }
+  }
+}
+
+TEST(SystemFileTest, PhasePairsComeFromThePlotsTableOrConsecutiveStates) {
+  const auto chain = load_system_file(shipped("coupled-duffing"));
+  const std::vector<std::array<int, 2>> expected = {{0, 1}, {2, 3}, {0, 2}};
+  EXPECT_EQ(chain->phase_pairs(), expected);
+  EXPECT_EQ(make_system("duffing")->phase_pairs(), (std::vector<std::array<int, 2>>{{0, 1}}));
+}
+
+// ---- malformed files: FILE:LINE and the fix ---------------------------------
+
+const char* kGood = R"(name = "toy"
+states = ["q", "p"]
+inputs = ["u"]
+ports = ["w"]
+H = "p^2/(2*m) + k*q^2/2"
+z = ["c*w"]
+S = [[0, 1, 0, 0], [-1, 0, -1, -1], [0, 1, 0, 0], [0, 1, 0, 0]]
+[parameters]
+m = 1.0
+k = 2.0
+c = 0.1
+[initial]
+method = "energy"
+energy = [0.1, 1.0]
+[control]
+design = "constant"
+range = [[-1, 1]]
+)";
+
+std::string replaced(const std::string& from, const std::string& to) {
+  std::string text = kGood;
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    compile_system(text, "toy.toml");
+  } catch (const SystemFileError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(SystemFileErrorTest, TheGoodFileCompiles) { EXPECT_EQ(error_of(kGood), "(no error)"); }
+
+TEST(SystemFileErrorTest, UnknownSymbolInTheEnergy) {
+  EXPECT_THAT(error_of(replaced("k*q^2/2", "kk*q^2/2")),
+              AllOf(HasSubstr("toy.toml:5:"), HasSubstr("unknown symbol \"kk\""),
+                    HasSubstr("declare it under [parameters]")));
+}
+
+TEST(SystemFileErrorTest, StructureMatrixNotSkewSymmetric) {
+  EXPECT_THAT(error_of(replaced("[-1, 0, -1, -1]", "[-1, 0, -1, 1]")),
+              AllOf(HasSubstr("toy.toml:7:"), HasSubstr("not skew-symmetric"), HasSubstr("S[4][2]")));
+}
+
+TEST(SystemFileErrorTest, StructureMatrixOfTheWrongSize) {
+  EXPECT_THAT(error_of(replaced(", [0, 1, 0, 0]]", "]")),
+              AllOf(HasSubstr("toy.toml:7:"), HasSubstr("4 x 4 matrix"), HasSubstr("got 3 rows")));
+}
+
+TEST(SystemFileErrorTest, EnergyNegativeAtASampledInitialState) {
+  EXPECT_THAT(error_of(replaced("k*q^2/2\"", "k*q^2/2 - 0.5\"")),
+              AllOf(HasSubstr("toy.toml:5:"), HasSubstr("is negative"), HasSubstr("fix H")));
+}
+
+TEST(SystemFileErrorTest, EnergyNotFinite) {
+  EXPECT_THAT(error_of(replaced("k*q^2/2\"", "k*q^2/2 + log(q^2)\"")),
+              AllOf(HasSubstr("toy.toml:5:"), HasSubstr("not finite")));
+}
+
+TEST(SystemFileErrorTest, EmptyEnergyInterval) {
+  EXPECT_THAT(error_of(replaced("energy = [0.1, 1.0]", "energy = [1.0, 0.1]")),
+              AllOf(HasSubstr("toy.toml:14:"), HasSubstr("is empty"), HasSubstr("lo <= hi")));
+}
+
+TEST(SystemFileErrorTest, UnknownTopLevelKeyWithSuggestion) {
+  EXPECT_THAT(error_of(replaced("ports = [\"w\"]", "port = [\"w\"]")),
+              AllOf(HasSubstr("toy.toml:4:"), HasSubstr("did you mean \"ports\"")));
+}
+
+TEST(SystemFileErrorTest, NonZeroPortBlock) {
+  const std::string two_ports = R"(name = "toy2"
+states = ["q", "p"]
+ports = ["w1", "w2"]
+H = "p^2/2 + q^2/2"
+z = ["w1", "w2"]
+S = [[0, 1, 0, 0], [-1, 0, -1, 0], [0, 1, 0, 1], [0, 0, -1, 0]]
+[initial]
+method = "energy"
+energy = [0.1, 1.0]
+)";
+  EXPECT_THAT(error_of(two_ports), AllOf(HasSubstr("toy.toml:6:"), HasSubstr("S_ww")));
+}
+
+TEST(SystemFileErrorTest, DissipationLawCountDiffersFromPorts) {
+  EXPECT_THAT(error_of(replaced("z = [\"c*w\"]", "z = [\"c*w\", \"w\"]")),
+              AllOf(HasSubstr("toy.toml:6:"), HasSubstr("2 expressions for 1 ports")));
+}
+
+TEST(SystemFileErrorTest, UnknownInitialMethod) {
+  EXPECT_THAT(error_of(replaced("method = \"energy\"", "method = \"enrgy\"")),
+              AllOf(HasSubstr("toy.toml:13:"), HasSubstr("did you mean \"energy\"")));
+}
+
+TEST(SystemFileErrorTest, TomlSyntaxError) {
+  EXPECT_THAT(error_of(replaced("m = 1.0", "m = 1.0.0")),
+              AllOf(HasSubstr("toy.toml:9:"), HasSubstr("not valid TOML")));
+}
+
+TEST(SystemFileErrorTest, ExpressionThatDoesNotParse) {
+  EXPECT_THAT(error_of(replaced("z = [\"c*w\"]", "z = [\"c*(w\"]")),
+              AllOf(HasSubstr("toy.toml:6:"), HasSubstr("is not an expression")));
+}
+
+TEST(SystemFileErrorTest, ReservedOrRepeatedNames) {
+  EXPECT_THAT(error_of(replaced("states = [\"q\", \"p\"]", "states = [\"q\", \"exp\"]")),
+              AllOf(HasSubstr("toy.toml:2:"), HasSubstr("reserved")));
+  EXPECT_THAT(error_of(replaced("c = 0.1", "q = 0.1")),
+              AllOf(HasSubstr("toy.toml:11:"), HasSubstr("used twice")));
+}
+
+TEST(SystemFileErrorTest, MissingFileNamesThePath) {
+  EXPECT_THAT([] { load_system_file("/nonexistent/dir/x.toml"); },
+              ::testing::ThrowsMessage<SystemFileError>(
+                  AllOf(HasSubstr("/nonexistent/dir/x.toml"), HasSubstr("no such file"))));
+}
+
+TEST(SystemFileErrorTest, UnknownSystemNameSuggestsAFile) {
+  EXPECT_THAT([] { make_system("pendulum"); },
+              ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("or a system file")));
+}
+
+}  // namespace
+}  // namespace phnn
