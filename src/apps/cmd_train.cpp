@@ -16,6 +16,8 @@
 #include "apps/provenance.h"
 #include "phnn/common/check.h"
 #include "phnn/data/dataset_file.h"
+#include "phnn/data/ph_dataset_file.h"
+#include "phnn/systems/system_file.h"
 #include "phnn/report/tables.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/results_file.h"
@@ -116,7 +118,7 @@ void require_new_output(const std::string& path) {
 }
 
 void declare_train_options(cli::Parser* parser) {
-  parser->option("system", "harmonic | duffing | self-sustained", "", true);
+  parser->option("system", "harmonic | duffing | self-sustained | a system file (.toml)", "", true);
   parser->option("model",
                  "formulation-integrator as in sweep files: node-rk2, node-rk4, phnn-s-rk2, "
                  "phnn-s-dg, phnn-s-rk4, phnn-s-dg4, phnn-jr-rk2, phnn-jr-dg, phnn-jr-rk4, "
@@ -210,11 +212,11 @@ SystemData data_from_options(const cli::Parser& parser, SystemKind system, int n
   return make_system_data(physics, options, n_train);
 }
 
-// Trains the cell; a terminal gets one self-overwriting progress line, a log
-// file a plain line per tenth of the run (no carriage returns in logs).
-std::vector<RunResult> train_with_progress(const CellSpec& cell, const SystemData& data, bool quiet) {
+// A terminal gets one self-overwriting progress line, a log file a plain
+// line per tenth of the run (no carriage returns in logs).
+ProgressCallback progress_printer(bool quiet) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
-  return train_cell(cell, data, [&](const TrainProgress& p) {
+  return [quiet, terminal](const TrainProgress& p) {
     if (quiet) return;
     const int tenth = std::max(1, p.total_steps / 10);
     if (!terminal && p.step % tenth != 0 && p.step != p.total_steps) return;
@@ -222,7 +224,7 @@ std::vector<RunResult> train_with_progress(const CellSpec& cell, const SystemDat
     std::fprintf(stderr, "%s  step %d/%d  best val %.3e  elapsed %.0f s  ETA %.0f s   %s",
                  terminal ? "\r" : "", p.step, p.total_steps, p.best_validation_loss, p.elapsed_s,
                  eta, terminal && p.step != p.total_steps ? "" : "\n");
-  });
+  };
 }
 
 // One line per seed, then the reducer's statistics (numpy linear quartiles).
@@ -245,6 +247,54 @@ void print_cell_results(const CellSpec& cell, const std::vector<RunResult>& resu
               q75 - q25, results.empty() ? 0L : results[0].parameter_count, wall);
 }
 
+// A system file's data set: read from --data (it must have been made from
+// the same file text) or generated for the cell's N_train.
+PhSystemData file_system_data(const cli::Parser& parser, const PhSystem& system, int n_train) {
+  if (parser.has("data")) {
+    PhSystemData data = read_ph_dataset_file(parser.get("data"));
+    if (data.system_text != system.source_text()) {
+      throw cli::UsageError{"phnn train: --data " + parser.get("data") + " was made from " +
+                            (data.system_text.empty() ? "the built-in system " + data.system_name
+                                                      : "another text of system " + data.system_name) +
+                            ", not from " + parser.get("system") +
+                            "; regenerate it with `phnn data --system " + parser.get("system") + "`"};
+    }
+    return data;
+  }
+  DatasetOptions options;
+  const auto ds = parser.get_int("data-seed");
+  if (ds < 0) throw cli::UsageError{"phnn train: --data-seed must be >= 0"};
+  options.data_seed = static_cast<std::uint64_t>(ds);
+  if (n_train < 1 || n_train > options.num_train_max) {
+    throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " outside [1, " +
+                          std::to_string(options.num_train_max) + "]"};
+  }
+  return make_ph_system_data(system, options, n_train);
+}
+
+// `phnn train --system FILE`: the n-dimensional models on a system file.
+int run_train_file_system(const cli::Parser& parser, const CellSpec& cell) {
+  const std::string path = parser.get("system");
+  if (parser.has("damping")) {
+    throw cli::UsageError{"phnn train: --damping sets the built-in systems' c; a system file sets "
+                          "its own under [parameters]: edit " + path};
+  }
+  if (parser.has("out")) {
+    throw cli::UsageError{"phnn train: --out is not available for system files yet (results "
+                          "files hold 2-state runs); drop --out, the per-seed results print here"};
+  }
+  const std::unique_ptr<PhSystem> system = load_system_file(path);
+  const PhSystemData data = file_system_data(parser, *system, cell.n_train);
+  std::cout << "phnn train: " << system->name() << " (" << system->n_x() << " states, "
+            << system->n_w() << " ports, " << system->n_u() << " inputs) "
+            << model_label(cell.model, cell.integrator) << " size=" << to_string(cell.size)
+            << " n_train=" << cell.n_train << " reg=" << to_string(cell.regularizer)
+            << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << "\n";
+  const auto results = train_cell(cell, data, *system, progress_printer(parser.flag_set("quiet")));
+  print_cell_results(cell, results);
+  return 0;
+}
+
 }  // namespace
 
 int run_train(int argc, char** argv, int first) {
@@ -253,11 +303,12 @@ int run_train(int argc, char** argv, int first) {
                      "then rolls every member out over the inference set (docs/METHOD.md §3-§5).");
   declare_train_options(&parser);
   if (!parser.parse(argc, argv, first)) return 0;
-  const SystemKind system = parse_system(parser.get("system"));
   const CellSpec cell = cell_from_options(parser);
   const auto threads = parser.get_int("threads");
   if (threads < 1) throw cli::UsageError{"phnn train: --threads must be >= 1"};
   torch::set_num_threads(static_cast<int>(threads));
+  if (is_system_file_argument(parser.get("system"))) return run_train_file_system(parser, cell);
+  const SystemKind system = parse_system(parser.get("system"));
   const SystemData data = data_from_options(parser, system, cell.n_train);
   cell.validate(data);
   std::cout << "phnn train: " << to_string(system) << " " << model_label(cell.model, cell.integrator)
@@ -266,7 +317,7 @@ int run_train(int argc, char** argv, int first) {
             << " steps=" << cell.training.steps << "\n";
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
   if (parser.has("out")) require_new_output(parser.get("out"));
-  const auto results = train_with_progress(cell, data, parser.flag_set("quiet"));
+  const auto results = train_cell(cell, data, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
   if (parser.has("out")) {
     write_cell_file(parser.get("out"), cell, data, results, provenance,

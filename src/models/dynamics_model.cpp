@@ -2,6 +2,7 @@
 #include "phnn/models/dynamics_model.h"
 
 #include "phnn/common/check.h"
+#include "phnn/models/general_ph.h"
 #include "phnn/models/port_hamiltonian.h"
 
 namespace phnn {
@@ -91,6 +92,13 @@ const std::vector<const StackedMlp*> DynamicsModel::networks() const {
 
 std::unique_ptr<DynamicsModel> DynamicsModel::create(const ModelOptions& options,
                                                      const std::vector<std::uint64_t>& seeds) {
+  if (options.general) {
+    switch (options.kind) {
+      case ModelKind::kNode: return std::make_unique<GeneralNode>(options, seeds);
+      case ModelKind::kPhnnS: return std::make_unique<GeneralPhnnS>(options, seeds);
+      case ModelKind::kPhnnJr: return std::make_unique<GeneralPhnnJr>(options, seeds);
+    }
+  }
   switch (options.kind) {
     case ModelKind::kNode: return std::make_unique<Node>(options, seeds);
     case ModelKind::kPhnnS: return std::make_unique<PhnnS>(options, seeds);

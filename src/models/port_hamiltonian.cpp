@@ -78,7 +78,11 @@ torch::Tensor PortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
 }
 
 torch::Tensor PortHamiltonianModel::grad_hamiltonian(const torch::Tensor& x) const {
-  return hamiltonian_and_gradient(l_h(), x).grad;
+  return energy_and_gradient(x).grad;
+}
+
+HamiltonianAndGradient PortHamiltonianModel::energy_and_gradient(const torch::Tensor& x) const {
+  return hamiltonian_and_gradient(l_h(), x);
 }
 
 Jet PortHamiltonianModel::curvature_jet(const torch::Tensor& x) const {
@@ -94,7 +98,7 @@ FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tenso
   FieldEval out;
   if (!with_jacobian) {
     Jet effort;
-    effort.v = hamiltonian_and_gradient(l_h(), x).grad;
+    effort.v = energy_and_gradient(x).grad;
     out.f = field_from_effort(effort, x, u, /*order=*/0, /*dissipation_fixed=*/false).v;
     return out;
   }
@@ -121,7 +125,7 @@ torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
   }
   // One network call for H(x), H(x + dx) and gradH(x + dx/2).
   const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
-  const HamiltonianAndGradient h = hamiltonian_and_gradient(l_h(), points);
+  const HamiltonianAndGradient h = energy_and_gradient(points);
   const auto h_x = h.h.narrow(1, 0, B);
   const auto h_xdx = h.h.narrow(1, B, B);
   const auto grad_mid = h.grad.narrow(1, 2 * B, B);  // [E, B, 2]
@@ -167,7 +171,7 @@ FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
   const Jet grad_m = curvature_jet(m);  // v = g, g = Hm
   const auto hess = grad_m.g;                                                // [E, B, 2, 2]
   const auto h0 = hamiltonian(x).unsqueeze(-1);
-  const auto end = hamiltonian_and_gradient(l_h(), x + dx);
+  const auto end = energy_and_gradient(x + dx);
   const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);                       // [E, B, 1]
   const auto small = n2 < min_dx_norm * min_dx_norm;
   const auto safe_n2 = torch::where(small, torch::ones_like(n2), n2);
@@ -176,7 +180,7 @@ FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
   const auto hess_dx = torch::matmul(hess, dx.unsqueeze(-1)).squeeze(-1);  // Hm dx
   const auto dk = torch::where(small, torch::zeros_like(dx),
                                (end.grad - grad_m.v - 0.5 * hess_dx) / safe_n2 - 2.0 * k * dx / safe_n2);
-  const auto eye = torch::eye(2, x.options());
+  const auto eye = torch::eye(x.size(-1), x.options());
   // J_dg[a][b] = d dg_a / d dx_b.
   const auto j_dg = 0.5 * hess + dx.unsqueeze(-1) * dk.unsqueeze(-2) + k.unsqueeze(-1) * eye;
   Jet effort;
@@ -352,7 +356,7 @@ torch::Tensor PortHamiltonianModel::average_vector_field_gradient(const torch::T
   const int64_t B = x.size(1);
   const auto points = torch::cat({x, x + dx, x + (0.5 - c) * dx, x + 0.5 * dx, x + (0.5 + c) * dx},
                                  /*dim=*/1);
-  const HamiltonianAndGradient hg = hamiltonian_and_gradient(l_h(), points);
+  const HamiltonianAndGradient hg = energy_and_gradient(points);
   const auto g = (5.0 / 18.0) * hg.grad.narrow(1, 2 * B, B) +
                  (8.0 / 18.0) * hg.grad.narrow(1, 3 * B, B) +
                  (5.0 / 18.0) * hg.grad.narrow(1, 4 * B, B);
@@ -381,7 +385,8 @@ FieldEval PortHamiltonianModel::discrete_gradient4_field(const torch::Tensor& x,
   Jet effort;
   effort.v = average_vector_field_gradient(x, dx, min_dx_norm);
   effort.g = curvature_jet(m).g;  // Q [E, B, 2 (direction), 2]
-  effort.h = torch::zeros({x.size(0), x.size(1), 2, 2, 2}, x.options());
+  const int64_t n = x.size(-1);
+  effort.h = torch::zeros({x.size(0), x.size(1), n, n, n}, x.options());
   const Jet phi = field_from_effort(effort, m, u, /*order=*/2, /*dissipation_fixed=*/false);
   const auto v = phi.v;                               // [E, B, 2]
   const auto A = phi.g.transpose(-1, -2);             // [E, B, component, direction]

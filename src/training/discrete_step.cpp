@@ -63,7 +63,13 @@ namespace {
 // The Newton update delta = -M^{-1} r of every row by Cramer's rule, with
 // M = m (+ I when add_identity) [.., 2, 2] and r [.., 2]. The identity is
 // added as 1 + m_ii, so callers passing -h J get I - h J to the bit.
+// More than two states: an LU solve per row (torch::linalg_solve).
 torch::Tensor newton_update(const torch::Tensor& m, bool add_identity, const torch::Tensor& r) {
+  const int64_t n = r.size(-1);
+  if (n != 2) {
+    const auto M = add_identity ? m + torch::eye(n, m.options()) : m;
+    return -torch::linalg_solve(M, r.unsqueeze(-1)).squeeze(-1);
+  }
   const double one = add_identity ? 1.0 : 0.0;
   const auto m00 = m.select(-2, 0).select(-1, 0), m11 = m.select(-2, 1).select(-1, 1);
   const auto a = add_identity ? one + m00 : m00, b = m.select(-2, 0).select(-1, 1);
@@ -92,7 +98,7 @@ DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tenso
   // does not depend on the other rows or members in the batch.
   const bool have_cache = cache && cache->dfddx.defined() && cache->dfddx.size(0) == x.size(0) &&
                           cache->dfddx.size(1) == x.size(1);
-  torch::Tensor jacobian = have_cache ? cache->dfddx : torch::zeros({x.size(0), x.size(1), 2, 2}, x.options());
+  torch::Tensor jacobian = have_cache ? cache->dfddx : torch::zeros({x.size(0), x.size(1), x.size(-1), x.size(-1)}, x.options());
   torch::Tensor previous_norm;
   for (int it = 0;; ++it) {
     // r(dx) = dx - h f_bar(x, dx, u);  r'(dx) = I - h d f_bar / d dx.
@@ -140,7 +146,7 @@ torch::Tensor dg4_residual_jacobian(const DynamicsModel& model, const torch::Ten
                                     double min_dx_norm, const torch::Tensor& r) {
   const auto eta = 1e-7 * torch::clamp_min(std::get<0>(dx.abs().max(-1, /*keepdim=*/true)), 1e-8);
   std::vector<torch::Tensor> columns;
-  for (int j = 0; j < 2; ++j) {
+  for (int64_t j = 0; j < dx.size(-1); ++j) {
     auto step = torch::zeros_like(dx);
     step.select(-1, j).copy_(eta.squeeze(-1));
     const auto moved = dx + step;
@@ -163,7 +169,7 @@ DgInferenceStep dg4_inference_step(const DynamicsModel& model, const torch::Tens
   auto converged = torch::zeros(row_shape, x.options().dtype(torch::kBool));
   auto full_newton = torch::zeros(row_shape, converged.options());
   torch::Tensor previous_norm;
-  const auto eye = torch::eye(2, x.options());
+  const auto eye = torch::eye(x.size(-1), x.options());
   for (int it = 0;; ++it) {
     const FieldEval f4 = model.discrete_gradient4_field(x, dx, u, h, options.min_dx_norm);
     const auto r = dx - h * f4.f;

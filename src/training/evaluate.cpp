@@ -55,7 +55,7 @@ std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemDat
                                 std::to_string(cell.seeds.size()));
   }
   // The trainer's inference model (float64 whatever the training precision).
-  auto model = DynamicsModel::create(inference_model_options(cell, data),
+  auto model = DynamicsModel::create(inference_model_options(cell, make_cell_data(data)),
                                      {static_cast<std::uint64_t>(cell.seeds[0])});
   if (static_cast<long>(weights.size()) != model->parameter_count()) {
     throw std::invalid_argument("load_member: " + std::to_string(weights.size()) +
@@ -76,13 +76,14 @@ std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemDat
 
 Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
                                const std::vector<double>& weights) {
-  cell.validate(data);
+  const CellData cell_data = make_cell_data(data);
+  validate_cell(cell, cell_data);
   const auto model = load_member(cell, data, weights);
-  const Rollouts rollouts = roll_out(*model, cell, data);
+  const Rollouts rollouts = roll_out(*model, cell, cell_data);
   Evaluation out;
   RunResult& r = out.result;
   fill_inference(rollouts, /*e=*/0, member_mse(rollouts).at(0), &r);
-  fill_figures(rollouts, /*e=*/0, figure_references(data), &r);
+  fill_figures(rollouts, /*e=*/0, cell_data, &r);
   r.parameter_count = model->parameter_count();
   r.weights = weights;
   r.status = r.diverged_rollouts > 0 ? RunStatus::kDiverged : RunStatus::kDone;

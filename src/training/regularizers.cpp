@@ -15,7 +15,20 @@ torch::Tensor safe_sqrt(const torch::Tensor& s) {
 }
 }  // namespace
 
+JacobianStats jacobian_stats_general(const torch::Tensor& jacobian, double eps) {
+  const int64_t n = jacobian.size(-1);
+  const auto sigma = torch::linalg_svdvals(jacobian);  // descending
+  JacobianStats out;
+  out.sigma_max = sigma.select(-1, 0);
+  out.sigma_min = sigma.select(-1, n - 1);
+  out.kappa = out.sigma_max / (out.sigma_min + eps);
+  const auto re = torch::real(torch::linalg_eigvals(jacobian)).abs();
+  out.rho = std::get<0>(re.max(-1)) / (std::get<0>(re.min(-1)) + eps);
+  return out;
+}
+
 JacobianStats jacobian_stats(const torch::Tensor& jacobian, double eps) {
+  if (jacobian.size(-1) != 2) return jacobian_stats_general(jacobian, eps);
   const auto a = jacobian.select(-2, 0).select(-1, 0);
   const auto b = jacobian.select(-2, 0).select(-1, 1);
   const auto c = jacobian.select(-2, 1).select(-1, 0);

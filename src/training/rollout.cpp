@@ -48,12 +48,12 @@ std::vector<double> reference_trajectory(const OscillatorOptions& system,
   return out;
 }
 
-ModelOptions inference_model_options(const CellSpec& cell, const SystemData& data) {
-  return ModelOptions{cell.model, cell.size, data.system.kind, cell.fused_networks,
-                      cell.training.dg_structure_point, torch::kFloat64};
+ModelOptions inference_model_options(const CellSpec& cell, const CellData& data) {
+  return ModelOptions{cell.model, cell.size, data.builtin, cell.fused_networks,
+                      cell.training.dg_structure_point, torch::kFloat64, data.general};
 }
 
-Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const SystemData& data) {
+Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const CellData& data) {
   PHNN_CHECK(model_ref.options().dtype == torch::kFloat64,
              "roll_out: inference is float64; got a " << model_ref.options().dtype << " model");
   torch::NoGradGuard no_grad;
@@ -61,42 +61,35 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Sy
   const TrainerOptions& opt = cell.training;
   const int64_t E = model_ref.members();
   const bool use_dg = is_discrete_gradient(cell.integrator);
-  const InferenceSet& inf = data.inference;
-  const int64_t B_inf = static_cast<int64_t>(inf.size());
-  const int steps = static_cast<int>(inf.states.empty() ? 0 : inf.states[0].size() - 1);
-  const FigureSetup fig = figure_setup(data.system);
-  // Rows: the inference trajectories, then the two figure trajectories.
-  const int64_t B = B_inf + 2;
-  auto x0 = torch::empty({B, 2}, torch::kFloat64);
-  auto u0 = torch::empty({B, 1}, torch::kFloat64);
-  auto ref = torch::empty({steps + 1, B_inf, 2}, torch::kFloat64);
-  {
-    auto xa = x0.accessor<double, 2>();
-    auto ua = u0.accessor<double, 2>();
-    auto ra = ref.accessor<double, 3>();
-    for (int64_t i = 0; i < B_inf; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      xa[i][0] = inf.states[ui][0](0);
-      xa[i][1] = inf.states[ui][0](1);
-      ua[i][0] = inf.u[ui];
-      for (int n = 0; n <= steps; ++n) {
-        ra[n][i][0] = inf.states[ui][static_cast<std::size_t>(n)](0);
-        ra[n][i][1] = inf.states[ui][static_cast<std::size_t>(n)](1);
-      }
-    }
-    xa[B_inf][0] = fig.x0_05(0);
-    xa[B_inf][1] = fig.x0_05(1);
-    xa[B_inf + 1][0] = fig.x0_075(0);
-    xa[B_inf + 1][1] = fig.x0_075(1);
-    ua[B_inf][0] = ua[B_inf + 1][0] = fig.u;
+  const int64_t nx = data.n_x, nu = data.n_u;
+  const int64_t B_inf = static_cast<int64_t>(data.inference_count);
+  const int steps = data.inference_steps;
+  // Rows: the inference trajectories, then the figure trajectories (if any).
+  const int64_t F = data.has_figures ? 2 : 0;
+  const int64_t B = B_inf + F;
+  // states [B_inf][steps + 1][n_x] -> ref [steps + 1, B_inf, n_x]; x0 = ref[0].
+  const auto ref = torch::from_blob(const_cast<double*>(data.inference_states.data()),
+                                    {B_inf, steps + 1, nx}, torch::kFloat64)
+                       .transpose(0, 1)
+                       .contiguous();
+  auto x0 = torch::empty({B, nx}, torch::kFloat64);
+  auto u0 = torch::empty({B, nu}, torch::kFloat64);
+  x0.narrow(0, 0, B_inf).copy_(ref[0]);
+  u0.narrow(0, 0, B_inf)
+      .copy_(torch::from_blob(const_cast<double*>(data.inference_u.data()), {B_inf, nu},
+                              torch::kFloat64));
+  for (int64_t k = 0; k < F; ++k) {
+    for (int64_t j = 0; j < 2; ++j) x0[B_inf + k][j] = data.figure_x0[k][j];
+    u0[B_inf + k][0] = data.figure_u;
   }
-  const double h_inf = inf.step;
-  auto x = x0.unsqueeze(0).expand({E, B, 2}).contiguous();
-  const auto u = u0.unsqueeze(0).expand({E, B, 1}).contiguous();
+  const double h_inf = data.inference_step;
+  auto x = x0.unsqueeze(0).expand({E, B, nx}).contiguous();
+  const auto u = u0.unsqueeze(0).expand({E, B, nu}).contiguous();
   auto diverged = torch::zeros({E, B}, torch::kBool);
   auto sq_err = torch::zeros({E, B_inf}, torch::kFloat64);
   auto newton_failures = torch::zeros({E}, torch::kLong);
-  std::vector<torch::Tensor> figure_states{x.narrow(1, B_inf, 2).clone()};
+  std::vector<torch::Tensor> figure_states;
+  if (F > 0) figure_states.push_back(x.narrow(1, B_inf, F).clone());
   DgInferenceOptions dg_options;
   dg_options.tolerance = opt.newton_tolerance;
   dg_options.max_iterations = opt.newton_max_iterations;
@@ -119,15 +112,17 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Sy
     x = torch::where(diverged.unsqueeze(-1), torch::zeros_like(next), next);
     const auto diff = x.narrow(1, 0, B_inf) - ref[n].unsqueeze(0);
     sq_err += (diff * diff).sum(-1);
-    figure_states.push_back(torch::where(diverged.narrow(1, B_inf, 2).unsqueeze(-1),
-                                         torch::full_like(next.narrow(1, B_inf, 2), NAN),
-                                         next.narrow(1, B_inf, 2)));
+    if (F > 0) {
+      figure_states.push_back(torch::where(diverged.narrow(1, B_inf, F).unsqueeze(-1),
+                                           torch::full_like(next.narrow(1, B_inf, F), NAN),
+                                           next.narrow(1, B_inf, F)));
+    }
   }
   Rollouts out;
   out.sq_err = sq_err;
   out.diverged = diverged;
   out.newton_failures = newton_failures;
-  out.figure = torch::stack(figure_states, 1);
+  if (F > 0) out.figure = torch::stack(figure_states, 1);
   out.steps = steps;
   return out;
 }
@@ -161,14 +156,8 @@ void fill_inference(const Rollouts& rollouts, int64_t e, double mse, RunResult* 
   r->mse = mse;
 }
 
-FigureReferences figure_references(const SystemData& data) {
-  const FigureSetup fig = figure_setup(data.system);
-  return {reference_trajectory(data.system, data.options, fig.x0_05, fig.u),
-          reference_trajectory(data.system, data.options, fig.x0_075, fig.u)};
-}
-
-void fill_figures(const Rollouts& rollouts, int64_t e, const FigureReferences& references,
-                  RunResult* r) {
+void fill_figures(const Rollouts& rollouts, int64_t e, const CellData& data, RunResult* r) {
+  if (!data.has_figures) return;
   const auto fig_e = rollouts.figure[e].contiguous();
   const auto fa = fig_e.accessor<double, 3>();
   for (int n = 0; n <= rollouts.steps; ++n) {
@@ -177,8 +166,8 @@ void fill_figures(const Rollouts& rollouts, int64_t e, const FigureReferences& r
     r->figure_prediction_075.push_back(fa[n][1][0]);
     r->figure_prediction_075.push_back(fa[n][1][1]);
   }
-  r->figure_reference_05 = references.at_05;
-  r->figure_reference_075 = references.at_075;
+  r->figure_reference_05 = data.figure_references[0];
+  r->figure_reference_075 = data.figure_references[1];
 }
 
 }  // namespace phnn

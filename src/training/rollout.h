@@ -12,6 +12,7 @@
 #include "phnn/models/dynamics_model.h"
 #include "phnn/training/run_result.h"
 #include "phnn/training/trainer.h"
+#include "training/cell_data.h"
 
 namespace phnn {
 
@@ -19,19 +20,21 @@ namespace phnn {
 // (CellSpec::fused_networks), whatever the training precision (float32
 // training hands over its best weights upcast, docs/DECISIONS.md), so the
 // trainer's inference and `phnn eval` (load_member) build it alike.
-ModelOptions inference_model_options(const CellSpec& cell, const SystemData& data);
+ModelOptions inference_model_options(const CellSpec& cell, const CellData& data);
 
 // The autoregressive rollouts of Eq. 31 for every member of the stack:
 // the inference trajectories, then the two figure trajectories (rows B_inf,
-// B_inf + 1), from the model's current weights (a float64 model).
+// B_inf + 1; built-in systems only), from the model's current weights (a
+// float64 model).
 struct Rollouts {
   torch::Tensor sq_err;           // [E, B_inf]: sum over steps of |x - x_ref|^2
-  torch::Tensor diverged;         // [E, B_inf + 2]
+  torch::Tensor diverged;         // [E, B_inf + figures]
   torch::Tensor newton_failures;  // [E]
-  torch::Tensor figure;           // [E, steps + 1, 2, 2] (NaN after divergence)
+  torch::Tensor figure;           // [E, steps + 1, 2, 2] (NaN after divergence); undefined
+                                  // without figure trajectories
   int steps = 0;
 };
-Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const SystemData& data);
+Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const CellData& data);
 
 // Eq. 31 per member from the rollouts: the mean over the inference
 // trajectories of their mean squared error, +inf if any diverged.
@@ -42,13 +45,8 @@ std::vector<double> member_mse(const Rollouts& rollouts);
 // failures.
 void fill_inference(const Rollouts& rollouts, int64_t e, double mse, RunResult* r);
 
-// The reference trajectories of the figures (paper Figures 7 and 9), made
-// once per cell, and member e's predicted ones, into r.
-struct FigureReferences {
-  std::vector<double> at_05, at_075;
-};
-FigureReferences figure_references(const SystemData& data);
-void fill_figures(const Rollouts& rollouts, int64_t e, const FigureReferences& references,
-                  RunResult* r);
+// Member e's predicted figure trajectories (paper Figures 7 and 9) and the
+// true ones (CellData::figure_references) into r; nothing without figures.
+void fill_figures(const Rollouts& rollouts, int64_t e, const CellData& data, RunResult* r);
 
 }  // namespace phnn

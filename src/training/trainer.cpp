@@ -20,6 +20,7 @@
 #include "phnn/training/flat_adam.h"
 #include "phnn/training/regularizers.h"
 #include "training/batch_sampler.h"
+#include "training/cell_data.h"
 #include "training/rollout.h"
 
 namespace phnn {
@@ -28,26 +29,20 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The first `count` values in `dtype` (float32: the float64 data rounded).
-torch::Tensor to_tensor(const std::vector<Vec2>& v, std::size_t count, torch::ScalarType dtype) {
-  auto t = torch::empty({static_cast<int64_t>(count), 2}, torch::kFloat64);
-  auto a = t.accessor<double, 2>();
-  for (std::size_t i = 0; i < count; ++i) {
-    a[static_cast<int64_t>(i)][0] = v[i](0);
-    a[static_cast<int64_t>(i)][1] = v[i](1);
-  }
-  return t.to(dtype);
-}
-
-torch::Tensor to_tensor(const std::vector<double>& v, std::size_t count, torch::ScalarType dtype) {
-  return torch::tensor(std::vector<double>(v.begin(), v.begin() + static_cast<long>(count)), dtype)
-      .unsqueeze(-1);
+// The first `count` rows of a row-major [.][width] array as [count, width]
+// in `dtype` (float32: the float64 data rounded).
+torch::Tensor to_tensor(const std::vector<double>& v, std::size_t count, int width,
+                        torch::ScalarType dtype) {
+  const auto rows = static_cast<int64_t>(count);
+  return torch::from_blob(const_cast<double*>(v.data()), {rows, width}, torch::kFloat64)
+      .clone()
+      .to(dtype);
 }
 
 // The model a cell trains: the inference model (float64) unless training is
 // float32, which runs on the reference networks (the fused kernels are
 // float64 only) with the float64 initialization rounded.
-ModelOptions training_model_options(const CellSpec& cell, const SystemData& data) {
+ModelOptions training_model_options(const CellSpec& cell, const CellData& data) {
   ModelOptions options = inference_model_options(cell, data);
   if (cell.training.precision == Precision::kFloat32) {
     options.dtype = torch::kFloat32;
@@ -64,7 +59,7 @@ ModelOptions training_model_options(const CellSpec& cell, const SystemData& data
 // share is the members below.
 class CellTrainer {
  public:
-  CellTrainer(const CellSpec& cell, const SystemData& data, const ProgressCallback& progress);
+  CellTrainer(const CellSpec& cell, const CellData& data, const ProgressCallback& progress);
 
   void train();
   std::vector<RunResult> finish();
@@ -77,7 +72,7 @@ class CellTrainer {
   // The data of the cell as tensors; *_all / validation ones expanded over
   // the E members (views, no copies).
   struct Tensors {
-    torch::Tensor x, x_next, u;              // [N, 2], [N, 2], [N, 1]
+    torch::Tensor x, x_next, u;              // [N, n_x], [N, n_x], [N, n_u]
     torch::Tensor x_all, x_next_all, u_all;  // [E, N, .]
     torch::Tensor xv, xv_next, uv;           // [E, V, .]
   };
@@ -102,11 +97,10 @@ class CellTrainer {
   double train_seconds_per_run() const {
     return (elapsed() - checkpoint_overhead_s_) / static_cast<double>(E_);
   }
-  void fill_result(int64_t e, const Rollouts& rollouts, const FigureReferences& references,
-                   double mse, double train_s, double wall);
+  void fill_result(int64_t e, const Rollouts& rollouts, double mse, double train_s, double wall);
 
   const CellSpec& cell_;
-  const SystemData& data_;
+  const CellData& data_;
   const TrainerOptions& opt_;
   const ProgressCallback& progress_;
   const Clock::time_point start_ = Clock::now();
@@ -127,10 +121,10 @@ class CellTrainer {
   double checkpoint_overhead_s_ = 0.0;
 };
 
-CellTrainer::CellTrainer(const CellSpec& cell, const SystemData& data,
+CellTrainer::CellTrainer(const CellSpec& cell, const CellData& data,
                          const ProgressCallback& progress)
     : cell_(cell), data_(data), opt_(cell.training), progress_(progress),
-      E_(static_cast<int64_t>(cell.seeds.size())), h_(data.train.step) {
+      E_(static_cast<int64_t>(cell.seeds.size())), h_(data.step) {
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   model_ = DynamicsModel::create(training_model_options(cell, data), seeds);
   if (model_->options().dtype != torch::kFloat64) {
@@ -155,18 +149,19 @@ CellTrainer::CellTrainer(const CellSpec& cell, const SystemData& data,
 
 CellTrainer::Tensors CellTrainer::make_tensors() const {
   const auto N = static_cast<std::size_t>(cell_.n_train);
-  const std::size_t V = data_.validation.size();
+  const std::size_t V = data_.validation.count;
+  const int nx = data_.n_x, nu = data_.n_u;
   const torch::ScalarType dtype = model_->options().dtype;
   Tensors t;
-  t.x = to_tensor(data_.train.x, N, dtype);
-  t.x_next = to_tensor(data_.train.x_next, N, dtype);
-  t.u = to_tensor(data_.train.u, N, dtype);
+  t.x = to_tensor(data_.train.x, N, nx, dtype);
+  t.x_next = to_tensor(data_.train.x_next, N, nx, dtype);
+  t.u = to_tensor(data_.train.u, N, nu, dtype);
   t.x_all = t.x.unsqueeze(0).expand({E_, -1, -1});
   t.x_next_all = t.x_next.unsqueeze(0).expand({E_, -1, -1});
   t.u_all = t.u.unsqueeze(0).expand({E_, -1, -1});
-  t.xv = to_tensor(data_.validation.x, V, dtype).unsqueeze(0).expand({E_, -1, -1});
-  t.xv_next = to_tensor(data_.validation.x_next, V, dtype).unsqueeze(0).expand({E_, -1, -1});
-  t.uv = to_tensor(data_.validation.u, V, dtype).unsqueeze(0).expand({E_, -1, -1});
+  t.xv = to_tensor(data_.validation.x, V, nx, dtype).unsqueeze(0).expand({E_, -1, -1});
+  t.xv_next = to_tensor(data_.validation.x_next, V, nx, dtype).unsqueeze(0).expand({E_, -1, -1});
+  t.uv = to_tensor(data_.validation.u, V, nu, dtype).unsqueeze(0).expand({E_, -1, -1});
   return t;
 }
 
@@ -340,15 +335,13 @@ std::vector<RunResult> CellTrainer::finish() {
   const Rollouts rollouts = roll_out_best();
   const double wall = elapsed();
   const std::vector<double> mse = member_mse(rollouts);
-  const FigureReferences references = figure_references(data_);
   for (int64_t e = 0; e < E_; ++e) {
-    fill_result(e, rollouts, references, mse[static_cast<std::size_t>(e)], train_s, wall);
+    fill_result(e, rollouts, mse[static_cast<std::size_t>(e)], train_s, wall);
   }
   return std::move(results_);
 }
 
-void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
-                              const FigureReferences& references, double mse, double train_s,
+void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts, double mse, double train_s,
                               double wall) {
   RunResult& r = results_[static_cast<std::size_t>(e)];
   const int64_t B_inf = rollouts.sq_err.size(1);
@@ -364,7 +357,7 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
     r.checkpoint_mse.push_back(r.mse);
     r.checkpoint_train_seconds.push_back(train_s);
   }
-  fill_figures(rollouts, e, references, &r);
+  fill_figures(rollouts, e, data_, &r);
   // The weights the rollouts used (float32 training: upcast, exactly).
   for (const torch::Tensor& best : best_) {
     const torch::Tensor w = best[e].to(torch::kFloat64).contiguous();
@@ -393,15 +386,31 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts,
 
 }  // namespace
 
-std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
-                                  const ProgressCallback& progress,
-                                  std::unique_ptr<DynamicsModel>* trained) {
-  cell.validate(data);
+namespace {
+
+std::vector<RunResult> train_cell_data(const CellSpec& cell, const CellData& data,
+                                       const ProgressCallback& progress,
+                                       std::unique_ptr<DynamicsModel>* trained) {
+  validate_cell(cell, data);
   CellTrainer trainer(cell, data, progress);
   trainer.train();
   std::vector<RunResult> results = trainer.finish();
   if (trained) *trained = trainer.release_model();
   return results;
+}
+
+}  // namespace
+
+std::vector<RunResult> train_cell(const CellSpec& cell, const PhSystemData& data,
+                                  const PhSystem& system, const ProgressCallback& progress,
+                                  std::unique_ptr<DynamicsModel>* trained) {
+  return train_cell_data(cell, make_cell_data(data, system), progress, trained);
+}
+
+std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
+                                  const ProgressCallback& progress,
+                                  std::unique_ptr<DynamicsModel>* trained) {
+  return train_cell_data(cell, make_cell_data(data), progress, trained);
 }
 
 }  // namespace phnn

@@ -14,7 +14,8 @@
 
 namespace phnn {
 
-/// Shapes: x, dx [E, B, 2]; u [E, B, 1]; f [E, B, 2]; df/dx [E, B, 2, 2]
+/// Shapes: x, dx [E, B, n_x]; u [E, B, n_u]; f [E, B, n_x]; df/dx [E, B, n_x, n_x]
+/// (n_x = 2, n_u = 1 for the built-in systems)
 /// (row = component of f, column = component of x).
 struct FieldEval {
   torch::Tensor f;
@@ -39,6 +40,10 @@ struct ModelOptions {
   /// float64 either way and then rounded, so a float32 model starts from the
   /// float64 model's weights rounded to float32.
   torch::ScalarType dtype = torch::kFloat64;
+  /// Set for a file-defined system: the n-dimensional models of
+  /// general_ph.h on this structure (`structure` is then ignored); unset,
+  /// the 2-state models of port_hamiltonian.h on a built-in structure.
+  std::shared_ptr<const ModelStructure> general = nullptr;
 };
 
 /// Base of NODE, PHNN-S and PHNN-JR. Every method is batched over members.

@@ -26,6 +26,15 @@ enum class ModelSize { kSmall = 0, kMedium = 1, kLarge = 2 };
 /// RK2/RK4 and DG4 (always the midpoint) do not depend on it.
 enum class DgStructurePoint { kMidpoint = 0, kStart = 1 };
 
+/// The known interconnection of an n-dimensional (file-defined) system, as
+/// the models need it: S of eq:phs_S ((n_x + n_w + n_u) square, rows and
+/// columns ordered states, ports, inputs) for PHNN-S and J of eq:phs_JR
+/// ((n_x + n_u) square) for PHNN-JR, both row-major.
+struct ModelStructure {
+  int n_x = 2, n_w = 1, n_u = 1;
+  std::vector<double> S, J;
+};
+
 /// "node", "phnn-s", "phnn-jr".
 std::string to_string(ModelKind kind);
 /// "rk2", "dg", "rk4", "dg4".

@@ -58,8 +58,8 @@ class PortHamiltonianModel : public DynamicsModel {
   /// Gonzalez discrete gradient of H_theta (eq: gonzalez-discrete-gradient):
   ///   dg = gradH(x + dx/2) + (H(x+dx) - H(x) - gradH(x+dx/2)^T dx) / |dx|^2 dx,
   /// = gradH(x + dx/2) where |dx| < min_dx_norm (docs/METHOD.md §4).
-  torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
-                                  double min_dx_norm) const;
+  virtual torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
+                                          double min_dx_norm) const;
 
  protected:
   PortHamiltonianModel(ModelOptions options, int64_t members)
@@ -76,9 +76,12 @@ class PortHamiltonianModel : public DynamicsModel {
   /// ModelOptions::dg_structure_point = kStart).
   bool dissipation_at_start() const;
   const StackedMlp& l_h() const { return *nets_[0]; }
-  /// Jet whose value is gradH(x) [E, B, 2] and whose g is the Hessian
-  /// [E, B, 2, 2].
-  Jet curvature_jet(const torch::Tensor& x) const;
+  /// H [E, B, 1] and gradH [E, B, n_x] (the 2-state closed form; the
+  /// n-dimensional models of general_ph.h override it).
+  virtual HamiltonianAndGradient energy_and_gradient(const torch::Tensor& x) const;
+  /// Jet whose value is gradH(x) [E, B, n_x] and whose g is the Hessian
+  /// [E, B, n_x, n_x].
+  virtual Jet curvature_jet(const torch::Tensor& x) const;
 };
 
 /// PHNN-S (eq:f_theta-PHS-DAF): w = S_wx gradH + S_wu u,

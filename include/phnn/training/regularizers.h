@@ -7,7 +7,7 @@
 
 namespace phnn {
 
-/// Closed-form spectral quantities of 2 x 2 Jacobians J [E, B, 2, 2],
+/// Spectral quantities of the Jacobians J [E, B, n, n]; for n = 2 in closed form,
 /// differentiable. With J = [[a, b], [c, d]]:
 ///   s1 = |(a + d, c - b)|, s2 = |(a - d, c + b)|,
 ///   sigma_max = (s1 + s2) / 2, sigma_min = |s1 - s2| / 2,
@@ -18,7 +18,13 @@ namespace phnn {
 struct JacobianStats {
   torch::Tensor sigma_max, sigma_min, kappa, rho;  // [E, B]
 };
+///
+/// For n x n Jacobians with n != 2 (file-defined systems) the same
+/// quantities come from torch::linalg_svdvals (sigma) and the real parts of
+/// torch::linalg_eigvals (rho), both differentiable; jacobian_stats_general
+/// is that path for any n (tests compare it with the closed form at n = 2).
 JacobianStats jacobian_stats(const torch::Tensor& jacobian, double eps);
+JacobianStats jacobian_stats_general(const torch::Tensor& jacobian, double eps);
 
 /// Per-member penalty [E]: CN lambda_CN mean(kappa^2), SN lambda_SN
 /// mean(sigma_max), SR lambda_SR mean((rho - 1)^2); zeros for kNone.

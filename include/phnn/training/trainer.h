@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "phnn/data/dataset_file.h"
+#include "phnn/data/ph_dataset.h"
 #include "phnn/models/model_config.h"
 #include "phnn/sweep/run_config.h"
 #include "phnn/training/run_result.h"
@@ -64,6 +65,17 @@ using ProgressCallback = std::function<void(const TrainProgress&)>;
 std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
                                   const ProgressCallback& progress = {},
                                   std::unique_ptr<DynamicsModel>* trained = nullptr);
+
+/// The same for a file-defined system's data set (any n_x, n_u): the
+/// n-dimensional models of general_ph.h on the system's S and J; no figure
+/// trajectories (RunResult's figure fields stay empty).
+std::vector<RunResult> train_cell(const CellSpec& cell, const PhSystemData& data,
+                                  const PhSystem& system, const ProgressCallback& progress = {},
+                                  std::unique_ptr<DynamicsModel>* trained = nullptr);
+
+/// The structure the n-dimensional models of a system use (its S and J,
+/// row-major, and n_x, n_w, n_u).
+ModelStructure model_structure(const PhSystem& system);
 
 /// Initial states of the figure trajectories (paper Figures 7 and 9):
 /// (q0, 0) with H(q0, 0) = energy, q0 > 0; and their input: u = 0 for

@@ -1,0 +1,93 @@
+// include/phnn/models/general_ph.h — NODE, PHNN-S and PHNN-JR for any n_x
+// states, n_w dissipation ports and n_u inputs (paper §4 in its general
+// form; docs/METHOD.md "n-dimensional models"), on the known structure of a
+// file-defined system. Built from the same stacked MLPs and forward-mode
+// jets as the 2-state models, with the matrix algebra written for any size;
+// on the paper's 2-state structures they compute the 2-state models' fields
+// (tested to round-off). No fused closed-form heads.
+#pragma once
+
+#include "phnn/models/port_hamiltonian.h"
+
+namespace phnn {
+
+/// Jet algebra for matrices stored row-major in a jet's components.
+/// y = A b for A [.., n * m] (row-major n x m) and b [.., m]: the product
+/// rule on value, tangents and Hessians.
+Jet jet_matvec(const Jet& A, const Jet& b, int64_t n, int64_t m);
+/// y = a M for a constant matrix M [n_in, n_out]: linear in the jet.
+Jet jet_linear(const Jet& a, const torch::Tensor& M);
+/// Components [start, start + length).
+Jet jet_narrow(const Jet& a, int64_t start, int64_t length);
+
+/// H_theta(x) = 1/2 |L(x) x|^2 with L lower triangular n x n from the
+/// n (n + 1) / 2 outputs of L_H (row-major lower triangle; softplus on the
+/// diagonal), as a jet in the n state directions up to `order`.
+Jet general_hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order);
+
+/// Shared by the n-dimensional PHNN-S and PHNN-JR: H_theta, its gradient
+/// and Hessian from general_hamiltonian_jet, the Gonzalez DG by its
+/// reference formula; everything else is PortHamiltonianModel's.
+class GeneralPortHamiltonianModel : public PortHamiltonianModel {
+ public:
+  torch::Tensor hamiltonian(const torch::Tensor& x) const override;
+  torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
+                                  double min_dx_norm) const override;
+
+ protected:
+  GeneralPortHamiltonianModel(ModelOptions options, int64_t members);
+  HamiltonianAndGradient energy_and_gradient(const torch::Tensor& x) const override;
+  Jet curvature_jet(const torch::Tensor& x) const override;
+  const ModelStructure& structure() const { return *options().general; }
+  /// Row-major matrix block [r0, r0 + rows) x [c0, c0 + cols) of a
+  /// structure matrix with `width` columns, as a [cols, rows] tensor (the
+  /// right factor of jet_linear: y = a M^T).
+  torch::Tensor block_t(const std::vector<double>& matrix, int width, int r0, int rows, int c0,
+                        int cols) const;
+};
+
+/// PHNN-S (eq:f_theta-PHS-DAF) for n_w ports:
+///   w = S_wx gradH + S_wu u,
+///   z_theta(w) = (L_z(w)^T L_z(w) + K(w) - K(w)^T) w,
+///   f = S_xx gradH + S_xw z_theta(w) + S_xu u,
+/// one network n_w -> n_w (n_w + 1) / 2 (L_z, lower triangle) + n_w (n_w - 1) / 2
+/// (K, strictly lower); for n_w = 1 that is the 2-state model's 1 -> 1
+/// network and K is empty.
+class GeneralPhnnS : public GeneralPortHamiltonianModel {
+ public:
+  GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+
+ protected:
+  Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
+                        const torch::Tensor& u, int order, bool dissipation_fixed) const override;
+
+ private:
+  torch::Tensor s_w_, s_x_, s_y_;  // jet_linear factors, see the constructor
+  torch::Tensor place_l_, place_lt_, place_skew_;  // L_z outputs -> L, L^T, K - K^T
+};
+
+/// PHNN-JR (eq:f_theta-PHS-JR): f = [(J - R_theta(x, u)) [gradH; u]]_{1:n_x},
+/// R = L_R^T L_R, L_R lower triangular m x m (m = n_x + n_u) from an
+/// m -> m (m + 1) / 2 network of (x, u).
+class GeneralPhnnJr : public GeneralPortHamiltonianModel {
+ public:
+  GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+
+ protected:
+  Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
+                        const torch::Tensor& u, int order, bool dissipation_fixed) const override;
+
+ private:
+  torch::Tensor j_t_;                 // J^T [m, m]
+  torch::Tensor place_l_, place_lt_;  // L_R outputs -> L, L^T
+};
+
+/// NODE (eq: neural-ode): f = MLP([x; u]), n_x + n_u -> n_x.
+class GeneralNode : public DynamicsModel {
+ public:
+  GeneralNode(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
+                  bool with_jacobian) const override;
+};
+
+}  // namespace phnn

@@ -1,0 +1,98 @@
+// src/training/cell_data.cpp — CellData from the two kinds of data sets.
+#include "training/cell_data.h"
+
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+namespace {
+
+template <class Vec>
+void append(const Vec& v, std::vector<double>* out) {
+  for (int i = 0; i < static_cast<int>(v.size()); ++i) out->push_back(v(i));
+}
+
+FlatPairs flatten(const PairSet& p) {
+  FlatPairs out;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    append(p.x[i], &out.x);
+    append(p.x_next[i], &out.x_next);
+    out.u.push_back(p.u[i]);
+  }
+  out.count = p.size();
+  return out;
+}
+
+FlatPairs flatten(const PhPairSet& p) {
+  FlatPairs out;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    append(p.x[i], &out.x);
+    append(p.x_next[i], &out.x_next);
+    append(p.u[i], &out.u);
+  }
+  out.count = p.size();
+  return out;
+}
+
+std::vector<double> row_major(const MatX& m) {
+  std::vector<double> out;
+  for (int r = 0; r < m.rows(); ++r) {
+    for (int c = 0; c < m.cols(); ++c) out.push_back(m(r, c));
+  }
+  return out;
+}
+
+}  // namespace
+
+ModelStructure model_structure(const PhSystem& system) {
+  ModelStructure s;
+  s.n_x = system.n_x();
+  s.n_w = system.n_w();
+  s.n_u = system.n_u();
+  s.S = row_major(system.S());
+  s.J = row_major(system.J());
+  return s;
+}
+
+CellData make_cell_data(const SystemData& data) {
+  CellData d;
+  d.step = data.train.step;
+  d.train = flatten(data.train);
+  d.validation = flatten(data.validation);
+  d.inference_count = data.inference.size();
+  d.inference_steps =
+      static_cast<int>(data.inference.states.empty() ? 0 : data.inference.states[0].size() - 1);
+  d.inference_step = data.inference.step;
+  for (std::size_t i = 0; i < data.inference.size(); ++i) {
+    for (const Vec2& x : data.inference.states[i]) append(x, &d.inference_states);
+    d.inference_u.push_back(data.inference.u[i]);
+  }
+  d.builtin = data.system.kind;
+  d.has_figures = true;
+  const FigureSetup fig = figure_setup(data.system);
+  d.figure_x0 = {{{fig.x0_05(0), fig.x0_05(1)}, {fig.x0_075(0), fig.x0_075(1)}}};
+  d.figure_u = fig.u;
+  d.figure_references = {reference_trajectory(data.system, data.options, fig.x0_05, fig.u),
+                         reference_trajectory(data.system, data.options, fig.x0_075, fig.u)};
+  return d;
+}
+
+CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
+  CellData d;
+  d.n_x = system.n_x();
+  d.n_u = system.n_u();
+  d.step = data.train.step;
+  d.train = flatten(data.train);
+  d.validation = flatten(data.validation);
+  d.inference_count = data.inference.size();
+  d.inference_steps =
+      static_cast<int>(data.inference.states.empty() ? 0 : data.inference.states[0].size() - 1);
+  d.inference_step = data.inference.step;
+  for (std::size_t i = 0; i < data.inference.size(); ++i) {
+    for (const VecX& x : data.inference.states[i]) append(x, &d.inference_states);
+    append(data.inference.u[i], &d.inference_u);
+  }
+  d.general = std::make_shared<ModelStructure>(model_structure(system));
+  return d;
+}
+
+}  // namespace phnn
