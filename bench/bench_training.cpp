@@ -12,6 +12,12 @@
 //   bench_training run MODEL INTEGRATOR REG STEPS [SIZE] [N_TRAIN]   one cell, E = 10
 //                                      (for perf; PHNN_REFERENCE_NETWORKS=1
 //                                      selects the reference networks)
+//   bench_training general [repeats]   n-dimensional models on mass chains of
+//                                      n_x = 2, 4, 6, 8 states (system files
+//                                      made in memory), E = 10, µs per
+//                                      member-step; at n_x = 2 the built-in
+//                                      harmonic oscillator's fused path beside
+//                                      the general path on the same system
 //   bench_training cell                one full cell: small PHNN-JR-RK2,
 //                                      E = 10, 50 000 steps (+ inference)
 //
@@ -32,6 +38,7 @@
 #include <torch/torch.h>
 
 #include "phnn/data/dataset_file.h"
+#include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"
 
 namespace {
@@ -275,6 +282,93 @@ int full_cell() {
 
 }  // namespace
 
+// A chain of k unit masses (k = 1: the harmonic oscillator of the paper's
+// parameters), springs to a wall and between neighbours, a damper on each,
+// a force on the first: n_x = 2k, n_w = k, n_u = 1.
+std::string chain_text(int k) {
+  std::string states, ports, z, h = "k*q1^2/2";
+  for (int i = 1; i <= k; ++i) {
+    const std::string s = std::to_string(i);
+    states += std::string(i > 1 ? ", " : "") + "\"q" + s + "\", \"p" + s + "\"";
+    ports += std::string(i > 1 ? ", " : "") + "\"w" + s + "\"";
+    z += std::string(i > 1 ? ", " : "") + "\"c*w" + s + "\"";
+    h += " + p" + s + "^2/(2*m)";
+    if (i > 1) h += " + k*(q" + s + " - q" + std::to_string(i - 1) + ")^2/2";
+  }
+  const int n = 2 * k + k + 1;
+  std::vector<std::vector<int>> S(n, std::vector<int>(n, 0));
+  for (int i = 0; i < k; ++i) {
+    S[2 * i][2 * i + 1] = 1;   // dq = dH/dp
+    S[2 * i + 1][2 * i] = -1;  // dp = -dH/dq - z (- u)
+    S[2 * i + 1][2 * k + i] = -1;
+    S[2 * k + i][2 * i + 1] = 1;  // w = dH/dp
+  }
+  S[1][n - 1] = -1;
+  S[n - 1][1] = 1;  // y = dH/dp1
+  std::string rows;
+  for (int r = 0; r < n; ++r) {
+    rows += r ? ", [" : "[";
+    for (int c = 0; c < n; ++c) rows += (c ? ", " : "") + std::to_string(S[r][c]);
+    rows += "]";
+  }
+  return "name = \"chain-" + std::to_string(k) + "\"\nstates = [" + states + "]\ninputs = [\"u\"]\nports = [" +
+         ports + "]\nH = \"" + h + "\"\nz = [" + z + "]\nS = [" + rows +
+         "]\n[parameters]\nm = 0.16\nk = 6.25\nc = 0.1473654459516189\n[initial]\nmethod = "
+         "\"energy\"\nenergy = [0.1, 1.0]\n[control]\ndesign = \"constant\"\nrange = [[-1, 1]]\n";
+}
+
+double time_general_cell(CellSpec cell, const phnn::PhSystemData& data, const phnn::PhSystem& system,
+                         int steps) {
+  cell.training.steps = steps;
+  cell.training.eval_every = 1000000;
+  const auto t0 = Clock::now();
+  phnn::train_cell(cell, data, system);
+  return seconds_since(t0);
+}
+
+// µs per member-step, (T(700) - T(100)) / (600 E), medians of `repeats`;
+// at n_x = 2 the built-in fused path on the same harmonic system, interleaved.
+int general(int repeats) {
+  std::printf("| model | n_x | general µs/member-step | fused 2-state µs/member-step |\n");
+  for (int k = 1; k <= 4; ++k) {
+    const auto system = phnn::compile_system(chain_text(k), "chain.toml");
+    phnn::DatasetOptions options;
+    options.num_validation = 64;
+    options.num_inference = 1;
+    const phnn::PhSystemData data = phnn::make_ph_system_data(*system, options, 100);
+    const phnn::SystemData builtin = phnn::make_system_data(
+        phnn::OscillatorOptions::defaults(phnn::SystemKind::kHarmonic), options, 100);
+    for (const auto& [model, integrator] : kModels) {
+      CellSpec cell;
+      cell.model = model;
+      cell.integrator = integrator;
+      cell.n_train = 64;
+      cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+      std::vector<double> general_us, fused_us;
+      for (int r = 0; r < repeats; ++r) {
+        const double a = time_general_cell(cell, data, *system, 100);
+        const double b = time_general_cell(cell, data, *system, 700);
+        general_us.push_back((b - a) / 6000.0 * 1e6);
+        if (k == 1) {
+          cell.training.eval_every = 1000000;
+          cell.training.steps = 100;
+          auto t0 = Clock::now();
+          phnn::train_cell(cell, builtin);
+          const double c = seconds_since(t0);
+          cell.training.steps = 700;
+          t0 = Clock::now();
+          phnn::train_cell(cell, builtin);
+          fused_us.push_back((seconds_since(t0) - c) / 6000.0 * 1e6);
+        }
+      }
+      std::printf("| %s | %d | %.0f | %s |\n", phnn::model_label(model, integrator).c_str(), 2 * k,
+                  median(general_us), k == 1 ? std::to_string(static_cast<int>(median(fused_us) + 0.5)).c_str() : "");
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
   torch::set_num_threads(1);
   const std::string mode = argc > 1 ? argv[1] : "stacked";
@@ -315,6 +409,7 @@ int main(int argc, char** argv) {
   if (mode == "baseline") return baseline(repeats);
   if (mode == "precision") return precision(repeats);
   if (mode == "cell") return full_cell();
+  if (mode == "general") return general(repeats);
   std::fprintf(stderr, "usage: bench_training stacked|baseline|cell [repeats]\n");
   return 2;
 }

@@ -189,6 +189,19 @@ CellSpec cell_from_options(const cli::Parser& parser) {
   return cell;
 }
 
+// The options of a generated data set: --data-seed, and N_train checked.
+DatasetOptions generation_options(const cli::Parser& parser, int n_train) {
+  DatasetOptions options;
+  const auto ds = parser.get_int("data-seed");
+  if (ds < 0) throw cli::UsageError{"phnn train: --data-seed must be >= 0"};
+  options.data_seed = static_cast<std::uint64_t>(ds);
+  if (n_train < 1 || n_train > options.num_train_max) {
+    throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " outside [1, " +
+                          std::to_string(options.num_train_max) + "]"};
+  }
+  return options;
+}
+
 // The data set: read from --data, or generated for the cell's N_train.
 SystemData data_from_options(const cli::Parser& parser, SystemKind system, int n_train) {
   if (parser.has("data")) {
@@ -201,14 +214,7 @@ SystemData data_from_options(const cli::Parser& parser, SystemKind system, int n
   }
   OscillatorOptions physics = OscillatorOptions::defaults(system);
   if (parser.has("damping")) physics.damping = parser.get_double("damping");
-  DatasetOptions options;
-  const auto ds = parser.get_int("data-seed");
-  if (ds < 0) throw cli::UsageError{"phnn train: --data-seed must be >= 0"};
-  options.data_seed = static_cast<std::uint64_t>(ds);
-  if (n_train < 1 || n_train > options.num_train_max) {
-    throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " outside [1, " +
-                          std::to_string(options.num_train_max) + "]"};
-  }
+  const DatasetOptions options = generation_options(parser, n_train);
   return make_system_data(physics, options, n_train);
 }
 
@@ -261,14 +267,7 @@ PhSystemData file_system_data(const cli::Parser& parser, const PhSystem& system,
     }
     return data;
   }
-  DatasetOptions options;
-  const auto ds = parser.get_int("data-seed");
-  if (ds < 0) throw cli::UsageError{"phnn train: --data-seed must be >= 0"};
-  options.data_seed = static_cast<std::uint64_t>(ds);
-  if (n_train < 1 || n_train > options.num_train_max) {
-    throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " outside [1, " +
-                          std::to_string(options.num_train_max) + "]"};
-  }
+  const DatasetOptions options = generation_options(parser, n_train);
   return make_ph_system_data(system, options, n_train);
 }
 

@@ -6,6 +6,9 @@
 namespace phnn {
 namespace {
 
+Eigen::Matrix<double, 1, 1> as_vector(double u) { return Eigen::Matrix<double, 1, 1>(u); }
+const VecX& as_vector(const VecX& u) { return u; }
+
 template <class Vec>
 void append(const Vec& v, std::vector<double>* out) {
   for (int i = 0; i < static_cast<int>(v.size()); ++i) out->push_back(v(i));
@@ -41,6 +44,24 @@ std::vector<double> row_major(const MatX& m) {
   return out;
 }
 
+// The split sizes, steps and inference trajectories of either data set.
+template <class Data>
+CellData common_cell_data(const Data& data) {
+  CellData d;
+  d.step = data.train.step;
+  d.train = flatten(data.train);
+  d.validation = flatten(data.validation);
+  d.inference_count = data.inference.size();
+  d.inference_steps =
+      static_cast<int>(data.inference.states.empty() ? 0 : data.inference.states[0].size() - 1);
+  d.inference_step = data.inference.step;
+  for (std::size_t i = 0; i < data.inference.size(); ++i) {
+    for (const auto& x : data.inference.states[i]) append(x, &d.inference_states);
+    append(as_vector(data.inference.u[i]), &d.inference_u);
+  }
+  return d;
+}
+
 }  // namespace
 
 ModelStructure model_structure(const PhSystem& system) {
@@ -54,18 +75,7 @@ ModelStructure model_structure(const PhSystem& system) {
 }
 
 CellData make_cell_data(const SystemData& data) {
-  CellData d;
-  d.step = data.train.step;
-  d.train = flatten(data.train);
-  d.validation = flatten(data.validation);
-  d.inference_count = data.inference.size();
-  d.inference_steps =
-      static_cast<int>(data.inference.states.empty() ? 0 : data.inference.states[0].size() - 1);
-  d.inference_step = data.inference.step;
-  for (std::size_t i = 0; i < data.inference.size(); ++i) {
-    for (const Vec2& x : data.inference.states[i]) append(x, &d.inference_states);
-    d.inference_u.push_back(data.inference.u[i]);
-  }
+  CellData d = common_cell_data(data);
   d.builtin = data.system.kind;
   d.has_figures = true;
   const FigureSetup fig = figure_setup(data.system);
@@ -77,20 +87,9 @@ CellData make_cell_data(const SystemData& data) {
 }
 
 CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
-  CellData d;
+  CellData d = common_cell_data(data);
   d.n_x = system.n_x();
   d.n_u = system.n_u();
-  d.step = data.train.step;
-  d.train = flatten(data.train);
-  d.validation = flatten(data.validation);
-  d.inference_count = data.inference.size();
-  d.inference_steps =
-      static_cast<int>(data.inference.states.empty() ? 0 : data.inference.states[0].size() - 1);
-  d.inference_step = data.inference.step;
-  for (std::size_t i = 0; i < data.inference.size(); ++i) {
-    for (const VecX& x : data.inference.states[i]) append(x, &d.inference_states);
-    append(data.inference.u[i], &d.inference_u);
-  }
   d.general = std::make_shared<ModelStructure>(model_structure(system));
   return d;
 }

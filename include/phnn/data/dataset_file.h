@@ -23,7 +23,7 @@ struct SystemData {
 SystemData make_system_data(const OscillatorOptions& system,
                             const DatasetOptions& options, int num_train);
 
-/// Writes `data` to a new HDF5 file (layout in docs/FORMATS.md): groups
+/// Writes `data` to a new HDF5 file (layout in docs/DATASET_FORMAT.md): groups
 /// train/, validation/, inference/ with datasets x, x_next, u, trajectory,
 /// position (pairs) and u, trajectory, states (inference); parameters and
 /// units as attributes on the root.
