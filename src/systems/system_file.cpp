@@ -3,6 +3,8 @@
 // z'', and the Gonzalez defect in closed form when it is a polynomial);
 // muParser compiles the results to bytecode for fast evaluation. Reads the
 // system file; writes nothing.
+// Size: one class around one variable buffer that every compiled expression
+// points into: its compilation, evaluation and the checks that evaluate it.
 #include "phnn/systems/system_file.h"
 
 #include <sys/stat.h>

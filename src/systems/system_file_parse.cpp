@@ -2,6 +2,7 @@
 // toml++ parses; this file turns the table into a SystemDefinition and checks
 // everything that needs no expression algebra (names, sizes, S and J skew,
 // designs), each problem a SystemFileError at the key's line with the fix.
+// Size: one reader per part of the format, each with the checks of its keys.
 #include <toml++/toml.h>
 
 #include <cmath>

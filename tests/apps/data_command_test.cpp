@@ -59,5 +59,21 @@ TEST(DataCommandTest, RefusesAMalformedSystemFileWithItsLine) {
   std::remove(sys.c_str());
 }
 
+// `phnn train --system FILE`: the n-dimensional models train and print the
+// per-seed table; --out (2-state results files only) is refused up front.
+TEST(TrainCommandTest, TrainsOnASystemFileAndRefusesOut) {
+  const std::string sys = std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/coupled-duffing.toml";
+  std::string log;
+  ASSERT_EQ(phnn("train --system " + sys + " --model phnn-s-rk2 --seeds 0 --steps 5 --quiet", &log), 0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("coupled-duffing (4 states, 2 ports, 1 inputs) PHNN-S-RK2"));
+  EXPECT_THAT(log, HasSubstr("median [IQR]"));
+  const std::string out = ::testing::TempDir() + "phnn_train_file_out.h5";
+  EXPECT_EQ(phnn("train --system " + sys + " --model phnn-s-rk2 --seeds 0 --steps 5 --out " + out, &log), 2);
+  EXPECT_THAT(log, HasSubstr("--out is not available for system files yet"));
+  std::ifstream probe(out);
+  EXPECT_FALSE(probe.good());
+}
+
 }  // namespace
 }  // namespace phnn
