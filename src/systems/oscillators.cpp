@@ -234,7 +234,11 @@ std::array<double, 2> Oscillator::self_oscillation_interval() const {
                "self_oscillation_interval: z'(w) < 0 has no interval for "
                "z_coefficients = ("
                    << a[0] << ", " << a[1] << ", " << a[2] << ")");
-  // Stable quadratic roots.
+  return stable_quadratic_roots(A, B, C);
+}
+
+std::array<double, 2> stable_quadratic_roots(double A, double B, double C) {
+  const double disc = B * B - 4.0 * A * C;
   const double t = -0.5 * (B + std::copysign(std::sqrt(disc), B));
   double r1 = t / A, r2 = C / t;
   if (r1 > r2) std::swap(r1, r2);

@@ -7,6 +7,8 @@
 // points into: its compilation, evaluation and the checks that evaluate it.
 #include "phnn/systems/system_file.h"
 
+#include "phnn/systems/oscillators.h"
+
 #include <sys/stat.h>
 
 #include <cmath>
@@ -169,7 +171,6 @@ class FileSystem : public PhSystem {
     return def_.phase_pairs.empty() ? PhSystem::phase_pairs() : def_.phase_pairs;
   }
 
-  const SystemDefinition& definition() const { return def_; }
   /// Resolves the automatic box of initial.method = "energy" and checks H
   /// at the box's centre, axis ends and corners (finite, >= 0).
   void check_energy_and_box();
@@ -181,7 +182,8 @@ class FileSystem : public PhSystem {
     return def_.file + ":" + std::to_string(def_.line_of(key));
   }
   void compile();
-  void compile_defect(const GiNaC::ex& H);
+  void compile_defect(const GiNaC::ex& H, const std::vector<GiNaC::ex>& grad,
+                      const std::vector<GiNaC::ex>& hess);
   void compile_limit_cycle(const GiNaC::ex& z);
   void set_states(const VecX& x) const {
     for (int i = 0; i < n_x(); ++i) vars_[static_cast<std::size_t>(i)] = x(i);
@@ -201,7 +203,7 @@ class FileSystem : public PhSystem {
   SystemDefinition def_;
   Symbols syms_;  // one set: GiNaC symbols of equal names are still distinct
   std::unique_ptr<double[]> vars_;
-  std::size_t w_offset_ = 0, a_offset_ = 0, d_offset_ = 0;
+  std::size_t w_offset_ = 0, d_offset_ = 0;
   std::unique_ptr<CompiledExpressions> energy_, gradient_, hessian_, dissipation_,
       dissipation_jacobian_, dissipation_second_, gradient_and_defect_, hessian_and_defect_;
   bool defect_is_zero_ = false;
@@ -233,8 +235,7 @@ void FileSystem::compile() {
   vars_.reset(new double[s.names.size()]());
   for (std::size_t i = 0; i < np; ++i) vars_[nx + i] = def_.parameters[i].second;
   w_offset_ = nx + np;
-  a_offset_ = w_offset_ + nw;
-  d_offset_ = a_offset_ + nx;
+  d_offset_ = w_offset_ + nw + nx;  // after the ports and the midpoint symbols a
   const GiNaC::ex H = parse_expression(def_, "H", def_.energy, s.energy_table,
                                        "the states and parameters");
   std::vector<GiNaC::ex> grad, hess;
@@ -257,14 +258,15 @@ void FileSystem::compile() {
   dissipation_ = make(z, "z");
   dissipation_jacobian_ = make(dz, "z'(w)");
   dissipation_second_ = make(d2z, "z''(w)");
-  compile_defect(H);
+  compile_defect(H, grad, hess);
   if (def_.control.design == ControlDesign::Design::kLimitCycle) compile_limit_cycle(z[0]);
 }
 
 // D(a, d) = H(a + d/2) - H(a - d/2) - gradH(a)^T d, expanded. When it is a
 // polynomial in d (H polynomial in the states), every term is O(|d|^3) and
 // the Gonzalez quotient D / |d|^2 has no cancellation (docs/METHOD.md §4).
-void FileSystem::compile_defect(const GiNaC::ex& H) {
+void FileSystem::compile_defect(const GiNaC::ex& H, const std::vector<GiNaC::ex>& grad,
+                                const std::vector<GiNaC::ex>& hess) {
   const Symbols& s = syms_;
   GiNaC::exmap plus, minus, at_a;
   GiNaC::lst d_list;
@@ -275,7 +277,7 @@ void FileSystem::compile_defect(const GiNaC::ex& H) {
     d_list.append(s.d[i]);
   }
   GiNaC::ex D = H.subs(plus) - H.subs(minus);
-  for (std::size_t i = 0; i < s.x.size(); ++i) D -= H.diff(s.x[i]).subs(at_a) * s.d[i];
+  for (std::size_t i = 0; i < s.x.size(); ++i) D -= grad[i].subs(at_a) * s.d[i];
   D = D.expand();
   if (!D.is_polynomial(d_list)) return;  // the generic quotient with tau (PhSystem)
   if (D.is_zero()) {
@@ -287,11 +289,7 @@ void FileSystem::compile_defect(const GiNaC::ex& H) {
   // so one evaluation gives gradH(a) and D (resp. H''(a), D and dD/d dx).
   GiNaC::exmap a_as_x;
   for (std::size_t i = 0; i < s.x.size(); ++i) a_as_x[s.a[i]] = s.x[i];
-  std::vector<GiNaC::ex> dg = {}, jac = {};
-  for (std::size_t i = 0; i < s.x.size(); ++i) dg.push_back(H.diff(s.x[i]));
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
-    for (std::size_t j = i; j < s.x.size(); ++j) jac.push_back(H.diff(s.x[i]).diff(s.x[j]));
-  }
+  std::vector<GiNaC::ex> dg = grad, jac = hess;
   dg.push_back(D.subs(a_as_x));
   jac.push_back(D.subs(a_as_x));
   for (std::size_t j = 0; j < s.x.size(); ++j) {
@@ -323,11 +321,7 @@ void FileSystem::compile_limit_cycle(const GiNaC::ex& z) {
                                                " is never negative, so there is no self-oscillation "
                                                "interval I_w; check z or use design = \"constant\"");
   }
-  // Stable quadratic roots (as Oscillator::self_oscillation_interval).
-  const double t = -0.5 * (B + std::copysign(std::sqrt(disc), B));
-  double r1 = t / A, r2 = C / t;
-  if (r1 > r2) std::swap(r1, r2);
-  limit_cycle_ = {r1, r2};
+  limit_cycle_ = stable_quadratic_roots(A, B, C);
   has_limit_cycle_ = true;
 }
 

@@ -74,9 +74,10 @@ ModelStructure model_structure(const PhSystem& system) {
   return s;
 }
 
-CellData make_cell_data(const SystemData& data) {
+CellData make_cell_data(const SystemData& data, bool with_figures) {
   CellData d = common_cell_data(data);
   d.builtin = data.system.kind;
+  if (!with_figures) return d;
   d.has_figures = true;
   const FigureSetup fig = figure_setup(data.system);
   d.figure_x0 = {{{fig.x0_05(0), fig.x0_05(1)}, {fig.x0_075(0), fig.x0_075(1)}}};

@@ -51,8 +51,10 @@ struct CellSpec;  // phnn/training/trainer.h
 // finite data; std::invalid_argument naming the field and the fix.
 void validate_cell(const CellSpec& cell, const CellData& data);
 
-// A built-in system's data set, with its figure trajectories.
-CellData make_cell_data(const SystemData& data);
+// A built-in system's data set, with its figure trajectories (two reference
+// integrations of the true system) unless `with_figures` is false (checks
+// that read the pairs and inference trajectories only).
+CellData make_cell_data(const SystemData& data, bool with_figures = true);
 // A file-defined (or any PhSystem's) data set: no figure trajectories.
 CellData make_cell_data(const PhSystemData& data, const PhSystem& system);
 

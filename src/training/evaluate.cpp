@@ -55,7 +55,8 @@ std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemDat
                                 std::to_string(cell.seeds.size()));
   }
   // The trainer's inference model (float64 whatever the training precision).
-  auto model = DynamicsModel::create(inference_model_options(cell, make_cell_data(data)),
+  auto model = DynamicsModel::create(
+      inference_model_options(cell, make_cell_data(data, /*with_figures=*/false)),
                                      {static_cast<std::uint64_t>(cell.seeds[0])});
   if (static_cast<long>(weights.size()) != model->parameter_count()) {
     throw std::invalid_argument("load_member: " + std::to_string(weights.size()) +

@@ -47,6 +47,12 @@ struct OscillatorOptions {
   void validate() const;
 };
 
+/// Roots r1 <= r2 of A w^2 + B w + C (A > 0, B^2 - 4AC > 0 checked by the
+/// caller), computed without cancellation: t = -(B + sign(B) sqrt(disc)) / 2,
+/// roots t / A and C / t. Between them the quadratic is negative
+/// (Algorithm 4's I_w = {w : z'(w) < 0} for a cubic z).
+std::array<double, 2> stable_quadratic_roots(double A, double B, double C);
+
 /// Effort-to-flow map of the PH-DAE (eq:phs_S) for one state:
 ///   [x_dot; w; y] = S [gradH; z(w); u],   S = -S^T (4 x 4),
 /// rows (x_q, x_p, w, y), columns (grad_q H, grad_p H, z, u). For all three
