@@ -14,6 +14,7 @@
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
+#include "phnn/systems/system_file.h"
 #include "phnn/training/evaluate.h"
 
 namespace phnn {
@@ -44,13 +45,27 @@ int find_row(const ResultsFile& results, const std::vector<std::string>& ids,
 
 // The run's configuration, rebuilt from the sweep text stored in the file.
 RunConfig stored_config(const ResultsFile& results, const std::string& id) {
-  const SweepSpec spec = parse_sweep_text(results.sweep_text(), results.path() + " (sweep_text)");
+  const SweepSpec spec = parse_sweep_text(results.sweep_text(), results.path() + " (sweep_text)",
+                                          results.stored_system_files());
   for (const RunConfig& run : expand_grid(spec).runs) {
     if (run.id() == id) return run;
   }
   throw std::runtime_error(results.path() + ": run " + id +
                            " is not in the sweep text stored in the file; it was written by "
                            "another program version (" + results.program_version() + ")");
+}
+
+// The run evaluated again on the data stored in the file.
+Evaluation evaluate(const ResultsFile& results, const RunConfig& run,
+                    const std::vector<double>& weights) {
+  const CellSpec cell = cell_spec_for(run, {run.seed});
+  if (!run.has_system_file()) {
+    return evaluate_stored_run(cell, results.read_system_data(run.system_name()), weights);
+  }
+  const PhSystemData data = results.read_file_system_data(run.system_name());
+  const auto system =
+      compile_system(data.system_text, results.path() + "@/data/" + run.system_name());
+  return evaluate_stored_run(cell, data, *system, weights);
 }
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
@@ -102,11 +117,15 @@ int run_eval(int argc, char** argv, int first) {
                              "stored can be evaluated");
   }
   const RunConfig run = stored_config(results, id);
-  const SystemData data = results.read_system_data(to_string(run.system));
-  const Evaluation e = evaluate_stored_run(cell_spec_for(run, {run.seed}), data, stored.weights);
+  if (run.has_system_file() && !parser.get("out").empty()) {
+    throw cli::UsageError{"phnn eval: --out writes the energies along the paper's figure "
+                          "trajectories, which runs of system files (" + run.system_name() +
+                          ") do not have; drop --out"};
+  }
+  const Evaluation e = evaluate(results, run, stored.weights);
   const bool same = same_bits(e.result.mse, stored.mse);
   std::printf("phnn eval: run %s (%s): mse %.6e, stored %.6e: %s\n", id.c_str(),
-              run.canonical().substr(0, run.canonical().find(";mass=")).c_str(), e.result.mse,
+              run.canonical().substr(0, run.canonical().find(run.has_system_file() ? ";system_file=" : ";mass=")).c_str(), e.result.mse,
               stored.mse, same ? "bitwise equal" : "DIFFERENT");
   if (!parser.get("out").empty()) {
     write_energy_csv(parser.get("out"), e);

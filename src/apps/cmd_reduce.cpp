@@ -173,7 +173,8 @@ int run_reduce(int argc, char** argv, int first) {
   }
   const std::string path = parser.get("FILE");
   const ResultsFile file = ResultsFile::open_read_only(path);
-  const SweepSpec spec = parse_sweep_text(file.sweep_text(), path + "@sweep_text");
+  const SweepSpec spec =
+      parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
   const Grid grid = checked_grid(file, spec);
   if (per_run) {
     std::cout << render_per_run_csv(read_run_records(file, grid));

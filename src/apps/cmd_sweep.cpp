@@ -27,6 +27,7 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/provenance.h"
+#include "apps/sweep_data.h"
 #include "apps/sweep_phases.h"
 #include "apps/sweep_report.h"
 #include "h5/h5file.h"
@@ -237,36 +238,28 @@ class SweepRun {
     });
   }
 
-  // Data sets: deterministic, so every rank makes the ones it needs itself.
-  const SystemData& data_for(SystemKind kind) {
-    auto it = data_.find(kind);
-    if (it == data_.end()) {
-      int max_train = 0;
-      for (const RunConfig& run : grid_.runs) {
-        if (run.system == kind) max_train = std::max(max_train, run.n_train);
-      }
-      it = data_.emplace(kind, make_system_data(spec_.physics.at(kind), spec_.data, max_train)).first;
-    }
-    return it->second;
-  }
-
   // /data/<system> for every system of the grid: written at creation, and
   // again on resume if a crash during creation left it missing.
   int store_missing_data(bool resume) {
-    std::set<SystemKind> systems;
-    for (const RunConfig& run : grid_.runs) systems.insert(run.system);
+    std::set<std::string> systems;
+    for (const RunConfig& run : grid_.runs) systems.insert(run.system_name());
     std::vector<std::string> missing;
     if (int status = agreed(world_, root_, [&] {
-          for (SystemKind kind : systems) {
-            if (!results_->has_system_data(to_string(kind))) missing.push_back(to_string(kind));
+          for (const std::string& name : systems) {
+            if (!results_->has_system_data(name)) missing.push_back(name);
           }
         })) {
       return status;
     }
     mpi::broadcast(world_, missing, 0);
-    for (const std::string& name : missing) {
-      results_->store_system_data(name, data_for(parse_system(name)));
+    // Data sets: deterministic, so every rank makes them itself; a system
+    // file whose data cannot be generated fails on every rank alike.
+    if (int status = agreed(world_, true, [&] {
+          for (const std::string& name : missing) data_.make(name);
+        })) {
+      return status;
     }
+    for (const std::string& name : missing) data_.store(name, &*results_);
     if (root_ && resume && !missing.empty()) {
       std::cerr << "phnn sweep: " << out_ << ": wrote the missing data group(s) /data/"
                 << join(missing, ", /data/") << "\n";
@@ -293,17 +286,18 @@ class SweepRun {
   WriterLock lock_;  // rank 0 only; released after the file is closed
   std::optional<ResultsFile> results_;
   std::optional<Journal> journal_;
-  std::map<SystemKind, SystemData> data_;
+  SweepDataSets data_{spec_, grid_};
   Clock::time_point start_ = Clock::now();
 };
 
 // Trains one item's cell. A cell that throws is a result too: every run
 // failed, with the message.
-std::vector<RunResult> train_item(const CellSpec& cell, const SystemData& data,
-                                  const std::function<void()>& tick, const std::string& prefix,
-                                  int item_number) {
+std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
+                                  const std::string& system, const std::function<void()>& tick,
+                                  const std::string& prefix, int item_number) {
   try {
-    return train_cell(cell, data, [&](const TrainProgress&) { tick(); });
+    data->make(system);
+    return data->train(cell, system, [&](const TrainProgress&) { tick(); });
   } catch (const std::exception& e) {
     std::vector<RunResult> failed(cell.seeds.size());
     for (auto& r : failed) {
@@ -373,8 +367,8 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     }
     const auto cell_start = Clock::now();
     const std::string started = utc_now();
-    const std::vector<RunResult> cell_results = train_item(
-        cell, data_for(head.system), [&] { report_progress(false); }, prefix_, i + 1);
+    const std::vector<RunResult> cell_results =
+        train_item(cell, &data_, head.system_name(), [&] { report_progress(false); }, prefix_, i + 1);
     io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
     if (!io_error.empty()) break;
     my_runs += static_cast<int>(item.runs.size());

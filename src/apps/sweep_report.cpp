@@ -47,7 +47,7 @@ void ProgressLine::print(int items_done, double elapsed_s) const {
 
 std::string describe(const RunConfig& run) {
   std::ostringstream s;
-  s << to_string(run.system) << " " << model_label(run.model, run.integrator) << " "
+  s << run.system_name() << " " << model_label(run.model, run.integrator) << " "
     << to_string(run.size) << " n_train=" << run.n_train << " reg=" << to_string(run.regularizer);
   return s.str();
 }

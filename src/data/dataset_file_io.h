@@ -6,6 +6,7 @@
 
 #include "h5/h5file.h"
 #include "phnn/data/dataset_file.h"
+#include "phnn/data/ph_dataset.h"
 
 namespace phnn {
 namespace internal {
@@ -15,6 +16,11 @@ namespace internal {
 void write_system_data(h5::File& file, const std::string& group,
                        const SystemData& data);
 SystemData read_system_data(const h5::File& file, const std::string& group);
+
+/// The same for any system (format_version 2 of data-set files: state
+/// names, units, the system file's text as attributes of `group`).
+void write_ph_system_data(h5::File& file, const std::string& group, const PhSystemData& data);
+PhSystemData read_ph_system_data(const h5::File& file, const std::string& group);
 
 }  // namespace internal
 }  // namespace phnn

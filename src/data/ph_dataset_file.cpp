@@ -65,37 +65,37 @@ PhPairSet read_pairs(const h5::File& file, const std::string& group, int nx, int
   return p;
 }
 
-void write_options(h5::File& file, const DatasetOptions& o) {
-  file.set_attribute("/", "data_seed", static_cast<std::int64_t>(o.data_seed));
-  file.set_attribute("/", "generation_step_s", o.generation_step);
-  file.set_attribute("/", "period_s", o.period);
-  file.set_attribute("/", "alpha", o.alpha);
-  file.set_attribute("/", "beta", o.beta);
-  file.set_attribute("/", "sample_rate_Hz", o.sample_rate);
-  file.set_attribute("/", "energy_sampling", to_string(o.energy_sampling));
-  file.set_attribute("/", "num_trajectories", static_cast<std::int64_t>(o.num_trajectories));
-  file.set_attribute("/", "num_train_max", static_cast<std::int64_t>(o.num_train_max));
-  file.set_attribute("/", "num_validation", static_cast<std::int64_t>(o.num_validation));
-  file.set_attribute("/", "num_inference", static_cast<std::int64_t>(o.num_inference));
-  file.set_attribute("/", "newton_tolerance", o.newton.newton_tolerance);
+void write_options(h5::File& file, const std::string& g, const DatasetOptions& o) {
+  file.set_attribute(g, "data_seed", static_cast<std::int64_t>(o.data_seed));
+  file.set_attribute(g, "generation_step_s", o.generation_step);
+  file.set_attribute(g, "period_s", o.period);
+  file.set_attribute(g, "alpha", o.alpha);
+  file.set_attribute(g, "beta", o.beta);
+  file.set_attribute(g, "sample_rate_Hz", o.sample_rate);
+  file.set_attribute(g, "energy_sampling", to_string(o.energy_sampling));
+  file.set_attribute(g, "num_trajectories", static_cast<std::int64_t>(o.num_trajectories));
+  file.set_attribute(g, "num_train_max", static_cast<std::int64_t>(o.num_train_max));
+  file.set_attribute(g, "num_validation", static_cast<std::int64_t>(o.num_validation));
+  file.set_attribute(g, "num_inference", static_cast<std::int64_t>(o.num_inference));
+  file.set_attribute(g, "newton_tolerance", o.newton.newton_tolerance);
 }
 
-DatasetOptions read_options(const h5::File& file) {
+DatasetOptions read_options(const h5::File& file, const std::string& g) {
   DatasetOptions o;
-  o.data_seed = static_cast<std::uint64_t>(file.int_attribute("/", "data_seed"));
-  o.generation_step = file.double_attribute("/", "generation_step_s");
-  o.period = file.double_attribute("/", "period_s");
-  o.alpha = file.double_attribute("/", "alpha");
-  o.beta = file.double_attribute("/", "beta");
-  o.sample_rate = file.double_attribute("/", "sample_rate_Hz");
-  o.energy_sampling = file.string_attribute("/", "energy_sampling") == "direct"
+  o.data_seed = static_cast<std::uint64_t>(file.int_attribute(g, "data_seed"));
+  o.generation_step = file.double_attribute(g, "generation_step_s");
+  o.period = file.double_attribute(g, "period_s");
+  o.alpha = file.double_attribute(g, "alpha");
+  o.beta = file.double_attribute(g, "beta");
+  o.sample_rate = file.double_attribute(g, "sample_rate_Hz");
+  o.energy_sampling = file.string_attribute(g, "energy_sampling") == "direct"
                           ? EnergySampling::kDirect
                           : EnergySampling::kAlgorithm1;
-  o.num_trajectories = static_cast<int>(file.int_attribute("/", "num_trajectories"));
-  o.num_train_max = static_cast<int>(file.int_attribute("/", "num_train_max"));
-  o.num_validation = static_cast<int>(file.int_attribute("/", "num_validation"));
-  o.num_inference = static_cast<int>(file.int_attribute("/", "num_inference"));
-  o.newton.newton_tolerance = file.double_attribute("/", "newton_tolerance");
+  o.num_trajectories = static_cast<int>(file.int_attribute(g, "num_trajectories"));
+  o.num_train_max = static_cast<int>(file.int_attribute(g, "num_train_max"));
+  o.num_validation = static_cast<int>(file.int_attribute(g, "num_validation"));
+  o.num_inference = static_cast<int>(file.int_attribute(g, "num_inference"));
+  o.newton.newton_tolerance = file.double_attribute(g, "newton_tolerance");
   return o;
 }
 
@@ -135,25 +135,29 @@ PhSystemData from_version1(const SystemData& v1) {
 
 }  // namespace
 
-void write_ph_dataset_file(const std::string& path, const PhSystemData& data) {
-  h5::File file = h5::File::create(path);
+namespace internal {
+
+void write_ph_system_data(h5::File& file, const std::string& group, const PhSystemData& data) {
+  const std::string g = group;
+  const std::string p = group == "/" ? "" : group;  // prefix of the sub-groups
   const int nx = static_cast<int>(data.state_names.size());
   const int nu = static_cast<int>(data.input_names.size());
-  file.set_attribute("/", "format", std::string("phnn-dataset"));
-  file.set_attribute("/", "format_version", std::int64_t{2});
-  file.set_attribute("/", "system", data.system_name);
-  file.set_attribute("/", "system_file", data.system_text);
-  file.set_attribute("/", "n_x", static_cast<std::int64_t>(nx));
-  file.set_attribute("/", "n_w", static_cast<std::int64_t>(data.n_w));
-  file.set_attribute("/", "n_u", static_cast<std::int64_t>(nu));
-  file.set_attribute("/", "state_names", join(data.state_names));
-  file.set_attribute("/", "state_units", join(data.state_units));
-  file.set_attribute("/", "input_names", join(data.input_names));
-  file.set_attribute("/", "time_units", std::string("s"));
-  write_options(file, data.options);
-  write_pairs(file, "/train", data.train, nx, nu);
-  write_pairs(file, "/validation", data.validation, nx, nu);
-  file.create_group("/inference");
+  if (g != "/") file.create_group(g);
+  file.set_attribute(g, "format", std::string("phnn-dataset"));
+  file.set_attribute(g, "format_version", std::int64_t{2});
+  file.set_attribute(g, "system", data.system_name);
+  file.set_attribute(g, "system_file", data.system_text);
+  file.set_attribute(g, "n_x", static_cast<std::int64_t>(nx));
+  file.set_attribute(g, "n_w", static_cast<std::int64_t>(data.n_w));
+  file.set_attribute(g, "n_u", static_cast<std::int64_t>(nu));
+  file.set_attribute(g, "state_names", join(data.state_names));
+  file.set_attribute(g, "state_units", join(data.state_units));
+  file.set_attribute(g, "input_names", join(data.input_names));
+  file.set_attribute(g, "time_units", std::string("s"));
+  write_options(file, g, data.options);
+  write_pairs(file, p + "/train", data.train, nx, nu);
+  write_pairs(file, p + "/validation", data.validation, nx, nu);
+  file.create_group(p + "/inference");
   const std::uint64_t m = data.inference.size();
   const std::uint64_t steps = m ? data.inference.states[0].size() : 0;
   std::vector<double> states;
@@ -161,10 +165,50 @@ void write_ph_dataset_file(const std::string& path, const PhSystemData& data) {
     const auto flat = flatten(traj);
     states.insert(states.end(), flat.begin(), flat.end());
   }
-  file.write("/inference/states", {m, steps, static_cast<std::uint64_t>(nx)}, states);
-  if (nu > 0) file.write("/inference/u", {m, static_cast<std::uint64_t>(nu)}, flatten(data.inference.u));
-  file.write("/inference/trajectory", {m}, data.inference.trajectory);
-  file.set_attribute("/inference", "step_s", data.inference.step);
+  file.write(p + "/inference/states", {m, steps, static_cast<std::uint64_t>(nx)}, states);
+  if (nu > 0) {
+    file.write(p + "/inference/u", {m, static_cast<std::uint64_t>(nu)}, flatten(data.inference.u));
+  }
+  file.write(p + "/inference/trajectory", {m}, data.inference.trajectory);
+  file.set_attribute(p + "/inference", "step_s", data.inference.step);
+}
+
+PhSystemData read_ph_system_data(const h5::File& file, const std::string& group) {
+  const std::string g = group;
+  const std::string p = group == "/" ? "" : group;
+  PhSystemData d;
+  d.system_name = file.string_attribute(g, "system");
+  d.system_text = file.string_attribute(g, "system_file");
+  d.state_names = split(file.string_attribute(g, "state_names"));
+  d.state_units = split(file.string_attribute(g, "state_units"));
+  d.input_names = split(file.string_attribute(g, "input_names"));
+  d.n_w = static_cast<int>(file.int_attribute(g, "n_w"));
+  const int nx = static_cast<int>(d.state_names.size());
+  const int nu = static_cast<int>(d.input_names.size());
+  d.options = read_options(file, g);
+  d.train = read_pairs(file, p + "/train", nx, nu);
+  d.validation = read_pairs(file, p + "/validation", nx, nu);
+  d.inference.trajectory = file.read_ints(p + "/inference/trajectory");
+  d.inference.step = file.double_attribute(p + "/inference", "step_s");
+  const std::size_t m = d.inference.trajectory.size();
+  const auto dims = file.dims(p + "/inference/states");
+  const auto flat = file.read_doubles(p + "/inference/states");
+  const std::size_t steps = dims.size() == 3 ? dims[1] : 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::vector<double> part(flat.begin() + static_cast<long>(i * steps * nx),
+                                   flat.begin() + static_cast<long>((i + 1) * steps * nx));
+    d.inference.states.push_back(unflatten(part, nx, steps));
+  }
+  d.inference.u = nu > 0 ? unflatten(file.read_doubles(p + "/inference/u"), nu, m)
+                         : std::vector<VecX>(m, VecX(0));
+  return d;
+}
+
+}  // namespace internal
+
+void write_ph_dataset_file(const std::string& path, const PhSystemData& data) {
+  h5::File file = h5::File::create(path);
+  internal::write_ph_system_data(file, "/", data);
 }
 
 PhSystemData read_ph_dataset_file(const std::string& path) {
@@ -176,32 +220,7 @@ PhSystemData read_ph_dataset_file(const std::string& path) {
   if (!file.has_attribute("/", "format_version") || file.int_attribute("/", "format_version") == 1) {
     return from_version1(internal::read_system_data(file, "/"));
   }
-  PhSystemData d;
-  d.system_name = file.string_attribute("/", "system");
-  d.system_text = file.string_attribute("/", "system_file");
-  d.state_names = split(file.string_attribute("/", "state_names"));
-  d.state_units = split(file.string_attribute("/", "state_units"));
-  d.input_names = split(file.string_attribute("/", "input_names"));
-  d.n_w = static_cast<int>(file.int_attribute("/", "n_w"));
-  const int nx = static_cast<int>(d.state_names.size());
-  const int nu = static_cast<int>(d.input_names.size());
-  d.options = read_options(file);
-  d.train = read_pairs(file, "/train", nx, nu);
-  d.validation = read_pairs(file, "/validation", nx, nu);
-  d.inference.trajectory = file.read_ints("/inference/trajectory");
-  d.inference.step = file.double_attribute("/inference", "step_s");
-  const std::size_t m = d.inference.trajectory.size();
-  const auto dims = file.dims("/inference/states");
-  const auto flat = file.read_doubles("/inference/states");
-  const std::size_t steps = dims.size() == 3 ? dims[1] : 0;
-  for (std::size_t i = 0; i < m; ++i) {
-    const std::vector<double> part(flat.begin() + static_cast<long>(i * steps * nx),
-                                   flat.begin() + static_cast<long>((i + 1) * steps * nx));
-    d.inference.states.push_back(unflatten(part, nx, steps));
-  }
-  d.inference.u = nu > 0 ? unflatten(file.read_doubles("/inference/u"), nu, m)
-                         : std::vector<VecX>(m, VecX(0));
-  return d;
+  return internal::read_ph_system_data(file, "/");
 }
 
 }  // namespace phnn

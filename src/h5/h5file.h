@@ -67,6 +67,8 @@ class File {
   /// Names of the attributes of `object`, in creation-index order if
   /// tracked, else by name.
   std::vector<std::string> attribute_names(const std::string& object) const;
+  /// Names of the links (groups, datasets) in group `group`, by name.
+  std::vector<std::string> link_names(const std::string& group) const;
   std::string string_attribute(const std::string& object,
                                const std::string& name) const;
   double double_attribute(const std::string& object,

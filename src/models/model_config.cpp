@@ -102,6 +102,19 @@ long parameter_count(ModelKind kind, ModelSize size) {
   return 0;
 }
 
+long parameter_count(ModelKind kind, ModelSize size, int n_x, int n_w, int n_u) {
+  const NetworkWidths w = network_widths(size);
+  const int m = n_x + n_u;
+  const long l_h = mlp_parameter_count(n_x, w.l_h, n_x * (n_x + 1) / 2);
+  switch (kind) {
+    case ModelKind::kNode: return mlp_parameter_count(m, w.node, n_x);
+    case ModelKind::kPhnnJr: return l_h + mlp_parameter_count(m, w.l_r, m * (m + 1) / 2);
+    case ModelKind::kPhnnS:  // L_z: n_w(n_w+1)/2 lower-triangle + n_w(n_w-1)/2 skew outputs
+      return l_h + (n_w > 0 ? mlp_parameter_count(n_w, w.l_z, n_w * n_w) : 0);
+  }
+  return 0;
+}
+
 std::string model_label(ModelKind kind, IntegratorKind integrator) {
   std::string m = kind == ModelKind::kNode ? "NODE" : kind == ModelKind::kPhnnS ? "PHNN-S" : "PHNN-JR";
   std::string i = to_string(integrator);

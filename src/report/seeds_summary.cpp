@@ -59,7 +59,7 @@ void render_seeds_table(const TableEntries& t, TableFormat format, int expected_
     for (std::size_t r = 0; r < rows; ++r) {
       for (std::size_t c = 0; c < cols; ++c) {
         const SeedCounts n = count_seeds(t.cells[r][c], midpoints[c], expected_seeds);
-        out << csv_field(t.study->name) << "," << to_string(t.system) << ","
+        out << csv_field(t.study->name) << "," << t.system << ","
             << csv_field(t.study->rows[r]) << "," << csv_field(t.study->varied_axis) << ","
             << csv_field(t.study->columns[c]) << ","
             << (std::isnan(midpoints[c]) ? "" : format_number("%.6e", midpoints[c])) << ","
@@ -105,7 +105,7 @@ std::string render_seeds_summary(const std::vector<StudyTable>& studies,
     out << "study,system,model,axis,column,midpoint,below,above,diverged,missing,expected\n";
   }
   for (const StudyTable& study : studies) {
-    for (SystemKind system : study.systems) {
+    for (const std::string& system : study.systems) {
       render_seeds_table(gather_table(study, system, by_cell), format, expected_seeds, out);
     }
   }

@@ -63,13 +63,14 @@ std::string latex_escape(const std::string& text) {
 CellIndex index_cells(const std::vector<TableEntry>& entries) {
   CellIndex by_cell;
   for (const TableEntry& e : entries) {
-    by_cell[CellKey(e.study, static_cast<int>(e.system), e.row, e.column)].push_back(e);
+    by_cell[CellKey(e.study, e.system, e.row, e.column)].push_back(e);
   }
   return by_cell;
 }
 
 
-TableEntries gather_table(const StudyTable& study, SystemKind system, const CellIndex& by_cell) {
+TableEntries gather_table(const StudyTable& study, const std::string& system,
+                          const CellIndex& by_cell) {
   TableEntries t;
   t.study = &study;
   t.system = system;
@@ -77,7 +78,7 @@ TableEntries gather_table(const StudyTable& study, SystemKind system, const Cell
   for (std::size_t r = 0; r < study.rows.size(); ++r) {
     for (std::size_t c = 0; c < study.columns.size(); ++c) {
       const auto it =
-          by_cell.find(CellKey(study.name, static_cast<int>(system), study.rows[r], study.columns[c]));
+          by_cell.find(CellKey(study.name, system, study.rows[r], study.columns[c]));
       if (it != by_cell.end()) t.cells[r][c] = it->second;
     }
   }
@@ -87,7 +88,7 @@ TableEntries gather_table(const StudyTable& study, SystemKind system, const Cell
 namespace {
 
 std::string heading(const TextTable& t, const std::string& dash) {
-  std::string h = "Study " + t.study->name + " " + dash + " " + to_string(t.system);
+  std::string h = "Study " + t.study->name + " " + dash + " " + t.system;
   if (!t.study->varied_axis.empty()) h += " (columns: " + t.study->varied_axis + ")";
   return h;
 }

@@ -26,22 +26,23 @@ std::string annotations(int finished, int diverged, int missing, int expected);
 std::string latex_escape(const std::string& text);
 
 /// (study, system, row, column) -> entries.
-using CellKey = std::tuple<std::string, int, std::string, std::string>;
+using CellKey = std::tuple<std::string, std::string, std::string, std::string>;
 using CellIndex = std::map<CellKey, std::vector<TableEntry>>;
 CellIndex index_cells(const std::vector<TableEntry>& entries);
 
 /// The entries of one table, [row][column].
 struct TableEntries {
   const StudyTable* study = nullptr;
-  SystemKind system = SystemKind::kHarmonic;
+  std::string system;
   std::vector<std::vector<std::vector<TableEntry>>> cells;
 };
-TableEntries gather_table(const StudyTable& study, SystemKind system, const CellIndex& by_cell);
+TableEntries gather_table(const StudyTable& study, const std::string& system,
+                          const CellIndex& by_cell);
 
 /// One table as text, for the Markdown and LaTeX layouts.
 struct TextTable {
   const StudyTable* study = nullptr;
-  SystemKind system = SystemKind::kHarmonic;
+  std::string system;
   std::vector<std::string> columns;             // column labels
   std::vector<std::vector<std::string>> cells;  // [row][column], already formatted
   std::string caption_tail;                     // LaTeX: what the cells are

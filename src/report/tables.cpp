@@ -32,7 +32,7 @@ std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<R
       const RunConfig& run = grid.runs[r];
       TableEntry e;
       e.study = study.name;
-      e.system = run.system;
+      e.system = run.system_name();
       e.row = model_label(run.model, run.integrator);
       e.column = study.run_columns[i];
       e.status = status[r];
@@ -163,7 +163,7 @@ void render_summary_csv(const TableEntries& t, const std::vector<std::vector<Cel
       const auto number = [&](double v) {
         return s.finished() > 0 ? format_number("%.6e", v) : std::string();
       };
-      out << csv_field(t.study->name) << "," << to_string(t.system) << ","
+      out << csv_field(t.study->name) << "," << t.system << ","
           << csv_field(t.study->rows[r]) << "," << csv_field(t.study->varied_axis) << ","
           << csv_field(t.study->columns[c]) << "," << number(s.median) << "," << number(s.q25)
           << "," << number(s.q75) << "," << number(s.iqr()) << ","
@@ -217,7 +217,7 @@ std::string render_tables(const std::vector<StudyTable>& studies,
            "missing,expected,best,tie\n";
   }
   for (const StudyTable& study : studies) {
-    for (SystemKind system : study.systems) {
+    for (const std::string& system : study.systems) {
       render_summary_table(gather_table(study, system, by_cell), format, expected_seeds,
                            bootstrap, out);
     }

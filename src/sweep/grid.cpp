@@ -2,6 +2,7 @@
 #include "phnn/sweep/grid.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -41,9 +42,16 @@ CostParts cost_parts(const RunConfig& run, const CostModel& c) {
   const double inference = static_cast<double>(rollouts) * run.data.num_inference *
                            run.data.num_inference_steps() / c.reference_batch / c.rollout_speedup *
                            (is_discrete_gradient(run.integrator) ? c.dg_newton_factor : 1.0);
+  // A system file's runs: the n-dimensional models (general_ph.h).
+  const double general =
+      !run.has_system_file()          ? 1.0
+      : run.model == ModelKind::kNode ? c.general_node_factor
+                                      : c.general_phnn_factor *
+                                            std::max(1.0, std::pow(run.n_x / 4.0, c.general_phnn_exponent));
   CostParts parts;
-  parts.fixed_s = t.steps * fixed_us * precision * 1e-6;
-  parts.member_s = ((t.steps * batch_scale + validation) * precision + inference) * member_us * 1e-6;
+  parts.fixed_s = t.steps * fixed_us * precision * general * 1e-6;
+  parts.member_s =
+      ((t.steps * batch_scale + validation) * precision + inference) * member_us * general * 1e-6;
   return parts;
 }
 
@@ -157,6 +165,28 @@ void add_run(const RunConfig& run, const std::string& column, Grid* grid, StudyT
   table->run_columns.push_back(column);
 }
 
+// The system of `run`: a system file of the spec, or a built-in system and
+// its [physics] parameters.
+void set_system(const SweepSpec& spec, const std::string& name, RunConfig* run) {
+  if (const SweepSystemFile* file = spec.system_file(name)) {
+    run->system_file = file->name;
+    run->system_file_hash = file->text_hash;
+    run->n_x = file->n_x;
+    run->n_w = file->n_w;
+    run->n_u = file->n_u;
+    run->system = SystemKind::kHarmonic;  // unused
+    run->physics = OscillatorOptions();   // unused
+    return;
+  }
+  run->system_file.clear();
+  run->system_file_hash.clear();
+  run->n_x = 2;
+  run->n_w = 1;
+  run->n_u = 1;
+  run->system = parse_system(name);
+  run->physics = spec.physics.at(run->system);
+}
+
 // Every run of `study`, nested system, model, size, n_train, regularizer,
 // lambda (regularized runs only), seed (seed fastest).
 void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
@@ -170,9 +200,8 @@ void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
   RunConfig run;
   run.data = spec.data;
   run.training = spec.training;
-  for (SystemKind system : study.systems) {
-    run.system = system;
-    run.physics = spec.physics.at(system);
+  for (const std::string& system : study.systems) {
+    set_system(spec, system, &run);
     for (const auto& [model, integrator] : study.models) {
       run.model = model;
       run.integrator = integrator;

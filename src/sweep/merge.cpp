@@ -108,16 +108,22 @@ std::vector<int> result_sources(const std::vector<ResultsFile>& files,
   return source;
 }
 
-void copy_data_groups(const std::vector<ResultsFile>& files, const Grid& grid, ResultsFile* to) {
+void copy_data_groups(const std::vector<ResultsFile>& files, const SweepSpec& spec,
+                      const Grid& grid, ResultsFile* to) {
   std::vector<std::string> systems;
   for (const RunConfig& run : grid.runs) {
-    const std::string name = to_string(run.system);
+    const std::string name = run.system_name();
     if (std::find(systems.begin(), systems.end(), name) == systems.end()) systems.push_back(name);
   }
   for (const std::string& name : systems) {
+    const SweepSystemFile* system_file = spec.system_file(name);
     for (const ResultsFile& file : files) {
       if (!file.has_system_data(name)) continue;
-      to->store_system_data(name, file.read_system_data(name));
+      if (system_file) {
+        to->store_file_system_data(name, file.read_file_system_data(name), system_file->entry);
+      } else {
+        to->store_system_data(name, file.read_system_data(name));
+      }
       break;
     }
   }
@@ -145,7 +151,8 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
     }
   }
   const std::vector<ResultsFile> files = open_shards(shards, out);
-  const SweepSpec spec = parse_sweep_text(files.front().sweep_text(), shards.front() + "@sweep_text");
+  const SweepSpec spec = parse_sweep_text(files.front().sweep_text(), shards.front() + "@sweep_text",
+                                          files.front().stored_system_files());
   const Grid grid = expand_grid(spec);
   ResultsLayout layout = files.front().layout();
   for (const ResultsFile& file : files) layout = results_copy::wider_layout(layout, file.layout());
@@ -155,7 +162,7 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
     ResultsFile merged = ResultsFile::create(scratch, MPI_COMM_NULL, grid.runs,
                                              results_copy::joined_studies(grid), spec.name,
                                              spec.text, spec.text_hash, program_version, layout);
-    copy_data_groups(files, grid, &merged);
+    copy_data_groups(files, spec, grid, &merged);
     for (std::size_t s = 0; s < files.size(); ++s) {
       results_copy::copy_sessions(files[s], &merged);
       std::vector<std::pair<int, int>> rows;

@@ -261,6 +261,52 @@ SystemData ResultsFile::read_system_data(const std::string& system_name) const {
   return impl_->independent([&] { return internal::read_system_data(impl_->file, group); });
 }
 
+void ResultsFile::store_file_system_data(const std::string& system_name, const PhSystemData& data,
+                                         const std::string& sweep_entry) {
+  const std::string group = data_group(system_name);
+  require(!has_system_data(system_name),
+          path() + ": " + group + " is already stored; check has_system_data() first");
+  impl_->collective([&] {
+    impl_->file.remove(group);  // a group left incomplete by a crash
+    internal::write_ph_system_data(impl_->file, group, data);
+    impl_->file.set_attribute(group, "sweep_entry", sweep_entry);
+    impl_->file.set_attribute(group, "complete", std::int64_t{1});
+    impl_->file.flush();
+  });
+}
+
+PhSystemData ResultsFile::read_file_system_data(const std::string& system_name) const {
+  const std::string group = data_group(system_name);
+  return impl_->independent([&] { return internal::read_ph_system_data(impl_->file, group); });
+}
+
+SystemFileReader ResultsFile::stored_system_files() const {
+  std::vector<SystemFileText> texts;
+  std::vector<std::string> entries;
+  impl_->independent([&] {
+    if (!impl_->file.exists("/data")) return 0;
+    for (const std::string& name : impl_->file.link_names("/data")) {
+      const std::string group = "/data/" + name;
+      if (!impl_->file.has_attribute(group, "sweep_entry") ||
+          !impl_->file.has_attribute(group, "complete")) {
+        continue;
+      }
+      entries.push_back(impl_->file.string_attribute(group, "sweep_entry"));
+      texts.push_back({path() + "@" + group, impl_->file.string_attribute(group, "system_file")});
+    }
+    return 0;
+  });
+  const std::string file = path();
+  return [entries, texts, file](const std::string& entry) {
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+      if (entries[i] == entry) return texts[i];
+    }
+    throw std::runtime_error(file + " stores no system file " + entry +
+                             " (its /data group is missing: the sweep that made it stopped "
+                             "before storing it; run the sweep again to complete the file)");
+  };
+}
+
 void ResultsFile::write_run_times(int row, const std::string& started,
                                   const std::string& finished) {
   Impl& impl = *impl_;

@@ -43,7 +43,7 @@ struct ConfigColumns {
       require(inserted, where + "runs " + std::to_string(it->second) + " and " +
                             std::to_string(i) + " are the same run (id " + ids[i] +
                             "); the grid must list each run once");
-      systems.push_back(to_string(run.system));
+      systems.push_back(run.system_name());
       models.push_back(to_string(run.model));
       integrators.push_back(to_string(run.integrator));
       sizes.push_back(to_string(run.size));
@@ -51,7 +51,7 @@ struct ConfigColumns {
       n_train.push_back(run.n_train);
       seeds.push_back(run.seed);
       weights_offset.push_back(weights_total);
-      weights_total += parameter_count(run.model, run.size);
+      weights_total += parameter_count(run.model, run.size, run.n_x, run.n_w, run.n_u);
     }
   }
 };

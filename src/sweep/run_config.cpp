@@ -29,12 +29,17 @@ std::string num(double v) {
 }
 }  // namespace
 
-std::string RunConfig::cell_key() const {
-  std::ostringstream s;
-  s << "system=" << to_string(system) << ";model=" << to_string(model)
-    << ";integrator=" << to_string(integrator) << ";size=" << to_string(size)
-    << ";n_train=" << n_train << ";regularizer=" << to_string(regularizer);
-  // Physics: only the parameters the system uses.
+std::string RunConfig::system_name() const {
+  return has_system_file() ? system_file : to_string(system);
+}
+
+namespace {
+
+// A built-in system: only the parameters it uses, then the data options.
+void builtin_system_key(const RunConfig& run, std::ostringstream& s) {
+  const OscillatorOptions& physics = run.physics;
+  const DatasetOptions& data = run.data;
+  const SystemKind system = run.system;
   s << ";mass=" << num(physics.mass) << ";stiffness=" << num(physics.stiffness);
   if (system == SystemKind::kDuffing) s << ";cubic_stiffness=" << num(physics.cubic_stiffness);
   if (system == SystemKind::kSelfSustained) {
@@ -53,6 +58,34 @@ std::string RunConfig::cell_key() const {
   // Algorithm 1 only (harmonic, self-sustained); only away from the default.
   if (system != SystemKind::kDuffing && data.energy_sampling != EnergySampling::kAlgorithm1) {
     s << ";energy_sampling=" << to_string(data.energy_sampling);
+  }
+}
+
+// A system file: its text (hash) holds the parameters, the energy intervals
+// and the designs; the data options below are the ones its data use.
+void file_system_key(const RunConfig& run, std::ostringstream& s) {
+  const DatasetOptions& data = run.data;
+  s << ";system_file=" << run.system_file_hash << ";data_seed=" << data.data_seed
+    << ";h_gen=" << num(data.generation_step) << ";period=" << num(data.period)
+    << ";sample_rate=" << num(data.sample_rate) << ";n_traj=" << data.num_trajectories
+    << ";splits=" << data.num_train_max << "," << data.num_validation << ","
+    << data.num_inference << ";gen_tol=" << num(data.newton.newton_tolerance);
+  if (data.energy_sampling != EnergySampling::kAlgorithm1) {
+    s << ";energy_sampling=" << to_string(data.energy_sampling);
+  }
+}
+
+}  // namespace
+
+std::string RunConfig::cell_key() const {
+  std::ostringstream s;
+  s << "system=" << system_name() << ";model=" << to_string(model)
+    << ";integrator=" << to_string(integrator) << ";size=" << to_string(size)
+    << ";n_train=" << n_train << ";regularizer=" << to_string(regularizer);
+  if (has_system_file()) {
+    file_system_key(*this, s);
+  } else {
+    builtin_system_key(*this, s);
   }
   const TrainerOptions& t = training;
   s << ";steps=" << t.steps << ";lr=" << num(t.learning_rate) << ";adam=" << num(t.adam_beta1)

@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "phnn/sweep/run_config.h"
+#include "phnn/systems/system_file.h"
 #include "sweep/sweep_file_source.h"
 #include "sweep/sweep_file_tables.h"
 
@@ -47,7 +48,24 @@ std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs() {
   return pairs;
 }
 
-SweepSpec parse_sweep_text(const std::string& text, const std::string& display_name) {
+const SweepSystemFile* SweepSpec::system_file(const std::string& system_name) const {
+  for (const SweepSystemFile& f : system_files) {
+    if (f.name == system_name) return &f;
+  }
+  return nullptr;
+}
+
+std::string sweep_hash(const std::string& text, const std::vector<SweepSystemFile>& files) {
+  if (files.empty()) return hex64(fnv1a64(text));  // every sweep made before system files
+  std::string all = text;
+  for (const SweepSystemFile& f : files) {
+    all += '\0' + f.entry + '\0' + f.text;
+  }
+  return hex64(fnv1a64(all));
+}
+
+SweepSpec parse_sweep_text(const std::string& text, const std::string& display_name,
+                           const SystemFileReader& read_system_file) {
   if (text.size() > kMaxSweepFileBytes) {
     throw SweepFileError(display_name, 0, std::to_string(text.size()) + " bytes, more than the " +
                                               std::to_string(kMaxSweepFileBytes) +
@@ -55,10 +73,10 @@ SweepSpec parse_sweep_text(const std::string& text, const std::string& display_n
                                               "the results file)");
   }
   const SweepSource source(display_name, text);
-  SweepSpec spec = resolve_sweep_tables(parse_sweep_toml(source), source);
+  SweepSpec spec = resolve_sweep_tables(parse_sweep_toml(source), source, read_system_file);
   spec.source_path = display_name;
   spec.text = text;
-  spec.text_hash = hex64(fnv1a64(text));
+  spec.text_hash = sweep_hash(text, spec.system_files);
   return spec;
 }
 
@@ -96,7 +114,13 @@ SweepSpec parse_sweep_file(const std::string& path) {
     got += static_cast<std::size_t>(n);
   }
   text.resize(got);
-  return parse_sweep_text(text, path);
+  // System files: relative to the sweep file's directory.
+  const std::size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  return parse_sweep_text(text, path, [&dir](const std::string& entry) {
+    const std::string file = !entry.empty() && entry[0] == '/' ? entry : dir + entry;
+    return SystemFileText{file, read_system_file_text(file)};
+  });
 }
 
 }  // namespace phnn

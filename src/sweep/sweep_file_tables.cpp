@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "phnn/sweep/output_check.h"
+#include "sweep/sweep_file_systems.h"
 #include "sweep/sweep_file_values.h"
 
 namespace phnn {
@@ -20,7 +21,7 @@ namespace {
 // Axes of [grid] or of one [study.NAME]; unset axes are inherited.
 struct AxisSet {
   std::string title;
-  std::optional<std::vector<SystemKind>> systems;
+  std::optional<std::vector<std::string>> systems;
   std::optional<std::vector<std::pair<ModelKind, IntegratorKind>>> models;
   std::optional<std::vector<ModelSize>> sizes;
   std::optional<std::vector<int>> n_train;
@@ -43,7 +44,8 @@ const char kTableList[] =
 
 class TableWalker {
  public:
-  explicit TableWalker(const SweepSource& source) : source_(source), values_(source) {}
+  TableWalker(const SweepSource& source, SystemFileReader read_system_file)
+      : source_(source), values_(source), systems_(source, std::move(read_system_file)) {}
 
   SweepSpec resolve(const toml::table& root) {
     for (SystemKind kind : all_systems()) spec_.physics[kind] = OscillatorOptions::defaults(kind);
@@ -55,6 +57,8 @@ class TableWalker {
     validate_options();
     if (studies_.empty()) studies_.emplace_back("grid", AxisSet());
     for (const auto& [name, axes] : studies_) spec_.studies.push_back(study_spec(name, axes));
+    systems_.check_names();
+    spec_.system_files = systems_.files();
     check_lambdas();
     check_knobs_change_runs();
     return spec_;
@@ -204,7 +208,7 @@ class TableWalker {
     StudySpec study;
     study.name = name;
     study.title = axes.title;
-    study.systems = axes.systems ? *axes.systems : grid_.systems ? *grid_.systems : all_systems();
+    study.systems = axes.systems ? *axes.systems : grid_.systems ? *grid_.systems : system_names();
     study.models = axes.models ? *axes.models : grid_.models ? *grid_.models : all_model_pairs();
     study.sizes = axes.sizes    ? *axes.sizes
                   : grid_.sizes ? *grid_.sizes
@@ -267,7 +271,8 @@ class TableWalker {
   void check_knobs_change_runs() const {
     bool algorithm1 = false, jr_dg = false;
     for (const StudySpec& s : spec_.studies) {
-      for (SystemKind k : s.systems) algorithm1 = algorithm1 || k != SystemKind::kDuffing;
+      // A system file may use Algorithm 1 ([initial] method = "algorithm1").
+      for (const std::string& k : s.systems) algorithm1 = algorithm1 || k != "duffing" || spec_.system_file(k);
       for (const auto& m : s.models) {
         jr_dg = jr_dg || m == std::make_pair(ModelKind::kPhnnJr, IntegratorKind::kDg);
       }
@@ -289,7 +294,10 @@ class TableWalker {
     if (allow_title) {
       h.emplace_back("title", [this, &axes](const Entry& e) { axes.title = values_.string(e); });
     }
-    h.emplace_back("systems", [this, &axes](const Entry& e) { axes.systems = values_.systems(e); });
+    h.emplace_back("systems", [this, &axes](const Entry& e) {
+      axes.systems = values_.systems(
+          e, [this](const std::string& value, int line) { return systems_.resolve(value, line); });
+    });
     h.emplace_back("models", [this, &axes](const Entry& e) { axes.models = values_.models(e); });
     h.emplace_back("sizes", [this, &axes](const Entry& e) { axes.sizes = values_.sizes(e); });
     h.emplace_back("n_train", [this, &axes](const Entry& e) {
@@ -383,6 +391,8 @@ class TableWalker {
 
   const SweepSource& source_;
   ValueReader values_;
+  // Mutable: the const handlers record the systems they read.
+  mutable SweepSystems systems_;
   SweepSpec spec_;
   AxisSet grid_;
   std::vector<std::pair<std::string, AxisSet>> studies_;  // file order
@@ -395,8 +405,9 @@ class TableWalker {
 
 }  // namespace
 
-SweepSpec resolve_sweep_tables(const toml::table& root, const SweepSource& source) {
-  return TableWalker(source).resolve(root);
+SweepSpec resolve_sweep_tables(const toml::table& root, const SweepSource& source,
+                               const SystemFileReader& read_system_file) {
+  return TableWalker(source, read_system_file).resolve(root);
 }
 
 }  // namespace phnn

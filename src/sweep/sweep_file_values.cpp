@@ -12,6 +12,7 @@
 
 #include "phnn/common/closest_name.h"
 #include "phnn/sweep/sweep_file.h"
+#include "phnn/systems/ph_system.h"
 
 namespace phnn {
 
@@ -263,9 +264,27 @@ T ValueReader::enum_value(const toml::node& v, const std::string& axis,
                        "; expected one of: " + join(allowed));
 }
 
-std::vector<SystemKind> ValueReader::systems(const Entry& e) const {
-  return string_axis<SystemKind>(
-      e, [this](const toml::node& v) { return enum_value(v, "systems", all_systems()); });
+std::vector<std::string> ValueReader::systems(
+    const Entry& e, const std::function<std::string(const std::string&, int)>& resolve) const {
+  std::vector<int> lines;
+  std::vector<std::string> names = string_axis<std::string>(e, [&](const toml::node& v) {
+    const std::string& s = v.as_string()->get();
+    lines.push_back(line_of(v));
+    if (is_system_file_argument(s) || find_system(s)) return resolve(s, line_of(v));
+    fail(line_of(v), "unknown systems value " + source_.raw(v) + did_you_mean(s, system_names()) +
+                         "; expected one of: " + join(system_names()) +
+                         ", or a system file (a path ending in .toml, relative to this file; "
+                         "sweeps/FORMAT.md, \"System files\")");
+  });
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (names[i] == names[j]) {
+        fail(lines[i], "systems lists two systems named " + quoted(names[i]) +
+                           "; list each system once (a system file's name is its `name` key)");
+      }
+    }
+  }
+  return names;
 }
 
 std::vector<ModelSize> ValueReader::sizes(const Entry& e) const {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -81,7 +82,13 @@ class ValueReader {
   std::size_t choice_index(const Entry& e, const std::vector<std::string>& allowed) const;
   /// seeds = [0, 1, 2] or seeds = "0-9".
   std::vector<int> seeds(const Entry& e) const;
-  std::vector<SystemKind> systems(const Entry& e) const;
+  /// systems = ["duffing", "systems/pendulum.toml"]: each value that is a
+  /// built-in name or a system file (ends in ".toml" or contains '/') is
+  /// handed to `resolve` (value, line), which returns the system's name;
+  /// other values fail. Two values of one name fail.
+  std::vector<std::string> systems(
+      const Entry& e,
+      const std::function<std::string(const std::string&, int)>& resolve) const;
   std::vector<std::pair<ModelKind, IntegratorKind>> models(const Entry& e) const;
   std::vector<ModelSize> sizes(const Entry& e) const;
   std::vector<Regularizer> regularizers(const Entry& e) const;

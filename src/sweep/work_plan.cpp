@@ -380,7 +380,7 @@ std::string cell_costs_csv(const Grid& grid) {
   for (std::size_t c = 0; c < grid.cells.size(); ++c) {
     const Cell& cell = grid.cells[c];
     const RunConfig& run = grid.runs[static_cast<std::size_t>(cell.runs.front())];
-    out << c << "," << to_string(run.system) << "," << model_label(run.model, run.integrator) << ","
+    out << c << "," << run.system_name() << "," << model_label(run.model, run.integrator) << ","
         << to_string(run.size) << "," << run.n_train << "," << to_string(run.regularizer) << ","
         << cell.runs.size() << "," << cell.fixed_cost_s << "," << cell.member_cost_s << ","
         << cell.estimated_cost_s << ",";

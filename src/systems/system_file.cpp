@@ -8,6 +8,7 @@
 #include "phnn/systems/system_file.h"
 
 #include "phnn/systems/oscillators.h"
+#include "systems/expression_code.h"
 
 #include <sys/stat.h>
 
@@ -21,35 +22,7 @@
 namespace phnn {
 namespace {
 
-// Comma-separated expressions compiled by muParser over variables that
-// live in a buffer owned by the caller (addresses must stay put).
-class CompiledExpressions {
- public:
-  CompiledExpressions(const std::vector<std::string>& exprs, double* vars,
-                      const std::vector<std::string>& names)
-      : count_(static_cast<int>(exprs.size())) {
-    if (count_ == 0) return;
-    for (std::size_t i = 0; i < names.size(); ++i) parser_.DefineVar(names[i], vars + i);
-    parser_.DefineFun("pow", [](double a, double b) { return std::pow(a, b); });
-    parser_.DefineFun("fabs", [](double a) { return std::fabs(a); });
-    parser_.DefineFun("csgn", [](double a) { return a > 0 ? 1.0 : (a < 0 ? -1.0 : 0.0); });
-    parser_.DefineConst("Pi", 3.141592653589793238462643383279502884);
-    std::string joined;
-    for (const std::string& e : exprs) joined += (joined.empty() ? "" : ",") + e;
-    parser_.SetExpr(joined);
-    int n = 0;
-    parser_.Eval(n);  // compiles; throws mu::ParserError on what it cannot read
-  }
-  const double* eval() const {
-    int n = 0;
-    return parser_.Eval(n);
-  }
-  int count() const { return count_; }
-
- private:
-  mu::Parser parser_;
-  int count_;
-};
+using internal::CompiledExpressions;
 
 std::string to_c(const GiNaC::ex& e) {
   std::ostringstream os;
@@ -215,12 +188,19 @@ FileSystem::FileSystem(SystemDefinition def) : def_(std::move(def)) { compile();
 
 std::unique_ptr<CompiledExpressions> FileSystem::make(const std::vector<GiNaC::ex>& exprs,
                                                       const std::string& what) const {
+  const std::string key = what.rfind("z", 0) == 0 ? "z" : "H";
   std::vector<std::string> c;
-  for (const auto& e : exprs) c.push_back(to_c(e));
+  try {
+    for (const auto& e : exprs) c.push_back(internal::muparser_source(e));
+  } catch (const std::invalid_argument& e) {
+    throw SystemFileError(def_.file, def_.line_of(key),
+                          "cannot evaluate " + what + " (it contains " + e.what() +
+                              "); use the functions sin, cos, tan, exp, log, sqrt, sinh, cosh, "
+                              "tanh, asin, acos, atan, abs");
+  }
   try {
     return std::make_unique<CompiledExpressions>(c, vars_.get(), syms_.names);
   } catch (const mu::Parser::exception_type& e) {
-    const std::string key = what.rfind("z", 0) == 0 ? "z" : "H";
     throw SystemFileError(def_.file, def_.line_of(key),
                           "cannot evaluate " + what + " (" + e.GetMsg() +
                               "); use the functions sin, cos, tan, exp, log, sqrt, sinh, cosh, "
@@ -459,7 +439,9 @@ void FileSystem::check_energy_at(const std::vector<VecX>& points) const {
   }
 }
 
-std::string read_whole_file(const std::string& path) {
+}  // namespace
+
+std::string read_system_file_text(const std::string& path) {
   struct stat st;
   if (::stat(path.c_str(), &st) != 0) {
     throw SystemFileError(path, 0, "cannot open the system file (no such file); check the path "
@@ -477,8 +459,6 @@ std::string read_whole_file(const std::string& path) {
   return text.str();
 }
 
-}  // namespace
-
 std::unique_ptr<PhSystem> compile_system(const std::string& text, const std::string& file) {
   auto sys = std::make_unique<FileSystem>(parse_system_definition(text, file));
   sys->check_energy_and_box();
@@ -486,7 +466,7 @@ std::unique_ptr<PhSystem> compile_system(const std::string& text, const std::str
 }
 
 std::unique_ptr<PhSystem> load_system_file(const std::string& path) {
-  return compile_system(read_whole_file(path), path);
+  return compile_system(read_system_file_text(path), path);
 }
 
 }  // namespace phnn

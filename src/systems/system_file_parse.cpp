@@ -5,6 +5,7 @@
 // Size: one reader per part of the format, each with the checks of its keys.
 #include <toml++/toml.h>
 
+#include <cctype>
 #include <cmath>
 #include <regex>
 #include <set>
@@ -401,6 +402,13 @@ SystemDefinition parse_system_definition(const std::string& text, const std::str
   def.name = r.string(*name, "name");
   def.lines["name"] = Reader::line(*name);
   if (def.name.empty()) r.fail(Reader::line(*name), "\"name\" is empty; give the system a name");
+  for (char c : def.name) {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.') continue;
+    r.fail(Reader::line(*name), "name \"" + def.name +
+                                    "\" may hold only letters, digits, '-', '_' and '.' (it names "
+                                    "the system in run ids, tables and results files); e.g. "
+                                    "\"coupled-duffing\"");
+  }
   if (const toml::node* d = t.get("description")) def.description = r.string(*d, "description");
   read_names(r, t, &def);
   read_structure(r, t, &def);

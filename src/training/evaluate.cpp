@@ -48,15 +48,16 @@ EnergyTrace energy_trace(const DynamicsModel& model, const Oscillator& system, d
 
 }  // namespace
 
-std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemData& data,
+namespace {
+
+std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const CellData& data,
                                            const std::vector<double>& weights) {
   if (cell.seeds.size() != 1) {
     throw std::invalid_argument("load_member: expected one seed, got " +
                                 std::to_string(cell.seeds.size()));
   }
   // The trainer's inference model (float64 whatever the training precision).
-  auto model = DynamicsModel::create(
-      inference_model_options(cell, make_cell_data(data, /*with_figures=*/false)),
+  auto model = DynamicsModel::create(inference_model_options(cell, data),
                                      {static_cast<std::uint64_t>(cell.seeds[0])});
   if (static_cast<long>(weights.size()) != model->parameter_count()) {
     throw std::invalid_argument("load_member: " + std::to_string(weights.size()) +
@@ -75,11 +76,12 @@ std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemDat
   return model;
 }
 
-Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
-                               const std::vector<double>& weights) {
-  const CellData cell_data = make_cell_data(data);
+// Inference results of the stored weights on `cell_data`.
+Evaluation evaluate_on(const CellSpec& cell, const CellData& cell_data,
+                       const std::vector<double>& weights,
+                       std::unique_ptr<DynamicsModel>* model_out) {
   validate_cell(cell, cell_data);
-  const auto model = load_member(cell, data, weights);
+  auto model = load_member(cell, cell_data, weights);
   const Rollouts rollouts = roll_out(*model, cell, cell_data);
   Evaluation out;
   RunResult& r = out.result;
@@ -88,12 +90,34 @@ Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
   r.parameter_count = model->parameter_count();
   r.weights = weights;
   r.status = r.diverged_rollouts > 0 ? RunStatus::kDiverged : RunStatus::kDone;
+  *model_out = std::move(model);
+  return out;
+}
+
+}  // namespace
+
+std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemData& data,
+                                           const std::vector<double>& weights) {
+  return load_member(cell, make_cell_data(data, /*with_figures=*/false), weights);
+}
+
+Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
+                               const std::vector<double>& weights) {
+  std::unique_ptr<DynamicsModel> model;
+  Evaluation out = evaluate_on(cell, make_cell_data(data), weights, &model);
+  const RunResult& r = out.result;
   const Oscillator system(data.system);
   out.energy_05 = energy_trace(*model, system, data.inference.step, r.figure_prediction_05,
                                r.figure_reference_05);
   out.energy_075 = energy_trace(*model, system, data.inference.step, r.figure_prediction_075,
                                 r.figure_reference_075);
   return out;
+}
+
+Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
+                               const PhSystem& system, const std::vector<double>& weights) {
+  std::unique_ptr<DynamicsModel> model;
+  return evaluate_on(cell, make_cell_data(data, system), weights, &model);
 }
 
 }  // namespace phnn

@@ -42,6 +42,37 @@ TEST(DataCommandTest, WritesASystemFilesDataSet) {
   std::remove(out.c_str());
 }
 
+// The bits of a system file's data depend on the file only, not on the
+// process: GiNaC orders the terms of its expressions by hashes of addresses
+// (different in every process), so two `phnn data` processes compare them.
+TEST(DataCommandTest, SystemFileDataAreTheSameBitsInEveryProcess) {
+  std::vector<PhSystemData> runs;
+  for (int k = 0; k < 2; ++k) {
+    const std::string out = ::testing::TempDir() + "phnn_data_bits_" + std::to_string(k) + ".h5";
+    std::remove(out.c_str());
+    std::string log;
+    ASSERT_EQ(phnn("data --system " + std::string(PHNN_SOURCE_DIR) +
+                       "/sweeps/systems/coupled-duffing.toml --n-train 25 --out " + out,
+                   &log),
+              0)
+        << log;
+    runs.push_back(read_ph_dataset_file(out));
+    std::remove(out.c_str());
+  }
+  const PhSystemData& a = runs[0];
+  const PhSystemData& b = runs[1];
+  ASSERT_EQ(a.inference.size(), b.inference.size());
+  for (std::size_t i = 0; i < a.inference.size(); ++i) {
+    for (std::size_t n = 0; n < a.inference.states[i].size(); ++n) {
+      ASSERT_EQ(a.inference.states[i][n], b.inference.states[i][n])
+          << "trajectory " << i << ", step " << n;
+    }
+  }
+  for (std::size_t i = 0; i < a.validation.size(); ++i) {
+    ASSERT_EQ(a.validation.x_next[i], b.validation.x_next[i]) << "validation pair " << i;
+  }
+}
+
 TEST(DataCommandTest, RefusesAMalformedSystemFileWithItsLine) {
   const std::string sys = ::testing::TempDir() + "phnn_bad_system.toml";
   const std::string out = ::testing::TempDir() + "phnn_bad_system.h5";

@@ -40,7 +40,7 @@ class TableTest : public ::testing::Test {
     study_.varied_axis = "n_train";
     study_.columns = {"25", "100"};
     study_.rows = {"NODE-RK2", "PHNN-JR-DG"};
-    study_.systems = {SystemKind::kHarmonic};
+    study_.systems = {"harmonic"};
     for (double mse : {3e-3, 1e-3, 5e-3, 2e-3, 4e-3}) add("NODE-RK2", "25", RunStatus::kDone, mse);
     for (double mse : {2e-4, 1e-4, 3e-4}) add("PHNN-JR-DG", "25", RunStatus::kDone, mse);
     add("PHNN-JR-DG", "25", RunStatus::kDiverged, kInf);
@@ -50,11 +50,11 @@ class TableTest : public ::testing::Test {
     add("NODE-RK2", "100", RunStatus::kFailed, 0.0);
     // Not in the table: another study, another system.
     add("NODE-RK2", "25", RunStatus::kDone, 1e-9, "II");
-    add("NODE-RK2", "25", RunStatus::kDone, 1e-9, "I", SystemKind::kDuffing);
+    add("NODE-RK2", "25", RunStatus::kDone, 1e-9, "I", "duffing");
   }
 
   void add(const std::string& row, const std::string& column, RunStatus status, double mse,
-           const std::string& study = "I", SystemKind system = SystemKind::kHarmonic) {
+           const std::string& study = "I", const std::string& system = "harmonic") {
     entries_.push_back(TableEntry{study, system, row, column, status, mse});
   }
 

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "phnn/systems/oscillators.h"
+#include "systems/expression_code.h"
 
 namespace phnn {
 namespace {
@@ -141,6 +142,22 @@ TEST(SystemFileTest, DiscreteGradientJacobianMatchesDifferences) {
       EXPECT_LE((jac.col(j) - fd).norm(), 1e-6 * (1 + fd.norm())) << name << " column " << j;
     }
   }
+}
+
+// GiNaC's own order of a sum's terms depends on symbol serials and
+// addresses; the muParser source must not: the same expression built from
+// symbols made in either order prints the same text.
+TEST(SystemFileTest, MuparserSourceDoesNotDependOnGinacsTermOrder) {
+  std::string printed[2];
+  for (int order = 0; order < 2; ++order) {
+    std::vector<GiNaC::realsymbol> made;
+    for (int k = 0; k < 3; ++k) made.emplace_back(std::string(1, (order == 0 ? "abc" : "cba")[k]));
+    const GiNaC::ex a = made[order == 0 ? 0 : 2], b = made[1], c = made[order == 0 ? 2 : 0];
+    const GiNaC::ex e = GiNaC::expand(GiNaC::pow(a + 2 * b - c / 3, 3) + GiNaC::sin(a * b) * c);
+    printed[order] = internal::muparser_source(e);
+  }
+  EXPECT_EQ(printed[0], printed[1]);
+  EXPECT_THAT(printed[0], HasSubstr("phnn_sin("));
 }
 
 TEST(SystemFileTest, PhasePairsComeFromThePlotsTableOrConsecutiveStates) {

@@ -19,7 +19,8 @@ namespace phnn {
 /// several studies has one entry per study.
 struct TableEntry {
   std::string study;
-  SystemKind system = SystemKind::kHarmonic;
+  /// RunConfig::system_name(): "duffing", a system file's name.
+  std::string system;
   std::string row;
   std::string column;
   RunStatus status = RunStatus::kPending;

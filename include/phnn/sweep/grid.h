@@ -96,6 +96,17 @@ struct CostModel {
   /// costs member_us x (1 - small_batch_saving x (64 - batch) / 64) per
   /// member (validation and inference are not affected).
   double small_batch_saving = 0.85;  // PHNN-JR-RK2 E = 10: 64 us at batch 25, 110 at 64
+  /// Runs of a system file train the n-dimensional models (general_ph.h):
+  /// their fixed and member costs are the fused 2-state path's times
+  ///   general_node_factor                                  (NODE)
+  ///   general_phnn_factor * max(1, (n_x / 4)^general_phnn_exponent)  (PHNNs)
+  /// fit to `bench_training general` (docs/BENCHMARKS.md, "n-dimensional
+  /// systems"): PHNN-JR-RK2 1 053, 1 247, 1 982, 3 325 us per member-step at
+  /// n_x = 2, 4, 6, 8 against 114 fused (9.2, 10.9, 17.4, 29.2x); NODE
+  /// 48-56 against 49.
+  double general_node_factor = 1.1;
+  double general_phnn_factor = 9.5;
+  double general_phnn_exponent = 1.7;
   /// Pairs per batch-step in the validation and inference terms.
   double reference_batch = 64.0;
   /// A rollout state-step costs 1 / rollout_speedup of a training pair-step
@@ -150,8 +161,8 @@ struct StudyTable {
   std::vector<std::string> columns;
   /// Model labels in file order, e.g. "NODE-RK2", "PHNN-JR-DG".
   std::vector<std::string> rows;
-  /// StudySpec::systems.
-  std::vector<SystemKind> systems;
+  /// StudySpec::systems (built-in names and system files' names).
+  std::vector<std::string> systems;
   /// Indices into Grid::runs of every run of the study (shared runs too), in
   /// expansion order.
   std::vector<int> runs;

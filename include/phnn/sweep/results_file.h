@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "phnn/data/dataset_file.h"
+#include "phnn/data/ph_dataset.h"
 #include "phnn/sweep/run_config.h"
+#include "phnn/sweep/sweep_file.h"
 #include "phnn/training/run_result.h"
 
 namespace phnn {
@@ -177,6 +179,20 @@ class ResultsFile {
   bool has_system_data(const std::string& system_name) const;
   /// Reads a data set stored by store_system_data.
   SystemData read_system_data(const std::string& system_name) const;
+
+  /// Collective: stores a system file's data set once under
+  /// /data/<system_name> (format_version 2 of data-set files, with the
+  /// system file's text) and `sweep_entry`, the sweep file's `systems`
+  /// value that named the file, so that the sweep can be parsed again from
+  /// this file alone (stored_system_files). Flushes the file.
+  void store_file_system_data(const std::string& system_name, const PhSystemData& data,
+                              const std::string& sweep_entry);
+  /// Reads a data set stored by store_file_system_data.
+  PhSystemData read_file_system_data(const std::string& system_name) const;
+  /// The system files stored with their data sets, as a reader for
+  /// parse_sweep_text: the text stored for the `systems` value `entry`;
+  /// throws std::runtime_error naming the file when none is stored.
+  SystemFileReader stored_system_files() const;
 
   /// Independent: UTC start and end (ISO 8601) of the work item that
   /// trained run `row`, in /runs/started_utc and /runs/finished_utc. Call

@@ -15,7 +15,16 @@ namespace phnn {
 /// that runs it, not the other runs). Two runs with equal canonical() are the
 /// same run and are trained once.
 struct RunConfig {
+  /// A built-in system; unused when system_file is set.
   SystemKind system = SystemKind::kHarmonic;
+  /// A system file's `name` and hex64 text hash (SweepSystemFile), or empty
+  /// for a built-in system. The hash is part of the run's identity: a
+  /// changed system file makes different runs.
+  std::string system_file, system_file_hash;
+  /// The system's states, dissipation ports and inputs (the cost model's
+  /// and the results layout's; not part of the identity, which the file's
+  /// hash fixes).
+  int n_x = 2, n_w = 1, n_u = 1;
   ModelKind model = ModelKind::kNode;
   IntegratorKind integrator = IntegratorKind::kRk2;
   ModelSize size = ModelSize::kSmall;
@@ -25,6 +34,10 @@ struct RunConfig {
   OscillatorOptions physics;
   DatasetOptions data;
   TrainerOptions training;
+
+  /// system_file, or the built-in system's name ("duffing").
+  std::string system_name() const;
+  bool has_system_file() const { return !system_file.empty(); }
 
   /// "key=value;..." with every field that affects the result, in a fixed
   /// order, numbers printed with 17 significant digits.

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -46,7 +47,9 @@ struct StudySpec {
   std::string name;
   /// Optional human-readable title (paper's study caption).
   std::string title;
-  std::vector<SystemKind> systems;
+  /// System names: a built-in system ("duffing") or the `name` of a system
+  /// file of SweepSpec::system_files ("coupled-duffing").
+  std::vector<std::string> systems;
   /// Formulation-integrator pairs, e.g. {kPhnnJr, kDg} for "phnn-jr-dg".
   std::vector<std::pair<ModelKind, IntegratorKind>> models;
   std::vector<ModelSize> sizes;
@@ -61,6 +64,33 @@ struct StudySpec {
   /// Model-initialization seeds, each >= 0.
   std::vector<int> seeds;
 };
+
+/// A system file named in a sweep file's `systems` (a value ending in ".toml"
+/// or containing '/', relative to the sweep file): its text is part of the
+/// sweep (stored in the results file, hashed into SweepSpec::text_hash and
+/// into every run id), so a changed file is a different sweep.
+struct SweepSystemFile {
+  /// The value as written in `systems` ("systems/coupled-duffing.toml").
+  std::string entry;
+  /// The file's `name`: the system's name in runs, tables and /data.
+  std::string name;
+  /// The whole file, and hex64(fnv1a64(text)).
+  std::string text, text_hash;
+  /// States, dissipation ports and inputs of the system.
+  int n_x = 0, n_w = 0, n_u = 0;
+};
+
+/// A system file's text and the name its errors show (its path as opened,
+/// or where in a results file it was stored).
+struct SystemFileText {
+  std::string shown_as, text;
+};
+
+/// Returns the system file a sweep file names (`entry` as written in
+/// `systems`); throws SystemFileError (or any std::exception) when it
+/// cannot. parse_sweep_file reads from disk, relative to the sweep file;
+/// readers of a results file take the texts stored in it.
+using SystemFileReader = std::function<SystemFileText(const std::string& entry)>;
 
 /// A parsed and validated sweep file: docs/METHOD.md defaults overridden by the file.
 ///
@@ -88,13 +118,20 @@ struct SweepSpec {
   TrainerOptions training;
   /// The studies in file order (at least one).
   std::vector<StudySpec> studies;
+  /// System files of the `systems` axes, in order of first appearance (each
+  /// once; their names differ from each other and from the built-ins').
+  std::vector<SweepSystemFile> system_files;
+
+  /// The system file named `name`, or nullptr for a built-in system.
+  const SweepSystemFile* system_file(const std::string& name) const;
 };
 
 /// Largest sweep file, in bytes: its text is stored verbatim in one HDF5
 /// attribute of the results file (an object header message < 64 KiB).
 constexpr std::size_t kMaxSweepFileBytes = 60000;
 
-/// Reads and parses a sweep file (format: sweeps/FORMAT.md). Throws
+/// Reads and parses a sweep file (format: sweeps/FORMAT.md); system files
+/// named in `systems` are read relative to the sweep file's directory. Throws
 /// SweepFileError naming the path, without waiting or reading past the cap,
 /// if it cannot be opened, is not a regular file (a FIFO, /dev/zero, a
 /// directory) or has more than kMaxSweepFileBytes bytes; otherwise the line
@@ -102,9 +139,16 @@ constexpr std::size_t kMaxSweepFileBytes = 60000;
 SweepSpec parse_sweep_file(const std::string& path);
 
 /// Parses sweep-file text; `display_name` is used in error messages and as
-/// SweepSpec::source_path. Throws SweepFileError (also for a text over
-/// kMaxSweepFileBytes).
-SweepSpec parse_sweep_text(const std::string& text, const std::string& display_name);
+/// SweepSpec::source_path; `read_system_file` supplies the system files it
+/// names (without one, a system file in `systems` is an error). Throws
+/// SweepFileError (also for a text over kMaxSweepFileBytes), for a bad
+/// system file with the system file's own FILE:LINE.
+SweepSpec parse_sweep_text(const std::string& text, const std::string& display_name,
+                           const SystemFileReader& read_system_file = {});
+
+/// hex64 of the sweep text alone when it names no system file, else of the
+/// text followed by each system file's entry and text (SweepSpec::text_hash).
+std::string sweep_hash(const std::string& text, const std::vector<SweepSystemFile>& files);
 
 /// "node-rk2", "phnn-jr-dg", ...: the sweep-file spelling of a model.
 std::string model_key(ModelKind kind, IntegratorKind integrator);

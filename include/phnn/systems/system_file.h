@@ -64,6 +64,10 @@ SystemDefinition parse_system_definition(const std::string& text, const std::str
 /// file or exceeds kMaxSystemFileBytes; otherwise FILE:LINE of the problem.
 std::unique_ptr<PhSystem> load_system_file(const std::string& path);
 
+/// The text of a system file, with load_system_file's checks (a regular
+/// file of at most kMaxSystemFileBytes); throws SystemFileError naming it.
+std::string read_system_file_text(const std::string& path);
+
 /// The same from text already read (`file` names it in messages).
 std::unique_ptr<PhSystem> compile_system(const std::string& text, const std::string& file);
 

@@ -46,4 +46,9 @@ struct Evaluation {
 Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
                                const std::vector<double>& weights);
 
+/// The same for a system file's run: the inference results (no figure
+/// trajectories and no energy traces).
+Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
+                               const PhSystem& system, const std::vector<double>& weights);
+
 }  // namespace phnn

@@ -1,0 +1,53 @@
+// src/apps/sweep_data.h — the data sets a sweep trains on, one per system:
+// a built-in system's (SystemData) or a system file's (PhSystemData, with the
+// compiled system its models take S and J from). Made on demand, the same on
+// every rank (deterministic); stored once in the results file's /data.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "phnn/data/dataset_file.h"
+#include "phnn/data/ph_dataset.h"
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/results_file.h"
+#include "phnn/sweep/sweep_file.h"
+#include "phnn/systems/ph_system.h"
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+namespace apps {
+
+class SweepDataSets {
+ public:
+  /// Keeps references to `spec` and `grid`, which must outlive it.
+  SweepDataSets(const SweepSpec& spec, const Grid& grid) : spec_(spec), grid_(grid) {}
+
+  /// Makes the data set of `system_name` (RunConfig::system_name()) with
+  /// as many training pairs as its largest n_train, unless made already.
+  /// Throws what data generation throws (a system file's Newton failure).
+  void make(const std::string& system_name);
+  /// Collective: stores the data set under /data/<system_name> (make first).
+  void store(const std::string& system_name, ResultsFile* results) const;
+  /// Trains one cell of `system_name` (make first): train_cell on its data.
+  std::vector<RunResult> train(const CellSpec& cell, const std::string& system_name,
+                               const ProgressCallback& progress) const;
+
+ private:
+  struct DataSet {
+    std::optional<SystemData> builtin;
+    std::optional<PhSystemData> file;
+    std::unique_ptr<PhSystem> system;  // a system file's, compiled
+  };
+  const DataSet& at(const std::string& system_name) const;
+
+  const SweepSpec& spec_;
+  const Grid& grid_;
+  std::map<std::string, DataSet> data_;
+};
+
+}  // namespace apps
+}  // namespace phnn
