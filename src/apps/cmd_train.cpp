@@ -35,6 +35,18 @@ std::string g17(double v) {
   return buf;
 }
 
+// The [grid] table of a one-cell sweep on `system` (a name or a system file).
+std::string grid_text(const CellSpec& cell, const std::string& system) {
+  std::ostringstream s;
+  s << "[grid]\nsystems = [\"" << system << "\"]\nmodels = [\"" << to_string(cell.model) << "-"
+    << to_string(cell.integrator) << "\"]\nsizes = [\"" << to_string(cell.size)
+    << "\"]\nn_train = [" << cell.n_train << "]\nregularizers = [\"" << to_string(cell.regularizer)
+    << "\"]\nseeds = [";
+  for (std::size_t i = 0; i < cell.seeds.size(); ++i) s << (i ? ", " : "") << cell.seeds[i];
+  s << "]\n";
+  return s.str();
+}
+
 // The cell as a one-study sweep file, so that `phnn train --out` writes a
 // results file that `phnn reduce` and analysis/ read like any sweep's.
 std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
@@ -60,20 +72,33 @@ std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
   } else {
     s << "damping = " << g17(data.system.damping) << "\n";
   }
-  s << "\n[grid]\nsystems = [\"" << system << "\"]\nmodels = [\"" << to_string(cell.model) << "-"
-    << to_string(cell.integrator) << "\"]\nsizes = [\"" << to_string(cell.size)
-    << "\"]\nn_train = [" << cell.n_train << "]\nregularizers = [\"" << to_string(cell.regularizer)
-    << "\"]\nseeds = [";
-  for (std::size_t i = 0; i < cell.seeds.size(); ++i) s << (i ? ", " : "") << cell.seeds[i];
-  s << "]\n";
+  s << "\n" << grid_text(cell, system);
   return s.str();
 }
 
-void write_cell_file(const std::string& path, const CellSpec& cell, const SystemData& data,
+// The same for a system file's cell (`system_entry`: its path as given).
+std::string cell_sweep_text(const CellSpec& cell, const PhSystemData& data,
+                            const std::string& system_entry) {
+  std::ostringstream s;
+  s << "# written by `phnn train --out`\n"
+    << "name = \"train-" << data.system_name << "-" << to_string(cell.model) << "-"
+    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed
+    << "\n\n[training]\nsteps = " << cell.training.steps
+    << "\nlearning_rate = " << g17(cell.training.learning_rate)
+    << "\nbatch_size = " << cell.training.batch_size
+    << "\neval_every = " << cell.training.eval_every << "\n\n"
+    << grid_text(cell, system_entry);
+  return s.str();
+}
+
+// Writes the cell's results file: the runs of `text` (a one-cell sweep whose
+// system files `read` supplies), the data set (`store_data`), the results.
+void write_cell_file(const std::string& path, const CellSpec& cell, const std::string& text,
+                     const SystemFileReader& read,
+                     const std::function<void(ResultsFile*)>& store_data,
                      const std::vector<RunResult>& results, const Provenance& provenance,
                      const std::string& started) {
-  const std::string text = cell_sweep_text(cell, data);
-  const SweepSpec spec = parse_sweep_text(text, path + "@sweep_text");
+  const SweepSpec spec = parse_sweep_text(text, path + "@sweep_text", read);
   const Grid grid = expand_grid(spec);
   PHNN_CHECK(grid.runs.size() == results.size(), "cell sweep text expands to "
                                                      << grid.runs.size() << " runs, not "
@@ -83,7 +108,7 @@ void write_cell_file(const std::string& path, const CellSpec& cell, const System
                                          spec.text_hash, program_version(),
                                          ResultsLayout::for_runs(grid.runs));
   file.begin_session(provenance);
-  file.store_system_data(to_string(data.system.kind), data);
+  store_data(&file);
   const std::string finished = utc_now();
   // Grid rows are ordered by seed, like the cell's members.
   for (std::size_t i = 0; i < grid.runs.size(); ++i) {
@@ -272,17 +297,15 @@ PhSystemData file_system_data(const cli::Parser& parser, const PhSystem& system,
 }
 
 // `phnn train --system FILE`: the n-dimensional models on a system file.
-int run_train_file_system(const cli::Parser& parser, const CellSpec& cell) {
+int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int argc, char** argv) {
   const std::string path = parser.get("system");
   if (parser.has("damping")) {
     throw cli::UsageError{"phnn train: --damping sets the built-in systems' c; a system file sets "
                           "its own under [parameters]: edit " + path};
   }
-  if (parser.has("out")) {
-    throw cli::UsageError{"phnn train: --out is not available for system files yet (results "
-                          "files hold 2-state runs); drop --out, the per-seed results print here"};
-  }
   const std::unique_ptr<PhSystem> system = load_system_file(path);
+  const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
+  if (parser.has("out")) require_new_output(parser.get("out"));
   const PhSystemData data = file_system_data(parser, *system, cell.n_train);
   std::cout << "phnn train: " << system->name() << " (" << system->n_x() << " states, "
             << system->n_w() << " ports, " << system->n_u() << " inputs) "
@@ -291,6 +314,15 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell) {
             << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << "\n";
   const auto results = train_cell(cell, data, *system, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
+  if (parser.has("out")) {
+    const std::string out = parser.get("out");
+    write_cell_file(
+        out, cell, cell_sweep_text(cell, data, path),
+        [&](const std::string&) { return SystemFileText{path, system->source_text()}; },
+        [&](ResultsFile* file) { file->store_file_system_data(data.system_name, data, path); },
+        results, provenance, provenance_value(provenance, "started"));
+    std::printf("runs written to %s\n", out.c_str());
+  }
   return 0;
 }
 
@@ -306,7 +338,7 @@ int run_train(int argc, char** argv, int first) {
   const auto threads = parser.get_int("threads");
   if (threads < 1) throw cli::UsageError{"phnn train: --threads must be >= 1"};
   torch::set_num_threads(static_cast<int>(threads));
-  if (is_system_file_argument(parser.get("system"))) return run_train_file_system(parser, cell);
+  if (is_system_file_argument(parser.get("system"))) return run_train_file_system(parser, cell, argc, argv);
   const SystemKind system = parse_system(parser.get("system"));
   const SystemData data = data_from_options(parser, system, cell.n_train);
   cell.validate(data);
@@ -319,8 +351,10 @@ int run_train(int argc, char** argv, int first) {
   const auto results = train_cell(cell, data, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
   if (parser.has("out")) {
-    write_cell_file(parser.get("out"), cell, data, results, provenance,
-                    provenance_value(provenance, "started"));
+    write_cell_file(
+        parser.get("out"), cell, cell_sweep_text(cell, data), {},
+        [&](ResultsFile* file) { file->store_system_data(to_string(data.system.kind), data); },
+        results, provenance, provenance_value(provenance, "started"));
     std::printf("runs written to %s\n", parser.get("out").c_str());
   }
   return 0;

@@ -147,7 +147,13 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
   if (!cmp.changes.empty()) {
     text += "\n  it changes the configuration of runs (a results file holds one configuration "
             "per grid point):";
-    for (const std::string& change : cmp.changes) text += "\n    " + change;
+    for (const std::string& change : cmp.changes) {
+      text += "\n    " + change;
+      if (change.rfind("system_file:", 0) == 0) {
+        text += "\n      (the text of a system file the sweep names changed: any byte of it is "
+                "part of the runs' identity)";
+      }
+    }
   }
   if (!cmp.removed_result_rows.empty()) {
     text += "\n  " + std::to_string(cmp.removed_result_rows.size()) +
@@ -156,8 +162,9 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
       text += "\n    " + describe_point(split_canonical(file_canonical[cmp.removed_result_rows[k]]));
     }
   }
-  return text + "\n  restore the sweep file's settings and runs, or write to a new results "
-                "file with --out (or another `output`); the file is unchanged";
+  return text + "\n  restore the sweep file's settings and runs (and its system files), or "
+                "write to a new results file with --out (or another `output`); the file is "
+                "unchanged";
 }
 
 // Copies every row of `from` that holds a result into its row of `to`;

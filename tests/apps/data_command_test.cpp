@@ -14,6 +14,7 @@
 namespace phnn {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 int phnn(const std::string& args, std::string* output) {
@@ -92,7 +93,9 @@ TEST(DataCommandTest, RefusesAMalformedSystemFileWithItsLine) {
 
 // `phnn train --system FILE`: the n-dimensional models train and print the
 // per-seed table; --out (2-state results files only) is refused up front.
-TEST(TrainCommandTest, TrainsOnASystemFileAndRefusesOut) {
+// `phnn train --system FILE --out`: a results file like a sweep's, which
+// reduce and eval read without the system file (its text is stored).
+TEST(TrainCommandTest, TrainsOnASystemFileAndWritesItsResults) {
   const std::string sys = std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/coupled-duffing.toml";
   std::string log;
   ASSERT_EQ(phnn("train --system " + sys + " --model phnn-s-rk2 --seeds 0 --steps 5 --quiet", &log), 0)
@@ -100,10 +103,22 @@ TEST(TrainCommandTest, TrainsOnASystemFileAndRefusesOut) {
   EXPECT_THAT(log, HasSubstr("coupled-duffing (4 states, 2 ports, 1 inputs) PHNN-S-RK2"));
   EXPECT_THAT(log, HasSubstr("median [IQR]"));
   const std::string out = ::testing::TempDir() + "phnn_train_file_out.h5";
+  std::remove(out.c_str());
+  ASSERT_EQ(phnn("train --system " + sys + " --model phnn-jr-dg --seeds 0,1 --steps 5 --quiet --out " +
+                     out,
+                 &log),
+            0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("runs written to " + out));
+  ASSERT_EQ(phnn("reduce " + out, &log), 0) << log;
+  EXPECT_THAT(log, AllOf(HasSubstr("— coupled-duffing"), HasSubstr("PHNN-JR-DG")));
+  ASSERT_EQ(phnn("reduce " + out + " --format csv --per-run", &log), 0) << log;
+  const std::size_t line = log.find('\n') + 1;
+  ASSERT_EQ(phnn("eval " + out + " --run " + log.substr(line, 16), &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("bitwise equal"));
   EXPECT_EQ(phnn("train --system " + sys + " --model phnn-s-rk2 --seeds 0 --steps 5 --out " + out, &log), 2);
-  EXPECT_THAT(log, HasSubstr("--out is not available for system files yet"));
-  std::ifstream probe(out);
-  EXPECT_FALSE(probe.good());
+  EXPECT_THAT(log, HasSubstr("exists; choose a new path"));
+  std::remove(out.c_str());
 }
 
 }  // namespace
