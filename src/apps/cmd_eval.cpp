@@ -70,13 +70,15 @@ Evaluation evaluate(const ResultsFile& results, const RunConfig& run,
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-void write_energy_csv(const std::string& path, const Evaluation& e) {
+// First column: the figure's initial energy h0 (0.5, 0.75 J) for a built-in
+// system, the inference trajectory (0, 1) for a system file.
+void write_energy_csv(const std::string& path, const Evaluation& e, bool system_file) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot write the CSV; is the directory writable?");
-  out << "h0," << EnergyTrace::kColumns << "\n";
+  out << (system_file ? "trajectory," : "h0,") << e.energy_05.columns << "\n";
   char buf[32];
-  for (const auto& [h0, trace] : {std::make_pair("0.5", &e.energy_05),
-                                  std::make_pair("0.75", &e.energy_075)}) {
+  for (const auto& [h0, trace] : {std::make_pair(system_file ? "0" : "0.5", &e.energy_05),
+                                  std::make_pair(system_file ? "1" : "0.75", &e.energy_075)}) {
     for (const auto& row : trace->rows) {
       out << h0;
       for (double v : row) {
@@ -96,9 +98,10 @@ int run_eval(int argc, char** argv, int first) {
       "eval",
       "Reloads one finished run of a results file from its stored best-validation\n"
       "weights, evaluates it again on the stored data (the inference MSE of Eq. 31 and\n"
-      "the figure trajectories from H(x0) = 0.5 J and 0.75 J), checks the MSE against\n"
-      "the stored one (exit 1 if it differs), and writes the true and learned energy\n"
-      "along the figure trajectories to --out (CSV).");
+      "the figure trajectories: from H(x0) = 0.5 J and 0.75 J for a built-in system,\n"
+      "inference trajectories 0 and 1 for a system file), checks the MSE against the\n"
+      "stored one (exit 1 if it differs), and writes the states and the true and\n"
+      "learned energy along the figure trajectories to --out (CSV).");
   parser.positional("RESULTS", "results file of `phnn sweep` or `phnn train --out`");
   parser.option("run", "run id (or a unique prefix of it), as in `phnn reduce --per-run`", "");
   parser.option("out", "CSV of t, states and energies along the figure trajectories", "");
@@ -117,18 +120,13 @@ int run_eval(int argc, char** argv, int first) {
                              "stored can be evaluated");
   }
   const RunConfig run = stored_config(results, id);
-  if (run.has_system_file() && !parser.get("out").empty()) {
-    throw cli::UsageError{"phnn eval: --out writes the energies along the paper's figure "
-                          "trajectories, which runs of system files (" + run.system_name() +
-                          ") do not have; drop --out"};
-  }
   const Evaluation e = evaluate(results, run, stored.weights);
   const bool same = same_bits(e.result.mse, stored.mse);
   std::printf("phnn eval: run %s (%s): mse %.6e, stored %.6e: %s\n", id.c_str(),
               run.canonical().substr(0, run.canonical().find(run.has_system_file() ? ";system_file=" : ";mass=")).c_str(), e.result.mse,
               stored.mse, same ? "bitwise equal" : "DIFFERENT");
   if (!parser.get("out").empty()) {
-    write_energy_csv(parser.get("out"), e);
+    write_energy_csv(parser.get("out"), e, run.has_system_file());
     std::printf("phnn eval: energies along the figure trajectories -> %s\n",
                 parser.get("out").c_str());
   }

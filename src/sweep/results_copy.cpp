@@ -47,6 +47,7 @@ ResultsLayout wider_layout(const ResultsLayout& a, const ResultsLayout& b) {
   layout.num_inference = std::max(a.num_inference, b.num_inference);
   layout.trace_points = std::max(a.trace_points, b.trace_points);
   layout.figure_points = std::max(a.figure_points, b.figure_points);
+  layout.figure_states = std::max(a.figure_states, b.figure_states);
   layout.checkpoints = std::max(a.checkpoints, b.checkpoints);
   layout.weights = a.weights || b.weights;
   return layout;

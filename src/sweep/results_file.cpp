@@ -151,6 +151,7 @@ ResultsLayout ResultsLayout::for_runs(const std::vector<RunConfig>& runs) {
     }
     layout.figure_points =
         std::max(layout.figure_points, run.data.num_inference_steps() + 1);
+    layout.figure_states = std::max(layout.figure_states, run.n_x);
     layout.checkpoints =
         std::max(layout.checkpoints, static_cast<int>(run.training.checkpoints.size()));
   }
@@ -168,6 +169,9 @@ void ResultsLayout::validate() const {
   require(figure_points > 0, "Invalid ResultsLayout: figure_points = " +
                                  std::to_string(figure_points) +
                                  "; violated constraint: figure_points > 0.");
+  require(figure_states > 0, "Invalid ResultsLayout: figure_states = " +
+                                 std::to_string(figure_states) +
+                                 "; violated constraint: figure_states > 0.");
   require(checkpoints >= 0, "Invalid ResultsLayout: checkpoints = " + std::to_string(checkpoints) +
                                 "; violated constraint: checkpoints >= 0.");
 }

@@ -20,7 +20,7 @@ namespace {
 // rank has the same arguments, so these throw everywhere).
 struct ConfigColumns {
   std::vector<std::string> ids, canonical, systems, models, integrators, sizes, regularizers;
-  std::vector<std::int64_t> n_train, seeds;
+  std::vector<std::int64_t> n_train, seeds, states;
   // Where each run's weights start in /weights, and their total count.
   std::vector<std::int64_t> weights_offset;
   std::int64_t weights_total = 0;
@@ -49,6 +49,7 @@ struct ConfigColumns {
       sizes.push_back(to_string(run.size));
       regularizers.push_back(to_string(run.regularizer));
       n_train.push_back(run.n_train);
+      states.push_back(run.n_x);
       seeds.push_back(run.seed);
       weights_offset.push_back(weights_total);
       weights_total += parameter_count(run.model, run.size, run.n_x, run.n_w, run.n_u);
@@ -89,6 +90,7 @@ void create_config_datasets(const DatasetMaker& make) {
   make.text(kRegularizer, kNameLength, "none, cn, sn or sr");
   make.ints(kNTrain, {R}, "training pairs");
   make.ints(kSeed, {R}, "model initialization seed");
+  make.ints(kStates, {R}, "states of the run's system (n_x): the valid columns of /runs/figure/*");
   make.text(kStudies, kStudiesLength, "comma-separated studies of the run, e.g. I,II,III");
 }
 
@@ -124,11 +126,19 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
                           std::string("step, elapsed_s, train_loss, validation_loss, kappa, "
                                       "sigma_max, rho"));
   make.ints(kTraceLength, {R}, "valid points of trace");
-  const std::string figure = kStateUnits + " per point; NaN after figure/length";
-  make.floats(kPrediction05, {R, F, 2}, figure + "; model rollout from H(x0) = 0.5 J");
-  make.floats(kPrediction075, {R, F, 2}, figure + "; model rollout from H(x0) = 0.75 J");
-  make.floats(kReference05, {R, F, 2}, figure + "; reference from H(x0) = 0.5 J");
-  make.floats(kReference075, {R, F, 2}, figure + "; reference from H(x0) = 0.75 J");
+  const auto W = static_cast<std::uint64_t>(layout.figure_states);
+  const std::string figure =
+      "the system's states per point (built-in: " + kStateUnits +
+      "; a system file's: /data/<system> state_names and state_units), the first /runs/n_x "
+      "columns; NaN after figure/length";
+  const std::string first = "; model rollout from H(x0) = 0.5 J (built-in) or of inference "
+                            "trajectory 0 (system file)";
+  const std::string second = "; model rollout from H(x0) = 0.75 J (built-in) or of inference "
+                             "trajectory 1 (system file)";
+  make.floats(kPrediction05, {R, F, W}, figure + first);
+  make.floats(kPrediction075, {R, F, W}, figure + second);
+  make.floats(kReference05, {R, F, W}, figure + "; the true trajectory of prediction_05");
+  make.floats(kReference075, {R, F, W}, figure + "; the true trajectory of prediction_075");
   make.ints(kFigureLength, {R, 4}, "valid points of each figure trajectory");
   make.file.set_attribute(kFigureLength, "columns",
                           std::string("prediction_05, prediction_075, reference_05, "
@@ -172,6 +182,7 @@ void write_config_columns(h5::File& file, const ConfigColumns& c,
   file.write_string_rows(kStudies, 0, run_studies);
   file.write_rows(kNTrain, 0, R, c.n_train.data());
   file.write_rows(kSeed, 0, R, c.seeds.data());
+  file.write_rows(kStates, 0, R, c.states.data());
   if (file.exists(kWeightsOffset)) file.write_rows(kWeightsOffset, 0, R, c.weights_offset.data());
 }
 

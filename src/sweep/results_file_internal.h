@@ -38,6 +38,8 @@ inline const std::string kSize = "/runs/size";
 inline const std::string kRegularizer = "/runs/regularizer";
 inline const std::string kNTrain = "/runs/n_train";
 inline const std::string kSeed = "/runs/seed";
+// Added with system files; files written before have 2 states per run.
+inline const std::string kStates = "/runs/n_x";
 inline const std::string kStudies = "/runs/studies";
 inline const std::string kStatus = "/runs/status";
 inline const std::string kMessage = "/runs/message";
@@ -113,6 +115,7 @@ struct ResultsFile::Impl {
   bool open = true;
   int num_runs = 0;
   ResultsLayout layout;
+  std::vector<std::int64_t> run_states;  // /runs/n_x
   bool has_run_times = false;  // false in files written before provenance
   std::string session;         // this process's /provenance/session_<k>
 
@@ -126,6 +129,9 @@ struct ResultsFile::Impl {
     layout.num_inference = static_cast<int>(file.dims(results_io::kTrajectoryErrors).at(1));
     layout.trace_points = static_cast<int>(file.dims(results_io::kTrace).at(1));
     layout.figure_points = static_cast<int>(file.dims(results_io::kPrediction05).at(1));
+    layout.figure_states = static_cast<int>(file.dims(results_io::kPrediction05).at(2));
+    run_states = file.exists(results_io::kStates) ? file.read_ints(results_io::kStates)
+                                                  : std::vector<std::int64_t>(num_runs, 2);
     layout.checkpoints =
         file.exists(results_io::kCheckpointMse) ? static_cast<int>(file.dims(results_io::kCheckpointMse).at(1)) : 0;
     has_run_times = file.exists(results_io::kStartedUtc) && file.exists(results_io::kFinishedUtc);

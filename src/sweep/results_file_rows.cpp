@@ -33,8 +33,9 @@ std::array<const std::vector<double>*, 4> figures_of(const RunResult& r) {
 }
 
 // Throws (naming the field and the layout limit) unless `r` fits one row of
-// a file with layout `L`.
-void require_fits(const RunResult& r, const ResultsLayout& L, const std::string& where) {
+// a file with layout `L`, its figures being of `states` values per point.
+void require_fits(const RunResult& r, const ResultsLayout& L, std::int64_t states,
+                  const std::string& where) {
   require(r.trajectory_errors.size() <= static_cast<std::size_t>(L.num_inference),
           where + "trajectory_errors has " + std::to_string(r.trajectory_errors.size()) +
               " entries, the file holds " + std::to_string(L.num_inference) +
@@ -48,10 +49,12 @@ void require_fits(const RunResult& r, const ResultsLayout& L, const std::string&
   const auto figures = figures_of(r);
   for (int k = 0; k < 4; ++k) {
     const std::size_t size = figures[k]->size();
-    require(size % 2 == 0 && size / 2 <= static_cast<std::size_t>(L.figure_points),
+    const auto w = static_cast<std::size_t>(states);
+    require(size % w == 0 && size / w <= static_cast<std::size_t>(L.figure_points),
             where + figure_names[k] + " has " + std::to_string(size) +
-                " values; expected an even count of at most 2 * " +
-                std::to_string(L.figure_points) + " (ResultsLayout::figure_points)");
+                " values; expected a multiple of the run's " + std::to_string(w) +
+                " states of at most " + std::to_string(L.figure_points) +
+                " points (ResultsLayout::figure_points)");
   }
   require(r.checkpoint_steps.size() <= static_cast<std::size_t>(L.checkpoints) &&
               r.checkpoint_mse.size() == r.checkpoint_steps.size() &&
@@ -75,17 +78,45 @@ std::vector<double> trace_row(const std::vector<TracePoint>& points, int trace_p
   return row;
 }
 
+// A figure of `states` values per point as a NaN-padded row of
+// [figure_points][figure_states].
+std::vector<double> figure_row(const std::vector<double>& figure, std::size_t states,
+                               const ResultsLayout& L) {
+  const auto W = static_cast<std::size_t>(L.figure_states);
+  std::vector<double> row(static_cast<std::size_t>(L.figure_points) * W, kNaN);
+  for (std::size_t n = 0; n < figure.size() / states; ++n) {
+    std::copy(figure.begin() + static_cast<std::ptrdiff_t>(n * states),
+              figure.begin() + static_cast<std::ptrdiff_t>((n + 1) * states),
+              row.begin() + static_cast<std::ptrdiff_t>(n * W));
+  }
+  return row;
+}
+
+// The first `points` points of a figure row, `states` values each.
+std::vector<double> figure_of_row(const std::vector<double>& row, std::int64_t points,
+                                  std::size_t states, const ResultsLayout& L) {
+  const auto W = static_cast<std::size_t>(L.figure_states);
+  const auto n = static_cast<std::size_t>(
+      std::clamp<std::int64_t>(points, 0, static_cast<std::int64_t>(L.figure_points)));
+  std::vector<double> out;
+  out.reserve(n * states);
+  for (std::size_t p = 0; p < n; ++p) {
+    const auto at = row.begin() + static_cast<std::ptrdiff_t>(p * W);
+    out.insert(out.end(), at, at + static_cast<std::ptrdiff_t>(states));
+  }
+  return out;
+}
+
 // Figures and checkpoints of row `at` (raw data only).
 void write_figures_and_checkpoints(h5::File& f, std::uint64_t at, const RunResult& r,
-                                   const ResultsLayout& L) {
+                                   std::size_t states, const ResultsLayout& L) {
   const std::string* figure_sets[4] = {&kPrediction05, &kPrediction075, &kReference05,
                                        &kReference075};
   const auto figures = figures_of(r);
-  const auto F = static_cast<std::size_t>(L.figure_points) * 2;
   std::int64_t figure_length[4];
   for (int k = 0; k < 4; ++k) {
-    f.write_rows(*figure_sets[k], at, 1, padded(*figures[k], F).data());
-    figure_length[k] = static_cast<std::int64_t>(figures[k]->size() / 2);
+    f.write_rows(*figure_sets[k], at, 1, figure_row(*figures[k], states, L).data());
+    figure_length[k] = static_cast<std::int64_t>(figures[k]->size() / states);
   }
   f.write_rows(kFigureLength, at, 1, figure_length);
   if (L.checkpoints > 0) {
@@ -118,7 +149,8 @@ void ResultsFile::write_run(int row, const RunResult& r) {
       impl.prefix() + path() + ": write_run(row " + std::to_string(row) + "): ";
   require(row >= 0 && row < impl.num_runs,
           where + "row outside [0, " + std::to_string(impl.num_runs) + ")");
-  require_fits(r, L, where);
+  const std::int64_t states = impl.run_states.at(static_cast<std::size_t>(row));
+  require_fits(r, L, states, where);
   // A file written before weights were stored drops them.
   std::int64_t weights_offset = 0;
   const bool store_weights = L.weights && !r.weights.empty();
@@ -152,7 +184,7 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     put_int(kNewtonFailures, r.newton_failures);
     f.write_rows(kTrace, at, 1, trace.data());
     put_int(kTraceLength, static_cast<std::int64_t>(r.trace.size()));
-    write_figures_and_checkpoints(f, at, r, L);
+    write_figures_and_checkpoints(f, at, r, static_cast<std::size_t>(states), L);
     f.write_string_rows(kMessage, at, {truncate_message(r.message, kMessageLength)});
     if (store_weights) {
       f.write_rows(kWeights, static_cast<std::uint64_t>(weights_offset), r.weights.size(),
@@ -223,10 +255,12 @@ RunResult ResultsFile::read_run(int row) const {
     r.trace.push_back(t);
   }
   const std::vector<std::int64_t> lengths = impl.ints(kFigureLength, at, 1);
-  r.figure_prediction_05 = unpadded(impl.doubles(kPrediction05, at, 1), 2 * lengths.at(0));
-  r.figure_prediction_075 = unpadded(impl.doubles(kPrediction075, at, 1), 2 * lengths.at(1));
-  r.figure_reference_05 = unpadded(impl.doubles(kReference05, at, 1), 2 * lengths.at(2));
-  r.figure_reference_075 = unpadded(impl.doubles(kReference075, at, 1), 2 * lengths.at(3));
+  const auto states = static_cast<std::size_t>(impl.run_states.at(at));
+  const ResultsLayout& L = impl.layout;
+  r.figure_prediction_05 = figure_of_row(impl.doubles(kPrediction05, at, 1), lengths.at(0), states, L);
+  r.figure_prediction_075 = figure_of_row(impl.doubles(kPrediction075, at, 1), lengths.at(1), states, L);
+  r.figure_reference_05 = figure_of_row(impl.doubles(kReference05, at, 1), lengths.at(2), states, L);
+  r.figure_reference_075 = figure_of_row(impl.doubles(kReference075, at, 1), lengths.at(3), states, L);
   if (impl.layout.checkpoints > 0) {
     for (std::int64_t s : impl.ints(kCheckpointSteps, at, 1)) {
       if (s > 0) r.checkpoint_steps.push_back(static_cast<int>(s));
@@ -260,6 +294,7 @@ std::vector<std::string> ResultsFile::read_regularizers() const {
 }
 std::vector<std::string> ResultsFile::read_studies() const { return impl_->strings(kStudies); }
 std::vector<std::int64_t> ResultsFile::read_n_train() const { return impl_->ints(kNTrain); }
+std::vector<std::int64_t> ResultsFile::read_n_x() const { return impl_->run_states; }
 std::vector<std::int64_t> ResultsFile::read_seeds() const { return impl_->ints(kSeed); }
 
 std::vector<double> ResultsFile::read_double_column(const std::string& column) const {

@@ -80,8 +80,9 @@ CellData make_cell_data(const SystemData& data, bool with_figures) {
   if (!with_figures) return d;
   d.has_figures = true;
   const FigureSetup fig = figure_setup(data.system);
-  d.figure_x0 = {{{fig.x0_05(0), fig.x0_05(1)}, {fig.x0_075(0), fig.x0_075(1)}}};
-  d.figure_u = fig.u;
+  d.figure_x0 = {std::vector<double>{fig.x0_05(0), fig.x0_05(1)},
+                 std::vector<double>{fig.x0_075(0), fig.x0_075(1)}};
+  d.figure_u = {std::vector<double>{fig.u}, std::vector<double>{fig.u}};
   d.figure_references = {reference_trajectory(data.system, data.options, fig.x0_05, fig.u),
                          reference_trajectory(data.system, data.options, fig.x0_075, fig.u)};
   return d;
@@ -92,6 +93,18 @@ CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
   d.n_x = system.n_x();
   d.n_u = system.n_u();
   d.general = std::make_shared<ModelStructure>(model_structure(system));
+  if (d.inference_count == 0) return d;
+  d.has_figures = true;
+  const std::size_t nx = static_cast<std::size_t>(d.n_x), nu = static_cast<std::size_t>(d.n_u);
+  const std::size_t points = static_cast<std::size_t>(d.inference_steps) + 1;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const std::size_t i = std::min(k, d.inference_count - 1);
+    const auto states = d.inference_states.begin() + static_cast<long>(i * points * nx);
+    d.figure_references[k].assign(states, states + static_cast<long>(points * nx));
+    d.figure_x0[k].assign(states, states + static_cast<long>(nx));
+    const auto u = d.inference_u.begin() + static_cast<long>(i * nu);
+    d.figure_u[k].assign(u, u + static_cast<long>(nu));
+  }
   return d;
 }
 

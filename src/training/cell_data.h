@@ -34,12 +34,13 @@ struct CellData {
   std::size_t inference_count = 0;
   int inference_steps = 0;
   double inference_step = 0.01;
-  // Built-in systems: the structure's kind and the figure trajectories
-  // (x0 at H = 0.5 J and 0.75 J, their input, the true trajectories [n][2]).
+  // The built-in system's kind (the structure of the fused 2-state models).
   SystemKind builtin = SystemKind::kHarmonic;
+  // The two figure trajectories: their x0 (n_x), input (n_u) and true
+  // trajectory ([steps + 1][n_x]). Built-in systems: the paper's, from
+  // H(x0) = 0.5 J and 0.75 J; system files: inference trajectories 0 and 1.
   bool has_figures = false;
-  std::array<std::array<double, 2>, 2> figure_x0{};
-  double figure_u = 0.0;
+  std::array<std::vector<double>, 2> figure_x0, figure_u;
   std::array<std::vector<double>, 2> figure_references;
   // File-defined systems: the structure of the n-dimensional models.
   std::shared_ptr<const ModelStructure> general;
@@ -55,7 +56,8 @@ void validate_cell(const CellSpec& cell, const CellData& data);
 // integrations of the true system) unless `with_figures` is false (checks
 // that read the pairs and inference trajectories only).
 CellData make_cell_data(const SystemData& data, bool with_figures = true);
-// A file-defined (or any PhSystem's) data set: no figure trajectories.
+// A file-defined (or any PhSystem's) data set; its figure trajectories are
+// inference trajectories 0 and 1 (the only one twice; none without any).
 CellData make_cell_data(const PhSystemData& data, const PhSystem& system);
 
 }  // namespace phnn

@@ -3,6 +3,7 @@
 #include "phnn/training/evaluate.h"
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -13,35 +14,50 @@
 namespace phnn {
 namespace {
 
-// Points of a [n][2] trajectory as a tensor [1, n, 2].
-torch::Tensor as_states(const std::vector<double>& flat) {
-  const auto n = static_cast<int64_t>(flat.size() / 2);
-  return torch::from_blob(const_cast<double*>(flat.data()), {1, n, 2}, torch::kFloat64).clone();
+// Points of a [n][n_x] trajectory as a tensor [1, n, n_x].
+torch::Tensor as_states(const std::vector<double>& flat, int64_t nx) {
+  const auto n = static_cast<int64_t>(flat.size()) / nx;
+  return torch::from_blob(const_cast<double*>(flat.data()), {1, n, nx}, torch::kFloat64).clone();
 }
 
-EnergyTrace energy_trace(const DynamicsModel& model, const Oscillator& system, double step,
+// The learned energy at every point of a [n][n_x] trajectory (NaN for NODE).
+std::vector<double> learned_energy(const DynamicsModel& model, const std::vector<double>& flat,
+                                   int64_t nx) {
+  const std::size_t n = flat.size() / static_cast<std::size_t>(nx);
+  std::vector<double> h(n, std::numeric_limits<double>::quiet_NaN());
+  if (!model.is_port_hamiltonian() || n == 0) return h;
+  torch::NoGradGuard no_grad;
+  const auto values = model.hamiltonian(as_states(flat, nx)).reshape({-1}).contiguous();
+  for (std::size_t i = 0; i < n; ++i) h[i] = values[static_cast<int64_t>(i)].item<double>();
+  return h;
+}
+
+// The energy trace of one figure trajectory of n_x = names.size() states;
+// `energy` is the true Hamiltonian.
+EnergyTrace energy_trace(const DynamicsModel& model,
+                         const std::function<double(const VecX&)>& energy, double step,
+                         const std::vector<std::string>& names,
                          const std::vector<double>& prediction,
                          const std::vector<double>& reference) {
-  const std::size_t n = std::min(prediction.size(), reference.size()) / 2;
-  std::vector<double> h_model(n, std::numeric_limits<double>::quiet_NaN());
-  std::vector<double> h_model_ref = h_model;
-  if (model.is_port_hamiltonian() && n > 0) {
-    torch::NoGradGuard no_grad;
-    const auto a = model.hamiltonian(as_states(prediction)).reshape({-1}).contiguous();
-    const auto b = model.hamiltonian(as_states(reference)).reshape({-1}).contiguous();
-    for (std::size_t i = 0; i < n; ++i) {
-      h_model[i] = a[static_cast<int64_t>(i)].item<double>();
-      h_model_ref[i] = b[static_cast<int64_t>(i)].item<double>();
-    }
-  }
+  const auto nx = static_cast<int64_t>(names.size());
+  const std::size_t n = std::min(prediction.size(), reference.size()) / static_cast<std::size_t>(nx);
+  const std::vector<double> h_model = learned_energy(model, prediction, nx);
+  const std::vector<double> h_model_ref = learned_energy(model, reference, nx);
   EnergyTrace trace;
+  trace.columns = "t";
+  for (const std::string& name : names) trace.columns += "," + name;
+  for (const std::string& name : names) trace.columns += "," + name + "_ref";
+  trace.columns += ",H_true,H_true_ref,H_model,H_model_ref";
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 x(prediction[2 * i], prediction[2 * i + 1]);
-    const Vec2 x_ref(reference[2 * i], reference[2 * i + 1]);
+    const auto at = static_cast<std::ptrdiff_t>(i) * nx;
+    const VecX x = Eigen::Map<const VecX>(prediction.data() + at, nx);
+    const VecX x_ref = Eigen::Map<const VecX>(reference.data() + at, nx);
+    std::vector<double> row = {static_cast<double>(i) * step};
+    row.insert(row.end(), x.data(), x.data() + nx);
+    row.insert(row.end(), x_ref.data(), x_ref.data() + nx);
     // A diverged rollout has NaN states; H of them is NaN, as it should be.
-    trace.rows.push_back({static_cast<double>(i) * step, x(0), x(1), x_ref(0), x_ref(1),
-                          system.hamiltonian(x), system.hamiltonian(x_ref), h_model[i],
-                          h_model_ref[i]});
+    row.insert(row.end(), {energy(x), energy(x_ref), h_model[i], h_model_ref[i]});
+    trace.rows.push_back(std::move(row));
   }
   return trace;
 }
@@ -107,17 +123,26 @@ Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
   Evaluation out = evaluate_on(cell, make_cell_data(data), weights, &model);
   const RunResult& r = out.result;
   const Oscillator system(data.system);
-  out.energy_05 = energy_trace(*model, system, data.inference.step, r.figure_prediction_05,
-                               r.figure_reference_05);
-  out.energy_075 = energy_trace(*model, system, data.inference.step, r.figure_prediction_075,
-                                r.figure_reference_075);
+  const auto energy = [&system](const VecX& x) { return system.hamiltonian(Vec2(x(0), x(1))); };
+  const std::vector<std::string> names = {"q", "p"};
+  out.energy_05 = energy_trace(*model, energy, data.inference.step, names,
+                               r.figure_prediction_05, r.figure_reference_05);
+  out.energy_075 = energy_trace(*model, energy, data.inference.step, names,
+                                r.figure_prediction_075, r.figure_reference_075);
   return out;
 }
 
 Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
                                const PhSystem& system, const std::vector<double>& weights) {
   std::unique_ptr<DynamicsModel> model;
-  return evaluate_on(cell, make_cell_data(data, system), weights, &model);
+  Evaluation out = evaluate_on(cell, make_cell_data(data, system), weights, &model);
+  const RunResult& r = out.result;
+  const auto energy = [&system](const VecX& x) { return system.hamiltonian(x); };
+  out.energy_05 = energy_trace(*model, energy, data.inference.step, data.state_names,
+                               r.figure_prediction_05, r.figure_reference_05);
+  out.energy_075 = energy_trace(*model, energy, data.inference.step, data.state_names,
+                                r.figure_prediction_075, r.figure_reference_075);
+  return out;
 }
 
 }  // namespace phnn

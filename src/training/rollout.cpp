@@ -79,8 +79,8 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
       .copy_(torch::from_blob(const_cast<double*>(data.inference_u.data()), {B_inf, nu},
                               torch::kFloat64));
   for (int64_t k = 0; k < F; ++k) {
-    for (int64_t j = 0; j < 2; ++j) x0[B_inf + k][j] = data.figure_x0[k][j];
-    u0[B_inf + k][0] = data.figure_u;
+    for (int64_t j = 0; j < nx; ++j) x0[B_inf + k][j] = data.figure_x0[k][j];
+    for (int64_t j = 0; j < nu; ++j) u0[B_inf + k][j] = data.figure_u[k][j];
   }
   const double h_inf = data.inference_step;
   auto x = x0.unsqueeze(0).expand({E, B, nx}).contiguous();
@@ -161,10 +161,8 @@ void fill_figures(const Rollouts& rollouts, int64_t e, const CellData& data, Run
   const auto fig_e = rollouts.figure[e].contiguous();
   const auto fa = fig_e.accessor<double, 3>();
   for (int n = 0; n <= rollouts.steps; ++n) {
-    r->figure_prediction_05.push_back(fa[n][0][0]);
-    r->figure_prediction_05.push_back(fa[n][0][1]);
-    r->figure_prediction_075.push_back(fa[n][1][0]);
-    r->figure_prediction_075.push_back(fa[n][1][1]);
+    for (int64_t j = 0; j < data.n_x; ++j) r->figure_prediction_05.push_back(fa[n][0][j]);
+    for (int64_t j = 0; j < data.n_x; ++j) r->figure_prediction_075.push_back(fa[n][1][j]);
   }
   r->figure_reference_05 = data.figure_references[0];
   r->figure_reference_075 = data.figure_references[1];

@@ -30,7 +30,7 @@ struct Rollouts {
   torch::Tensor sq_err;           // [E, B_inf]: sum over steps of |x - x_ref|^2
   torch::Tensor diverged;         // [E, B_inf + figures]
   torch::Tensor newton_failures;  // [E]
-  torch::Tensor figure;           // [E, steps + 1, 2, 2] (NaN after divergence); undefined
+  torch::Tensor figure;           // [E, steps + 1, 2, n_x] (NaN after divergence); undefined
                                   // without figure trajectories
   int steps = 0;
 };

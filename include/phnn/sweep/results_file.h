@@ -28,6 +28,9 @@ struct ResultsLayout {
   int trace_points = 102;
   /// Points of each /runs/figure/* trajectory (x_0 ... x_500).
   int figure_points = 501;
+  /// States per figure point: the most of any run (2 for the built-in
+  /// systems); a run with fewer fills its first /runs/n_x of them.
+  int figure_states = 2;
   /// Columns of /runs/checkpoint_* (the most TrainerOptions::checkpoints of
   /// any run); 0: those datasets are not created (files before them have none).
   int checkpoints = 0;
@@ -37,7 +40,7 @@ struct ResultsLayout {
   bool weights = false;
 
   /// The smallest layout that holds every run of `runs`: max num_inference,
-  /// max steps / eval_every + 2, max num_inference_steps() + 1.
+  /// max steps / eval_every + 2, max num_inference_steps() + 1, max n_x.
   static ResultsLayout for_runs(const std::vector<RunConfig>& runs);
 
   /// Throws std::invalid_argument naming the field and value unless all > 0.
@@ -164,6 +167,8 @@ class ResultsFile {
   std::vector<std::string> read_regularizers() const;  // "none", "cn", ...
   std::vector<std::string> read_studies() const;       // "I,II"
   std::vector<std::int64_t> read_n_train() const;
+  /// States of each run's system (/runs/n_x; 2 in files written before it).
+  std::vector<std::int64_t> read_n_x() const;
   std::vector<std::int64_t> read_seeds() const;
 
   /// Any column of /runs by name ("mse", "wall_time_s", "figure/length",

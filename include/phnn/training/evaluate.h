@@ -23,14 +23,16 @@ namespace phnn {
 std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemData& data,
                                            const std::vector<double>& weights);
 
-/// Energies along one figure trajectory (paper Figures 7, 9), one row per
-/// point: t [s], q, p (model rollout), q_ref, p_ref (true system),
+/// Energies along one figure trajectory (paper Figures 7, 9; a system
+/// file's inference trajectories 0 and 1), one row per point: t [s], the
+/// states of the model rollout (q, p for the built-in systems; a system
+/// file's state names), the same of the true system (q_ref, p_ref, ...),
 /// H(x), H(x_ref) (true Hamiltonian) [J], H_theta(x), H_theta(x_ref)
 /// (learned; NaN for NODE, which has none) [J].
 struct EnergyTrace {
-  static constexpr const char* kColumns =
-      "t,q,p,q_ref,p_ref,H_true,H_true_ref,H_model,H_model_ref";
-  std::vector<std::array<double, 9>> rows;
+  /// "t,q,p,q_ref,p_ref,H_true,H_true_ref,H_model,H_model_ref" for 2 states.
+  std::string columns;
+  std::vector<std::vector<double>> rows;
 };
 
 struct Evaluation {
@@ -46,8 +48,8 @@ struct Evaluation {
 Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
                                const std::vector<double>& weights);
 
-/// The same for a system file's run: the inference results (no figure
-/// trajectories and no energy traces).
+/// The same for a system file's run (figure trajectories: inference
+/// trajectories 0 and 1).
 Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
                                const PhSystem& system, const std::vector<double>& weights);
 

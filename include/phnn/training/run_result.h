@@ -46,9 +46,10 @@ struct RunResult {
   /// spent to get there (this run's share of the stack, inference excluded).
   std::vector<int> checkpoint_steps;
   std::vector<double> checkpoint_mse, checkpoint_train_seconds;
-  /// Predicted trajectories of paper Figures 7 and 9 ([n][2] each): from
-  /// H(x0) = 0.5 J and 0.75 J, u = 0 (harmonic, Duffing) or a limit-cycle u
-  /// (self-sustained); with the reference trajectories.
+  /// Two figure trajectories, predicted and true, each [n][n_x] row-major:
+  /// for a built-in system those of paper Figures 7 and 9 (from H(x0) =
+  /// 0.5 J and 0.75 J, u = 0 (harmonic, Duffing) or a limit-cycle u
+  /// (self-sustained)); for a system file inference trajectories 0 and 1.
   std::vector<double> figure_prediction_05, figure_prediction_075;
   std::vector<double> figure_reference_05, figure_reference_075;
   /// The best-validation weights used for inference (DynamicsModel::
