@@ -333,6 +333,64 @@ TEST_F(ResultsFileTest, StoresEachSystemsDataOnce) {
   EXPECT_EQ(back.inference.states[1][500], data.inference.states[1][500]);
 }
 
+// Runs of systems with 2 and 4 states in one file: the figure datasets are
+// [points][4], each run's figures round-trip with its own state count
+// (/runs/n_x), the padding is NaN; a system file's data set and the text it
+// was made from come back through stored_system_files().
+TEST_F(ResultsFileTest, StoresFiguresOfAnyStateCountAndSystemFileData) {
+  std::vector<RunConfig> runs = sample_runs(2);
+  runs[1].system_file = "quad";
+  runs[1].system_file_hash = "00000000000000aa";
+  runs[1].n_x = 4;
+  runs[1].n_w = 2;
+  ResultsLayout layout = sample_layout();
+  layout.figure_states = 2;
+  EXPECT_EQ(ResultsLayout::for_runs(runs).figure_states, 4);
+  layout.figure_states = 4;
+  RunResult two = sample_result(0, layout), four = sample_result(1, layout);
+  for (auto* f : {&four.figure_prediction_05, &four.figure_prediction_075,
+                  &four.figure_reference_05, &four.figure_reference_075}) {
+    f->resize(f->size() / 2 * 2);  // an even count: [n][2] -> [n/2][4]
+    while (f->size() % 4 != 0) f->pop_back();
+  }
+  PhSystemData data;
+  data.system_name = "quad";
+  data.system_text = "name = \"quad\"\n# the file's text\n";
+  data.state_names = {"a", "b", "c", "d"};
+  data.state_units = {"m", "m", "m", "m"};
+  data.input_names = {"u"};
+  data.n_w = 2;
+  data.train.x = {VecX::Constant(4, 0.5)};
+  data.train.x_next = {VecX::Constant(4, 0.25)};
+  data.train.u = {VecX::Constant(1, 1.0)};
+  data.train.trajectory = {3};
+  data.train.position = {7};
+  {
+    ResultsFile file = ResultsFile::create(path_, MPI_COMM_NULL, runs, sample_studies(2), "demo",
+                                           "name = demo\n", kSweepHash, "phnn-sweep 0.1.0", layout);
+    file.write_run(0, two);
+    file.write_run(1, four);
+    file.store_file_system_data("quad", data, "systems/quad.toml");
+    file.close();
+  }
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  EXPECT_EQ(file.layout().figure_states, 4);
+  EXPECT_EQ(file.read_n_x(), (std::vector<std::int64_t>{2, 4}));
+  expect_bit_equal(two, file.read_run(0));
+  expect_bit_equal(four, file.read_run(1));
+  const std::vector<double> column = file.read_double_column("figure/prediction_05");
+  EXPECT_TRUE(std::isnan(column[2]) && std::isnan(column[3]));  // run 0, point 0, states 3-4
+  EXPECT_EQ(bits(column[0]), bits(two.figure_prediction_05[0]));
+  const PhSystemData back = file.read_file_system_data("quad");
+  EXPECT_EQ(back.state_names, data.state_names);
+  EXPECT_EQ(back.train.x_next[0], data.train.x_next[0]);
+  const SystemFileText stored = file.stored_system_files()("systems/quad.toml");
+  EXPECT_EQ(stored.text, data.system_text);
+  EXPECT_THAT(stored.shown_as, EndsWith("@/data/quad"));
+  EXPECT_THAT([&] { file.stored_system_files()("systems/other.toml"); },
+              ThrowsMessage<std::runtime_error>(HasSubstr("stores no system file systems/other.toml")));
+}
+
 // All metadata is written by create(), so a writer killed without closing
 // (kill -9 mid-sweep) leaves a readable file with its finished rows.
 TEST_F(ResultsFileTest, SurvivesAWriterKilledWithoutClosing) {

@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <string>
@@ -216,8 +217,33 @@ TEST(SweepSystemFilesTest, SweepOfASystemFileFinishesResumesReducesAndEvaluates)
   const std::size_t at = log.find(",osc,phnn-s,dg,");
   ASSERT_NE(at, std::string::npos) << log;
   const std::string id = log.substr(log.rfind('\n', at) + 1, 16);
-  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " eval " + out + " --run " + id, &log), 0) << log;
+  const std::string csv = out + ".csv";
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " eval " + out + " --run " + id + " --out " + csv, &log),
+            0)
+      << log;
   EXPECT_THAT(log, HasSubstr("bitwise equal"));
+  {
+    // The figure trajectories of a system file: inference trajectories 0
+    // and 1, states by the file's names, from the true x0.
+    std::ifstream in(csv);
+    std::string line;
+    ASSERT_TRUE(std::getline(in, line));
+    EXPECT_EQ(line, "trajectory,t,q,p,q_ref,p_ref,H_true,H_true_ref,H_model,H_model_ref");
+    ASSERT_TRUE(std::getline(in, line));
+    double v[10];
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1],
+                          &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9]),
+              10)
+        << line;
+    EXPECT_EQ(v[0], 0.0);
+    EXPECT_EQ(v[1], 0.0);
+    EXPECT_EQ(v[2], v[4]);  // x0 is the true initial state
+    EXPECT_EQ(v[3], v[5]);
+    EXPECT_EQ(v[6], v[7]);
+    int rows = 1;
+    while (std::getline(in, line)) ++rows;
+    EXPECT_EQ(rows, 2 * 501);
+  }
   // The system file changed: refused, file unchanged.
   const std::string dir2 = temp_dir("e2e_changed");
   write_osc(dir2, "m = 0.2 ", "m = 0.25");
