@@ -12,7 +12,10 @@ studies has one pseudo-study, e.g. "grid"):
                               edge with their count, n per box under it; failed/pending runs counted
                               in the title.
   trajectories_<sys>.png      paper Figs. 7/9: q(t), p(t) and the phase portrait from H(x0) = 0.5 J
-                              and 0.75 J, reference vs NODE-RK2 and the best PHNN of the cell
+                              and 0.75 J (a system file: every state against t by its name and
+                              unit, and one phase portrait per pair of its [plots] phase, along
+                              inference trajectories 0 and 1), reference vs NODE-RK2 and the best
+                              PHNN of the cell
                               (lowest median MSE); the seed drawn is the one with the median MSE
                               of its cell (lower median for even n), named in the legend.  Cell:
                               the file's most common size (small in paper.toml), no regularizer,
@@ -133,11 +136,42 @@ def load(path):
             runs[k] = r[k][()]
         for k in ("prediction_05", "prediction_075", "reference_05", "reference_075", "length"):
             runs[k] = r["figure/" + k][()]
+        runs["n_x"] = r["n_x"][()] if "n_x" in r else np.full(len(runs["system"]), 2)
+        runs["states"] = {name: system_states(f, name) for name in set(runs["system"])}
         name = text([f.attrs.get("sweep_name", b"")])[0]
         sweep = parse_sweep(text([f.attrs.get("sweep_text", b"")])[0])
     runs["mse"] = np.where(runs["status"] == DIVERGED, np.inf, runs["mse"])
     runs["rows"] = np.arange(len(runs["status"]))
     return runs, name, sweep
+
+
+def system_states(f, name):
+    """A system's state names, units, phase pairs (indices) and whether it is a system file:
+    from /data/<name> (a system file's group has state_names and its text with [plots] phase);
+    the built-in systems' q [m], p [kg m/s] otherwise."""
+    group = f["data"][name] if "data" in f and name in f["data"] else None
+    if group is None or "state_names" not in group.attrs:
+        return {"names": ["q", "p"], "units": ["m", "kg m/s"], "pairs": [(0, 1)], "file": False}
+    names = text([group.attrs["state_names"]])[0].split(",")
+    units = text([group.attrs["state_units"]])[0].split(",")
+    pairs = [(i, i + 1 if i + 1 < len(names) else 0) for i in range(0, len(names), 2)]
+    if len(names) == 1:
+        pairs = []
+    plots = parse_sweep(text([group.attrs.get("system_file", b"")])[0]).get("plots", {})
+    if plots.get("phase"):
+        pairs = [(names.index(a), names.index(b)) for a, b in plots["phase"]]
+    return {"names": names, "units": units, "pairs": pairs, "file": True}
+
+
+def state_label(states, k):
+    return f"{states['names'][k]} [{states['units'][k]}]"
+
+
+def figure_label(states, energy):
+    """Row label of a figure trajectory: its initial energy, or a system file's trajectory."""
+    if states["file"]:
+        return f"inference trajectory {0 if energy == '05' else 1}"
+    return f"H(x0) = {0.5 if energy == '05' else 0.75} J"
 
 
 def parse_sweep(sweep_text):
@@ -381,14 +415,15 @@ def trajectories(runs, name, out):
         if not picks:
             print(f"  skipped trajectories_{system}.png: no finished run at N_train = {n_train}")
             continue
-        fig, axes = plt.subplots(2, 3, figsize=(13, 7))
+        states = runs["states"][system]
+        fig, axes = trajectory_axes(states)
         for r, energy in enumerate(("05", "075")):
             draw_reference(runs, axes[r], median_seed_row(runs, cell), energy)
             for m in picks:
                 i = median_seed_row(runs, [j for j in cell if runs["model"][j] == m])
                 draw_prediction(runs, axes[r], i, energy, m, medians[m])
-            axes[r, 0].set_ylabel(f"H(x0) = {0.5 if energy == '05' else 0.75} J\nq [m]")
-        axes[0, 2].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+            axes[r, 0].set_ylabel(f"{figure_label(states, energy)}\n{state_label(states, 0)}")
+        axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
         seeds = seeds_per_cell(runs, cell)
         note = "" if n_train == target else f" (paper: {target}, not in this file)"
         suptitle(fig, f"{name}: {system}, {study_names(runs, cell)}, {runs['size'][cell[0]]}, "
@@ -428,7 +463,8 @@ def size_trajectories(runs, name, out):
         if len(picks) < 2:
             continue
         model = SIZE_TRAJECTORY_MODEL[system]
-        fig, axes = plt.subplots(2, 3, figsize=(13, 7))
+        states = runs["states"][system]
+        fig, axes = trajectory_axes(states)
         for r, energy in enumerate(("05", "075")):
             draw_reference(runs, axes[r], next(iter(picks.values())), energy)
             for size, i in picks.items():
@@ -437,8 +473,8 @@ def size_trajectories(runs, name, out):
                 median = float(np.median(np.nan_to_num(cell, nan=np.inf)))
                 draw_prediction(runs, axes[r], i, energy, model, median,
                                 label_prefix=f"{size}: ", linestyle=SIZE_STYLES.get(size, "--"))
-            axes[r, 0].set_ylabel(f"H(x0) = {0.5 if energy == '05' else 0.75} J\nq [m]")
-        axes[0, 2].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+            axes[r, 0].set_ylabel(f"{figure_label(states, energy)}\n{state_label(states, 0)}")
+        axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
         rows = [i for r in groups.values() for i in r]
         suptitle(fig, f"{name}: {system}, {model} at each model size, no regularizer, "
                  f"N_train = {n_train} (paper Fig. 9); n = {seeds_per_cell(runs, rows)} seeds per size",
@@ -449,20 +485,40 @@ def size_trajectories(runs, name, out):
 
 
 def trajectory(runs, i, key, column):
+    """Figure trajectory `key` of row i: [points, n_x] (its valid points and states)."""
     length = int(runs["length"][i][column])
-    return runs[key][i][:length]
+    return runs[key][i][:length, :int(runs["n_x"][i])]
+
+
+def trajectory_axes(states):
+    """Two rows (the figure trajectories); a column per state against t, then one per phase
+    pair: q(t), p(t), (q, p) for the built-in systems."""
+    columns = len(states["names"]) + len(states["pairs"])
+    return plt.subplots(2, columns, figsize=(max(13, 3.3 * columns), 7), squeeze=False)
+
+
+def plot_states(runs, axes, i, data, t, style):
+    """Each state of `data` against t, then each phase pair of row i's system."""
+    states = runs["states"][runs["system"][i]]
+    n = len(states["names"])
+    for k in range(n):
+        axes[k].plot(t, data[:, k], **style)
+    for c, (a, b) in enumerate(states["pairs"]):
+        axes[n + c].plot(data[:, a], data[:, b], **style)
 
 
 def draw_reference(runs, axes, i, energy):
-    """Reference q(t), p(t) and phase portrait of row i (energy '05' or '075'), axis labels."""
+    """Reference states against t and phase portraits of row i (energy '05' or '075'), axis
+    labels."""
     ref = trajectory(runs, i, "reference_" + energy, 2 if energy == "05" else 3)
     t = np.arange(len(ref)) / float(canonical_value(runs, i, "sample_rate", 100))
     style = {"color": "black", "lw": 2.2, "label": "reference (data generator)"}
-    axes[0].plot(t, ref[:, 0], **style)
-    axes[1].plot(t, ref[:, 1], **style)
-    axes[2].plot(ref[:, 0], ref[:, 1], **style)
-    for ax, xl, yl in ((axes[0], "t [s]", None), (axes[1], "t [s]", "p [kg m/s]"),
-                       (axes[2], "q [m]", "p [kg m/s]")):
+    plot_states(runs, axes, i, ref, t, style)
+    states = runs["states"][runs["system"][i]]
+    n = len(states["names"])
+    labels = [("t [s]", None if k == 0 else state_label(states, k)) for k in range(n)]
+    labels += [(state_label(states, a), state_label(states, b)) for a, b in states["pairs"]]
+    for ax, (xl, yl) in zip(axes, labels):
         ax.set_xlabel(xl)
         if yl:
             ax.set_ylabel(yl)
@@ -477,9 +533,7 @@ def draw_prediction(runs, axes, i, energy, model, median, label_prefix="", lines
     label = (f"{label_prefix}{model}, seed {int(runs['seed'][i])} (MSE {runs['mse'][i]:.2g}; "
              f"cell median {median:.2g})")
     style = {"color": colour(model), "lw": 1.3, "ls": linestyle, "label": label}
-    axes[0].plot(t[finite], pred[finite, 0], **style)
-    axes[1].plot(t[finite], pred[finite, 1], **style)
-    axes[2].plot(pred[finite, 0], pred[finite, 1], **style)
+    plot_states(runs, axes, i, pred[finite], t[finite], style)
     if not finite.all():
         axes[0].text(0.02, 0.02, f"{model}: rollout non-finite after t = {t[~finite][0]:.2f} s",
                      transform=axes[0].transAxes, fontsize=7, color=colour(model))
@@ -520,8 +574,11 @@ def energies(runs, path, name, out):
         if data is None:
             continue
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=False)
-        for ax, h0 in zip(axes, (0.5, 0.75)):
-            rows = data[np.isclose(data["h0"], h0)]
+        states = runs["states"][system]
+        for ax, energy in zip(axes, ("05", "075")):
+            # The CSV's first column: h0 (built-in) or the inference trajectory (system file).
+            rows = (data[data["trajectory"] == (0 if energy == "05" else 1)] if states["file"]
+                    else data[np.isclose(data["h0"], 0.5 if energy == "05" else 0.75)])
             c = colour(picks[0])
             ax.plot(rows["t"], rows["H_true_ref"], color="black", lw=2.2,
                     label="H along the reference")
@@ -531,7 +588,7 @@ def energies(runs, path, name, out):
                     label=f"H along the {picks[0]} rollout")
             ax.plot(rows["t"], rows["H_model"], color=c, lw=1.3, ls=":",
                     label=f"H_theta along the {picks[0]} rollout")
-            ax.set_title(f"H(x0) = {h0} J")
+            ax.set_title(figure_label(states, energy))
             ax.set_xlabel("t [s]")
             ax.set_ylabel("energy [J]")
             ax.grid(alpha=0.3)

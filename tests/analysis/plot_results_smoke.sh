@@ -32,6 +32,13 @@ if [ $# -ge 2 ]; then
         --eval-every 10 --quiet --out "$out/trained.h5" > /dev/null
     PHNN="$2" "$py" "$root/analysis/plot_results.py" "$out/trained.h5" "$out/fig2"
     test -s "$out/fig2/energy_duffing.png" || { echo "missing energy_duffing.png" >&2; exit 1; }
+    # A system file (4 states, named q1 p1 q2 p2, three phase pairs): trajectories and energy.
+    "$2" train --system "$root/sweeps/systems/coupled-duffing.toml" --model phnn-s-rk2 \
+        --n-train 25 --seeds 0-1 --steps 20 --eval-every 10 --quiet --out "$out/file.h5" > /dev/null
+    PHNN="$2" "$py" "$root/analysis/plot_results.py" "$out/file.h5" "$out/fig3" > "$out/fig3.log"
+    for f in trajectories_coupled-duffing energy_coupled-duffing mse_grid_coupled-duffing; do
+        test -s "$out/fig3/$f.png" || { echo "missing $f.png" >&2; cat "$out/fig3.log" >&2; exit 1; }
+    done
     # compare_ablation.py: a file against itself is one row per cell, every verdict "~".
     PHNN="$2" "$py" "$root/analysis/compare_ablation.py" "$out/trained.h5" "self=$out/trained.h5" \
         > "$out/ablation.md"
