@@ -1,4 +1,5 @@
 // bench/bench_training.cpp — training cost per member-step (not a test).
+// Size: one benchmark binary, one mode per table of docs/BENCHMARKS.md.
 //
 //   bench_training stacked [repeats]   µs per member-step, every model x
 //                                      integrator, +-CN, E = 1 and E = 10

@@ -2,7 +2,9 @@
 // (cells, or member groups of a cell) taken from a shared queue; every result
 // lands in one parallel HDF5 file, each run first in this rank's journal
 // (fsync), then in its row of the file. The phases that can fail on some
-// ranks: sweep_phases.cpp; what rank 0 prints: sweep_report.cpp.
+// ranks: sweep_phases.cpp; what rank 0 prints: sweep_report.cpp; the data
+// sets: sweep_data.cpp.
+// Size: one command; its rank-agreement steps read best in one place.
 #include <sys/stat.h>
 
 #include <algorithm>

@@ -1,4 +1,6 @@
-// src/models/port_hamiltonian.cpp
+// src/models/port_hamiltonian.cpp — the 2-state PHNN-S and PHNN-JR (fused heads) and the
+// virtual hooks the n-dimensional models override.
+// Size: both formulations share the energy, curvature and discrete-gradient paths.
 #include "phnn/models/port_hamiltonian.h"
 
 #include <cmath>

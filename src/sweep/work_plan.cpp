@@ -1,5 +1,6 @@
 // src/sweep/work_plan.cpp — cells split into member groups by the cost model;
 // the LPT schedule simulation behind `--dry-run`.
+// Size: the split decision and the schedule it is judged by belong together.
 #include "phnn/sweep/work_plan.h"
 
 #include <algorithm>

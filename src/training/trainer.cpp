@@ -2,6 +2,7 @@
 // step / validate / checkpoint, finish (the rollouts are in rollout.cpp, the
 // minibatch order in batch_sampler.h, CellSpec's checks in cell_spec.cpp),
 // in the training precision (float64, or float32 with float64 inference).
+// Size: one class whose phases share the stack, the optimizer and the best weights.
 #include "phnn/training/trainer.h"
 
 #include <algorithm>

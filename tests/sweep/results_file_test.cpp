@@ -1,5 +1,6 @@
 // tests/sweep/results_file_test.cpp — the serial path (MPI_COMM_NULL, no
 // MPI_Init); tests/mpi/results_file_mpi_test.cpp covers the parallel one.
+// Size: one test file per module; each layout feature needs its round trip.
 #include "phnn/sweep/results_file.h"
 
 #include "phnn/models/model_config.h"

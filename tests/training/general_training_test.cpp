@@ -57,7 +57,12 @@ TEST(GeneralTrainingTest, EveryModelIntegratorAndRegularizerTrains) {
         EXPECT_TRUE(std::isfinite(res.mse)) << what;
         EXPECT_EQ(res.trajectory_errors.size(), 4u) << what;
         EXPECT_TRUE(std::isfinite(res.trace.back().kappa) && res.trace.back().kappa >= 1.0) << what;
-        EXPECT_TRUE(res.figure_prediction_05.empty()) << "no figure trajectories for a file system";
+        // Figure trajectories of a system file: inference trajectories 0 and 1.
+        const auto& states = coupled().data.inference.states;
+        ASSERT_EQ(res.figure_reference_075.size(), states[1].size() * 4) << what;
+        EXPECT_EQ(res.figure_reference_075[4 * 7 + 2], states[1][7](2)) << what;
+        ASSERT_EQ(res.figure_prediction_05.size(), states[0].size() * 4) << what;
+        for (int j = 0; j < 4; ++j) EXPECT_EQ(res.figure_prediction_05[j], states[0][0](j)) << what;
       }
     }
   }
