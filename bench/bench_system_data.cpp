@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "phnn/data/dataset_file.h"
 #include "phnn/data/ph_dataset.h"
+#include "phnn/store/dataset_file.h"
 #include "phnn/systems/system_file.h"
 
 namespace {

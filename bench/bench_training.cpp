@@ -38,7 +38,7 @@
 
 #include <torch/torch.h>
 
-#include "phnn/data/dataset_file.h"
+#include "phnn/store/dataset_file.h"
 #include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"
 

@@ -7,7 +7,7 @@
 #include <torch/csrc/autograd/profiler_legacy.h>
 #include <torch/torch.h>
 
-#include "phnn/data/dataset_file.h"
+#include "phnn/store/dataset_file.h"
 #include "phnn/training/trainer.h"
 
 int main(int argc, char** argv) {

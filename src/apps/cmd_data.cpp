@@ -6,8 +6,8 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
-#include "phnn/data/dataset_file.h"
-#include "phnn/data/ph_dataset_file.h"
+#include "phnn/store/dataset_file.h"
+#include "phnn/store/ph_dataset_file.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {

@@ -11,8 +11,8 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/systems/system_file.h"
 #include "phnn/training/evaluate.h"

@@ -10,8 +10,8 @@
 #include "apps/commands.h"
 #include "phnn/report/per_run.h"
 #include "phnn/report/tables.h"
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 
 namespace phnn {

@@ -15,14 +15,14 @@
 #include "apps/commands.h"
 #include "apps/provenance.h"
 #include "phnn/common/check.h"
-#include "phnn/data/dataset_file.h"
-#include "phnn/data/ph_dataset_file.h"
-#include "phnn/systems/system_file.h"
 #include "phnn/report/tables.h"
+#include "phnn/store/dataset_file.h"
+#include "phnn/store/ph_dataset_file.h"
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/sweep/version.h"
+#include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "phnn/data/dataset_file.h"
+#include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/systems/ph_system.h"
 #include "phnn/training/trainer.h"

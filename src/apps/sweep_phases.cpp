@@ -11,7 +11,7 @@
 #include <boost/serialization/string.hpp>
 #include <boost/serialization/vector.hpp>
 
-#include "phnn/sweep/journal.h"
+#include "phnn/store/journal.h"
 #include "phnn/sweep/output_check.h"
 #include "phnn/sweep/sweep_growth.h"
 #include "phnn/sweep/version.h"

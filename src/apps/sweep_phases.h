@@ -10,9 +10,9 @@
 #include <boost/mpi/communicator.hpp>
 
 #include "apps/cli.h"
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"  // Shard
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/sweep/work_plan.h"
 #include "phnn/sweep/writer_lock.h"

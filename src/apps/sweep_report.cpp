@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "phnn/common/utc_time.h"
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 
 namespace phnn {
 namespace apps {

@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 #include "results_copy.h"
 

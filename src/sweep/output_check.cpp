@@ -12,8 +12,8 @@
 #include <stdexcept>
 
 #include "h5/h5file.h"
-#include "phnn/sweep/journal.h"
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/journal.h"
+#include "phnn/store/results_file.h"
 
 namespace phnn {
 namespace {

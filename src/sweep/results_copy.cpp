@@ -12,7 +12,7 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "phnn/sweep/journal.h"
+#include "phnn/store/journal.h"
 
 namespace phnn {
 namespace results_copy {

@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/results_file.h"
 
 namespace phnn {
 namespace results_copy {

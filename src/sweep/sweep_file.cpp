@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "phnn/sweep/run_config.h"
+#include "phnn/config/run_config.h"
 #include "phnn/systems/system_file.h"
 #include "sweep/sweep_file_source.h"
 #include "sweep/sweep_file_tables.h"

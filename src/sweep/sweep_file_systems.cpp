@@ -4,7 +4,7 @@
 
 #include <memory>
 
-#include "phnn/sweep/run_config.h"
+#include "phnn/config/run_config.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {

@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "phnn/models/model_config.h"
+#include "phnn/config/model_config.h"
+#include "phnn/config/trainer_options.h"
 #include "phnn/systems/oscillators.h"
-#include "phnn/training/trainer_options.h"
 #include "sweep/sweep_file_source.h"
 
 namespace phnn {

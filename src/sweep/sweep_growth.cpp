@@ -7,7 +7,7 @@
 #include <set>
 #include <utility>
 
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 #include "results_copy.h"
 
 namespace phnn {

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "phnn/models/model_config.h"
+#include "phnn/config/model_config.h"
 
 namespace phnn {
 

@@ -11,9 +11,9 @@
 #include <memory>
 #include <vector>
 
-#include "phnn/data/dataset_file.h"
+#include "phnn/config/model_config.h"
+#include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
-#include "phnn/models/model_config.h"
 #include "phnn/systems/oscillators.h"
 #include "phnn/systems/ph_system.h"
 

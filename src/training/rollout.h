@@ -9,8 +9,8 @@
 
 #include <torch/torch.h>
 
+#include "phnn/config/run_result.h"
 #include "phnn/models/dynamics_model.h"
-#include "phnn/training/run_result.h"
 #include "phnn/training/trainer.h"
 #include "training/cell_data.h"
 

@@ -8,7 +8,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "phnn/data/ph_dataset_file.h"
+#include "phnn/store/ph_dataset_file.h"
 #include "test_util.h"
 
 namespace phnn {

@@ -15,8 +15,8 @@
 #include "sweep/sample_results.h"
 #include "test_util.h"
 
+#include "phnn/store/journal.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/journal.h"
 
 namespace phnn {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "test_util.h"
 
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 
 namespace phnn {
 namespace {

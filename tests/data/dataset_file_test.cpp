@@ -1,5 +1,5 @@
 // tests/data/dataset_file_test.cpp
-#include "phnn/data/dataset_file.h"
+#include "phnn/store/dataset_file.h"
 
 #include <cstdio>
 #include <cstdlib>

@@ -12,9 +12,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "phnn/data/dataset_file.h"
-#include "phnn/data/ph_dataset_file.h"
 #include "phnn/integrators/ph_steps.h"
+#include "phnn/store/dataset_file.h"
+#include "phnn/store/ph_dataset_file.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {

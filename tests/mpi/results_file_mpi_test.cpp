@@ -1,6 +1,6 @@
 // tests/mpi/results_file_mpi_test.cpp — the parallel results file and the
 // per-rank journals, run with mpiexec -n 1, 2 and 3 (ctest mpi_np1..3).
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 
 #include <mpi.h>
 #include <unistd.h>
@@ -12,7 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "phnn/sweep/journal.h"
+#include "phnn/store/journal.h"
 #include "sweep/sample_results.h"
 
 namespace phnn {

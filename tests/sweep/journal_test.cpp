@@ -1,5 +1,5 @@
 // tests/sweep/journal_test.cpp
-#include "phnn/sweep/journal.h"
+#include "phnn/store/journal.h"
 
 #include <unistd.h>
 

@@ -11,8 +11,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 #include "sample_results.h"
 

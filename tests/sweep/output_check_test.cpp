@@ -13,9 +13,9 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
-#include "phnn/data/dataset_file.h"
-#include "phnn/sweep/journal.h"
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/dataset_file.h"
+#include "phnn/store/journal.h"
+#include "phnn/store/results_file.h"
 #include "sample_results.h"
 
 namespace phnn {

@@ -1,9 +1,9 @@
 // tests/sweep/results_file_test.cpp — the serial path (MPI_COMM_NULL, no
 // MPI_Init); tests/mpi/results_file_mpi_test.cpp covers the parallel one.
 // Size: one test file per module; each layout feature needs its round trip.
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 
-#include "phnn/models/model_config.h"
+#include "phnn/config/model_config.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,7 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
-#include "phnn/sweep/journal.h"
+#include "phnn/store/journal.h"
 #include "sweep/sample_results.h"
 
 namespace phnn {

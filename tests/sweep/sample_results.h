@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 
 namespace phnn {
 namespace testing_util {

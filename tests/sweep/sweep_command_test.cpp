@@ -18,9 +18,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "phnn/store/journal.h"
+#include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/journal.h"
-#include "phnn/sweep/results_file.h"
 #include "phnn/sweep/sweep_file.h"
 #include "test_util.h"
 

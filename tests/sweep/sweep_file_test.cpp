@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "phnn/config/run_config.h"
 #include "phnn/sweep/grid.h"
-#include "phnn/sweep/run_config.h"
 
 namespace phnn {
 namespace {

@@ -13,7 +13,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 #include "sample_results.h"
 
 namespace phnn {

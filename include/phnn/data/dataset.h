@@ -133,4 +133,20 @@ struct InferenceSet {
 InferenceSet inference_set(const Oscillator& system,
                            const DatasetOptions& options);
 
+/// Everything one system contributes to an experiment: the training pairs
+/// (first n_train of them are used by a run), validation pairs and inference
+/// trajectories (docs/METHOD.md §2).
+struct SystemData {
+  OscillatorOptions system;
+  DatasetOptions options;
+  PairSet train;
+  PairSet validation;
+  InferenceSet inference;
+};
+
+/// Generates a system's splits. `num_train` pairs of the train split (at most
+/// options.num_train_max) are generated; only what is asked is computed.
+SystemData make_system_data(const OscillatorOptions& system,
+                            const DatasetOptions& options, int num_train);
+
 }  // namespace phnn

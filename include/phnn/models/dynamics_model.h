@@ -8,7 +8,7 @@
 
 #include <torch/torch.h>
 
-#include "phnn/models/model_config.h"
+#include "phnn/config/model_config.h"
 #include "phnn/models/stacked_mlp.h"
 #include "phnn/systems/oscillators.h"
 

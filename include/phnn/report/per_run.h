@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "phnn/training/run_result.h"
+#include "phnn/config/run_result.h"
 
 namespace phnn {
 

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "phnn/config/run_result.h"
 #include "phnn/report/statistics.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/systems/oscillators.h"
-#include "phnn/training/run_result.h"
 
 namespace phnn {
 

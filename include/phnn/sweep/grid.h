@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "phnn/sweep/run_config.h"
+#include "phnn/config/run_config.h"
 #include "phnn/sweep/sweep_file.h"
 
 namespace phnn {

@@ -2,17 +2,17 @@
 #pragma once
 
 #include <cstddef>
-#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "phnn/config/model_config.h"
+#include "phnn/config/system_file_text.h"
+#include "phnn/config/trainer_options.h"
 #include "phnn/data/dataset.h"
-#include "phnn/models/model_config.h"
 #include "phnn/systems/oscillators.h"
-#include "phnn/training/trainer_options.h"
 
 namespace phnn {
 
@@ -79,18 +79,6 @@ struct SweepSystemFile {
   /// States, dissipation ports and inputs of the system.
   int n_x = 0, n_w = 0, n_u = 0;
 };
-
-/// A system file's text and the name its errors show (its path as opened,
-/// or where in a results file it was stored).
-struct SystemFileText {
-  std::string shown_as, text;
-};
-
-/// Returns the system file a sweep file names (`entry` as written in
-/// `systems`); throws SystemFileError (or any std::exception) when it
-/// cannot. parse_sweep_file reads from disk, relative to the sweep file;
-/// readers of a results file take the texts stored in it.
-using SystemFileReader = std::function<SystemFileText(const std::string& entry)>;
 
 /// A parsed and validated sweep file: docs/METHOD.md defaults overridden by the file.
 ///

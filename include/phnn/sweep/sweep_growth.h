@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "phnn/config/run_result.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
-#include "phnn/training/run_result.h"
 
 namespace phnn {
 

@@ -3,8 +3,8 @@
 
 #include <torch/torch.h>
 
+#include "phnn/config/trainer_options.h"
 #include "phnn/models/dynamics_model.h"
-#include "phnn/training/trainer_options.h"
 
 namespace phnn {
 

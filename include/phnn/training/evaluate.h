@@ -9,9 +9,9 @@
 #include <memory>
 #include <vector>
 
-#include "phnn/data/dataset_file.h"
+#include "phnn/config/run_result.h"
+#include "phnn/data/dataset.h"
 #include "phnn/models/dynamics_model.h"
-#include "phnn/training/run_result.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {

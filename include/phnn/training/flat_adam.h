@@ -3,7 +3,7 @@
 
 #include <torch/torch.h>
 
-#include "phnn/training/trainer_options.h"
+#include "phnn/config/trainer_options.h"
 
 namespace phnn {
 

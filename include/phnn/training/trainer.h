@@ -6,12 +6,12 @@
 #include <memory>
 #include <vector>
 
-#include "phnn/data/dataset_file.h"
+#include "phnn/config/model_config.h"
+#include "phnn/config/run_config.h"
+#include "phnn/config/run_result.h"
+#include "phnn/config/trainer_options.h"
+#include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
-#include "phnn/models/model_config.h"
-#include "phnn/sweep/run_config.h"
-#include "phnn/training/run_result.h"
-#include "phnn/training/trainer_options.h"
 
 namespace phnn {
 

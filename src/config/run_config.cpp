@@ -1,5 +1,6 @@
-// src/sweep/run_config.cpp
-#include "phnn/sweep/run_config.h"
+// src/config/run_config.cpp — a run's canonical string, cell key and id: every
+// field that affects its result, nothing else.
+#include "phnn/config/run_config.h"
 
 #include <cstdio>
 #include <sstream>

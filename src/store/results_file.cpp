@@ -1,17 +1,17 @@
-// src/sweep/results_file.cpp — ResultsFile: opening (with the checks that
+// src/store/results_file.cpp — ResultsFile: opening (with the checks that
 // name what a path is if it is not our file), closing, file attributes, the
 // /data groups, run times and provenance sessions; the helpers that make
 // every rank fail together. Creation: results_file_create.cpp; rows:
 // results_file_rows.cpp.
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
 
-#include "data/dataset_file_io.h"
-#include "sweep/results_file_internal.h"
+#include "store/dataset_file_io.h"
+#include "store/results_file_internal.h"
 
 namespace phnn {
 namespace results_io {

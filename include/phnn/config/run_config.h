@@ -1,13 +1,13 @@
-// include/phnn/sweep/run_config.h — one run of a sweep, fully resolved.
+// include/phnn/config/run_config.h — one run of a sweep, fully resolved.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include "phnn/config/model_config.h"
+#include "phnn/config/trainer_options.h"
 #include "phnn/data/dataset.h"
-#include "phnn/models/model_config.h"
 #include "phnn/systems/oscillators.h"
-#include "phnn/training/trainer_options.h"
 
 namespace phnn {
 

@@ -1,4 +1,4 @@
-// include/phnn/training/run_result.h — what one run produces, no LibTorch.
+// include/phnn/config/run_result.h — what one run produces, no LibTorch.
 #pragma once
 
 #include <cstdint>

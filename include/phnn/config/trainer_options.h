@@ -1,11 +1,11 @@
-// include/phnn/training/trainer_options.h — training settings, no LibTorch.
+// include/phnn/config/trainer_options.h — training settings, no LibTorch.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "phnn/models/model_config.h"
+#include "phnn/config/model_config.h"
 
 namespace phnn {
 

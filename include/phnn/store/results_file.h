@@ -1,4 +1,4 @@
-// include/phnn/sweep/results_file.h — the one parallel-HDF5 file that holds
+// include/phnn/store/results_file.h — the one parallel-HDF5 file that holds
 // every run of a sweep (layout: docs/RESULTS_FORMAT.md).
 #pragma once
 
@@ -10,11 +10,11 @@
 #include <utility>
 #include <vector>
 
-#include "phnn/data/dataset_file.h"
+#include "phnn/config/run_config.h"
+#include "phnn/config/run_result.h"
+#include "phnn/config/system_file_text.h"
 #include "phnn/data/ph_dataset.h"
-#include "phnn/sweep/run_config.h"
-#include "phnn/sweep/sweep_file.h"
-#include "phnn/training/run_result.h"
+#include "phnn/store/dataset_file.h"
 
 namespace phnn {
 

@@ -1,11 +1,12 @@
-// src/training/trainer_options.cpp
-#include "phnn/training/trainer_options.h"
+// src/config/trainer_options.cpp — training settings and run statuses: names,
+// parsers, validation (LibTorch-free).
+#include "phnn/config/trainer_options.h"
 
 #include <cmath>
 #include <stdexcept>
 
 #include "phnn/common/check.h"
-#include "phnn/training/run_result.h"
+#include "phnn/config/run_result.h"
 
 namespace phnn {
 

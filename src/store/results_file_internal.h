@@ -1,4 +1,4 @@
-// src/sweep/results_file_internal.h — shared by the results_file*.cpp files
+// src/store/results_file_internal.h — shared by the results_file*.cpp files
 // only: the dataset names and units texts of docs/RESULTS_FORMAT.md,
 // ResultsFile::Impl (the open h5::File and the layout read from it), and the
 // helpers that make every rank fail together. Includes HDF5 only through
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "h5/h5file.h"
-#include "phnn/sweep/results_file.h"
+#include "phnn/store/results_file.h"
 
 namespace phnn {
 namespace results_io {

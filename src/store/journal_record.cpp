@@ -1,4 +1,4 @@
-// src/sweep/journal_record.cpp — one journal line: every RunResult field
+// src/store/journal_record.cpp — one journal line: every RunResult field
 // written exactly (hex floats, NaN payloads, percent-escaped strings) and a
 // checksum, and its parser. The files themselves: journal.cpp.
 #include <locale.h>
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "phnn/sweep/journal.h"
-#include "phnn/sweep/run_config.h"  // fnv1a64, hex64
+#include "phnn/config/run_config.h"  // fnv1a64, hex64
+#include "phnn/store/journal.h"
 
 namespace phnn {
 namespace {

@@ -1,4 +1,4 @@
-// include/phnn/data/ph_dataset_file.h — data-set files of any PhSystem
+// include/phnn/store/ph_dataset_file.h — data-set files of any PhSystem
 // (format_version 2 of "phnn-dataset"; docs/RESULTS_FORMAT.md, "Data-set
 // files"): states of n_x components, inputs of n_u, the state names and
 // units, and the system file's text, so the data say what made them.

@@ -1,11 +1,12 @@
-// src/data/dataset_file.cpp
-#include "phnn/data/dataset_file.h"
+// src/store/dataset_file.cpp — format_version 1 data-set files (the built-in
+// systems' SystemData) and their groups inside results files.
+#include "phnn/store/dataset_file.h"
 
 #include <sys/stat.h>
 
 #include <stdexcept>
 
-#include "data/dataset_file_io.h"
+#include "store/dataset_file_io.h"
 
 namespace phnn {
 

@@ -1,13 +1,13 @@
-// src/data/ph_dataset_file.cpp — format_version 2 data-set files
-// (include/phnn/data/ph_dataset_file.h); version 1 (built-in systems) is
+// src/store/ph_dataset_file.cpp — format_version 2 data-set files
+// (include/phnn/store/ph_dataset_file.h); version 1 (built-in systems) is
 // read through dataset_file.cpp and converted.
-#include "phnn/data/ph_dataset_file.h"
+#include "phnn/store/ph_dataset_file.h"
 
 #include <sstream>
 #include <stdexcept>
 
-#include "data/dataset_file_io.h"
 #include "h5/h5file.h"
+#include "store/dataset_file_io.h"
 
 namespace phnn {
 namespace {

@@ -1,4 +1,4 @@
-// include/phnn/models/model_config.h — what a model is, without LibTorch.
+// include/phnn/config/model_config.h — what a model is, without LibTorch.
 #pragma once
 
 #include <string>

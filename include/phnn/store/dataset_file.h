@@ -1,4 +1,6 @@
-// include/phnn/data/dataset_file.h
+// include/phnn/store/dataset_file.h — data-set files of the built-in systems
+// (format_version 1, docs/DATASET_FORMAT.md): SystemData to and from HDF5.
+// Reads and writes only the file it is given.
 #pragma once
 
 #include <string>
@@ -6,22 +8,6 @@
 #include "phnn/data/dataset.h"
 
 namespace phnn {
-
-/// Everything one system contributes to an experiment: the training pairs
-/// (first n_train of them are used by a run), validation pairs and inference
-/// trajectories (docs/METHOD.md §2).
-struct SystemData {
-  OscillatorOptions system;
-  DatasetOptions options;
-  PairSet train;
-  PairSet validation;
-  InferenceSet inference;
-};
-
-/// Generates a system's splits. `num_train` pairs of the train split (at most
-/// options.num_train_max) are generated; only what is asked is computed.
-SystemData make_system_data(const OscillatorOptions& system,
-                            const DatasetOptions& options, int num_train);
 
 /// Writes `data` to a new HDF5 file (layout in docs/DATASET_FORMAT.md): groups
 /// train/, validation/, inference/ with datasets x, x_next, u, trajectory,

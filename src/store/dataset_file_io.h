@@ -1,12 +1,12 @@
-// src/data/dataset_file_io.h — data-set groups inside any HDF5 file (data
+// src/store/dataset_file_io.h — data-set groups inside any HDF5 file (data
 // files and the results file, which stores each system's data once).
 #pragma once
 
 #include <string>
 
 #include "h5/h5file.h"
-#include "phnn/data/dataset_file.h"
 #include "phnn/data/ph_dataset.h"
+#include "phnn/store/dataset_file.h"
 
 namespace phnn {
 namespace internal {

@@ -1,4 +1,4 @@
-// src/sweep/results_file_create.cpp — ResultsFile::create: every dataset of
+// src/store/results_file_create.cpp — ResultsFile::create: every dataset of
 // docs/RESULTS_FORMAT.md made up front (allocated and filled, so a row write
 // later touches raw data only) and the configuration columns written.
 #include <unistd.h>
@@ -7,8 +7,8 @@
 #include <map>
 
 #include "phnn/common/utc_time.h"
-#include "phnn/models/model_config.h"
-#include "sweep/results_file_internal.h"
+#include "phnn/config/model_config.h"
+#include "store/results_file_internal.h"
 
 namespace phnn {
 

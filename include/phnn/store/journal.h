@@ -1,4 +1,4 @@
-// include/phnn/sweep/journal.h — per-rank append-only record of finished
+// include/phnn/store/journal.h — per-rank append-only record of finished
 // runs: the source of truth for recovering a sweep (the results file is
 // rebuilt from it on resume).
 #pragma once
@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-#include "phnn/training/run_result.h"
+#include "phnn/config/run_result.h"
 
 namespace phnn {
 

@@ -1,7 +1,7 @@
-// src/sweep/journal.cpp — the per-rank journal files: append a record and
+// src/store/journal.cpp — the per-rank journal files: append a record and
 // fsync it, replay the latest record of every run, delete old journals.
 // The record format: journal_record.cpp.
-#include "phnn/sweep/journal.h"
+#include "phnn/store/journal.h"
 
 #include <dirent.h>
 #include <fcntl.h>

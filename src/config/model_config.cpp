@@ -1,5 +1,6 @@
-// src/models/model_config.cpp
-#include "phnn/models/model_config.h"
+// src/config/model_config.cpp — model kinds, sizes and widths: names, parsers,
+// parameter counts (LibTorch-free).
+#include "phnn/config/model_config.h"
 
 #include <cctype>
 #include <stdexcept>

@@ -1,10 +1,10 @@
-// src/sweep/results_file_rows.cpp — one row of /runs: ResultsFile::write_run
+// src/store/results_file_rows.cpp — one row of /runs: ResultsFile::write_run
 // (independent raw-data writes, status last) and read_run, and the column
 // readers of the reducer.
 #include <algorithm>
 #include <array>
 
-#include "sweep/results_file_internal.h"
+#include "store/results_file_internal.h"
 
 namespace phnn {
 
