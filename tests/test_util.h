@@ -69,5 +69,13 @@ inline int run_shell(const std::string& command, std::string* output = nullptr) 
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+#if defined(PHNN_MPIEXEC) && defined(PHNN_BINARY)
+/// "mpiexec -n RANKS <preflags> build/phnn": the start of a command line.
+inline std::string mpiexec_phnn(int ranks) {
+  return std::string(PHNN_MPIEXEC) + " -n " + std::to_string(ranks) + " " + PHNN_MPIEXEC_PREFLAGS +
+         " " + PHNN_BINARY;
+}
+#endif
+
 }  // namespace testing_util
 }  // namespace phnn

@@ -242,16 +242,23 @@ std::string data_group(const std::string& system_name) {
 }
 }  // namespace
 
-void ResultsFile::store_system_data(const std::string& system_name, const SystemData& data) {
+void ResultsFile::store_data_group(const std::string& system_name,
+                                   const std::function<void(const std::string&)>& write) {
   const std::string group = data_group(system_name);
   // Every rank sees the same file state, so all throw together.
   require(!has_system_data(system_name),
           path() + ": " + group + " is already stored; check has_system_data() first");
   impl_->collective([&] {
     impl_->file.remove(group);  // a group left incomplete by a crash
-    internal::write_system_data(impl_->file, group, data);
+    write(group);
     impl_->file.set_attribute(group, "complete", std::int64_t{1});
     impl_->file.flush();
+  });
+}
+
+void ResultsFile::store_system_data(const std::string& system_name, const SystemData& data) {
+  store_data_group(system_name, [&](const std::string& group) {
+    internal::write_system_data(impl_->file, group, data);
   });
 }
 
@@ -267,15 +274,9 @@ SystemData ResultsFile::read_system_data(const std::string& system_name) const {
 
 void ResultsFile::store_file_system_data(const std::string& system_name, const PhSystemData& data,
                                          const std::string& sweep_entry) {
-  const std::string group = data_group(system_name);
-  require(!has_system_data(system_name),
-          path() + ": " + group + " is already stored; check has_system_data() first");
-  impl_->collective([&] {
-    impl_->file.remove(group);  // a group left incomplete by a crash
+  store_data_group(system_name, [&](const std::string& group) {
     internal::write_ph_system_data(impl_->file, group, data);
     impl_->file.set_attribute(group, "sweep_entry", sweep_entry);
-    impl_->file.set_attribute(group, "complete", std::int64_t{1});
-    impl_->file.flush();
   });
 }
 

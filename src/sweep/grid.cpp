@@ -46,8 +46,7 @@ CostParts cost_parts(const RunConfig& run, const CostModel& c) {
   const double general =
       !run.has_system_file()          ? 1.0
       : run.model == ModelKind::kNode ? c.general_node_factor
-                                      : c.general_phnn_factor *
-                                            std::max(1.0, std::pow(run.n_x / 4.0, c.general_phnn_exponent));
+                                      : c.general_phnn_base + c.general_phnn_per_state2 * run.n_x * run.n_x;
   CostParts parts;
   parts.fixed_s = t.steps * fixed_us * precision * general * 1e-6;
   parts.member_s =

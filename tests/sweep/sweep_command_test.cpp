@@ -37,10 +37,7 @@ std::string temp_dir(const std::string& name) {
   return dir;
 }
 
-std::string mpiexec(int ranks) {
-  return std::string(PHNN_MPIEXEC) + " -n " + std::to_string(ranks) + " " + PHNN_MPIEXEC_PREFLAGS +
-         " " + PHNN_BINARY;
-}
+std::string mpiexec(int ranks) { return testing_util::mpiexec_phnn(ranks); }
 
 int shell(const std::string& command, std::string* output = nullptr) {
   return testing_util::run_shell(command, output);

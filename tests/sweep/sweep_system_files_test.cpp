@@ -86,10 +86,7 @@ std::string error_of_text(const std::string& text) {
   return "(no error)";
 }
 
-std::string mpiexec(int ranks) {
-  return std::string(PHNN_MPIEXEC) + " -n " + std::to_string(ranks) + " " + PHNN_MPIEXEC_PREFLAGS +
-         " " + PHNN_BINARY;
-}
+std::string mpiexec(int ranks) { return testing_util::mpiexec_phnn(ranks); }
 
 int shell(const std::string& command, std::string* output) {
   return testing_util::run_shell(command, output);

@@ -5,6 +5,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -227,6 +228,9 @@ class ResultsFile {
  private:
   struct Impl;
   explicit ResultsFile(std::unique_ptr<Impl> impl);
+  /// Collective: /data/<system_name> written by `write(group)`, then marked complete.
+  void store_data_group(const std::string& system_name,
+                        const std::function<void(const std::string&)>& write);
   std::unique_ptr<Impl> impl_;
 };
 

@@ -98,15 +98,19 @@ struct CostModel {
   double small_batch_saving = 0.85;  // PHNN-JR-RK2 E = 10: 64 us at batch 25, 110 at 64
   /// Runs of a system file train the n-dimensional models (general_ph.h):
   /// their fixed and member costs are the fused 2-state path's times
-  ///   general_node_factor                                  (NODE)
-  ///   general_phnn_factor * max(1, (n_x / 4)^general_phnn_exponent)  (PHNNs)
+  ///   general_node_factor                                   (NODE)
+  ///   general_phnn_base + general_phnn_per_state2 * n_x^2   (PHNNs)
   /// fit to `bench_training general` (docs/BENCHMARKS.md, "n-dimensional
-  /// systems"): PHNN-JR-RK2 1 053, 1 247, 1 982, 3 325 us per member-step at
-  /// n_x = 2, 4, 6, 8 against 114 fused (9.2, 10.9, 17.4, 29.2x); NODE
-  /// 48-56 against 49.
+  /// systems", E = 10): PHNN-JR-RK2 1 053, 1 247, 1 982, 3 325 us per
+  /// member-step at n_x = 2, 4, 6, 8 against this model's 78 for the fused
+  /// path at E = 10 (70 + 82 / 10): 13.5, 16.0, 25.4, 42.6x (PHNN-S-RK2 at
+  /// n_x = 4: 1 450 against 80, 18x); NODE 48-56 against 49 measured.
+  /// Checked on sweeps/examples/coupled-duffing.toml (n_x = 4): its two
+  /// largest cells took 34-35 min on a core shared with builds, the model
+  /// says 14 min alone.
   double general_node_factor = 1.1;
-  double general_phnn_factor = 9.5;
-  double general_phnn_exponent = 1.7;
+  double general_phnn_base = 11.6;
+  double general_phnn_per_state2 = 0.48;
   /// Pairs per batch-step in the validation and inference terms.
   double reference_batch = 64.0;
   /// A rollout state-step costs 1 / rollout_speedup of a training pair-step
