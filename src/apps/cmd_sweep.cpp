@@ -28,6 +28,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/early_signals.h"
 #include "apps/provenance.h"
 #include "apps/sweep_data.h"
 #include "apps/sweep_phases.h"
@@ -35,6 +36,7 @@
 #include "h5/h5file.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
+#include "phnn/store/scratch_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"
 #include "phnn/sweep/output_check.h"
@@ -162,23 +164,20 @@ class SweepRun {
     torch::set_num_threads(static_cast<int>(parser_.get_int("threads")));
     out_ = parser_.has("out") ? parser_.get("out")
                               : (shard_.count > 1 ? shard_.output_path(spec_.output) : spec_.output);
-    int action = 0;
-    if (int status = agreed(world_, root_, [&] {
-          action = prepare_output(out_, parser_.get("FILE"), spec_, grid_, &lock_);
-        })) {
-      return status;
-    }
-    mpi::broadcast(world_, action, 0);
-    if (int status = open_results(action == 1)) return status;
-    results_->begin_session(session_provenance(MPI_COMM_WORLD, argc_, argv_));
-    if (int status = store_missing_data(action == 1)) return status;
+    const Provenance session = session_provenance(MPI_COMM_WORLD, argc_, argv_);
+    // Rank 0 alone creates or updates the file, serially; the other ranks open
+    // it only to write their rows (docs/DECISIONS.md, "No rank waits forever").
     std::vector<int> status_codes;
-    if (int status = agreed(world_, root_, [&] {
-          status_codes = recover_from_journals(&*results_, out_, action == 0);
-        })) {
+    if (int status = agreed(world_, root_, [&] { status_codes = prepare_results(session); })) {
       return status;
     }
     mpi::broadcast(world_, status_codes, 0);
+    mpi::broadcast(world_, session_, 0);
+    if (int status = agreed(world_, true, [&] {
+          results_.emplace(ResultsFile::open(out_, MPI_COMM_WORLD, spec_.text_hash));
+        })) {
+      return status;
+    }
     if (int status = agreed(world_, true, [&] { journal_.emplace(out_, rank_); })) return status;
     return train_and_close(status_codes);
   }
@@ -226,47 +225,55 @@ class SweepRun {
                          : std::string());
   }
 
-  int open_results(bool resume) {
-    return agreed(world_, true, [&] {
+  // Rank 0, alone: the writer lock and what is at out_ (prepare_output);
+  // then the new file, or a copy of the one to resume, gets the data groups
+  // it lacks, this session's provenance and the journals' results, and
+  // replaces out_ atomically (scratch_file.h): a failure here (a full disk)
+  // leaves out_ as it was. Returns every row's status code.
+  std::vector<int> prepare_results(const Provenance& session) {
+    const bool resume = prepare_output(out_, parser_.get("FILE"), spec_, grid_, &lock_) == 1;
+    const std::string scratch = scratch_path(out_, resume ? "updating" : "creating");
+    std::vector<int> codes;
+    try {
+      std::optional<ResultsFile> file;
       if (resume) {
-        results_.emplace(ResultsFile::open(out_, MPI_COMM_WORLD, spec_.text_hash));
-        return;
+        copy_file(out_, scratch);
+        file.emplace(ResultsFile::open(scratch, MPI_COMM_NULL, spec_.text_hash));
+      } else {
+        std::vector<std::string> studies;
+        for (const auto& s : grid_.run_studies) studies.push_back(join(s, ","));
+        file.emplace(ResultsFile::create(scratch, MPI_COMM_NULL, grid_.runs, studies, spec_.name,
+                                         spec_.text, spec_.text_hash, program_version(),
+                                         ResultsLayout::for_runs(grid_.runs)));
       }
-      std::vector<std::string> studies;
-      for (const auto& s : grid_.run_studies) studies.push_back(join(s, ","));
-      results_.emplace(ResultsFile::create(out_, MPI_COMM_WORLD, grid_.runs, studies, spec_.name,
-                                           spec_.text, spec_.text_hash, program_version(),
-                                           ResultsLayout::for_runs(grid_.runs)));
-    });
+      store_missing_data(&*file, resume);
+      session_ = file->begin_session(session);
+      codes = recover_from_journals(&*file, out_, !resume);
+      file->close();
+      commit_scratch(scratch, out_);
+    } catch (...) {
+      std::remove(scratch.c_str());
+      throw;
+    }
+    return codes;
   }
 
   // /data/<system> for every system of the grid: written at creation, and
   // again on resume if a crash during creation left it missing.
-  int store_missing_data(bool resume) {
+  void store_missing_data(ResultsFile* file, bool resume) {
     std::set<std::string> systems;
     for (const RunConfig& run : grid_.runs) systems.insert(run.system_name());
     std::vector<std::string> missing;
-    if (int status = agreed(world_, root_, [&] {
-          for (const std::string& name : systems) {
-            if (!results_->has_system_data(name)) missing.push_back(name);
-          }
-        })) {
-      return status;
+    for (const std::string& name : systems) {
+      if (file->has_system_data(name)) continue;
+      data_.make(name);
+      data_.store(name, file);
+      missing.push_back(name);
     }
-    mpi::broadcast(world_, missing, 0);
-    // Data sets: deterministic, so every rank makes them itself; a system
-    // file whose data cannot be generated fails on every rank alike.
-    if (int status = agreed(world_, true, [&] {
-          for (const std::string& name : missing) data_.make(name);
-        })) {
-      return status;
-    }
-    for (const std::string& name : missing) data_.store(name, &*results_);
-    if (root_ && resume && !missing.empty()) {
+    if (resume && !missing.empty()) {
       std::cerr << "phnn sweep: " << out_ << ": wrote the missing data group(s) /data/"
                 << join(missing, ", /data/") << "\n";
     }
-    return 0;
   }
 
   int train_and_close(const std::vector<int>& status_codes);
@@ -288,6 +295,7 @@ class SweepRun {
   WriterLock lock_;  // rank 0 only; released after the file is closed
   std::optional<ResultsFile> results_;
   std::optional<Journal> journal_;
+  int session_ = 0;  // this run's /provenance/session_<k>
   SweepDataSets data_{spec_, grid_};
   Clock::time_point start_ = Clock::now();
 };
@@ -312,21 +320,29 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
 }
 
 // Journal record first (the source of truth), then the run times and the
-// row, for each run of the item. Returns "" or the I/O error.
+// row, for each run of the item. A failed journal append (a full disk) does
+// not stop the row: its space was allocated when the file was made, so the
+// result is kept there. Returns "" or the first I/O error.
 std::string record_item(const Grid& grid, const WorkItem& item,
                         const std::vector<RunResult>& cell_results, const std::string& started,
                         const std::string& finished, Journal* journal, ResultsFile* results) {
-  try {
-    for (std::size_t k = 0; k < item.runs.size(); ++k) {
-      const int row = item.runs[k];
-      journal->append(grid.runs[static_cast<std::size_t>(row)].id(), cell_results[k]);
+  std::string error;
+  auto attempt = [&](const auto& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      if (error.empty()) error = std::string("phnn sweep: ") + e.what();
+    }
+  };
+  for (std::size_t k = 0; k < item.runs.size(); ++k) {
+    const int row = item.runs[k];
+    attempt([&] { journal->append(grid.runs[static_cast<std::size_t>(row)].id(), cell_results[k]); });
+    attempt([&] {
       results->write_run_times(row, started, finished);
       results->write_run(row, cell_results[k]);
-    }
-  } catch (const std::exception& e) {
-    return std::string("phnn sweep: ") + e.what();
+    });
   }
-  return "";
+  return error;
 }
 
 int SweepRun::train_and_close(const std::vector<int>& status_codes) {
@@ -353,10 +369,20 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     last_progress = elapsed();
     progress_line.print(queue.done(), elapsed());
   };
-  // An I/O error on this rank: it takes no more items; the others finish
-  // theirs, then every rank learns of it (agree below) and exits 1.
+  // An I/O error on this rank: it takes no more items, nor do the others
+  // after the one in hand; then every rank learns of it (agree below) and
+  // exits 1.
   std::string io_error;
-  for (int i = g_stop_signal ? -1 : queue.next(); i >= 0; i = g_stop_signal ? -1 : queue.next()) {
+  // A stop signal on any rank stops every rank at its next item boundary:
+  // this rank posts it at once, from the training's progress ticks too.
+  auto post_stop = [&] {
+    if (g_stop_signal != 0 && !queue.stop_requested()) queue.request_stop();
+  };
+  auto next_item = [&] {
+    post_stop();
+    return queue.next();
+  };
+  for (int i = next_item(); i >= 0; i = next_item()) {
     const WorkItem& item = work[static_cast<std::size_t>(i)];
     const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
     std::vector<int> seeds;
@@ -370,10 +396,16 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     const auto cell_start = Clock::now();
     const std::string started = utc_now();
     const std::vector<RunResult> cell_results =
-        train_item(cell, &data_, head.system_name(), [&] { report_progress(false); }, prefix_, i + 1);
+        train_item(cell, &data_, head.system_name(), [&] {
+          post_stop();
+          report_progress(false);
+        }, prefix_, i + 1);
     io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
-    if (!io_error.empty()) break;
     my_runs += static_cast<int>(item.runs.size());
+    if (!io_error.empty()) {
+      queue.request_stop();  // the others stop at their next item too
+      break;
+    }
     queue.mark_done();
     if (!quiet) {
       print_item("%sitem %d/%zu done in %s\n", prefix_, i + 1, work.size(),
@@ -381,18 +413,35 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     }
     report_progress(true);
   }
-  const int stopped = mpi::all_reduce(world_, g_stop_signal ? 1 : 0, mpi::maximum<int>());
+  post_stop();
+  const int stopped = mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>());
   queue.close();
   const int total_runs = mpi::all_reduce(world_, my_runs, std::plus<int>());
-  const int failed = agree(world_, io_error.empty() ? 0 : kExitFailed, io_error);
+  // Every rank closes (collective, but nothing is left to write: rows are
+  // raw data in allocated space), then every rank learns every error.
   try {
-    results_->end_session(utc_now());
     results_->close();
   } catch (const std::exception& e) {
-    std::cerr << prefix_ << e.what() << "\n";
-    MPI_Abort(MPI_COMM_WORLD, 1);
+    if (io_error.empty()) io_error = prefix_ + e.what();
   }
-  if (root_) print_summary(out_, total_runs, elapsed(), stopped != 0, shard_);
+  int failed = agree(world_, io_error.empty() ? 0 : kExitFailed, io_error);
+  // The session's end, written in place by rank 0 alone.
+  if (int status = agreed(world_, root_, [&] {
+        ResultsFile file = ResultsFile::open(out_, MPI_COMM_NULL, spec_.text_hash);
+        file.end_session(session_, utc_now());
+        file.close();
+      })) {
+    failed = std::max(failed, status);
+  }
+  if (root_) {
+    try {
+      print_summary(out_, total_runs, elapsed(), failed ? StopReason::kError
+                                                 : stopped ? StopReason::kSignal
+                                                           : StopReason::kNone, shard_);
+    } catch (const std::exception& e) {
+      std::cerr << "phnn sweep: " << e.what() << "\n";
+    }
+  }
   if (failed) return failed;
   return stopped ? kExitStopped : 0;
 }
@@ -401,9 +450,10 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
 
 int run_sweep(int argc, char** argv, int first) {
   // Before MPI_Init: a SIGTERM/SIGUSR1 while starting up is a clean stop too
-  // (exit 75), not 143/138.
+  // (exit 75), not 143/138; one caught before main (early_signals.h) counts.
   std::signal(SIGTERM, request_stop);
   std::signal(SIGUSR1, request_stop);
+  if (early_stop_signal() != 0) g_stop_signal = early_stop_signal();
   mpi::environment env(argc, argv);
   return SweepRun(argc, argv, first).run();
 }

@@ -1,4 +1,5 @@
 // src/apps/phnn.cpp — the single `phnn` executable: phnn <command> [options].
+#include <csignal>
 #include <cstring>
 #include <exception>
 #include <iostream>
@@ -7,6 +8,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/early_signals.h"
 #include "apps/provenance.h"
 #include "phnn/common/closest_name.h"
 
@@ -60,6 +62,10 @@ const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
+  // SIGTERM/SIGUSR1 are held from the process's start (apps/early_signals.h).
+  // A file-size limit (ulimit -f) then fails the write with EFBIG, reported
+  // like a full disk, instead of killing the process without a word.
+  std::signal(SIGXFSZ, SIG_IGN);
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
     std::cout << kUsage;
     return argc < 2 ? phnn::cli::kUsageError : 0;
@@ -69,6 +75,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string command = argv[1];
+  // Only a sweep stops gracefully; the others end by the signal, as usual.
+  if (command != "sweep") phnn::apps::restore_default_stop_signals();
   try {
     for (const Command& c : kCommands) {
       if (command == c.name) return c.run(argc, argv, 2);

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "phnn/common/utc_time.h"
+#include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 
 namespace phnn {
@@ -72,7 +73,7 @@ void print_item(const char* format, const std::string& prefix, int item_number,
   std::fflush(stdout);
 }
 
-void print_summary(const std::string& out, int total_runs, double seconds, bool stopped,
+void print_summary(const std::string& out, int total_runs, double seconds, StopReason stop,
                    const Shard& shard) {
   const ResultsFile summary = ResultsFile::open_read_only(out);
   int counts[4] = {0, 0, 0, 0};
@@ -81,7 +82,11 @@ void print_summary(const std::string& out, int total_runs, double seconds, bool 
               "%d pending of %d\n",
               total_runs, format_duration(seconds).c_str(), out.c_str(), counts[1], counts[2],
               counts[3], counts[0], summary.num_runs());
-  if (stopped) {
+  if (stop == StopReason::kError) {
+    std::printf("phnn sweep: stopped by the error above; every finished run is in the journals "
+                "(%s); fix the cause (free space?) and run the same command again to resume\n",
+                journal_directory(out).c_str());
+  } else if (stop == StopReason::kSignal) {
     std::printf("phnn sweep: stopped on a signal; run the same command again to resume\n");
   } else if (shard.count > 1) {
     std::printf("phnn sweep: shard %d/%d done (the pending runs are other shards'); when every "

@@ -48,8 +48,11 @@ void print_plan(const SweepSpec& spec, const Grid& grid, const Shard& shard,
 void print_item(const char* format, const std::string& prefix, int item_number,
                 std::size_t items, const std::string& what);
 
+/// Why a sweep ended before its queue was empty.
+enum class StopReason { kNone, kSignal, kError };
+
 /// Rank 0's summary line(s) after the file is closed.
-void print_summary(const std::string& out, int total_runs, double seconds, bool stopped,
+void print_summary(const std::string& out, int total_runs, double seconds, StopReason stop,
                    const Shard& shard);
 
 }  // namespace apps

@@ -18,12 +18,39 @@ namespace detail {
 static_assert(sizeof(hid_t) == sizeof(std::int64_t), "hid_t must be 64-bit");
 
 // Silences HDF5's own error stack printing: we report errors ourselves.
+// And no cleanup at exit: phnn closes every file itself, and HDF5's own
+// atexit cleanup crashes on a file whose close failed (a full disk).
 struct SilenceHdf5 {
-  SilenceHdf5() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+  SilenceHdf5() {
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
 };
 
-[[noreturn]] inline void fail(const std::string& file, const std::string& what) {
-  throw Error(file + ": " + what);
+// The operating system's words for the failure on HDF5's error stack, e.g.
+// "No space left on device" ("" if the failure was not a system call's).
+inline std::string system_error_text() {
+  std::string text;
+  auto visit = [](unsigned, const H5E_error2_t* e, void* data) -> herr_t {
+    const std::string desc = e->desc != nullptr ? e->desc : "";
+    const std::size_t at = desc.find("error message = '");
+    if (at != std::string::npos) {
+      const std::size_t begin = at + 17;
+      *static_cast<std::string*>(data) = desc.substr(begin, desc.find('\'', begin) - begin);
+    }
+    return 0;
+  };
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, visit, &text);
+  return text;
+}
+
+// Throws Error("<file>: <what>: <the system's reason>"), or with `hint`
+// instead of the reason when the failure was not a system call's.
+[[noreturn]] inline void fail(const std::string& file, const std::string& what,
+                              const std::string& hint = "") {
+  const std::string system = system_error_text();
+  throw Error(file + ": " + what +
+              (!system.empty() ? ": " + system : hint.empty() ? "" : "; " + hint));
 }
 
 // RAII for one HDF5 identifier.

@@ -28,7 +28,7 @@ File::File(std::int64_t id, std::string path, MPI_Comm comm)
 File File::create(const std::string& path, MPI_Comm comm) {
   Handle fapl(file_access_plist(comm), H5Pclose);
   const hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
-  if (id < 0) fail(path, "cannot create the HDF5 file; is the directory writable?");
+  if (id < 0) fail(path, "cannot create the HDF5 file", "is the directory writable?");
   return File(id, path, comm);
 }
 
@@ -47,7 +47,10 @@ File File::open(const std::string& path, Access access, MPI_Comm comm) {
   Handle fapl(file_access_plist(comm), H5Pclose);
   const unsigned flags = access == Access::kReadOnly ? H5F_ACC_RDONLY : H5F_ACC_RDWR;
   const hid_t id = H5Fopen(path.c_str(), flags, fapl.get());
-  if (id < 0) fail(path, "cannot open the HDF5 file (locked by another process?)");
+  if (id < 0) {
+    fail(path, "cannot open the HDF5 file",
+         "truncated or damaged, or locked by another process (HDF5 file locking)");
+  }
   return File(id, path, comm);
 }
 
@@ -75,9 +78,12 @@ File::~File() {
 }
 
 void File::close() {
-  if (id_ >= 0) {
-    H5Fclose(id_);
-    id_ = -1;
+  if (id_ < 0) return;
+  const hid_t id = id_;
+  id_ = -1;
+  if (H5Fclose(id) < 0) {
+    fail(path_, "cannot close the HDF5 file: its last changes could not be written (disk "
+                "full, file-size limit or I/O error?)");
   }
 }
 
@@ -162,7 +168,18 @@ void write_attribute(hid_t file, const std::string& fname, const std::string& ob
                      const std::string& name, hid_t type, const void* value) {
   Handle obj(open_object(file, object), H5Oclose);
   if (!obj.ok()) fail(fname, "no object " + object + " for attribute " + name);
-  if (H5Aexists(obj.get(), name.c_str()) > 0) H5Adelete(obj.get(), name.c_str());
+  if (H5Aexists(obj.get(), name.c_str()) > 0) {
+    // The same type and size: overwrite the value in place (no allocation).
+    Handle old(H5Aopen(obj.get(), name.c_str(), H5P_DEFAULT), H5Aclose);
+    Handle old_type(H5Aget_type(old.get()), H5Tclose);
+    if (old.ok() && old_type.ok() && H5Tequal(old_type.get(), type) > 0) {
+      if (H5Awrite(old.get(), type, value) < 0) {
+        fail(fname, "cannot write attribute " + object + "@" + name);
+      }
+      return;
+    }
+    H5Adelete(obj.get(), name.c_str());
+  }
   Handle space(H5Screate(H5S_SCALAR), H5Sclose);
   Handle attr(H5Acreate2(obj.get(), name.c_str(), type, space.get(), H5P_DEFAULT,
                          H5P_DEFAULT),

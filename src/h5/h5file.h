@@ -46,6 +46,8 @@ class File {
   ~File();
 
   const std::string& path() const { return path_; }
+  /// Writes what is pending and closes; throws h5::Error if that fails (the
+  /// file is closed either way). Collective in parallel.
   void close();
   void flush();
 

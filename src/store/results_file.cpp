@@ -338,6 +338,11 @@ std::vector<std::string> ResultsFile::read_finished_utc() const {
   return impl_->strings(kFinishedUtc);
 }
 
+// "finished" is reserved at the start with kFinishedWidth NUL bytes, so
+// end_session overwrites the value in place: ending a session allocates
+// nothing, and cannot fail for a full disk.
+constexpr std::size_t kFinishedWidth = 20;  // "2026-11-25T08:43:21Z"
+
 int ResultsFile::begin_session(const Provenance& provenance) {
   Impl& impl = *impl_;
   // Every rank reads the same metadata, so every rank picks the same k.
@@ -349,15 +354,23 @@ int ResultsFile::begin_session(const Provenance& provenance) {
   impl.collective([&] {
     impl.file.create_group(impl.session);
     for (const auto& [key, value] : provenance) impl.file.set_attribute(impl.session, key, value);
+    impl.file.set_attribute(impl.session, "finished", std::string(kFinishedWidth, '\0'));
     impl.file.flush();
   });
   return k;
 }
 
 void ResultsFile::end_session(const std::string& finished_utc) {
+  if (impl_->session.empty()) return;
+  end_session(std::stoi(impl_->session.substr(impl_->session.rfind('_') + 1)), finished_utc);
+}
+
+void ResultsFile::end_session(int session, const std::string& finished_utc) {
   Impl& impl = *impl_;
-  if (impl.session.empty()) return;
-  impl.collective([&] { impl.file.set_attribute(impl.session, "finished", finished_utc); });
+  const std::string group = kProvenance + "/session_" + std::to_string(session);
+  std::string value = finished_utc;
+  if (value.size() < kFinishedWidth) value.resize(kFinishedWidth, '\0');
+  impl.collective([&] { impl.file.set_attribute(group, "finished", value); });
 }
 
 std::vector<Provenance> ResultsFile::read_sessions() const {
@@ -369,7 +382,9 @@ std::vector<Provenance> ResultsFile::read_sessions() const {
       if (!impl.file.exists(group)) break;
       Provenance p;
       for (const std::string& name : impl.file.attribute_names(group)) {
-        p.emplace_back(name, impl.file.string_attribute(group, name));
+        std::string value = impl.file.string_attribute(group, name);
+        if (name == "finished" && value.empty()) continue;  // reserved, not yet ended
+        p.emplace_back(name, std::move(value));
       }
       sessions.push_back(std::move(p));
     }
@@ -383,8 +398,8 @@ void ResultsFile::flush() {
 
 void ResultsFile::close() {
   if (!impl_ || !impl_->open) return;
-  impl_->collective([&] { impl_->file.close(); });
   impl_->open = false;
+  impl_->file.close();
 }
 
 }  // namespace phnn

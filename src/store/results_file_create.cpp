@@ -3,11 +3,16 @@
 // later touches raw data only) and the configuration columns written.
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 #include <algorithm>
 #include <map>
 
 #include "phnn/common/utc_time.h"
 #include "phnn/config/model_config.h"
+#include "phnn/store/scratch_file.h"
 #include "store/results_file_internal.h"
 
 namespace phnn {
@@ -186,6 +191,44 @@ void write_config_columns(h5::File& file, const ConfigColumns& c,
   if (file.exists(kWeightsOffset)) file.write_rows(kWeightsOffset, 0, R, c.weights_offset.data());
 }
 
+struct FileAttributes {
+  std::string sweep_name, sweep_text, sweep_hash, program_version, created;
+};
+
+// The whole new file, written serially under a scratch name next to `path`
+// (<path>.creating), fsynced, then renamed onto `path`: a file at `path` is
+// complete or absent, never half-created. On an error the scratch file is
+// removed and the error rethrown.
+void write_new_file(const std::string& path, const ConfigColumns& columns,
+                    const std::vector<std::string>& run_studies, const ResultsLayout& layout,
+                    const FileAttributes& a) {
+  const std::string scratch = scratch_path(path, "creating");
+  try {
+    h5::File file = h5::File::create(scratch);
+    file.set_attribute("/", "format", std::string(ResultsFile::kFormat));
+    file.set_attribute("/", "format_version", ResultsFile::kFormatVersion);
+    file.set_attribute("/", "sweep_name", a.sweep_name);
+    file.set_attribute("/", "sweep_text", a.sweep_text);
+    file.set_attribute("/", "sweep_hash", a.sweep_hash);
+    file.set_attribute("/", "program_version", a.program_version);
+    file.set_attribute("/", "units", kFileUnits);
+    file.set_attribute("/", "created", a.created);
+    // Every dataset now, allocated and filled (pending rows: status 0, NaN
+    // floats, zero lengths): writing a row later touches raw data only.
+    const DatasetMaker make{file, static_cast<std::uint64_t>(columns.ids.size())};
+    create_config_datasets(make);
+    create_result_datasets(make, layout);
+    create_trace_and_figure_datasets(make, layout);
+    if (layout.weights) create_weight_datasets(make, columns.weights_total);
+    write_config_columns(file, columns, run_studies);
+    file.close();  // throws if the metadata cannot be written
+    commit_scratch(scratch, path);
+  } catch (...) {
+    std::remove(scratch.c_str());
+    throw;
+  }
+}
+
 }  // namespace
 
 ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
@@ -220,29 +263,17 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
     return "";
   });
   const std::string created = broadcast(comm, utc_now());
-
+  const FileAttributes attributes{sweep_name, sweep_text, sweep_hash, program_version, created};
+  // Rank 0 alone writes the new file, serially, so an I/O error (a full disk)
+  // stays on rank 0 and reaches every rank as one error: no rank is left in a
+  // collective HDF5 call (docs/DECISIONS.md, "No rank waits forever").
+  check_on_rank0(comm, [&] {
+    write_new_file(path, columns, run_studies, layout, attributes);
+    return std::string();
+  });
   std::unique_ptr<Impl> impl;
   collective_or_abort(comm, [&] {
-    h5::File file = h5::File::create(path, comm);
-    file.set_attribute("/", "format", std::string(kFormat));
-    file.set_attribute("/", "format_version", kFormatVersion);
-    file.set_attribute("/", "sweep_name", sweep_name);
-    file.set_attribute("/", "sweep_text", sweep_text);
-    file.set_attribute("/", "sweep_hash", sweep_hash);
-    file.set_attribute("/", "program_version", program_version);
-    file.set_attribute("/", "units", kFileUnits);
-    file.set_attribute("/", "created", created);
-    // Every dataset now, allocated and filled (pending rows: status 0, NaN
-    // floats, zero lengths): writing a row later touches raw data only.
-    const DatasetMaker make{file, static_cast<std::uint64_t>(runs.size())};
-    create_config_datasets(make);
-    create_result_datasets(make, layout);
-    create_trace_and_figure_datasets(make, layout);
-    if (layout.weights) create_weight_datasets(make, columns.weights_total);
-    if (comm_rank(comm) == 0) write_config_columns(file, columns, run_studies);
-    // Metadata on disk now: from here on a crash can only lose row data.
-    file.flush();
-    impl = std::make_unique<Impl>(std::move(file), comm);
+    impl = std::make_unique<Impl>(h5::File::open(path, h5::Access::kReadWrite, comm), comm);
   });
   return ResultsFile(std::move(impl));
 }

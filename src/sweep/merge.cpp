@@ -13,6 +13,7 @@
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
+#include "phnn/store/scratch_file.h"
 #include "results_copy.h"
 
 namespace phnn {
@@ -157,7 +158,7 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
   ResultsLayout layout = files.front().layout();
   for (const ResultsFile& file : files) layout = results_copy::wider_layout(layout, file.layout());
   const std::vector<int> source = result_sources(files, shards);
-  const std::string scratch = results_copy::scratch_path(out, "partial");
+  const std::string scratch = scratch_path(out, "partial");
   {
     ResultsFile merged = ResultsFile::create(scratch, MPI_COMM_NULL, grid.runs,
                                              results_copy::joined_studies(grid), spec.name,
@@ -173,7 +174,7 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
     }
     merged.close();
   }
-  results_copy::commit_scratch(scratch, out);
+  commit_scratch(scratch, out);
   return summary(out, files.size(), ResultsFile::open_read_only(out).read_statuses());
 }
 

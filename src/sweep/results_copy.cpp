@@ -18,24 +18,6 @@ namespace phnn {
 namespace results_copy {
 namespace {
 
-std::string errno_text() { return std::strerror(errno); }
-
-void fsync_path(const std::string& path, int flags) {
-  const int fd = ::open(path.c_str(), flags);
-  if (fd < 0) throw std::runtime_error(path + ": cannot open to sync: " + errno_text());
-  const int status = ::fsync(fd);
-  ::close(fd);
-  if (status != 0 && flags != O_RDONLY) {  // directories: best effort
-    throw std::runtime_error(path + ": fsync failed: " + errno_text());
-  }
-}
-
-std::string parent_directory(const std::string& path) {
-  const std::size_t slash = path.rfind('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
-
 }  // namespace
 
 bool same_result(const RunResult& a, const RunResult& b) {
@@ -86,32 +68,6 @@ std::vector<std::string> joined_studies(const Grid& grid) {
     joined.push_back(text);
   }
   return joined;
-}
-
-std::string scratch_path(const std::string& out, const std::string& suffix) {
-  const std::string path = out + "." + suffix;
-  struct stat st;
-  if (::stat(path.c_str(), &st) != 0) return path;
-  char head[4] = {};
-  std::ifstream in(path, std::ios::binary);
-  const bool hdf5 = in.read(head, 4) && std::memcmp(head, "\x89HDF", 4) == 0;
-  if (!S_ISREG(st.st_mode) || (st.st_size > 0 && !hdf5)) {
-    throw std::runtime_error(path + ": exists and is not a results file phnn left behind; move "
-                             "it away (phnn writes a results file there before renaming it)");
-  }
-  if (std::remove(path.c_str()) != 0) {
-    throw std::runtime_error(path + ": cannot remove a leftover of an earlier run: " +
-                             errno_text());
-  }
-  return path;
-}
-
-void commit_scratch(const std::string& scratch, const std::string& out) {
-  fsync_path(scratch, O_RDWR);
-  if (std::rename(scratch.c_str(), out.c_str()) != 0) {
-    throw std::runtime_error(scratch + ": cannot rename it to " + out + ": " + errno_text());
-  }
-  fsync_path(parent_directory(out), O_RDONLY);
 }
 
 }  // namespace results_copy

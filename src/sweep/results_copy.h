@@ -30,13 +30,5 @@ void copy_rows(const ResultsFile& from, const std::vector<std::pair<int, int>>& 
 /// The studies of each run of `grid`, joined for ResultsFile::create ("I,II").
 std::vector<std::string> joined_studies(const Grid& grid);
 
-/// Our scratch name next to `out` (`<out>.<suffix>`), free: a leftover of a
-/// crash there (empty, or an HDF5 file) is removed; anything else throws
-/// std::runtime_error naming it.
-std::string scratch_path(const std::string& out, const std::string& suffix);
-
-/// fsyncs `scratch`, renames it to `out` (atomic) and fsyncs the directory.
-void commit_scratch(const std::string& scratch, const std::string& out);
-
 }  // namespace results_copy
 }  // namespace phnn

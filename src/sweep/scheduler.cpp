@@ -13,16 +13,14 @@ WorkQueue::WorkQueue(MPI_Comm comm, int num_items, ScheduleMode mode)
   MPI_Comm_size(comm_, &size_);
   static_next_ = rank_;
   // The decision must be collective: every rank takes part in the allocation.
+  // The window is made in static mode too: it carries the stop flag.
   int want_dynamic = mode == ScheduleMode::kDynamic ? 1 : 0;
   MPI_Bcast(&want_dynamic, 1, MPI_INT, 0, comm_);
-  if (!want_dynamic) {
-    mode_ = ScheduleMode::kStatic;
-    return;
-  }
+  mode_ = ScheduleMode::kStatic;
   MPI_Errhandler previous;
   MPI_Comm_get_errhandler(comm_, &previous);
   MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
-  const MPI_Aint bytes = rank_ == 0 ? static_cast<MPI_Aint>(2 * sizeof(long)) : 0;
+  const MPI_Aint bytes = rank_ == 0 ? static_cast<MPI_Aint>(3 * sizeof(long)) : 0;
   const int rc = MPI_Win_allocate(bytes, sizeof(long), MPI_INFO_NULL, comm_, &counters_, &window_);
   MPI_Comm_set_errhandler(comm_, previous);
   MPI_Errhandler_free(&previous);
@@ -31,18 +29,16 @@ WorkQueue::WorkQueue(MPI_Comm comm, int num_items, ScheduleMode mode)
   if (!all_ok) {
     if (rc == MPI_SUCCESS) MPI_Win_free(&window_);
     window_ = MPI_WIN_NULL;
-    mode_ = ScheduleMode::kStatic;
     return;
   }
   if (rank_ == 0) {
     MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window_);
-    counters_[0] = 0;
-    counters_[1] = 0;
+    counters_[0] = counters_[1] = counters_[2] = 0;
     MPI_Win_unlock(0, window_);
   }
   MPI_Barrier(comm_);
   MPI_Win_lock_all(0, window_);
-  mode_ = ScheduleMode::kDynamic;
+  if (want_dynamic) mode_ = ScheduleMode::kDynamic;
 }
 
 WorkQueue::~WorkQueue() {
@@ -50,36 +46,43 @@ WorkQueue::~WorkQueue() {
   // rank only must not block, so it frees nothing if close() was not called.
 }
 
+long WorkQueue::fetch_and_add(int counter, long value, MPI_Op op) const {
+  long previous = 0;
+  MPI_Fetch_and_op(&value, &previous, MPI_LONG, 0, counter, op, window_);
+  MPI_Win_flush(0, window_);
+  return previous;
+}
+
 int WorkQueue::next() {
+  if (stop_requested()) return -1;
   if (mode_ == ScheduleMode::kStatic) {
     if (static_next_ >= num_items_) return -1;
     const int item = static_next_;
     static_next_ += size_;
     return item;
   }
-  const long one = 1;
-  long item = 0;
-  MPI_Fetch_and_op(&one, &item, MPI_LONG, 0, 0, MPI_SUM, window_);
-  MPI_Win_flush(0, window_);
+  const long item = fetch_and_add(0, 1, MPI_SUM);
   return item < num_items_ ? static_cast<int>(item) : -1;
+}
+
+void WorkQueue::request_stop() {
+  stop_seen_ = true;
+  if (window_ != MPI_WIN_NULL) fetch_and_add(2, 1, MPI_REPLACE);
+}
+
+bool WorkQueue::stop_requested() {
+  if (!stop_seen_ && window_ != MPI_WIN_NULL) stop_seen_ = fetch_and_add(2, 0, MPI_NO_OP) != 0;
+  return stop_seen_;
 }
 
 void WorkQueue::mark_done() {
   ++local_done_;
-  if (mode_ == ScheduleMode::kStatic) return;
-  const long one = 1;
-  long previous = 0;
-  MPI_Fetch_and_op(&one, &previous, MPI_LONG, 0, 1, MPI_SUM, window_);
-  MPI_Win_flush(0, window_);
+  if (mode_ == ScheduleMode::kDynamic) fetch_and_add(1, 1, MPI_SUM);
 }
 
 int WorkQueue::done() const {
-  if (mode_ == ScheduleMode::kStatic || window_ == MPI_WIN_NULL) return local_done_;
-  const long zero = 0;
-  long value = 0;
-  MPI_Fetch_and_op(&zero, &value, MPI_LONG, 0, 1, MPI_NO_OP, window_);
-  MPI_Win_flush(0, window_);
-  return static_cast<int>(value);
+  if (mode_ == ScheduleMode::kStatic) return local_done_;
+  return static_cast<int>(fetch_and_add(1, 0, MPI_NO_OP));
 }
 
 void WorkQueue::close() {

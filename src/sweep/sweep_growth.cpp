@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "phnn/store/results_file.h"
+#include "phnn/store/scratch_file.h"
 #include "results_copy.h"
 
 namespace phnn {
@@ -209,7 +210,7 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
     cmp = compare_run_sets(canonical, old.read_statuses(), grid.runs);
     if (cmp.refused()) throw RunSetRefused(refusal_message(out, cmp, canonical));
     const std::vector<std::string> studies = results_copy::joined_studies(grid);
-    scratch = results_copy::scratch_path(out, "new-version");
+    scratch = scratch_path(out, "new-version");
     ResultsFile fresh = ResultsFile::create(
         scratch, MPI_COMM_NULL, grid.runs, studies, spec.name, spec.text, spec.text_hash,
         program_version, results_copy::wider_layout(old.layout(), ResultsLayout::for_runs(grid.runs)));
@@ -218,7 +219,7 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
     fresh.close();
     verify_copies(old, scratch, copied);
   }
-  results_copy::commit_scratch(scratch, out);
+  commit_scratch(scratch, out);
   const std::string kept = std::to_string(copied.size()) + " runs with results kept bitwise";
   const std::size_t dropped = cmp.dropped_pending_rows.size();
   std::string what;

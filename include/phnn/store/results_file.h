@@ -215,8 +215,11 @@ class ResultsFile {
   /// string attributes of a new group /provenance/session_<k> (k = 0, 1, ...
   /// in the order of the sessions) and returns k.
   int begin_session(const Provenance& provenance);
-  /// Collective: adds attribute "finished" to the group of begin_session (no-op without one).
+  /// Collective: sets attribute "finished" of the group of begin_session
+  /// (no-op without one), in place: ending a session allocates no space.
   void end_session(const std::string& finished_utc);
+  /// The same for session k of begin_session, e.g. from another handle.
+  void end_session(int session, const std::string& finished_utc);
   /// Every session, in order; empty for files written before provenance.
   std::vector<Provenance> read_sessions() const;
 

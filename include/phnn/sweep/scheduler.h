@@ -11,7 +11,7 @@ namespace phnn {
 /// Dynamic: a shared counter on rank 0 read-and-incremented with MPI-3
 /// one-sided MPI_Fetch_and_op, so a free rank takes the next item (items are
 /// sorted largest cost first: longest-processing-time-first). Static: item i
-/// goes to rank i % size, no communication at all.
+/// goes to rank i % size, no communication but the stop flag.
 enum class ScheduleMode { kDynamic, kStatic };
 std::string to_string(ScheduleMode mode);
 
@@ -37,6 +37,12 @@ class WorkQueue {
   /// this rank's own count in static mode).
   int done() const;
   ScheduleMode mode() const { return mode_; }
+  /// This rank stops (a signal): next() returns -1 here now and on every
+  /// other rank from its next call on (a flag in rank 0's window; without a
+  /// window, on this rank only).
+  void request_stop();
+  /// True once any rank called request_stop() (seen here by now).
+  bool stop_requested();
   /// Collective: frees the window. Called by the destructor if needed.
   void close();
 
@@ -45,8 +51,12 @@ class WorkQueue {
   int rank_ = 0, size_ = 1, num_items_ = 0;
   ScheduleMode mode_;
   MPI_Win window_ = MPI_WIN_NULL;
-  long* counters_ = nullptr;  // [0] = next item, [1] = items done (rank 0)
+  // Rank 0's window: [0] = next item, [1] = items done, [2] = stop flag.
+  long* counters_ = nullptr;
   int static_next_ = 0, local_done_ = 0;
+  bool stop_seen_ = false;
+  // Atomic op on counter `counter` of rank 0's window; returns its old value.
+  long fetch_and_add(int counter, long value, MPI_Op op) const;
 };
 
 }  // namespace phnn
