@@ -7,6 +7,8 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "phnn/store/dataset_file.h"
+#include "phnn/store/output_path.h"
+#include "phnn/store/scratch_file.h"
 #include "phnn/store/ph_dataset_file.h"
 #include "phnn/systems/system_file.h"
 
@@ -19,7 +21,7 @@ int write_file_system_data(const std::string& path, const DatasetOptions& option
                            const std::string& out, std::chrono::steady_clock::time_point start) {
   const std::unique_ptr<PhSystem> system = load_system_file(path);
   const PhSystemData data = make_ph_system_data(*system, options, n_train);
-  write_ph_dataset_file(out, data);
+  write_atomically(out, [&](const std::string& scratch) { write_ph_dataset_file(scratch, data); });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "phnn data: " << system->name() << " (" << path << ", " << system->n_x()
@@ -69,16 +71,12 @@ int run_data(int argc, char** argv, int first) {
                           " outside [1, " + std::to_string(options.num_train_max) + "]"};
   }
   const std::string out = parser.get("out");
-  struct stat st;
-  if (::lstat(out.c_str(), &st) == 0 && !is_dataset_file(out)) {
-    throw cli::UsageError{"phnn data: --out " + out +
-                          " exists and is not a data-set file written by `phnn data`; phnn "
-                          "data only replaces its own files: pass a new path or move it away"};
-  }
+  const std::string problem = output_problem("data", out, OutputKind::kDataSet, {system_arg});
+  if (!problem.empty()) throw cli::UsageError{"phnn data: --out " + problem};
   const auto start = std::chrono::steady_clock::now();
   if (from_file) return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, start);
   const SystemData data = make_system_data(system, options, static_cast<int>(n_train));
-  write_dataset_file(parser.get("out"), data);
+  write_atomically(out, [&](const std::string& path) { write_dataset_file(path, data); });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "phnn data: " << to_string(system.kind) << ": " << data.train.size()

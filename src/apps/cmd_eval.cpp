@@ -11,7 +11,9 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "phnn/store/output_path.h"
 #include "phnn/store/results_file.h"
+#include "phnn/store/scratch_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/systems/system_file.h"
@@ -107,6 +109,11 @@ int run_eval(int argc, char** argv, int first) {
   parser.option("out", "CSV of t, states and energies along the figure trajectories", "");
   if (!parser.parse(argc, argv, first)) return 0;
   if (parser.get("run").empty()) throw cli::UsageError{"phnn eval: --run ID is required"};
+  if (!parser.get("out").empty()) {
+    const std::string problem =
+        output_problem("eval", parser.get("out"), OutputKind::kEvalCsv, {parser.get("RESULTS")});
+    if (!problem.empty()) throw cli::UsageError{"phnn eval: --out " + problem};
+  }
   const ResultsFile results = ResultsFile::open_read_only(parser.get("RESULTS"));
   const std::vector<std::string> ids = results.read_run_ids();
   const int row = find_row(results, ids, parser.get("run"));
@@ -126,7 +133,8 @@ int run_eval(int argc, char** argv, int first) {
               run.canonical().substr(0, run.canonical().find(run.has_system_file() ? ";system_file=" : ";mass=")).c_str(), e.result.mse,
               stored.mse, same ? "bitwise equal" : "DIFFERENT");
   if (!parser.get("out").empty()) {
-    write_energy_csv(parser.get("out"), e, run.has_system_file());
+    write_atomically(parser.get("out"),
+                     [&](const std::string& path) { write_energy_csv(path, e, run.has_system_file()); });
     std::printf("phnn eval: energies along the figure trajectories -> %s\n",
                 parser.get("out").c_str());
   }

@@ -18,6 +18,7 @@
 #include "phnn/report/tables.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/ph_dataset_file.h"
+#include "phnn/store/output_path.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
@@ -127,19 +128,13 @@ std::string provenance_value(const Provenance& provenance, const std::string& ke
   return "";
 }
 
-// --out is checked before training, not after: it must not exist (train
-// never overwrites results) and its directory must exist and be writable.
-void require_new_output(const std::string& path) {
-  if (std::ifstream(path).good()) {
-    throw cli::UsageError{"phnn train: --out " + path +
-                          " exists; choose a new path (train never overwrites results)"};
-  }
-  const std::size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
-  if (::access(dir.c_str(), W_OK) != 0) {
-    throw cli::UsageError{"phnn train: --out " + path + ": directory " + dir +
-                          " does not exist or is not writable; create it or choose another path"};
-  }
+// --out is checked before training, not after (store/output_path.h): a new
+// results file, not an input, in a writable directory.
+void require_new_output(const cli::Parser& parser) {
+  std::vector<std::string> inputs = {parser.get("system")};
+  if (parser.has("data")) inputs.push_back(parser.get("data"));
+  const std::string problem = output_problem("train", parser.get("out"), OutputKind::kResults, inputs);
+  if (!problem.empty()) throw cli::UsageError{"phnn train: --out " + problem};
 }
 
 void declare_train_options(cli::Parser* parser) {
@@ -305,7 +300,7 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int a
   }
   const std::unique_ptr<PhSystem> system = load_system_file(path);
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  if (parser.has("out")) require_new_output(parser.get("out"));
+  if (parser.has("out")) require_new_output(parser);
   const PhSystemData data = file_system_data(parser, *system, cell.n_train);
   std::cout << "phnn train: " << system->name() << " (" << system->n_x() << " states, "
             << system->n_w() << " ports, " << system->n_u() << " inputs) "
@@ -347,7 +342,7 @@ int run_train(int argc, char** argv, int first) {
             << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
             << " steps=" << cell.training.steps << "\n";
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  if (parser.has("out")) require_new_output(parser.get("out"));
+  if (parser.has("out")) require_new_output(parser);
   const auto results = train_cell(cell, data, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
   if (parser.has("out")) {

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "phnn/store/output_path.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
@@ -47,24 +48,8 @@ std::string Shard::output_path(const std::string& sweep_output) const {
 
 namespace {
 
-bool exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0;
-}
-
-bool same_file(const std::string& a, const std::string& b) {
-  struct stat sa, sb;
-  return ::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0 && sa.st_dev == sb.st_dev &&
-         sa.st_ino == sb.st_ino;
-}
-
-std::vector<ResultsFile> open_shards(const std::vector<std::string>& shards,
-                                     const std::string& out) {
+std::vector<ResultsFile> open_shards(const std::vector<std::string>& shards) {
   if (shards.empty()) throw std::invalid_argument("phnn merge: no shard given");
-  if (exists(out)) {
-    throw std::invalid_argument(out + ": exists; phnn merge writes a new file: pass another "
-                                "output path or move it away");
-  }
   std::vector<ResultsFile> files;
   for (const std::string& path : shards) {
     try {
@@ -146,12 +131,9 @@ std::string summary(const std::string& out, std::size_t shards,
 
 std::string merge_shards(const std::vector<std::string>& shards, const std::string& out,
                          const std::string& program_version) {
-  for (const std::string& shard : shards) {
-    if (shard == out || same_file(shard, out)) {
-      throw std::invalid_argument(out + ": is one of the shards; pass a new output path");
-    }
-  }
-  const std::vector<ResultsFile> files = open_shards(shards, out);
+  const std::string problem = output_problem("merge", out, OutputKind::kResults, shards);
+  if (!problem.empty()) throw std::invalid_argument(problem);
+  const std::vector<ResultsFile> files = open_shards(shards);
   const SweepSpec spec = parse_sweep_text(files.front().sweep_text(), shards.front() + "@sweep_text",
                                           files.front().stored_system_files());
   const Grid grid = expand_grid(spec);

@@ -3,6 +3,7 @@
 // next to it, fsync, rename (atomic on POSIX), fsync the directory.
 #pragma once
 
+#include <cstdio>
 #include <string>
 
 namespace phnn {
@@ -19,5 +20,20 @@ void copy_file(const std::string& from, const std::string& to);
 /// fsyncs `scratch`, renames it to `out` (atomic) and fsyncs the directory;
 /// throws std::runtime_error naming the step that failed.
 void commit_scratch(const std::string& scratch, const std::string& out);
+
+/// Calls write(scratch) on a scratch path next to `out`, then commits it onto
+/// `out`: `out` holds the old file or the whole new one, never half of one.
+/// The scratch file is removed if write or the commit throws.
+template <class Write>
+void write_atomically(const std::string& out, Write&& write) {
+  const std::string scratch = scratch_path(out, "writing");
+  try {
+    write(scratch);
+    commit_scratch(scratch, out);
+  } catch (...) {
+    std::remove(scratch.c_str());
+    throw;
+  }
+}
 
 }  // namespace phnn
