@@ -49,7 +49,7 @@ std::string Shard::output_path(const std::string& sweep_output) const {
 namespace {
 
 std::vector<ResultsFile> open_shards(const std::vector<std::string>& shards) {
-  if (shards.empty()) throw std::invalid_argument("phnn merge: no shard given");
+  if (shards.empty()) throw std::invalid_argument("no shard given: phnn merge OUT SHARD...");
   std::vector<ResultsFile> files;
   for (const std::string& path : shards) {
     try {
@@ -72,23 +72,35 @@ std::vector<ResultsFile> open_shards(const std::vector<std::string>& shards) {
 }
 
 // Per row, the shard that gives its result (-1: none); throws if two shards
-// hold different results for a row.
+// hold different results for a row (clocks aside). *notes names each shard
+// whose results all came from earlier shards (given twice, or a copy).
 std::vector<int> result_sources(const std::vector<ResultsFile>& files,
-                                const std::vector<std::string>& shards) {
+                                const std::vector<std::string>& shards, std::string* notes) {
   std::vector<int> source(static_cast<std::size_t>(files.front().num_runs()), -1);
   for (std::size_t s = 0; s < files.size(); ++s) {
     const std::vector<RunStatus> status = files[s].read_statuses();
+    int finished = 0, repeated = 0;
     for (std::size_t row = 0; row < source.size(); ++row) {
       if (status[row] == RunStatus::kPending) continue;
+      ++finished;
       if (source[row] < 0) {
         source[row] = static_cast<int>(s);
-      } else if (!results_copy::same_result(files[source[row]].read_run(static_cast<int>(row)),
-                                            files[s].read_run(static_cast<int>(row)))) {
+        continue;
+      }
+      ++repeated;
+      if (!results_copy::same_result(files[source[row]].read_run(static_cast<int>(row)),
+                                     files[s].read_run(static_cast<int>(row)))) {
         throw std::runtime_error("run " + std::to_string(row) + " differs between " +
                                  shards[source[row]] + " and " + shards[s] +
-                                 " (a run's result depends only on its configuration and seed); "
-                                 "were they written by different phnn builds?");
+                                 " beyond its wall times (a run's result depends only on its "
+                                 "configuration and seed); were they written by different phnn "
+                                 "builds or kernels?");
       }
+    }
+    if (finished > 0 && repeated == finished) {
+      *notes += "\nphnn merge: note: " + shards[s] + " adds nothing: its " +
+                std::to_string(finished) + " results are all in the shards before it (given "
+                "twice, or a copy?)";
     }
   }
   return source;
@@ -139,7 +151,8 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
   const Grid grid = expand_grid(spec);
   ResultsLayout layout = files.front().layout();
   for (const ResultsFile& file : files) layout = results_copy::wider_layout(layout, file.layout());
-  const std::vector<int> source = result_sources(files, shards);
+  std::string notes;
+  const std::vector<int> source = result_sources(files, shards, &notes);
   const std::string scratch = scratch_path(out, "partial");
   {
     ResultsFile merged = ResultsFile::create(scratch, MPI_COMM_NULL, grid.runs,
@@ -157,7 +170,7 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
     merged.close();
   }
   commit_scratch(scratch, out);
-  return summary(out, files.size(), ResultsFile::open_read_only(out).read_statuses());
+  return summary(out, files.size(), ResultsFile::open_read_only(out).read_statuses()) + notes;
 }
 
 }  // namespace phnn

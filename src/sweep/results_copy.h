@@ -13,7 +13,8 @@
 namespace phnn {
 namespace results_copy {
 
-/// Every field of both equal, doubles bit for bit (their journal encodings).
+/// Every field of both equal, doubles bit for bit (their journal encodings),
+/// but the clocks: wall times of the run, its trace and its checkpoints.
 bool same_result(const RunResult& a, const RunResult& b);
 
 /// The layout that holds rows of both.

@@ -125,5 +125,34 @@ TEST_F(MergeShardsTest, ConflictingResultsForeignSweepsAndExistingOutputAreRefus
   }
 }
 
+// Two trainings of the same run differ in their clocks only: merged, and a
+// shard whose results all came before is named.
+TEST_F(MergeShardsTest, ResultsDifferingOnlyInWallTimesMergeAndADuplicateShardIsNamed) {
+  const std::string a = shard("a.h5", {0, 1});
+  const std::string b = dir_ + "/b.h5";
+  {
+    const SweepSpec spec = parse_sweep_text(kSweep, "sweep.toml");
+    const Grid grid = expand_grid(spec);
+    ResultsFile file = ResultsFile::create(b, MPI_COMM_NULL, grid.runs,
+                                           std::vector<std::string>(grid.runs.size(), "grid"),
+                                           spec.name, spec.text, spec.text_hash, "v1",
+                                           ResultsLayout::for_runs(grid.runs));
+    for (int row : {0, 1}) {
+      RunResult r = testing_util::sample_result(row, file.layout());
+      r.wall_time_s += 17.0;
+      for (TracePoint& p : r.trace) p.elapsed_s += 3.0;
+      for (double& t : r.checkpoint_train_seconds) t += 5.0;
+      file.write_run(row, r);
+    }
+  }
+  const std::string summary = merge_shards({a, b}, dir_ + "/merged.h5", "v2");
+  EXPECT_THAT(summary, HasSubstr("2 of 4 runs with results"));
+  EXPECT_THAT(summary, HasSubstr(b + " adds nothing: its 2 results are all in the shards before it"));
+  const std::string twice = merge_shards({a, a}, dir_ + "/twice.h5", "v2");
+  EXPECT_THAT(twice, HasSubstr(a + " adds nothing"));
+  const std::string distinct = merge_shards({a, shard("c.h5", {2})}, dir_ + "/distinct.h5", "v2");
+  EXPECT_THAT(distinct, ::testing::Not(HasSubstr("adds nothing")));
+}
+
 }  // namespace
 }  // namespace phnn
