@@ -149,6 +149,12 @@ class SweepRun {
       return cli::kUsageError;
     }
     if (int status = check_same_sweep_file()) return status;
+    out_ = parser_.has("out") ? parser_.get("out")
+                              : (shard_.count > 1 ? shard_.output_path(spec_.output) : spec_.output);
+    if (const std::string problem = output_name_problem(out_); !problem.empty()) {
+      if (root_) std::cerr << "phnn sweep: " << problem << "\n";
+      return cli::kUsageError;
+    }
     if (parser_.flag_set("dry-run")) {
       if (root_) {
         if (parser_.flag_set("cell-costs")) {
@@ -162,8 +168,6 @@ class SweepRun {
       return 0;
     }
     torch::set_num_threads(static_cast<int>(parser_.get_int("threads")));
-    out_ = parser_.has("out") ? parser_.get("out")
-                              : (shard_.count > 1 ? shard_.output_path(spec_.output) : spec_.output);
     const Provenance session = session_provenance(MPI_COMM_WORLD, argc_, argv_);
     // Rank 0 alone creates or updates the file, serially; the other ranks open
     // it only to write their rows (docs/DECISIONS.md, "No rank waits forever").

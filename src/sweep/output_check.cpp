@@ -2,7 +2,9 @@
 // sweep touches it (see include/phnn/sweep/output_check.h).
 #include "phnn/sweep/output_check.h"
 
+#include <limits.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -116,6 +118,25 @@ std::string move_aside(const std::string& path, const std::string& reason) {
                              std::strerror(errno));
   }
   return aside;
+}
+
+std::string output_name_problem(const std::string& out) {
+  const std::size_t slash = out.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : out.substr(0, slash);
+  const std::string name = slash == std::string::npos ? out : out.substr(slash + 1);
+  long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  if (name_max <= 0) name_max = NAME_MAX;
+  if (name.size() + kLongestSuffix > static_cast<std::size_t>(name_max)) {
+    return "the output name " + name.substr(0, 40) + "... has " + std::to_string(name.size()) +
+           " bytes; with the suffixes of its lock, journal and scratch files (up to " +
+           std::to_string(kLongestSuffix) + ") it must fit the file system's " +
+           std::to_string(name_max) + ": choose a shorter `output` or --out";
+  }
+  if (out.size() + kLongestSuffix + 16 > PATH_MAX) {  // + "/rank-NNNNNN.log"
+    return "the output path has " + std::to_string(out.size()) + " bytes, too long for PATH_MAX (" +
+           std::to_string(PATH_MAX) + ") with its journal files: choose a shorter path";
+  }
+  return "";
 }
 
 std::string sanitize_file_name(const std::string& name) {

@@ -121,8 +121,17 @@ LockOutcome WriterLock::acquire(const std::string& results_path, const std::stri
   for (int attempt = 0; attempt < 10; ++attempt) {
     const int fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0664);
     if (fd < 0) {
-      throw std::runtime_error(lock + ": cannot create the writer lock: " + errno_text() +
-                               "; the results directory must be writable");
+      const int error = errno;
+      struct stat there;
+      if (::lstat(lock.c_str(), &there) == 0 && !S_ISREG(there.st_mode)) {
+        throw std::runtime_error(lock + ": the writer lock's path is taken by " +
+                                 (S_ISDIR(there.st_mode) ? "a directory" : S_ISLNK(there.st_mode)
+                                      ? "a symbolic link" : "a FIFO, device or socket") +
+                                 "; move it away or pass another --out path");
+      }
+      throw std::runtime_error(lock + ": cannot create the writer lock: " + std::strerror(error) +
+                               (error == EACCES || error == EROFS
+                                    ? "; the results directory must be writable" : ""));
     }
     struct stat mine;
     if (::fstat(fd, &mine) != 0 || !S_ISREG(mine.st_mode)) {

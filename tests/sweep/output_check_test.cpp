@@ -17,6 +17,7 @@
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "sample_results.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -142,6 +143,31 @@ TEST(SanitizeFileNameTest, KeepsOneComponentInsideTheDirectory) {
   EXPECT_EQ(sanitize_file_name("/etc/passwd"), "_etc_passwd");
   EXPECT_EQ(sanitize_file_name("a b\n"), "a_b_");
   EXPECT_EQ(sanitize_file_name(""), "unnamed");
+}
+
+}  // namespace
+}  // namespace phnn
+
+namespace phnn {
+namespace {
+
+// A name the file system cannot hold with the lock, journal and scratch
+// suffixes is refused up front (also by --dry-run), not after training.
+TEST(OutputNameTest, NamesTooLongForTheFileSystemAreRefusedUpFront) {
+  const std::string dir = ::testing::TempDir();
+  EXPECT_EQ(output_name_problem(dir + "/results.h5"), "");
+  EXPECT_EQ(output_name_problem(std::string(255 - kLongestSuffix - 3, 'x') + ".h5"), "");
+  EXPECT_THAT(output_name_problem(dir + "/" + std::string(250, 'x') + ".h5"),
+              HasSubstr("choose a shorter `output` or --out"));
+  EXPECT_THAT(output_name_problem(std::string(59000, 'y')), HasSubstr("bytes"));
+  std::string log;
+  const std::string sweep = std::string(PHNN_SOURCE_DIR) + "/sweeps/tiny.toml";
+  EXPECT_EQ(testing_util::run_shell(std::string(PHNN_BINARY) + " sweep " + sweep +
+                                        " --dry-run --out " + dir + "/" + std::string(250, 'x'),
+                                    &log),
+            2)
+      << log;
+  EXPECT_THAT(log, HasSubstr("choose a shorter"));
 }
 
 }  // namespace

@@ -117,5 +117,19 @@ TEST(LockHolderTest, ParsesItsOwnTextAndIgnoresJunk) {
   EXPECT_EQ(parse_lock_text("").pid, 0);
 }
 
+// A directory where the lock file goes is named as such (not blamed on the
+// results directory's permissions).
+TEST_F(WriterLockTest, ADirectoryAtTheLockPathIsNamed) {
+  ASSERT_EQ(::mkdir((results_ + ".lock").c_str(), 0755), 0);
+  WriterLock lock;
+  try {
+    lock.acquire(results_, "1a2b3c4d5e6f7081");
+    FAIL() << "a directory was taken for the lock";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("taken by a directory; move it away"));
+    EXPECT_THAT(e.what(), ::testing::Not(::testing::HasSubstr("must be writable")));
+  }
+}
+
 }  // namespace
 }  // namespace phnn

@@ -36,6 +36,13 @@ OutputCheck inspect_output(const std::string& out, const std::string& sweep_path
 /// the new name; throws std::runtime_error naming both if rename fails.
 std::string move_aside(const std::string& path, const std::string& reason);
 
+/// Why the file system cannot hold `out` and the names made from it (its
+/// lock, journal and scratch files: up to kLongestSuffix more bytes), ""
+/// if it can: a name longer than the directory allows (NAME_MAX), or a path
+/// longer than PATH_MAX.
+std::string output_name_problem(const std::string& out);
+constexpr std::size_t kLongestSuffix = 24;  // ".damaged-<10-digit time>-k"
+
 /// A sweep name made safe as one path component (the default output is
 /// `results/<name>.h5`): characters outside [A-Za-z0-9._+-] (so '/') and a
 /// leading '.' become '_'; "" becomes "unnamed". "../../x" → "_._.._x".
