@@ -121,6 +121,19 @@ std::vector<RunRecord> read_run_records(const ResultsFile& file, const Grid& gri
   return records;
 }
 
+// Rows whose checksum fails, named on stderr; the tables count them as
+// pending (their numbers cannot be trusted).
+std::vector<int> damaged_rows_named(const ResultsFile& file) {
+  const std::vector<int> damaged = file.damaged_rows();
+  if (damaged.empty()) return damaged;
+  const std::vector<std::string> ids = file.read_run_ids();
+  std::cerr << "phnn reduce: warning: " << file.path() << ": " << damaged.size()
+            << " damaged rows (checksum mismatch) left out, counted as pending:";
+  for (int row : damaged) std::cerr << " " << ids[static_cast<std::size_t>(row)];
+  std::cerr << "; `phnn verify` tells which the journals can repair, `phnn sweep` repairs them\n";
+  return damaged;
+}
+
 void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
                              const std::vector<RunStatus>& statuses, bool seeds_summary) {
   int counts[4] = {0, 0, 0, 0};
@@ -176,11 +189,15 @@ int run_reduce(int argc, char** argv, int first) {
   const SweepSpec spec =
       parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
   const Grid grid = checked_grid(file, spec);
+  const std::vector<int> damaged = damaged_rows_named(file);
   if (per_run) {
-    std::cout << render_per_run_csv(read_run_records(file, grid));
+    std::vector<RunRecord> records = read_run_records(file, grid);
+    for (int row : damaged) records[static_cast<std::size_t>(row)].status = RunStatus::kPending;
+    std::cout << render_per_run_csv(records);
     return 0;
   }
-  const auto statuses = file.read_statuses();
+  auto statuses = file.read_statuses();
+  for (int row : damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
   const auto entries = make_table_entries(grid, statuses, file.read_double_column("mse"));
   std::size_t expected_seeds = 0;
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());

@@ -12,6 +12,7 @@ int run_sweep(int argc, char** argv, int first);
 int run_reduce(int argc, char** argv, int first);
 int run_merge(int argc, char** argv, int first);
 int run_eval(int argc, char** argv, int first);
+int run_verify(int argc, char** argv, int first);
 
 }  // namespace apps
 }  // namespace phnn

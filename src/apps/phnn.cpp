@@ -28,6 +28,7 @@ const Command kCommands[] = {
 #ifdef PHNN_HAVE_SWEEP
     {"sweep", phnn::apps::run_sweep}, {"reduce", phnn::apps::run_reduce},
     {"merge", phnn::apps::run_merge}, {"eval", phnn::apps::run_eval},
+    {"verify", phnn::apps::run_verify},
 #endif
 };
 
@@ -55,7 +56,8 @@ const char* kUsage =
     "  sweep    run a sweep file over MPI ranks into one HDF5 results file\n"
     "  reduce   print the paper's median [IQR] tables from a results file\n"
     "  merge    merge the shard results files of one sweep into one\n"
-    "  eval     reload one run from its stored weights and evaluate it again\n\n"
+    "  eval     reload one run from its stored weights and evaluate it again\n"
+    "  verify   check a results file's structure and every row's checksum\n\n"
     "`phnn <command> --help` lists each command's options; `phnn --version` prints\n"
     "the version, git commit and library versions.\n";
 

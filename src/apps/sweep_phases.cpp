@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <iostream>
+#include <map>
 #include <set>
 
 #include <boost/mpi/collectives.hpp>
@@ -105,12 +106,45 @@ int prepare_output(const std::string& out, const std::string& sweep_path, const 
   throw cli::UsageError{"phnn sweep: " + check.message};
 }
 
+namespace {
+
+// Rows whose checksum fails: rewritten from the journal's record, or, if the
+// journal lacks it, made pending again (trained anew); both named.
+void repair_damaged_rows(ResultsFile* results, const std::map<std::string, RunResult>& journal,
+                         const std::vector<std::string>& ids, const std::string& out) {
+  std::vector<std::string> repaired, requeued;
+  for (int row : results->damaged_rows()) {
+    const std::string& id = ids[static_cast<std::size_t>(row)];
+    const auto it = journal.find(id);
+    if (it != journal.end()) {
+      results->write_run(row, it->second);
+      repaired.push_back(id);
+    } else {
+      results->requeue_run(row);
+      requeued.push_back(id);
+    }
+  }
+  if (!repaired.empty()) {
+    std::cerr << "phnn sweep: " << out << ": " << repaired.size()
+              << " damaged rows (checksum mismatch) repaired from the journals: "
+              << join(repaired, ", ") << "\n";
+  }
+  if (!requeued.empty()) {
+    std::cerr << "phnn sweep: " << out << ": " << requeued.size()
+              << " damaged rows not in the journals, trained again: " << join(requeued, ", ")
+              << "\n";
+  }
+}
+
+}  // namespace
+
 std::vector<int> recover_from_journals(ResultsFile* results, const std::string& out,
                                        bool created) {
   int skipped = 0;
   const auto journal = replay_journals(out, &skipped);
-  std::vector<RunStatus> statuses = results->read_statuses();
   const auto ids = results->read_run_ids();
+  repair_damaged_rows(results, journal, ids, out);
+  std::vector<RunStatus> statuses = results->read_statuses();
   int recovered = 0;
   for (std::size_t row = 0; row < ids.size(); ++row) {
     auto it = journal.find(ids[row]);

@@ -103,6 +103,9 @@ void create_result_datasets(const DatasetMaker& make, const ResultsLayout& layou
   const std::uint64_t R = make.rows;
   const auto I = static_cast<std::uint64_t>(layout.num_inference);
   make.ints(kStatus, {R}, "0 pending, 1 done, 2 diverged, 3 failed");
+  make.ints(kChecksum, {R},
+            "FNV-1a 64 of the row as stored (id, configuration, result, weights; clocks of "
+            "started_utc/finished_utc excepted), written after the status; 0: none yet");
   make.text(kMessage, kMessageLength, "why a run diverged or failed (truncated)");
   make.floats(kMse, {R}, kMseUnits);
   make.floats(kTrajectoryErrors, {R, I}, kMseUnits + "; per inference trajectory");

@@ -42,6 +42,7 @@ inline const std::string kSeed = "/runs/seed";
 inline const std::string kStates = "/runs/n_x";
 inline const std::string kStudies = "/runs/studies";
 inline const std::string kStatus = "/runs/status";
+inline const std::string kChecksum = "/runs/checksum";
 inline const std::string kMessage = "/runs/message";
 inline const std::string kMse = "/runs/mse";
 inline const std::string kTrajectoryErrors = "/runs/trajectory_errors";
@@ -117,6 +118,7 @@ struct ResultsFile::Impl {
   ResultsLayout layout;
   std::vector<std::int64_t> run_states;  // /runs/n_x
   bool has_run_times = false;  // false in files written before provenance
+  bool has_checksums = false;  // false in files written before row checksums
   std::string session;         // this process's /provenance/session_<k>
 
   Impl(h5::File f, MPI_Comm c)
@@ -135,6 +137,7 @@ struct ResultsFile::Impl {
     layout.checkpoints =
         file.exists(results_io::kCheckpointMse) ? static_cast<int>(file.dims(results_io::kCheckpointMse).at(1)) : 0;
     has_run_times = file.exists(results_io::kStartedUtc) && file.exists(results_io::kFinishedUtc);
+    has_checksums = file.exists(results_io::kChecksum);
     layout.weights = file.exists(results_io::kWeights);
   }
 
@@ -163,6 +166,9 @@ struct ResultsFile::Impl {
 
   std::vector<std::string> strings(const std::string& name) const {
     return independent([&] { return file.read_strings(name); });
+  }
+  std::string strings_at(const std::string& name, std::uint64_t row) const {
+    return independent([&] { return file.read_strings(name, row, 1).at(0); });
   }
   std::vector<std::int64_t> ints(const std::string& name, std::uint64_t row = 0,
                                  std::uint64_t count = 0) const {

@@ -3,7 +3,10 @@
 // readers of the reducer.
 #include <algorithm>
 #include <array>
+#include <set>
 
+#include "phnn/config/run_config.h"  // fnv1a64
+#include "phnn/store/journal.h"
 #include "store/results_file_internal.h"
 
 namespace phnn {
@@ -191,8 +194,76 @@ void ResultsFile::write_run(int row, const RunResult& r) {
                    r.weights.data());
     }
     if (L.weights) put_int(kWeightsLength, static_cast<std::int64_t>(store_weights ? r.weights.size() : 0));
-    // Last: until this lands the row reads as pending.
+    // Last but the checksum: until this lands the row reads as pending.
     put_int(kStatus, static_cast<std::int64_t>(r.status));
+  });
+  if (impl.has_checksums) {
+    const auto checksum = static_cast<std::int64_t>(row_checksum(row));
+    impl.independent([&] { impl.file.write_rows(kChecksum, static_cast<std::uint64_t>(row), 1, &checksum); });
+  }
+}
+
+// FNV-1a 64 (run_config.h) of the row's id, configuration, seed and result
+// as read back (the journal's encoding: every double bit for bit).
+std::uint64_t ResultsFile::row_checksum(int row) const {
+  const Impl& impl = *impl_;
+  const auto at = static_cast<std::uint64_t>(row);
+  const std::string id = impl.strings_at(kId, at);
+  const std::uint64_t hash = fnv1a64(id + "\n" + impl.strings_at(kCanonical, at) + "\n" +
+                                     std::to_string(impl.ints(kSeed, at, 1).at(0)) + "\n" +
+                                     internal::encode_journal_record(id, read_run(row), 0));
+  return hash == 0 ? 1 : hash;  // 0 means "no checksum"
+}
+
+std::vector<int> ResultsFile::damaged_rows() const {
+  std::vector<int> damaged;
+  if (!impl_->has_checksums) return damaged;
+  const std::vector<std::int64_t> codes = impl_->ints(kStatus);
+  const std::vector<std::int64_t> stored = impl_->ints(kChecksum);
+  for (int row = 0; row < impl_->num_runs; ++row) {
+    const auto i = static_cast<std::size_t>(row);
+    if (codes[i] == static_cast<std::int64_t>(RunStatus::kPending)) continue;
+    bool ok = false;
+    try {
+      ok = codes[i] > 0 && codes[i] <= static_cast<std::int64_t>(RunStatus::kFailed) &&
+           stored[i] != 0 && static_cast<std::uint64_t>(stored[i]) == row_checksum(row);
+    } catch (const std::exception&) {
+      ok = false;  // unreadable is damaged too
+    }
+    if (!ok) damaged.push_back(row);
+  }
+  return damaged;
+}
+
+std::vector<std::string> ResultsFile::structure_problems() const {
+  std::vector<std::string> problems;
+  try {
+    const std::vector<std::string> ids = read_run_ids();
+    std::set<std::string> seen;
+    for (std::size_t row = 0; row < ids.size(); ++row) {
+      if (ids[row].empty()) {
+        problems.push_back("row " + std::to_string(row) + " has no run id");
+      } else if (!seen.insert(ids[row]).second) {
+        problems.push_back("run id " + ids[row] + " repeats (row " + std::to_string(row) + ")");
+      }
+      if (problems.size() >= 5) break;
+    }
+    read_statuses();
+    read_canonical();
+  } catch (const std::exception& e) {
+    problems.push_back(e.what());
+  }
+  return problems;
+}
+
+bool ResultsFile::has_checksums() const { return impl_->has_checksums; }
+
+void ResultsFile::requeue_run(int row) {
+  Impl& impl = *impl_;
+  const std::int64_t zero = 0;
+  impl.independent([&] {
+    impl.file.write_rows(kStatus, static_cast<std::uint64_t>(row), 1, &zero);
+    if (impl.has_checksums) impl.file.write_rows(kChecksum, static_cast<std::uint64_t>(row), 1, &zero);
   });
 }
 

@@ -49,16 +49,10 @@ OutputCheck inspect_hdf5(const std::string& out, const std::string& sweep_hash) 
   try {
     const ResultsFile file = ResultsFile::open_read_only(out);
     same_text = file.sweep_hash() == sweep_hash;
-    file.read_run_ids();
-    try {
-      file.read_statuses();  // throws std::runtime_error on a status outside 0..3
-    } catch (const h5::Error&) {
-      throw;
-    } catch (const std::runtime_error& e) {
-      return refused(std::string(e.what()) +
-                     " (phnn never writes such a value); to rebuild the file from its "
-                     "journals, move it away and run the same command again");
-    }
+    // Fails its structural checks (a status outside 0..3, a missing or
+    // repeated id): moved aside and rebuilt from the journals.
+    const std::vector<std::string> problems = file.structure_problems();
+    if (!problems.empty()) return {OutputState::kDamaged, problems.front()};
   } catch (const h5::Error& e) {
     return {OutputState::kDamaged, e.what()};
   } catch (const std::exception& e) {

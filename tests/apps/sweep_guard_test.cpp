@@ -162,7 +162,9 @@ TEST(SweepGuardTest, FifoDeviceDirectoryAndOversizedSweepFilesFailWithoutWaiting
   EXPECT_FALSE(exists(dir + "/never.h5"));
 }
 
-TEST(SweepGuardTest, ResultsFileWithAnImpossibleStatusFailsOnEveryRankUnchanged) {
+// A file failing its structural checks is never resumed: moved aside (its
+// bytes kept) and rebuilt from the journals, every run restored untrained.
+TEST(SweepGuardTest, ResultsFileWithAnImpossibleStatusIsMovedAsideAndRebuilt) {
   const std::string dir = temp_dir("status");
   const std::string sweep = write_file(dir + "/tiny.toml", kTinySweep);
   const std::string out = dir + "/out.h5";
@@ -173,10 +175,15 @@ TEST(SweepGuardTest, ResultsFileWithAnImpossibleStatusFailsOnEveryRankUnchanged)
     file.write_rows("/runs/status", 1, 1, &bad);
   }
   const std::string before = read_all(out);
-  for (int ranks : {1, 2, 3}) {
-    expect_every_rank_exits(ranks, "sweep " + sweep + " --out " + out, 2, "/runs/status[1] = 7");
+  for (int ranks : {2, 1}) {
+    expect_every_rank_exits(ranks, "sweep " + sweep + " --out " + out, 0,
+                            ranks == 2 ? "the file is damaged; moved to " + out + ".damaged-"
+                                       : "0 to run");
   }
-  EXPECT_EQ(read_all(out), before);
+  std::string aside;
+  ASSERT_EQ(shell("ls " + out + ".damaged-*", &aside), 0) << aside;
+  EXPECT_EQ(read_all(aside.substr(0, aside.find('\n'))), before);
+  for (RunStatus s : ResultsFile::open_read_only(out).read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
 }
 
 TEST(SweepGuardTest, JournalPathThatIsARegularFileFailsOnEveryRank) {
@@ -330,7 +337,9 @@ TEST(SweepGuardTest, DataRefusesToOverwriteAFileItDidNotWrite) {
   std::string log;
   for (const std::string& out : {results, text, dir}) {
     EXPECT_EQ(shell("timeout 60 " + data + out, &log), 2) << log;
-    EXPECT_THAT(log, HasSubstr("--out " + out + " exists and is not a data-set file"));
+    EXPECT_THAT(log, HasSubstr("--out " + out + ": " +
+                               (out == dir ? "not a regular file"
+                                           : "exists; phnn data only replaces data-set files it wrote")));
   }
   EXPECT_EQ(read_all(results), results_bytes);
   EXPECT_EQ(read_all(text), "keep me\n");

@@ -103,17 +103,27 @@ TEST_F(OutputCheckTest, TruncatedResultsFileIsDamaged) {
   EXPECT_EQ(c.state, OutputState::kDamaged) << c.message;
 }
 
-TEST_F(OutputCheckTest, RefusesAnImpossibleStatusNamingTheRowAndTheFix) {
+// A file failing its structural checks is damaged (moved aside and rebuilt
+// from the journals), never resumed: an impossible status, an empty or a
+// repeated run id.
+TEST_F(OutputCheckTest, ImpossibleStatusOrBrokenIdsMakeTheFileDamagedNamingTheRow) {
   create_results();
   {
     h5::File file = h5::File::open(out_, h5::Access::kReadWrite);
     const std::int64_t bad = 7;
     file.write_rows("/runs/status", 1, 1, &bad);
   }
-  const OutputCheck c = check();
-  EXPECT_EQ(c.state, OutputState::kRefused);
+  OutputCheck c = check();
+  EXPECT_EQ(c.state, OutputState::kDamaged);
   EXPECT_THAT(c.message, HasSubstr("/runs/status[1] = 7"));
-  EXPECT_THAT(c.message, HasSubstr("rebuild the file from its journals"));
+  create_results();
+  {
+    h5::File file = h5::File::open(out_, h5::Access::kReadWrite);
+    file.write_string_rows("/runs/id", 2, {""});
+  }
+  c = check();
+  EXPECT_EQ(c.state, OutputState::kDamaged);
+  EXPECT_THAT(c.message, HasSubstr("row 2 has no run id"));
 }
 
 TEST_F(OutputCheckTest, RefusesAJournalPathThatIsNotADirectory) {

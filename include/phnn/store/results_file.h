@@ -211,6 +211,20 @@ class ResultsFile {
   std::vector<std::string> read_started_utc() const;
   std::vector<std::string> read_finished_utc() const;
 
+  /// Integrity (docs/RESULTS_FORMAT.md, "Checksums"): every row written by
+  /// write_run carries a checksum of what it stores. The rows with a result
+  /// (not pending) whose checksum is missing or wrong, or that cannot be
+  /// read; empty for a file written before checksums (has_checksums()).
+  std::vector<int> damaged_rows() const;
+  /// What makes the file unusable as a whole: an empty or repeated run id, a
+  /// status outside 0..3, an unreadable column ("" entries none).
+  std::vector<std::string> structure_problems() const;
+  bool has_checksums() const;
+  /// The checksum of row `row` as stored now.
+  std::uint64_t row_checksum(int row) const;
+  /// Independent: marks row `row` pending again (its result to be trained anew).
+  void requeue_run(int row);
+
   /// Collective (same `provenance` on every rank): records a session as the
   /// string attributes of a new group /provenance/session_<k> (k = 0, 1, ...
   /// in the order of the sessions) and returns k.

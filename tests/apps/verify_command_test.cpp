@@ -1,0 +1,100 @@
+// tests/apps/verify_command_test.cpp — damaged bytes in a finished results
+// file are found (phnn verify, phnn reduce) and repaired by the next `phnn
+// sweep`: from the journal when it holds the run, else by training it again.
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/store/results_file.h"
+#include "test_util.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+class VerifyCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = ::testing::TempDir() + "phnn_verify_" + std::to_string(::getpid());
+    ASSERT_EQ(std::system(("rm -rf " + dir_ + " && mkdir -p " + dir_).c_str()), 0);
+    out_ = dir_ + "/r.h5";
+  }
+  void TearDown() override { std::system(("rm -rf " + dir_).c_str()); }
+
+  int sweep(std::string* log) {
+    return testing_util::run_shell(testing_util::mpiexec_phnn(2) + " sweep " + PHNN_SOURCE_DIR +
+                                       "/sweeps/tiny.toml --quiet --out " + out_,
+                                   log);
+  }
+  int phnn(const std::string& args, std::string* log) {
+    return testing_util::run_shell(std::string(PHNN_BINARY) + " " + args, log);
+  }
+  // Flips one mantissa bit of run `row`'s stored MSE where its 8 bytes sit
+  // in the file (found by value: the test does not rely on HDF5's layout).
+  void flip_mse(int row) {
+    const double mse = ResultsFile::open_read_only(out_).read_run(row).mse;
+    std::string bytes;
+    {
+      std::ifstream in(out_, std::ios::binary);
+      std::stringstream s;
+      s << in.rdbuf();
+      bytes = s.str();
+    }
+    const std::string pattern(reinterpret_cast<const char*>(&mse), sizeof mse);
+    const std::size_t at = bytes.find(pattern);
+    ASSERT_NE(at, std::string::npos);
+    ASSERT_EQ(bytes.find(pattern, at + 1), std::string::npos) << "the MSE's bytes are not unique";
+    bytes[at + 2] = static_cast<char>(bytes[at + 2] ^ 0x10);
+    std::ofstream(out_, std::ios::binary | std::ios::trunc) << bytes;
+  }
+  double mse(int row) { return ResultsFile::open_read_only(out_).read_run(row).mse; }
+
+  std::string dir_, out_;
+};
+
+TEST_F(VerifyCommandTest, DamagedRowsAreFoundThenRepairedFromTheJournalOrTrainedAgain) {
+  std::string log;
+  ASSERT_EQ(sweep(&log), 0) << log;
+  ASSERT_EQ(phnn("verify " + out_, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("6 finished rows checked, 0 damaged"));
+  const std::string id = ResultsFile::open_read_only(out_).read_run_ids()[1];
+  const double original = mse(1);
+
+  flip_mse(1);
+  EXPECT_NE(mse(1), original);
+  EXPECT_EQ(phnn("verify " + out_, &log), 1) << log;
+  EXPECT_THAT(log, HasSubstr("damaged: run " + id + " (row 1): the journal holds it"));
+  EXPECT_EQ(phnn("reduce " + out_, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("1 damaged rows (checksum mismatch) left out, counted as pending: " + id));
+  ASSERT_EQ(sweep(&log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("1 damaged rows (checksum mismatch) repaired from the journals: " + id));
+  const double repaired = mse(1);
+  EXPECT_EQ(std::memcmp(&original, &repaired, sizeof original), 0);
+  EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
+
+  // Without the journal the run is trained again: the same bits (a result
+  // depends only on its configuration and seed).
+  flip_mse(1);
+  ASSERT_EQ(std::system(("rm -rf " + out_ + ".journal").c_str()), 0);
+  EXPECT_EQ(phnn("verify " + out_, &log), 1);
+  EXPECT_THAT(log, HasSubstr("not in the journals"));
+  ASSERT_EQ(sweep(&log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("damaged rows not in the journals, trained again: " + id));
+  EXPECT_THAT(log, HasSubstr("1 runs trained"));
+  const double retrained = mse(1);
+  EXPECT_EQ(std::memcmp(&original, &retrained, sizeof original), 0);
+  EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
+  EXPECT_THAT(log, Not(HasSubstr("damaged:")));
+}
+
+}  // namespace
+}  // namespace phnn
