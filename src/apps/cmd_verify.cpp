@@ -10,9 +10,42 @@
 #include "apps/commands.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/sweep_file.h"
 
 namespace phnn {
 namespace apps {
+namespace {
+
+// The file's attributes against each other: the stored sweep text (and
+// system files) hash to sweep_hash, and expand to the stored run ids.
+std::string configuration_problem(const ResultsFile& file) {
+  try {
+    const SweepSpec spec = parse_sweep_text(file.sweep_text(), file.path() + "@sweep_text",
+                                            file.stored_system_files());
+    if (spec.text_hash != file.sweep_hash()) {
+      return "the stored sweep text hashes to " + spec.text_hash + ", the attribute says " +
+             file.sweep_hash();
+    }
+    const Grid grid = expand_grid(spec);
+    const std::vector<std::string> ids = file.read_run_ids();
+    if (ids.size() != grid.runs.size()) {
+      return "the sweep text gives " + std::to_string(grid.runs.size()) + " runs, the file holds " +
+             std::to_string(ids.size());
+    }
+    for (std::size_t row = 0; row < ids.size(); ++row) {
+      if (ids[row] != grid.runs[row].id()) {
+        return "row " + std::to_string(row) + " holds run " + ids[row] + ", the sweep text gives " +
+               grid.runs[row].id();
+      }
+    }
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
 
 int run_verify(int argc, char** argv, int first) {
   cli::Parser parser(
@@ -36,6 +69,15 @@ int run_verify(int argc, char** argv, int first) {
     return 1;
   }
   std::printf("phnn verify: structure: ok (run ids unique, statuses valid)\n");
+  if (const std::string problem = configuration_problem(file); !problem.empty()) {
+    std::printf("phnn verify: configuration: %s\n", problem.c_str());
+    std::printf("phnn verify: damaged attributes or configuration columns: move the file "
+                "aside; `phnn sweep` rebuilds it from the journals in %s\n",
+                journal_directory(path).c_str());
+    return 1;
+  }
+  std::printf("phnn verify: configuration: ok (the sweep text matches its hash, the run ids "
+              "its grid)\n");
   if (!file.has_checksums()) {
     std::printf("phnn verify: checksums: none (the file predates them); nothing more to check\n");
     return 0;

@@ -65,6 +65,7 @@ TEST_F(VerifyCommandTest, DamagedRowsAreFoundThenRepairedFromTheJournalOrTrained
   std::string log;
   ASSERT_EQ(sweep(&log), 0) << log;
   ASSERT_EQ(phnn("verify " + out_, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("configuration: ok"));
   EXPECT_THAT(log, HasSubstr("6 finished rows checked, 0 damaged"));
   const std::string id = ResultsFile::open_read_only(out_).read_run_ids()[1];
   const double original = mse(1);
