@@ -281,6 +281,7 @@ class SweepRun {
   }
 
   int train_and_close(const std::vector<int>& status_codes);
+  int close_and_report(std::string io_error, bool stopped, int total_runs, double seconds);
 
   int argc_;
   char** argv_;
@@ -347,6 +348,36 @@ std::string record_item(const Grid& grid, const WorkItem& item,
     });
   }
   return error;
+}
+
+// Every rank closes the file (collective, but nothing is left to write: rows
+// are raw data in allocated space), every rank learns every error, rank 0
+// ends the session in place and prints the summary. Returns the exit status
+// of a failure (0: none).
+int SweepRun::close_and_report(std::string io_error, bool stopped, int total_runs,
+                               double seconds) {
+  try {
+    results_->close();
+  } catch (const std::exception& e) {
+    if (io_error.empty()) io_error = prefix_ + e.what();
+  }
+  int failed = agree(world_, io_error.empty() ? 0 : kExitFailed, io_error);
+  if (int status = agreed(world_, root_, [&] {
+        ResultsFile file = ResultsFile::open(out_, MPI_COMM_NULL, spec_.text_hash);
+        file.end_session(session_, utc_now());
+        file.close();
+      })) {
+    failed = std::max(failed, status);
+  }
+  if (!root_) return failed;
+  try {
+    print_summary(out_, total_runs, seconds,
+                  failed ? StopReason::kError : stopped ? StopReason::kSignal : StopReason::kNone,
+                  shard_);
+  } catch (const std::exception& e) {
+    std::cerr << "phnn sweep: " << e.what() << "\n";
+  }
+  return failed;
 }
 
 int SweepRun::train_and_close(const std::vector<int>& status_codes) {
@@ -421,31 +452,7 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   const int stopped = mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>());
   queue.close();
   const int total_runs = mpi::all_reduce(world_, my_runs, std::plus<int>());
-  // Every rank closes (collective, but nothing is left to write: rows are
-  // raw data in allocated space), then every rank learns every error.
-  try {
-    results_->close();
-  } catch (const std::exception& e) {
-    if (io_error.empty()) io_error = prefix_ + e.what();
-  }
-  int failed = agree(world_, io_error.empty() ? 0 : kExitFailed, io_error);
-  // The session's end, written in place by rank 0 alone.
-  if (int status = agreed(world_, root_, [&] {
-        ResultsFile file = ResultsFile::open(out_, MPI_COMM_NULL, spec_.text_hash);
-        file.end_session(session_, utc_now());
-        file.close();
-      })) {
-    failed = std::max(failed, status);
-  }
-  if (root_) {
-    try {
-      print_summary(out_, total_runs, elapsed(), failed ? StopReason::kError
-                                                 : stopped ? StopReason::kSignal
-                                                           : StopReason::kNone, shard_);
-    } catch (const std::exception& e) {
-      std::cerr << "phnn sweep: " << e.what() << "\n";
-    }
-  }
+  const int failed = close_and_report(io_error, stopped != 0, total_runs, elapsed());
   if (failed) return failed;
   return stopped ? kExitStopped : 0;
 }

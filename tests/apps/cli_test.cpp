@@ -234,7 +234,7 @@ TEST(PhnnCommandLineTest, AnUnknownCommandExitsTwoWithTheClosestName) {
   EXPECT_EQ(phnn("trian --steps 1", &log), kUsageError);
   EXPECT_EQ(log,
             "phnn: unknown command \"trian\" (did you mean train?); expected one of: data, "
-            "train, sweep, reduce, merge, eval\n");
+            "train, sweep, reduce, merge, eval, verify\n");
   EXPECT_EQ(phnn("--verison", &log), kUsageError);
   EXPECT_THAT(log, HasSubstr("(did you mean --version?)"));
   EXPECT_EQ(phnn("plot", &log), kUsageError);

@@ -1,0 +1,91 @@
+// src/store/results_file_sessions.cpp — ResultsFile: when each run was
+// trained (/runs/started_utc, finished_utc) and who wrote the file
+// (/provenance/session_<k>).
+#include "phnn/store/results_file.h"
+#include "store/results_file_internal.h"
+
+namespace phnn {
+
+using namespace results_io;
+
+void ResultsFile::write_run_times(int row, const std::string& started,
+                                  const std::string& finished) {
+  Impl& impl = *impl_;
+  require(row >= 0 && row < impl.num_runs,
+          impl.prefix() + path() + ": write_run_times(row " + std::to_string(row) +
+              "): row outside [0, " + std::to_string(impl.num_runs) + ")");
+  if (!impl.has_run_times) return;
+  impl.independent([&] {
+    const auto at = static_cast<std::uint64_t>(row);
+    impl.file.write_string_rows(kStartedUtc, at, {started.substr(0, kUtcLength)});
+    impl.file.write_string_rows(kFinishedUtc, at, {finished.substr(0, kUtcLength)});
+  });
+}
+
+bool ResultsFile::has_run_times() const { return impl_->has_run_times; }
+
+std::vector<std::string> ResultsFile::read_started_utc() const {
+  if (!impl_->has_run_times) return std::vector<std::string>(static_cast<std::size_t>(num_runs()));
+  return impl_->strings(kStartedUtc);
+}
+
+std::vector<std::string> ResultsFile::read_finished_utc() const {
+  if (!impl_->has_run_times) return std::vector<std::string>(static_cast<std::size_t>(num_runs()));
+  return impl_->strings(kFinishedUtc);
+}
+
+// "finished" is reserved at the start with kFinishedWidth NUL bytes, so
+// end_session overwrites the value in place: ending a session allocates
+// nothing, and cannot fail for a full disk.
+constexpr std::size_t kFinishedWidth = 20;  // "2026-11-25T08:43:21Z"
+
+int ResultsFile::begin_session(const Provenance& provenance) {
+  Impl& impl = *impl_;
+  // Every rank reads the same metadata, so every rank picks the same k.
+  int k = 0;
+  impl.independent([&] {
+    while (impl.file.exists(kProvenance + "/session_" + std::to_string(k))) ++k;
+  });
+  impl.session = kProvenance + "/session_" + std::to_string(k);
+  impl.collective([&] {
+    impl.file.create_group(impl.session);
+    for (const auto& [key, value] : provenance) impl.file.set_attribute(impl.session, key, value);
+    impl.file.set_attribute(impl.session, "finished", std::string(kFinishedWidth, '\0'));
+    impl.file.flush();
+  });
+  return k;
+}
+
+void ResultsFile::end_session(const std::string& finished_utc) {
+  if (impl_->session.empty()) return;
+  end_session(std::stoi(impl_->session.substr(impl_->session.rfind('_') + 1)), finished_utc);
+}
+
+void ResultsFile::end_session(int session, const std::string& finished_utc) {
+  Impl& impl = *impl_;
+  const std::string group = kProvenance + "/session_" + std::to_string(session);
+  std::string value = finished_utc;
+  if (value.size() < kFinishedWidth) value.resize(kFinishedWidth, '\0');
+  impl.collective([&] { impl.file.set_attribute(group, "finished", value); });
+}
+
+std::vector<Provenance> ResultsFile::read_sessions() const {
+  const Impl& impl = *impl_;
+  std::vector<Provenance> sessions;
+  impl.independent([&] {
+    for (int k = 0;; ++k) {
+      const std::string group = kProvenance + "/session_" + std::to_string(k);
+      if (!impl.file.exists(group)) break;
+      Provenance p;
+      for (const std::string& name : impl.file.attribute_names(group)) {
+        std::string value = impl.file.string_attribute(group, name);
+        if (name == "finished" && value.empty()) continue;  // reserved, not yet ended
+        p.emplace_back(name, std::move(value));
+      }
+      sessions.push_back(std::move(p));
+    }
+  });
+  return sessions;
+}
+
+}  // namespace phnn
