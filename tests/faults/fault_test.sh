@@ -5,7 +5,7 @@
 # without the fault must then finish every run with exactly the results of a
 # sweep that saw no fault (no finished run lost or changed).
 #   CASE: create-eio | row-eio | journal-enospc | disk-full-create |
-#         disk-full-journal | file-size-limit
+#         disk-full-journal | file-size-limit | read-only-dir
 # Exit 77 (skipped) where the case needs what this machine lacks (a tmpfs
 # mount for the disk-full cases).
 set -u
@@ -36,8 +36,9 @@ sweep() {  # sweep OUT [env...]: the sweep on 2 ranks, bounded in time
   local out=$1
   shift
   timeout -k 5 180 env "$@" "${mpiexec[@]}" "${rank_prefix[@]}" "$phnn" sweep "$dir/fault.toml" \
-    --out "$out" --quiet
+    --out "$out" "${quiet[@]}"
 }
+quiet=(--quiet)
 rank_prefix=()
 per_run() { "$phnn" reduce --per-run --format csv "$1"; }
 
@@ -60,6 +61,13 @@ case $case_name in
   journal-enospc)
     reason="No space left on device"
     faulty=("${preload[@]}" PHNN_FAIL_PATH=rank-0.log PHNN_FAIL_AFTER=$(( journal_kb * 1024 / 4 ))) ;;
+  read-only-dir)
+    reason="Read-only file system"
+    [[ $(id -u) -eq 0 ]] || { echo "SKIPPED: mounting a tmpfs needs root"; exit 77; }
+    mount -t tmpfs -o size=1m,ro tmpfs "$out_dir" 2>/dev/null ||
+      { echo "SKIPPED: cannot mount a tmpfs here"; exit 77; }
+    mounted=$out_dir
+    faulty=() ;;
   disk-full-create|disk-full-journal)
     reason="No space left on device"
     [[ $(id -u) -eq 0 ]] || { echo "SKIPPED: mounting a tmpfs needs root"; exit 77; }
@@ -74,6 +82,9 @@ case $case_name in
   *) fail "unknown case" ;;
 esac
 
+# The faulty sweep lists its items: every run of an item it started was
+# trained (a stop waits for the item in hand) and must survive the fault.
+quiet=()
 if [[ $case_name == file-size-limit ]]; then
   # ulimit -f (1024-byte blocks) on the ranks only (mpiexec's own files must
   # not hit it); the limit falls inside the journal.
@@ -92,6 +103,9 @@ case $status in
   *) fail "the sweep exited $status, expected 1 (a clean error)" ;;
 esac
 grep -q "$reason" "$dir/log" || fail "no \"$reason\" in the error output"
+trained=$(grep -oE "item [0-9]+/[0-9]+: .*, [0-9]+ seeds?$" "$dir/log" | grep -oE "[0-9]+ seeds?$" |
+          awk '{n += $1} END {print n + 0}')
+quiet=(--quiet)
 leftovers=$(ls -A "$out_dir" | grep -E '\.(creating|updating)' || true)
 [[ -z $leftovers ]] || fail "half-made files left behind: $leftovers"
 
@@ -99,8 +113,12 @@ leftovers=$(ls -A "$out_dir" | grep -E '\.(creating|updating)' || true)
 cp -a "$out_dir" "$dir/resume"
 [[ -n $mounted ]] && { umount "$mounted"; mounted=""; }
 sweep "$dir/resume/r.h5" > "$dir/log" 2>&1 || fail "the resumed sweep failed"
+kept=$(grep -oE "; [0-9]+ finished before" "$dir/log" | grep -oE "[0-9]+")
+(( ${kept:-0} >= trained )) ||
+  fail "the faulty sweep trained $trained runs, only ${kept:-0} were kept (file or journal)"
 grep -q "24 done, 0 diverged, 0 failed, 0 pending of 24" "$dir/log" || fail "the resume did not finish every run"
 per_run "$dir/resume/r.h5" > "$dir/resume.csv" || fail "reduce of the resumed file failed"
 python3 "$here/compare_runs.py" "$dir/ref.csv" "$dir/resume.csv" > "$dir/log" 2>&1 ||
   fail "results differ from the fault-free sweep"
-echo "PASSED ($case_name): clean error ($reason), nothing half-made, resume = fault-free results"
+echo "PASSED ($case_name): clean error ($reason), $trained trained runs all kept, nothing half-made," \
+     "resume = fault-free results"
