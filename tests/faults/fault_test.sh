@@ -4,7 +4,7 @@
 # system's reason on stderr, leave no half-made file, and the same command
 # without the fault must then finish every run with exactly the results of a
 # sweep that saw no fault (no finished run lost or changed).
-#   CASE: create-eio | row-eio | journal-enospc | disk-full-create |
+#   CASE: create-eio | row-eio | journal-eio | journal-enospc | disk-full-create |
 #         disk-full-journal | file-size-limit | read-only-dir
 # Exit 77 (skipped) where the case needs what this machine lacks (a tmpfs
 # mount for the disk-full cases).
@@ -58,6 +58,9 @@ case $case_name in
   row-eio)
     reason="Input/output error"
     faulty=("${preload[@]}" PHNN_FAIL_PATH=/r.h5 PHNN_FAIL_ERRNO=EIO PHNN_FAIL_RANK=1) ;;
+  journal-eio)
+    reason="Input/output error"
+    faulty=("${preload[@]}" PHNN_FAIL_PATH=rank-1.log PHNN_FAIL_ERRNO=EIO PHNN_FAIL_RANK=1) ;;
   journal-enospc)
     reason="No space left on device"
     faulty=("${preload[@]}" PHNN_FAIL_PATH=rank-0.log PHNN_FAIL_AFTER=$(( journal_kb * 1024 / 4 ))) ;;
