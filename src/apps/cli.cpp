@@ -143,6 +143,15 @@ std::int64_t Parser::get_int(const std::string& name) const {
   return v;
 }
 
+int Parser::get_int_in(const std::string& name, int lo, int hi) const {
+  const std::int64_t v = get_int(name);
+  if (v < lo || v > hi) {
+    throw usage("--" + name + " = " + get(name) + " is outside [" + std::to_string(lo) + ", " +
+                std::to_string(hi) + "]");
+  }
+  return static_cast<int>(v);
+}
+
 std::vector<std::int64_t> parse_int_list(const std::string& option, const std::string& text) {
   const std::string where = "--" + option + " = \"" + text + "\": ";
   const UsageError bad{where + "expected integers in [0, 2147483647] like 0-9 or 0,3,5"};

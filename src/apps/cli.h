@@ -64,6 +64,8 @@ class Parser {
   const std::vector<std::string>& rest() const { return rest_; }
   double get_double(const std::string& name) const;     // finite
   std::int64_t get_int(const std::string& name) const;  // base 10
+  /// get_int within [lo, hi] (a C++ int), or a UsageError naming the range.
+  int get_int_in(const std::string& name, int lo, int hi) const;
 
  private:
   UsageError usage(const std::string& what) const;  // "phnn COMMAND: what"

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include <torch/torch.h>
@@ -197,15 +198,15 @@ CellSpec cell_from_options(const cli::Parser& parser) {
   parse_model_option(parser, &cell);
   cell.size = parse_size(parser.get("size"));
   cell.regularizer = parse_regularizer(parser.get("reg"));
-  cell.n_train = static_cast<int>(parser.get_int("n-train"));
+  constexpr int kMax = std::numeric_limits<int>::max();
+  cell.n_train = parser.get_int_in("n-train", 1, kMax);
   cell.seeds.clear();
   for (auto s : cli::parse_int_list("seeds", parser.get("seeds"))) cell.seeds.push_back(static_cast<int>(s));
-  const auto steps = parser.get_int("steps");
-  if (steps < 0) throw cli::UsageError{"phnn train: --steps = " + std::to_string(steps) + " must be >= 0"};
-  cell.training.steps = static_cast<int>(steps);
+  // In the range of the trainer's int counters: no silent wrap-around.
+  cell.training.steps = parser.get_int_in("steps", 1, kMax);
   cell.training.learning_rate = parser.get_double("lr");
-  cell.training.batch_size = static_cast<int>(parser.get_int("batch"));
-  cell.training.eval_every = static_cast<int>(parser.get_int("eval-every"));
+  cell.training.batch_size = parser.get_int_in("batch", 1, kMax);
+  cell.training.eval_every = parser.get_int_in("eval-every", 1, kMax);
   return cell;
 }
 

@@ -52,7 +52,14 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
   EXPECT_THAT(log, HasSubstr("integrator = dg with model = node"));
   EXPECT_THAT(log, Not(HasSubstr("CellSpec")));  // no internal names in messages
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --steps -4", &log), 2);
-  EXPECT_THAT(log, HasSubstr("--steps = -4"));
+  EXPECT_THAT(log, HasSubstr("--steps = -4 is outside [1, 2147483647]"));
+  // No silent wrap-around of int counters, no empty training.
+  for (const char* bad : {"--steps 100000000000", "--steps 3000000000", "--steps 0",
+                          "--batch 4294967360", "--batch 0", "--eval-every 0",
+                          "--n-train 4294967321"}) {
+    EXPECT_EQ(run(std::string("train --system harmonic --model phnn-jr-rk2 ") + bad, &log), 2) << bad;
+    EXPECT_THAT(log, HasSubstr("is outside [")) << bad;
+  }
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 3-1", &log), 2);
   EXPECT_THAT(log, HasSubstr("--seeds"));
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 1,1 --steps 1", &log), 2);
