@@ -56,6 +56,12 @@ inline double global_error(bool dg, double h, double t_end) {
   return err;
 }
 
+/// The bytes of the file at `path` ("" if it cannot be read).
+inline std::string read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
 /// Runs `command` through the shell with stdout and stderr captured into
 /// *output (if given); returns its exit status (-1 if it did not exit).
 inline int run_shell(const std::string& command, std::string* output = nullptr) {

@@ -21,7 +21,7 @@ int write_file_system_data(const std::string& path, const DatasetOptions& option
                            const std::string& out, std::chrono::steady_clock::time_point start) {
   const std::unique_ptr<PhSystem> system = load_system_file(path);
   const PhSystemData data = make_ph_system_data(*system, options, n_train);
-  write_atomically(out, [&](const std::string& scratch) { write_ph_dataset_file(scratch, data); });
+  write_atomically(out, "writing", [&](const std::string& scratch) { write_ph_dataset_file(scratch, data); });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "phnn data: " << system->name() << " (" << path << ", " << system->n_x()
@@ -76,7 +76,7 @@ int run_data(int argc, char** argv, int first) {
   const auto start = std::chrono::steady_clock::now();
   if (from_file) return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, start);
   const SystemData data = make_system_data(system, options, static_cast<int>(n_train));
-  write_atomically(out, [&](const std::string& path) { write_dataset_file(path, data); });
+  write_atomically(out, "writing", [&](const std::string& path) { write_dataset_file(path, data); });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "phnn data: " << to_string(system.kind) << ": " << data.train.size()

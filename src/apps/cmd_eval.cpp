@@ -133,7 +133,7 @@ int run_eval(int argc, char** argv, int first) {
               run.canonical().substr(0, run.canonical().find(run.has_system_file() ? ";system_file=" : ";mass=")).c_str(), e.result.mse,
               stored.mse, same ? "bitwise equal" : "DIFFERENT");
   if (!parser.get("out").empty()) {
-    write_atomically(parser.get("out"),
+    write_atomically(parser.get("out"), "writing",
                      [&](const std::string& path) { write_energy_csv(path, e, run.has_system_file()); });
     std::printf("phnn eval: energies along the figure trajectories -> %s\n",
                 parser.get("out").c_str());

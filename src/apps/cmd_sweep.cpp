@@ -236,9 +236,8 @@ class SweepRun {
   // leaves out_ as it was. Returns every row's status code.
   std::vector<int> prepare_results(const Provenance& session) {
     const bool resume = prepare_output(out_, parser_.get("FILE"), spec_, grid_, &lock_) == 1;
-    const std::string scratch = scratch_path(out_, resume ? "updating" : "creating");
     std::vector<int> codes;
-    try {
+    write_atomically(out_, resume ? "updating" : "creating", [&](const std::string& scratch) {
       std::optional<ResultsFile> file;
       if (resume) {
         copy_file(out_, scratch);
@@ -254,11 +253,7 @@ class SweepRun {
       session_ = file->begin_session(session);
       codes = recover_from_journals(&*file, out_, !resume);
       file->close();
-      commit_scratch(scratch, out_);
-    } catch (...) {
-      std::remove(scratch.c_str());
-      throw;
-    }
+    });
     return codes;
   }
 

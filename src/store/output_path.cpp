@@ -7,15 +7,10 @@
 #include <fstream>
 
 #include "phnn/store/dataset_file.h"
+#include "phnn/store/scratch_file.h"
 
 namespace phnn {
 namespace {
-
-std::string directory_of(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
 
 bool same_file(const struct stat& a, const std::string& path) {
   struct stat b;
@@ -73,7 +68,7 @@ std::string output_problem(const std::string& command, const std::string& out, O
              " and never overwrites other files: pass a new path or move it away";
     }
   }
-  const std::string dir = directory_of(out);
+  const std::string dir = parent_directory(out);
   if (::access(dir.c_str(), W_OK) != 0) {
     return where + "directory " + dir + " does not exist or is not writable; create it or "
            "choose another path";

@@ -16,13 +16,6 @@
 namespace phnn {
 namespace results_io {
 
-std::string dirname_of(const std::string& path) {
-  const auto slash = path.rfind('/');
-  if (slash == std::string::npos) return ".";
-  if (slash == 0) return "/";
-  return path.substr(0, slash);
-}
-
 
 int comm_rank(MPI_Comm comm) {
   int rank = 0;
@@ -160,20 +153,16 @@ ResultsLayout ResultsLayout::for_runs(const std::vector<RunConfig>& runs) {
 }
 
 void ResultsLayout::validate() const {
-  require(num_inference > 0, "Invalid ResultsLayout: num_inference = " +
-                                 std::to_string(num_inference) +
-                                 "; violated constraint: num_inference > 0.");
-  require(trace_points > 0, "Invalid ResultsLayout: trace_points = " +
-                                std::to_string(trace_points) +
-                                "; violated constraint: trace_points > 0.");
-  require(figure_points > 0, "Invalid ResultsLayout: figure_points = " +
-                                 std::to_string(figure_points) +
-                                 "; violated constraint: figure_points > 0.");
-  require(figure_states > 0, "Invalid ResultsLayout: figure_states = " +
-                                 std::to_string(figure_states) +
-                                 "; violated constraint: figure_states > 0.");
-  require(checkpoints >= 0, "Invalid ResultsLayout: checkpoints = " + std::to_string(checkpoints) +
-                                "; violated constraint: checkpoints >= 0.");
+  auto check = [](int value, int lowest, const char* name) {
+    require(value >= lowest, "Invalid ResultsLayout: " + std::string(name) + " = " +
+                                 std::to_string(value) + "; violated constraint: " + name +
+                                 (lowest == 1 ? " > 0." : " >= 0."));
+  };
+  check(num_inference, 1, "num_inference");
+  check(trace_points, 1, "trace_points");
+  check(figure_points, 1, "figure_points");
+  check(figure_states, 1, "figure_states");
+  check(checkpoints, 0, "checkpoints");
 }
 
 ResultsFile::ResultsFile(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

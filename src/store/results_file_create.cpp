@@ -205,8 +205,7 @@ struct FileAttributes {
 void write_new_file(const std::string& path, const ConfigColumns& columns,
                     const std::vector<std::string>& run_studies, const ResultsLayout& layout,
                     const FileAttributes& a) {
-  const std::string scratch = scratch_path(path, "creating");
-  try {
+  write_atomically(path, "creating", [&](const std::string& scratch) {
     h5::File file = h5::File::create(scratch);
     file.set_attribute("/", "format", std::string(ResultsFile::kFormat));
     file.set_attribute("/", "format_version", ResultsFile::kFormatVersion);
@@ -225,11 +224,7 @@ void write_new_file(const std::string& path, const ConfigColumns& columns,
     if (layout.weights) create_weight_datasets(make, columns.weights_total);
     write_config_columns(file, columns, run_studies);
     file.close();  // throws if the metadata cannot be written
-    commit_scratch(scratch, path);
-  } catch (...) {
-    std::remove(scratch.c_str());
-    throw;
-  }
+  });
 }
 
 }  // namespace
@@ -258,7 +253,7 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
   // Rank 0 checks the directory; all ranks learn the outcome and the
   // creation time together.
   check_on_rank0(comm, [&]() -> std::string {
-    const std::string dir = dirname_of(path);
+    const std::string dir = parent_directory(path);
     if (::access(dir.c_str(), W_OK) != 0) {
       return path + ": cannot create the results file: directory " + dir +
              " does not exist or is not writable";

@@ -87,7 +87,6 @@ inline const std::string kFileUnits =
     "1/s. Every dataset of /runs has a units attribute.";
 
 
-std::string dirname_of(const std::string& path);
 int comm_rank(MPI_Comm comm);
 int comm_size(MPI_Comm comm);
 /// Rank `root`'s string on every rank (serial: unchanged).

@@ -27,13 +27,13 @@ void fsync_path(const std::string& path, int flags) {
   }
 }
 
+}  // namespace
+
 std::string parent_directory(const std::string& path) {
   const std::size_t slash = path.rfind('/');
   if (slash == std::string::npos) return ".";
   return slash == 0 ? "/" : path.substr(0, slash);
 }
-
-}  // namespace
 
 std::string scratch_path(const std::string& out, const std::string& suffix) {
   const std::string path = out + "." + suffix;

@@ -153,8 +153,7 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
   for (const ResultsFile& file : files) layout = results_copy::wider_layout(layout, file.layout());
   std::string notes;
   const std::vector<int> source = result_sources(files, shards, &notes);
-  const std::string scratch = scratch_path(out, "partial");
-  {
+  write_atomically(out, "partial", [&](const std::string& scratch) {
     ResultsFile merged = ResultsFile::create(scratch, MPI_COMM_NULL, grid.runs,
                                              results_copy::joined_studies(grid), spec.name,
                                              spec.text, spec.text_hash, program_version, layout);
@@ -168,8 +167,7 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
       results_copy::copy_rows(files[s], rows, &merged);
     }
     merged.close();
-  }
-  commit_scratch(scratch, out);
+  });
   return summary(out, files.size(), ResultsFile::open_read_only(out).read_statuses()) + notes;
 }
 

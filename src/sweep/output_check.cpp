@@ -16,6 +16,7 @@
 #include "h5/h5file.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
+#include "phnn/store/scratch_file.h"
 
 namespace phnn {
 namespace {
@@ -115,9 +116,8 @@ std::string move_aside(const std::string& path, const std::string& reason) {
 }
 
 std::string output_name_problem(const std::string& out) {
-  const std::size_t slash = out.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : out.substr(0, slash);
-  const std::string name = slash == std::string::npos ? out : out.substr(slash + 1);
+  const std::string dir = parent_directory(out);
+  const std::string name = out.substr(out.find_last_of('/') + 1);  // npos + 1 == 0
   long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
   if (name_max <= 0) name_max = NAME_MAX;
   if (name.size() + kLongestSuffix > static_cast<std::size_t>(name_max)) {

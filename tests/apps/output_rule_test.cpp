@@ -7,7 +7,6 @@
 
 #include <cstdio>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -20,12 +19,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using testing_util::read_all;
 
 class OutputRuleTest : public ::testing::Test {
  protected:
@@ -45,11 +39,11 @@ class OutputRuleTest : public ::testing::Test {
   // Expects `args` refused with status 2 naming `reason`, `victim` unchanged.
   void expect_refused(const std::string& args, const std::string& victim,
                       const std::string& reason) {
-    const std::string before = slurp(victim);
+    const std::string before = read_all(victim);
     std::string log;
     EXPECT_EQ(phnn(args, &log), 2) << log;
     EXPECT_THAT(log, HasSubstr(reason));
-    EXPECT_EQ(slurp(victim), before) << victim << " was changed";
+    EXPECT_EQ(read_all(victim), before) << victim << " was changed";
   }
   std::string train_results(const std::string& name) {
     const std::string out = dir_ + "/" + name;
@@ -70,7 +64,7 @@ TEST_F(OutputRuleTest, DataReplacesOnlyItsOwnDataSets) {
   expect_refused(args + notes_, notes_, "never overwrites other files");
   const std::string system = std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum.toml";
   const std::string copy = dir_ + "/pendulum.toml";
-  std::ofstream(copy) << slurp(system);
+  std::ofstream(copy) << read_all(system);
   expect_refused("data --system " + copy + " --n-train 25 --out " + copy, copy, "is the input");
 }
 
@@ -94,7 +88,7 @@ TEST_F(OutputRuleTest, EvalNeverWritesOverItsResultsFileOrOtherFiles) {
   std::string log;
   ASSERT_EQ(phnn(args + csv, &log), 0) << log;
   EXPECT_EQ(phnn(args + csv, &log), 0) << "an eval CSV is replaced: " << log;
-  EXPECT_THAT(slurp(csv), HasSubstr("h0,t,"));
+  EXPECT_THAT(read_all(csv), HasSubstr("h0,t,"));
 }
 
 TEST_F(OutputRuleTest, MergeNeverReplacesAFileNorAShard) {

@@ -74,10 +74,7 @@ void expect_every_rank_exits(int ranks, const std::string& args, int status,
   EXPECT_THAT(log, Not(HasSubstr("MPI_ABORT")));
 }
 
-std::string read_all(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+using testing_util::read_all;
 
 bool exists(const std::string& path) {
   struct stat st;

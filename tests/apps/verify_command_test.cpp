@@ -6,7 +6,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -42,13 +41,7 @@ class VerifyCommandTest : public ::testing::Test {
   // in the file (found by value: the test does not rely on HDF5's layout).
   void flip_mse(int row) {
     const double mse = ResultsFile::open_read_only(out_).read_run(row).mse;
-    std::string bytes;
-    {
-      std::ifstream in(out_, std::ios::binary);
-      std::stringstream s;
-      s << in.rdbuf();
-      bytes = s.str();
-    }
+    std::string bytes = testing_util::read_all(out_);
     const std::string pattern(reinterpret_cast<const char*>(&mse), sizeof mse);
     const std::size_t at = bytes.find(pattern);
     ASSERT_NE(at, std::string::npos);

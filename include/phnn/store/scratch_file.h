@@ -8,6 +8,9 @@
 
 namespace phnn {
 
+/// The directory of `path`: "." for a bare name, "/" for a file in the root.
+std::string parent_directory(const std::string& path);
+
 /// Our scratch name next to `out` (`<out>.<suffix>`), free: a leftover of a
 /// crash there (empty, or an HDF5 file) is removed; anything else throws
 /// std::runtime_error naming it.
@@ -21,12 +24,12 @@ void copy_file(const std::string& from, const std::string& to);
 /// throws std::runtime_error naming the step that failed.
 void commit_scratch(const std::string& scratch, const std::string& out);
 
-/// Calls write(scratch) on a scratch path next to `out`, then commits it onto
+/// Calls write(scratch) on scratch_path(out, suffix), then commits it onto
 /// `out`: `out` holds the old file or the whole new one, never half of one.
 /// The scratch file is removed if write or the commit throws.
 template <class Write>
-void write_atomically(const std::string& out, Write&& write) {
-  const std::string scratch = scratch_path(out, "writing");
+void write_atomically(const std::string& out, const std::string& suffix, Write&& write) {
+  const std::string scratch = scratch_path(out, suffix);
   try {
     write(scratch);
     commit_scratch(scratch, out);
