@@ -21,7 +21,7 @@ if [[ $(id -u) -eq 0 ]]; then MPI_FLAGS+=(--allow-run-as-root); fi
 OUT=${OUT:-results/$(basename "$SWEEP" .toml).h5}
 # Ctrl-C or SIGTERM stops the sweep gracefully: Open MPI's mpirun cannot
 # forward SIGTERM/SIGINT (it kills the ranks after 1 s) but forwards SIGUSR1,
-# on which every rank finishes its current cell and phnn exits 75. So mpirun
+# on which every rank saves its cell's training state and phnn exits 75. So mpirun
 # runs in its own process group (set -m: the terminal's Ctrl-C reaches only
 # this script) and the first INT/TERM becomes a USR1 to it; a second one
 # kills it (finished runs are never lost: they are in the journals).
@@ -33,7 +33,7 @@ SIGNALS=0
 on_signal() {
   SIGNALS=$((SIGNALS + 1))
   if (( SIGNALS == 1 )); then
-    echo "jobs/local.sh: stopping: each rank finishes its current cell (signal again to kill)" >&2
+    echo "jobs/local.sh: stopping: each rank saves its current cell's state (signal again to kill)" >&2
     kill -USR1 "$MPIRUN_PID" 2>/dev/null || true
   else
     echo "jobs/local.sh: killing the sweep; rerun the same command to resume" >&2

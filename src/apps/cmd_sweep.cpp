@@ -30,6 +30,7 @@
 #include "apps/commands.h"
 #include "apps/early_signals.h"
 #include "apps/provenance.h"
+#include "apps/sweep_checkpoints.h"
 #include "apps/sweep_data.h"
 #include "apps/sweep_phases.h"
 #include "apps/sweep_report.h"
@@ -40,6 +41,7 @@
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"
 #include "phnn/sweep/output_check.h"
+#include "phnn/sweep/resumed_items.h"
 #include "phnn/sweep/scheduler.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/sweep/sweep_growth.h"
@@ -56,7 +58,8 @@ namespace mpi = boost::mpi;
 using Clock = std::chrono::steady_clock;
 
 // Set by SIGTERM / SIGUSR1 (Slurm's --signal before the time limit, or
-// scancel): finish the item in hand, take no new one, close the file cleanly.
+// scancel): save the training state of the item in hand (sweep_checkpoints.h),
+// take no new one, close the file cleanly.
 volatile std::sig_atomic_t g_stop_signal = 0;
 extern "C" void request_stop(int signal) { g_stop_signal = signal; }
 
@@ -119,6 +122,11 @@ void declare_options(cli::Parser* parser) {
                  "I/N: train only cells c with c % N == I (cells largest first), into "
                  "<output>.shard-I-of-N.h5 unless --out is given; one shard per Slurm array "
                  "task, then `phnn merge` (docs/SLURM.md)");
+  parser->option("checkpoint-every",
+                 "save each cell's training state every SECONDS of its training (and at once "
+                 "on SIGTERM/SIGUSR1), beside the journals; a stopped, killed or requeued cell "
+                 "goes on from it, bitwise as if never interrupted; 0: only on a signal",
+                 "300");
   parser->option("threads", "LibTorch intra-op threads per rank", "1");
   parser->flag("quiet", "no per-item log lines");
 }
@@ -192,6 +200,11 @@ class SweepRun {
     spec_ = parse_sweep_file(parser_.get("FILE"));
     grid_ = expand_grid(spec_);
     if (parser_.get_int("threads") < 1) throw cli::UsageError{"phnn sweep: --threads must be >= 1"};
+    checkpoint_every_ = parser_.get_double("checkpoint-every");
+    if (checkpoint_every_ < 0) {
+      throw cli::UsageError{"phnn sweep: --checkpoint-every must be >= 0 seconds (0: save the "
+                            "training state only when stopped by a signal)"};
+    }
     if (parser_.flag_set("cell-costs") && !parser_.flag_set("dry-run")) {
       throw cli::UsageError{"phnn sweep: --cell-costs prints the cost model's estimates and trains "
                             "nothing: add --dry-run"};
@@ -291,6 +304,7 @@ class SweepRun {
   SplitOptions split_;
   Shard shard_;  // 0/1: the whole sweep
   std::vector<int> ranks_;
+  double checkpoint_every_ = 300.0;
   std::string out_;
   WriterLock lock_;  // rank 0 only; released after the file is closed
   std::optional<ResultsFile> results_;
@@ -300,14 +314,36 @@ class SweepRun {
   Clock::time_point start_ = Clock::now();
 };
 
-// Trains one item's cell. A cell that throws is a result too: every run
-// failed, with the message.
+// Trains one item's cell, from its saved state if it has one. A cell that
+// throws is a result too: every run failed, with the message. A cell stopped
+// by a signal returns no results (its state is saved; *interrupted).
 std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
                                   const std::string& system, const std::function<void()>& tick,
-                                  const std::string& prefix, int item_number) {
+                                  ItemCheckpoints* checkpoints, const std::string& prefix,
+                                  int item_number, bool* interrupted) {
+  *interrupted = false;
+  const auto progress = [&](const TrainProgress&) { tick(); };
   try {
     data->make(system);
-    return data->train(cell, system, [&](const TrainProgress&) { tick(); });
+    try {
+      return data->train(cell, system, progress, &checkpoints->checkpointing());
+    } catch (const std::invalid_argument& e) {
+      // A saved state that does not fit (e.g. written by another build).
+      if (checkpoints->resume_step() == 0 ||
+          std::string(e.what()).rfind("training state", 0) != 0) {
+        throw;
+      }
+      std::fprintf(stderr, "%sitem %d: %s; training it from the start\n", prefix.c_str(),
+                   item_number, e.what());
+      checkpoints->forget_state();
+      return data->train(cell, system, progress, &checkpoints->checkpointing());
+    }
+  } catch (const CellInterrupted& e) {
+    *interrupted = true;
+    std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its training state is in %s\n",
+                 prefix.c_str(), item_number, e.step, cell.training.steps,
+                 checkpoints->path().c_str());
+    return {};
   } catch (const std::exception& e) {
     std::vector<RunResult> failed(cell.seeds.size());
     for (auto& r : failed) {
@@ -379,16 +415,27 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
   // The same statuses on every rank give the same plan on every rank.
   int runs_done_before = 0;
-  const auto pending =
+  auto pending =
       pending_runs(grid_, status_codes, parser_.flag_set("retry-failed"), shard_, &runs_done_before);
-  const WorkPlan plan = plan_work(grid_, pending, size_, split_);
-  const std::vector<WorkItem>& work = plan.items;
   int runs_to_do = 0;
   for (const auto& runs : pending) runs_to_do += static_cast<int>(runs.size());
+  // Items with a saved training state, as they were (rank 0 reads the states).
+  std::vector<std::vector<int>> resumed;
+  if (root_) resumed = resumed_groups(grid_, &pending, out_, spec_.text_hash);
+  mpi::broadcast(world_, resumed, 0);
+  mpi::broadcast(world_, pending, 0);
+  const WorkPlan plan = plan_work(grid_, pending, size_, split_);
+  const std::vector<WorkItem> work = with_resumed(grid_, resumed, plan.items);
   const ScheduleMode mode = parser_.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
   WorkQueue queue(MPI_COMM_WORLD, static_cast<int>(work.size()), mode);
   if (root_) {
-    print_plan(spec_, grid_, shard_, runs_done_before, runs_to_do, plan, size_, queue.mode(), out_);
+    WorkPlan shown = plan;  // the resumed items counted too
+    shown.items = work;
+    print_plan(spec_, grid_, shard_, runs_done_before, runs_to_do, shown, size_, queue.mode(), out_);
+    if (!resumed.empty()) {
+      std::cout << "phnn sweep: " << resumed.size()
+                << " of them go on from their saved training state\n";
+    }
   }
   const bool quiet = parser_.flag_set("quiet");
   int my_runs = 0;
@@ -423,14 +470,27 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
                  describe(head) + ", " + std::to_string(cell.seeds.size()) + " seed" +
                      (cell.seeds.size() > 1 ? "s" : ""));
     }
+    ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, spec_.text_hash),
+                                checkpoint_every_, &g_stop_signal, prefix_);
+    if (!quiet && checkpoints.resume_step() > 0) {
+      print_item("%sitem %d/%zu: going on after step %s\n", prefix_, i + 1, work.size(),
+                 std::to_string(checkpoints.resume_step()) + " of " +
+                     std::to_string(cell.training.steps) + " (saved training state)");
+    }
     const auto cell_start = Clock::now();
     const std::string started = utc_now();
+    bool interrupted = false;
     const std::vector<RunResult> cell_results =
         train_item(cell, &data_, head.system_name(), [&] {
           post_stop();
           report_progress(false);
-        }, prefix_, i + 1);
+        }, &checkpoints, prefix_, i + 1, &interrupted);
+    if (interrupted) {
+      post_stop();
+      break;
+    }
     io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
+    if (io_error.empty()) checkpoints.remove();
     my_runs += static_cast<int>(item.runs.size());
     if (!io_error.empty()) {
       queue.request_stop();  // the others stop at their next item too

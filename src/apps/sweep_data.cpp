@@ -46,10 +46,11 @@ void SweepDataSets::store(const std::string& system_name, ResultsFile* results) 
 }
 
 std::vector<RunResult> SweepDataSets::train(const CellSpec& cell, const std::string& system_name,
-                                            const ProgressCallback& progress) const {
+                                            const ProgressCallback& progress,
+                                            const CellCheckpointing* checkpointing) const {
   const DataSet& d = at(system_name);
-  if (d.builtin) return train_cell(cell, *d.builtin, progress);
-  return train_cell(cell, *d.file, *d.system, progress);
+  if (d.builtin) return train_cell(cell, *d.builtin, progress, nullptr, checkpointing);
+  return train_cell(cell, *d.file, *d.system, progress, nullptr, checkpointing);
 }
 
 }  // namespace apps

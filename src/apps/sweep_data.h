@@ -34,7 +34,8 @@ class SweepDataSets {
   void store(const std::string& system_name, ResultsFile* results) const;
   /// Trains one cell of `system_name` (make first): train_cell on its data.
   std::vector<RunResult> train(const CellSpec& cell, const std::string& system_name,
-                               const ProgressCallback& progress) const;
+                               const ProgressCallback& progress,
+                               const CellCheckpointing* checkpointing = nullptr) const;
 
  private:
   struct DataSet {

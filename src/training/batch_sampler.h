@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 #include <torch/torch.h>
 
 #include "phnn/data/counter_rng.h"
+#include "training/state_bytes.h"
 
 namespace phnn {
 
@@ -47,6 +49,26 @@ class BatchSampler {
     cursor_ += size;
     if (cursor_ >= n_) cursor_ = 0;
     return idx;
+  }
+
+  // Position in the epoch, each member's permutation and stream: a sampler
+  // restored from them gives the same batches as this one from here on.
+  void save(internal::StateWriter* out) const {
+    out->put<std::int32_t>(cursor_);
+    for (std::size_t e = 0; e < perms_.size(); ++e) {
+      out->put<std::uint64_t>(rngs_[e].counter());
+      out->put_vector(perms_[e]);
+    }
+  }
+  void restore(internal::StateReader* in) {
+    cursor_ = in->get<std::int32_t>();
+    for (std::size_t e = 0; e < perms_.size(); ++e) {
+      rngs_[e] = CounterRng(rngs_[e].key(), in->get<std::uint64_t>());
+      perms_[e] = in->get_vector<int64_t>();
+      if (perms_[e].size() != static_cast<std::size_t>(n_)) {
+        throw std::invalid_argument("training state: a batch order of another N_train");
+      }
+    }
   }
 
  private:

@@ -20,6 +20,13 @@ FlatAdam::FlatAdam(torch::Tensor values, torch::Tensor gradients, const TrainerO
   v_ = torch::zeros_like(p_, torch::MemoryFormat::Preserve);
 }
 
+void FlatAdam::restore(const torch::Tensor& m, const torch::Tensor& v, int64_t steps_taken) {
+  torch::NoGradGuard no_grad;
+  m_.copy_(m);
+  v_.copy_(v);
+  t_ = steps_taken;
+}
+
 void FlatAdam::zero_grad() { g_.zero_(); }
 
 void FlatAdam::step() {

@@ -1,7 +1,9 @@
-// src/training/trainer.cpp — train_cell as CellTrainer's phases: prepare,
-// step / validate / checkpoint, finish (the rollouts are in rollout.cpp, the
-// minibatch order in batch_sampler.h, CellSpec's checks in cell_spec.cpp),
-// in the training precision (float64, or float32 with float64 inference).
+// src/training/trainer.cpp — train_cell as CellTrainer's phases (class in
+// cell_trainer.h): prepare, step / validate / checkpoint, finish (the
+// rollouts are in rollout.cpp, the minibatch order in batch_sampler.h,
+// CellSpec's checks in cell_spec.cpp, saved training states in
+// cell_trainer_state.cpp), in the training precision (float64, or float32
+// with float64 inference).
 // Size: one class whose phases share the stack, the optimizer and the best weights.
 #include "phnn/training/trainer.h"
 
@@ -20,15 +22,18 @@
 #include "phnn/training/discrete_step.h"
 #include "phnn/training/flat_adam.h"
 #include "phnn/training/regularizers.h"
-#include "training/batch_sampler.h"
-#include "training/cell_data.h"
-#include "training/rollout.h"
+#include "training/cell_trainer.h"
 
 namespace phnn {
 
-namespace {
+CellInterrupted::CellInterrupted(int at_step, int total_steps)
+    : std::runtime_error("training stopped after step " + std::to_string(at_step) + " of " +
+                         std::to_string(total_steps) + "; its state was saved"),
+      step(at_step) {}
 
-using Clock = std::chrono::steady_clock;
+namespace internal {
+
+namespace {
 
 // The first `count` rows of a row-major [.][width] array as [count, width]
 // in `dtype` (float32: the float64 data rounded).
@@ -52,80 +57,12 @@ ModelOptions training_model_options(const CellSpec& cell, const CellData& data) 
   return options;
 }
 
-// One cell's training as named phases (docs: the trainer in one sitting):
-//   CellTrainer trainer(cell, data, progress);   // prepare: model, Adam, tensors
-//   trainer.train();                             // step / validate / checkpoint
-//   results = trainer.finish();                  // best weights, rollouts, results
-// Each phase is a member function that fits on a screen; the state they
-// share is the members below.
-class CellTrainer {
- public:
-  CellTrainer(const CellSpec& cell, const CellData& data, const ProgressCallback& progress);
-
-  void train();
-  std::vector<RunResult> finish();
-  // The float64 stack the rollouts used, with the best weights.
-  std::unique_ptr<DynamicsModel> release_model() {
-    return std::move(inference_model_ ? inference_model_ : model_);
-  }
-
- private:
-  // The data of the cell as tensors; *_all / validation ones expanded over
-  // the E members (views, no copies).
-  struct Tensors {
-    torch::Tensor x, x_next, u;              // [N, n_x], [N, n_x], [N, n_u]
-    torch::Tensor x_all, x_next_all, u_all;  // [E, N, .]
-    torch::Tensor xv, xv_next, uv;           // [E, V, .]
-  };
-  Tensors make_tensors() const;
-
-  double elapsed() const {
-    return std::chrono::duration<double>(Clock::now() - start_).count();
-  }
-  // L_d (Eq. 30) per member in opt_.loss_norm (discrete_loss): by default the
-  // mean over batch and components of |x_{n+1} - x_hat| / h.
-  // `f_at_x`, when defined, is f(x, u), reused as an explicit step's first stage.
-  torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u,
-                          const torch::Tensor& f_at_x = {}) const;
-  void step(int step, BatchSampler& sampler);
-  void freeze_non_finite(const torch::Tensor& loss, int step, std::vector<int64_t>* dead);
-  void validate(int step);
-  void report_progress(int step, std::vector<double> live_best) const;
-  // Rollouts of the best weights so far, in float64: in the training model (the caller
-  // restores its weights if training goes on) or, after float32 training, inference_model_.
-  Rollouts roll_out_best();
-  void checkpoint(int step);
-  double train_seconds_per_run() const {
-    return (elapsed() - checkpoint_overhead_s_) / static_cast<double>(E_);
-  }
-  void fill_result(int64_t e, const Rollouts& rollouts, double mse, double train_s, double wall);
-
-  const CellSpec& cell_;
-  const CellData& data_;
-  const TrainerOptions& opt_;
-  const ProgressCallback& progress_;
-  const Clock::time_point start_ = Clock::now();
-  const int64_t E_;
-  const double h_;
-  std::unique_ptr<DynamicsModel> model_;
-  // float32 training only: the float64 stack the rollouts use.
-  std::unique_ptr<DynamicsModel> inference_model_;
-  DynamicsModel::FlatParameters flat_;
-  std::vector<torch::Tensor> params_, grads_;  // alias flat_.values / gradients
-  std::unique_ptr<FlatAdam> adam_;
-  Tensors t_;
-  std::vector<RunResult> results_;
-  std::vector<bool> alive_;
-  std::vector<int> diverged_at_;
-  std::vector<double> best_val_;
-  std::vector<torch::Tensor> best_, frozen_;
-  double checkpoint_overhead_s_ = 0.0;
-};
+}  // namespace
 
 CellTrainer::CellTrainer(const CellSpec& cell, const CellData& data,
-                         const ProgressCallback& progress)
+                         const ProgressCallback& progress, const CellCheckpointing* checkpointing)
     : cell_(cell), data_(data), opt_(cell.training), progress_(progress),
-      E_(static_cast<int64_t>(cell.seeds.size())), h_(data.step) {
+      E_(static_cast<int64_t>(cell.seeds.size())), h_(data.step), checkpointing_(checkpointing) {
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   model_ = DynamicsModel::create(training_model_options(cell, data), seeds);
   if (model_->options().dtype != torch::kFloat64) {
@@ -145,6 +82,10 @@ CellTrainer::CellTrainer(const CellSpec& cell, const CellData& data,
   for (const auto& p : params_) {
     best_.push_back(p.detach().clone());
     frozen_.push_back(p.detach().clone());
+  }
+  sampler_ = std::make_unique<BatchSampler>(cell_.seeds, cell_.n_train, opt_.batch_size);
+  if (checkpointing_ && !checkpointing_->resume_from.empty()) {
+    restore_state(checkpointing_->resume_from);
   }
 }
 
@@ -176,18 +117,18 @@ torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor
   return discrete_loss(xn, x_hat, h_, opt_.loss_norm);
 }
 
+// Steps first_step_..steps (1.. unless a saved state was restored).
 void CellTrainer::train() {
-  BatchSampler sampler(cell_.seeds, cell_.n_train, opt_.batch_size);
-  validate(0);
-  std::size_t next_checkpoint = 0;
-  for (int s = 1; s <= opt_.steps; ++s) {
-    step(s, sampler);
+  if (first_step_ == 1) validate(0);
+  for (int s = first_step_; s <= opt_.steps; ++s) {
+    step(s, *sampler_);
     if (s % opt_.eval_every == 0 || s == opt_.steps) validate(s);
-    if (next_checkpoint < opt_.checkpoints.size() && s == opt_.checkpoints[next_checkpoint]) {
+    if (next_checkpoint_ < opt_.checkpoints.size() && s == opt_.checkpoints[next_checkpoint_]) {
       if (s < opt_.steps) checkpoint(s);  // the last step's is the final inference
-      ++next_checkpoint;
+      ++next_checkpoint_;
     }
     if (std::none_of(alive_.begin(), alive_.end(), [](bool a) { return a; })) break;
+    save_if_due(s);
   }
 }
 
@@ -385,15 +326,16 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts, double mse, d
   r.message = msg.str();
 }
 
-}  // namespace
+}  // namespace internal
 
 namespace {
 
 std::vector<RunResult> train_cell_data(const CellSpec& cell, const CellData& data,
                                        const ProgressCallback& progress,
-                                       std::unique_ptr<DynamicsModel>* trained) {
+                                       std::unique_ptr<DynamicsModel>* trained,
+                                       const CellCheckpointing* checkpointing) {
   validate_cell(cell, data);
-  CellTrainer trainer(cell, data, progress);
+  internal::CellTrainer trainer(cell, data, progress, checkpointing);
   trainer.train();
   std::vector<RunResult> results = trainer.finish();
   if (trained) *trained = trainer.release_model();
@@ -404,14 +346,16 @@ std::vector<RunResult> train_cell_data(const CellSpec& cell, const CellData& dat
 
 std::vector<RunResult> train_cell(const CellSpec& cell, const PhSystemData& data,
                                   const PhSystem& system, const ProgressCallback& progress,
-                                  std::unique_ptr<DynamicsModel>* trained) {
-  return train_cell_data(cell, make_cell_data(data, system), progress, trained);
+                                  std::unique_ptr<DynamicsModel>* trained,
+                                  const CellCheckpointing* checkpointing) {
+  return train_cell_data(cell, make_cell_data(data, system), progress, trained, checkpointing);
 }
 
 std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
                                   const ProgressCallback& progress,
-                                  std::unique_ptr<DynamicsModel>* trained) {
-  return train_cell_data(cell, make_cell_data(data), progress, trained);
+                                  std::unique_ptr<DynamicsModel>* trained,
+                                  const CellCheckpointing* checkpointing) {
+  return train_cell_data(cell, make_cell_data(data), progress, trained, checkpointing);
 }
 
 }  // namespace phnn

@@ -31,7 +31,7 @@ sleep 1
 kill -TERM $(pgrep -f "^bash $root/jobs/local.sh $dir/stop.toml") 2>/dev/null
 wait "$pid"; status=$?
 [[ $status -eq 75 ]] || fail "first run exited $status, expected 75 (graceful stop)"
-grep -q "stopping: each rank finishes its current cell" "$dir/log" || fail "no stop message"
+grep -q "stopping: each rank saves its current cell" "$dir/log" || fail "no stop message"
 grep -q "run the same command again to resume" "$dir/log" || fail "no resume hint"
 grep -q "pending of 6 runs" "$dir/log" || fail "no partial table"
 run; status=$?

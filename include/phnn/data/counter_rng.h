@@ -35,6 +35,11 @@ class CounterRng {
   }
 
   explicit CounterRng(std::uint64_t key) : key_(key) {}
+  /// A stream resumed after `counter` draws (a saved training state).
+  CounterRng(std::uint64_t key, std::uint64_t counter) : key_(key), counter_(counter) {}
+  std::uint64_t key() const { return key_; }
+  /// Draws taken so far.
+  std::uint64_t counter() const { return counter_; }
 
   std::uint64_t next_u64() {
     ++counter_;

@@ -21,6 +21,11 @@ class FlatAdam {
   void zero_grad();
   void step();
   int64_t steps_taken() const { return t_; }
+  /// The moment estimates (shaped like the values), for a saved training
+  /// state; restore() puts them and the step count back.
+  const torch::Tensor& first_moment() const { return m_; }
+  const torch::Tensor& second_moment() const { return v_; }
+  void restore(const torch::Tensor& m, const torch::Tensor& v, int64_t steps_taken);
 
  private:
   torch::Tensor p_, g_, m_, v_;

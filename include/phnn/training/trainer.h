@@ -4,6 +4,8 @@
 
 #include <functional>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "phnn/config/model_config.h"
@@ -51,6 +53,44 @@ struct TrainProgress {
 };
 using ProgressCallback = std::function<void(const TrainProgress&)>;
 
+/// Saved training states inside a cell, so a stopped or killed cell goes on
+/// from its last state and ends bitwise as if never interrupted
+/// (docs/DECISIONS.md, "Preemptible cells"). The state is opaque bytes:
+/// weights, Adam moments and step count, each member's batch order and
+/// stream position, best-validation weights and losses, frozen members, the
+/// trace so far. Timings (trace elapsed_s, train seconds) go on from the
+/// saved ones; a repeated stretch of training is not counted twice.
+///
+///   CellCheckpointing c;
+///   c.interval_s = 300;
+///   c.resume_from = read_state_or_empty();
+///   c.save = [&](const std::string& state, int step) { write_atomically(state); };
+///   c.stop_requested = [] { return g_signal != 0; };
+///   try { results = train_cell(cell, data, progress, nullptr, &c); }
+///   catch (const CellInterrupted& e) { /* state of step e.step saved */ }
+struct CellCheckpointing {
+  /// Saves the state after the first step that ends this many seconds of
+  /// wall time after the previous save (or the start); <= 0: only when
+  /// stopped.
+  double interval_s = 0.0;
+  /// A state `save` received earlier for this same cell (spec, seeds and
+  /// data); empty: start at step 0. One that does not fit the cell throws
+  /// std::invalid_argument before any training.
+  std::string resume_from;
+  /// Receives each state and the step it ends; required.
+  std::function<void(const std::string& state, int step)> save;
+  /// Polled after every step (keep it cheap); true: save the state and
+  /// throw CellInterrupted.
+  std::function<bool()> stop_requested;
+};
+
+/// Thrown by train_cell when CellCheckpointing::stop_requested said stop,
+/// after the state of the last finished step was saved.
+struct CellInterrupted : std::runtime_error {
+  CellInterrupted(int step, int total_steps);
+  int step = 0;
+};
+
 /// Trains the cell on `data` (the first n_train training pairs, the
 /// validation pairs), keeps each member's best-validation weights, rolls all
 /// members out over the inference set (docs/METHOD.md §5) and the two figure
@@ -62,16 +102,19 @@ using ProgressCallback = std::function<void(const TrainProgress&)>;
 /// RunResult::weights are those float64 values.
 /// If `trained` is given it receives the (float64) model stack the rollouts
 /// used, with the best weights.
+/// With `checkpointing`, training states are saved and resumed as it says.
 std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
                                   const ProgressCallback& progress = {},
-                                  std::unique_ptr<DynamicsModel>* trained = nullptr);
+                                  std::unique_ptr<DynamicsModel>* trained = nullptr,
+                                  const CellCheckpointing* checkpointing = nullptr);
 
 /// The same for a file-defined system's data set (any n_x, n_u): the
 /// n-dimensional models of general_ph.h on the system's S and J; no figure
 /// trajectories (RunResult's figure fields stay empty).
 std::vector<RunResult> train_cell(const CellSpec& cell, const PhSystemData& data,
                                   const PhSystem& system, const ProgressCallback& progress = {},
-                                  std::unique_ptr<DynamicsModel>* trained = nullptr);
+                                  std::unique_ptr<DynamicsModel>* trained = nullptr,
+                                  const CellCheckpointing* checkpointing = nullptr);
 
 /// The structure the n-dimensional models of a system use (its S and J,
 /// row-major, and n_x, n_w, n_u).

@@ -1,0 +1,45 @@
+// src/apps/sweep_checkpoints.cpp — see apps/sweep_checkpoints.h. Touches
+// the item state files under `<results>.journal/` only.
+#include "apps/sweep_checkpoints.h"
+
+#include <cstdio>
+#include <iostream>
+
+#include "phnn/store/cell_checkpoint.h"
+
+namespace phnn {
+namespace apps {
+
+ItemCheckpoints::ItemCheckpoints(const std::string& out, const std::string& key,
+                                 double interval_s, const volatile std::sig_atomic_t* stop_signal,
+                                 std::string prefix)
+    : path_(cell_checkpoint_path(out, key)), key_(key), prefix_(std::move(prefix)) {
+  CellCheckpoint saved;
+  std::string problem;
+  if (read_cell_checkpoint(path_, &saved, &problem) && saved.key == key_) {
+    checkpointing_.resume_from = std::move(saved.state);
+    resume_step_ = saved.step;
+  } else if (!problem.empty()) {
+    std::fprintf(stderr, "%s%s; training the item from the start\n", prefix_.c_str(),
+                 problem.c_str());
+  }
+  checkpointing_.interval_s = interval_s;
+  checkpointing_.stop_requested = [stop_signal] { return *stop_signal != 0; };
+  checkpointing_.save = [this](const std::string& state, int step) {
+    try {
+      write_cell_checkpoint(path_, CellCheckpoint{key_, state, step});
+      saved_step_ = step;
+    } catch (const std::exception& e) {
+      if (!warned_) {
+        std::fprintf(stderr, "%scannot save the training state (%s); training goes on\n",
+                     prefix_.c_str(), e.what());
+      }
+      warned_ = true;
+    }
+  };
+}
+
+void ItemCheckpoints::remove() const { remove_cell_checkpoint(path_); }
+
+}  // namespace apps
+}  // namespace phnn

@@ -1,0 +1,219 @@
+// tests/training/cell_checkpoint_test.cpp — saved training states inside a
+// cell (CellCheckpointing): a cell stopped and resumed, once or twice, ends
+// bitwise as the uninterrupted cell (weights, MSE, trace, budget
+// checkpoints, frozen members), on built-in and file-defined systems, in
+// float64 and float32; a state that does not fit the cell is refused.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "phnn/systems/system_file.h"
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::HasSubstr;
+
+const SystemData& duffing() {
+  static const SystemData d = [] {
+    DatasetOptions options;
+    options.num_inference = 4;
+    return make_system_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 100);
+  }();
+  return d;
+}
+
+const SystemData& harmonic() {
+  static const SystemData d = [] {
+    DatasetOptions options;
+    options.num_inference = 4;
+    return make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic), options, 100);
+  }();
+  return d;
+}
+
+using Train = std::function<std::vector<RunResult>(const CellCheckpointing*)>;
+
+// Trains through `train`, stopping after each step listed in `stops` (as a
+// signal would) and resuming from the saved state; returns the results and
+// the steps the states were saved at.
+std::vector<RunResult> stopped_and_resumed(const Train& train, const std::vector<int>& stops,
+                                           std::vector<int>* saved_at) {
+  std::string state;
+  int polls = 0;
+  for (std::size_t k = 0;; ++k) {
+    CellCheckpointing c;
+    c.resume_from = state;
+    c.save = [&](const std::string& s, int step) {
+      state = s;
+      saved_at->push_back(step);
+    };
+    c.stop_requested = [&] { return k < stops.size() && ++polls == stops[k]; };
+    try {
+      return train(&c);
+    } catch (const CellInterrupted& e) {
+      EXPECT_EQ(e.step, stops[k]);
+      polls = e.step;  // polls count steps: the next run goes on from here
+    }
+  }
+}
+
+// Everything a run's result holds except its timings, bitwise.
+void expect_same_results(const std::vector<RunResult>& a, const std::vector<RunResult>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t e = 0; e < a.size(); ++e) {
+    SCOPED_TRACE("member " + std::to_string(e));
+    EXPECT_EQ(a[e].status, b[e].status);
+    EXPECT_EQ(a[e].message, b[e].message);
+    EXPECT_EQ(a[e].mse, b[e].mse);
+    EXPECT_EQ(a[e].trajectory_errors, b[e].trajectory_errors);
+    EXPECT_EQ(a[e].weights, b[e].weights);
+    EXPECT_EQ(a[e].best_step, b[e].best_step);
+    EXPECT_EQ(a[e].best_validation_loss, b[e].best_validation_loss);
+    EXPECT_EQ(a[e].checkpoint_steps, b[e].checkpoint_steps);
+    EXPECT_EQ(a[e].checkpoint_mse, b[e].checkpoint_mse);
+    EXPECT_EQ(a[e].figure_prediction_05, b[e].figure_prediction_05);
+    ASSERT_EQ(a[e].trace.size(), b[e].trace.size());
+    for (std::size_t i = 0; i < a[e].trace.size(); ++i) {
+      EXPECT_EQ(a[e].trace[i].step, b[e].trace[i].step);
+      EXPECT_EQ(a[e].trace[i].train_loss, b[e].trace[i].train_loss);
+      EXPECT_EQ(a[e].trace[i].validation_loss, b[e].trace[i].validation_loss);
+      EXPECT_EQ(a[e].trace[i].kappa, b[e].trace[i].kappa);
+    }
+  }
+}
+
+// PHNN-JR-DG + CN on Duffing, N_train 100 > batch 64: the batch order's
+// position inside an epoch, Adam's moments and the best weights carry over;
+// stops before, at and after a budget checkpoint and a validation point.
+TEST(CellCheckpointTest, StoppedTwiceEndsBitwiseAsUninterrupted) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnJr;
+  cell.integrator = IntegratorKind::kDg;
+  cell.n_train = 100;
+  cell.regularizer = Regularizer::kCn;
+  cell.training.steps = 60;
+  cell.training.eval_every = 10;
+  cell.training.checkpoints = {20, 60};
+  cell.seeds = {3, 8};
+  const Train train = [&](const CellCheckpointing* c) {
+    return train_cell(cell, duffing(), {}, nullptr, c);
+  };
+  const auto plain = train(nullptr);
+  std::vector<int> saved_at;
+  const auto resumed = stopped_and_resumed(train, {7, 20, 33}, &saved_at);
+  EXPECT_EQ(saved_at, (std::vector<int>{7, 20, 33}));
+  expect_same_results(resumed, plain);
+}
+
+// Float32 training with a member that diverges (frozen) before the stop:
+// the frozen weights and the divergence step survive the restart.
+TEST(CellCheckpointTest, FrozenMembersAndFloat32Survive) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnS;
+  cell.training.precision = Precision::kFloat32;
+  cell.training.steps = 50;
+  cell.training.eval_every = 10;
+  cell.training.learning_rate = 1e3;  // seeds 0 and 1 overflow within 50 steps
+  cell.seeds = {0, 1, 2};
+  const Train train = [&](const CellCheckpointing* c) {
+    return train_cell(cell, harmonic(), {}, nullptr, c);
+  };
+  const auto plain = train(nullptr);
+  ASSERT_THAT(plain[0].message, HasSubstr("training loss non-finite"));
+  std::vector<int> saved_at;
+  expect_same_results(stopped_and_resumed(train, {45}, &saved_at), plain);
+}
+
+// A file-defined system (n_x = 4) through the general models, NODE RK4.
+TEST(CellCheckpointTest, FileDefinedSystemResumesBitwise) {
+  static const auto system =
+      load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/coupled-duffing.toml");
+  DatasetOptions options;
+  options.num_validation = 30;
+  options.num_inference = 2;
+  const PhSystemData data = make_ph_system_data(*system, options, 25);
+  for (ModelKind model : {ModelKind::kNode, ModelKind::kPhnnJr}) {
+    CellSpec cell;
+    cell.model = model;
+    cell.integrator = IntegratorKind::kRk4;
+    cell.n_train = 25;
+    cell.training.steps = 30;
+    cell.training.eval_every = 10;
+    cell.seeds = {1, 2};
+    const Train train = [&](const CellCheckpointing* c) {
+      return train_cell(cell, data, *system, {}, nullptr, c);
+    };
+    std::vector<int> saved_at;
+    expect_same_results(stopped_and_resumed(train, {12}, &saved_at), train(nullptr));
+  }
+}
+
+// interval_s > 0 saves on time without stopping, never after the last step,
+// and changes no result; the last state saved resumes to the same results.
+TEST(CellCheckpointTest, TimedSavesChangeNothing) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnJr;
+  cell.n_train = 100;
+  cell.training.steps = 25;
+  cell.training.eval_every = 5;
+  cell.seeds = {0, 1};
+  const auto plain = train_cell(cell, duffing());
+  std::vector<int> saved_at;
+  std::vector<std::string> states;
+  CellCheckpointing c;
+  c.interval_s = 1e-12;  // every step
+  c.save = [&](const std::string& s, int step) {
+    states.push_back(s);
+    saved_at.push_back(step);
+  };
+  expect_same_results(train_cell(cell, duffing(), {}, nullptr, &c), plain);
+  ASSERT_EQ(saved_at.size(), 24u);
+  EXPECT_EQ(saved_at.front(), 1);
+  EXPECT_EQ(saved_at.back(), 24);
+  CellCheckpointing resume;
+  resume.resume_from = states[10];
+  expect_same_results(train_cell(cell, duffing(), {}, nullptr, &resume), plain);
+}
+
+// A state of other seeds, other steps or cut short is refused before training.
+TEST(CellCheckpointTest, AStateOfAnotherCellIsRefused) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnS;
+  cell.training.steps = 10;
+  cell.seeds = {0, 1};
+  std::string state;
+  CellCheckpointing c;
+  c.save = [&](const std::string& s, int) { state = s; };
+  c.stop_requested = [] { return true; };
+  EXPECT_THROW(train_cell(cell, harmonic(), {}, nullptr, &c), CellInterrupted);
+  ASSERT_FALSE(state.empty());
+  auto refused = [&](CellSpec other, const std::string& bytes) {
+    CellCheckpointing r;
+    r.resume_from = bytes;
+    try {
+      train_cell(other, harmonic(), {}, nullptr, &r);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  CellSpec other_seeds = cell;
+  other_seeds.seeds = {0, 2};
+  EXPECT_THAT(refused(other_seeds, state), HasSubstr("another cell"));
+  CellSpec other_steps = cell;
+  other_steps.training.steps = 11;
+  EXPECT_THAT(refused(other_steps, state), HasSubstr("another cell"));
+  CellSpec other_model = cell;
+  other_model.model = ModelKind::kPhnnJr;
+  EXPECT_THAT(refused(other_model, state), HasSubstr("another cell"));
+  EXPECT_THAT(refused(cell, state.substr(0, state.size() - 3)), HasSubstr("training state"));
+  EXPECT_THAT(refused(cell, state + "x"), HasSubstr("left over"));
+}
+
+}  // namespace
+}  // namespace phnn
