@@ -288,6 +288,12 @@ class SweepRun {
     }
   }
 
+  struct Planned {
+    WorkPlan plan;  // items: the resumed ones first
+    int runs_done_before = 0, runs_to_do = 0;
+    std::size_t resumed = 0;
+  };
+  Planned plan(const std::vector<int>& status_codes);
   int train_and_close(const std::vector<int>& status_codes);
   int close_and_report(std::string io_error, bool stopped, int total_runs, double seconds);
 
@@ -355,6 +361,19 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
   }
 }
 
+// "item 3/8: <cell>, 2 seeds", and where it goes on from a saved state.
+void announce_item(const std::string& prefix, int number, std::size_t items,
+                   const RunConfig& head, const CellSpec& cell, int resume_step) {
+  print_item("%sitem %d/%zu: %s\n", prefix, number, items,
+             describe(head) + ", " + std::to_string(cell.seeds.size()) + " seed" +
+                 (cell.seeds.size() > 1 ? "s" : ""));
+  if (resume_step > 0) {
+    print_item("%sitem %d/%zu: going on after step %s\n", prefix, number, items,
+               std::to_string(resume_step) + " of " + std::to_string(cell.training.steps) +
+                   " (saved training state)");
+  }
+}
+
 // Journal record first (the source of truth), then the run times and the
 // row, for each run of the item. A failed journal append (a full disk) does
 // not stop the row: its space was allocated when the file was made, so the
@@ -411,29 +430,35 @@ int SweepRun::close_and_report(std::string io_error, bool stopped, int total_run
   return failed;
 }
 
-int SweepRun::train_and_close(const std::vector<int>& status_codes) {
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
-  // The same statuses on every rank give the same plan on every rank.
-  int runs_done_before = 0;
-  auto pending =
-      pending_runs(grid_, status_codes, parser_.flag_set("retry-failed"), shard_, &runs_done_before);
-  int runs_to_do = 0;
-  for (const auto& runs : pending) runs_to_do += static_cast<int>(runs.size());
-  // Items with a saved training state, as they were (rank 0 reads the states).
+// What is left to train, as work items: the saved states' items as they
+// were (rank 0 reads the states), then the plan of the rest. The same
+// broadcast lists give the same items on every rank.
+SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
+  Planned p;
+  auto pending = pending_runs(grid_, status_codes, parser_.flag_set("retry-failed"), shard_,
+                              &p.runs_done_before);
+  for (const auto& runs : pending) p.runs_to_do += static_cast<int>(runs.size());
   std::vector<std::vector<int>> resumed;
   if (root_) resumed = resumed_groups(grid_, &pending, out_, spec_.text_hash);
   mpi::broadcast(world_, resumed, 0);
   mpi::broadcast(world_, pending, 0);
-  const WorkPlan plan = plan_work(grid_, pending, size_, split_);
-  const std::vector<WorkItem> work = with_resumed(grid_, resumed, plan.items);
+  p.plan = plan_work(grid_, pending, size_, split_);
+  p.plan.items = with_resumed(grid_, resumed, p.plan.items);
+  p.resumed = resumed.size();
+  return p;
+}
+
+int SweepRun::train_and_close(const std::vector<int>& status_codes) {
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
+  const Planned planned = plan(status_codes);
+  const std::vector<WorkItem>& work = planned.plan.items;
   const ScheduleMode mode = parser_.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
   WorkQueue queue(MPI_COMM_WORLD, static_cast<int>(work.size()), mode);
   if (root_) {
-    WorkPlan shown = plan;  // the resumed items counted too
-    shown.items = work;
-    print_plan(spec_, grid_, shard_, runs_done_before, runs_to_do, shown, size_, queue.mode(), out_);
-    if (!resumed.empty()) {
-      std::cout << "phnn sweep: " << resumed.size()
+    print_plan(spec_, grid_, shard_, planned.runs_done_before, planned.runs_to_do, planned.plan,
+               size_, queue.mode(), out_);
+    if (planned.resumed > 0) {
+      std::cout << "phnn sweep: " << planned.resumed
                 << " of them go on from their saved training state\n";
     }
   }
@@ -465,18 +490,9 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     std::vector<int> seeds;
     for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
     const CellSpec cell = cell_spec_for(head, seeds);
-    if (!quiet) {
-      print_item("%sitem %d/%zu: %s\n", prefix_, i + 1, work.size(),
-                 describe(head) + ", " + std::to_string(cell.seeds.size()) + " seed" +
-                     (cell.seeds.size() > 1 ? "s" : ""));
-    }
     ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, spec_.text_hash),
                                 checkpoint_every_, &g_stop_signal, prefix_);
-    if (!quiet && checkpoints.resume_step() > 0) {
-      print_item("%sitem %d/%zu: going on after step %s\n", prefix_, i + 1, work.size(),
-                 std::to_string(checkpoints.resume_step()) + " of " +
-                     std::to_string(cell.training.steps) + " (saved training state)");
-    }
+    if (!quiet) announce_item(prefix_, i + 1, work.size(), head, cell, checkpoints.resume_step());
     const auto cell_start = Clock::now();
     const std::string started = utc_now();
     bool interrupted = false;
