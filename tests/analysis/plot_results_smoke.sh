@@ -13,7 +13,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 py=${1:-/usr/bin/python3}
 # 77 = skipped (ctest SKIP_RETURN_CODE) when the Debian packages are not installed
-"$py" -c "import h5py, matplotlib, numpy" 2>/dev/null || { echo "h5py/matplotlib missing: skipped"; exit 77; }
+"$py" -c "import h5py, matplotlib, numpy, pandas" 2>/dev/null || { echo "h5py/matplotlib/pandas missing: skipped"; exit 77; }
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 "$py" "$here/test_plot_results.py"
@@ -39,6 +39,8 @@ if [ $# -ge 2 ]; then
     for f in trajectories_coupled-duffing energy_coupled-duffing mse_grid_coupled-duffing; do
         test -s "$out/fig3/$f.png" || { echo "missing $f.png" >&2; cat "$out/fig3.log" >&2; exit 1; }
     done
+    # analysis/results.py: pandas on real files (pending runs, traces, exact numbers).
+    PHNN="$2" "$py" "$here/test_results_loader.py"
     # compare_ablation.py: a file against itself is one row per cell, every verdict "~".
     PHNN="$2" "$py" "$root/analysis/compare_ablation.py" "$out/trained.h5" "self=$out/trained.h5" \
         > "$out/ablation.md"

@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Tests of analysis/results.py on real results files written by $PHNN: one row per run (pending
+ones too), one column per setting, exact numbers, a categorical status, the traces.
+
+    PHNN=build/phnn /usr/bin/python3 tests/analysis/test_results_loader.py
+"""
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+sys.path.insert(0, ROOT)
+from analysis.results import load, traces  # noqa: E402
+
+import h5py  # noqa: E402
+import numpy as np  # noqa: E402
+
+PHNN = os.environ.get("PHNN", os.path.join(ROOT, "build", "phnn"))
+
+
+class Loader(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.TemporaryDirectory()
+        # Shard 0 of 2 of the tiny sweep: one cell trained, the other's 3 runs pending.
+        cls.path = os.path.join(cls.dir.name, "tiny.h5")
+        subprocess.run([PHNN, "sweep", os.path.join(ROOT, "sweeps", "tiny.toml"), "--shard", "0/2",
+                        "--out", cls.path, "--quiet"], check=True, capture_output=True)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.dir.cleanup()
+
+    def test_one_row_per_run_with_its_settings(self):
+        runs = load(self.path)
+        with h5py.File(self.path, "r") as f:
+            ids = [s.decode().rstrip("\0") for s in f["runs/id"][:]]
+            mse = dict(zip(ids, f["runs/mse"][:]))
+            seeds = dict(zip(ids, f["runs/seed"][:]))
+        self.assertEqual(sorted(runs.run_id), sorted(ids))
+        self.assertEqual(list(runs.status.cat.categories), ["pending", "done", "diverged", "failed"])
+        self.assertEqual(sorted(runs.status.value_counts()[["done", "pending"]]), [3, 3])
+        for key in ("system", "model", "integrator", "size", "n_train", "regularizer", "seed",
+                    "steps", "learning_rate", "batch_size", "damping", "model_label", "mse"):
+            self.assertIn(key, runs.columns)
+        self.assertEqual(runs.n_train.dtype, np.int64)
+        self.assertEqual(runs.seed.dtype, np.int64)
+        self.assertEqual(runs.learning_rate.dtype, np.float64)
+        self.assertEqual(set(runs.model_label), {"PHNN-JR-RK2", "NODE-RK2"})
+        for row in runs.itertuples():
+            self.assertEqual(row.seed, seeds[row.run_id])
+            if row.status == "done":  # bitwise the stored double
+                self.assertEqual(row.mse, mse[row.run_id])
+            else:
+                self.assertTrue(np.isnan(row.mse))
+        medians = runs.groupby(["model", "n_train"]).mse.median()
+        self.assertEqual(int(medians.notna().sum()), 1)  # the pending cell has no median
+
+    def test_traces_are_every_validation_point(self):
+        t = traces(self.path)
+        with h5py.File(self.path, "r") as f:
+            self.assertEqual(len(t), int(f["runs/trace_length"][:].sum()))
+        self.assertEqual(list(t.columns), ["run_id", "step", "elapsed_s", "train_loss",
+                                           "validation_loss", "kappa", "sigma_max", "rho"])
+        self.assertEqual(sorted(set(t.step)), [0, 10, 20])
+
+    def test_a_missing_file_is_named(self):
+        with self.assertRaisesRegex(FileNotFoundError, "nowhere.h5"):
+            load(os.path.join(self.dir.name, "nowhere.h5"))
+
+
+if __name__ == "__main__":
+    unittest.main()
