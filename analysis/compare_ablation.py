@@ -17,6 +17,7 @@ intervals come from `phnn reduce --format csv` (the reducer's own statistics: li
 quartiles, percentile bootstrap, fixed key); the seed counts from `phnn reduce --format csv
 --per-run`, over the runs of the row's study. The phnn binary: $PHNN, else build/phnn.
 """
+import argparse
 import sys
 
 from phnn_tool import run_csv
@@ -83,16 +84,22 @@ def verdict(base, cell):
     return " ~"
 
 
-def main():
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    threshold = 1.0
-    if "--threshold" in sys.argv:
-        threshold = float(sys.argv[sys.argv.index("--threshold") + 1])
-        args.remove(sys.argv[sys.argv.index("--threshold") + 1])
-    if len(args) < 2:
-        sys.exit(__doc__)
-    base = cells(args[0], threshold)
-    variants = [(a.rsplit("=", 1)[0], cells(a.rsplit("=", 1)[1], threshold)) for a in args[1:]]
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        description="Each cell of ablation results files against a baseline file: median "
+        "(bootstrap interval) [seeds above the threshold / finished] and better/worse/~.")
+    parser.add_argument("baseline", help="results file of the baseline")
+    parser.add_argument("variants", nargs="+", metavar="NAME=RESULTS",
+                        help="a variant's column name and results file")
+    parser.add_argument("--threshold", type=float, default=1.0,
+                        help="count the seeds whose MSE is above this (default 1)")
+    args = parser.parse_args(argv)
+    for v in args.variants:
+        if "=" not in v:
+            parser.error(f"{v}: give a variant as NAME=RESULTS")
+    threshold = args.threshold
+    base = cells(args.baseline, threshold)
+    variants = [(a.rsplit("=", 1)[0], cells(a.rsplit("=", 1)[1], threshold)) for a in args.variants]
     keys = sorted((k for k in base if any(k in v for _, v in variants)), key=sort_key)
     only_n_train = all(k[2] == "n_train" for k in keys)
     print(f"| system | model | {'N_train' if only_n_train else 'column'} | baseline | "

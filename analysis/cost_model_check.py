@@ -11,6 +11,7 @@ counted.  Prints a Markdown table of measured / estimated per model label, size 
 (the median and range of the per-cell ratios, and the ratio of the sums), then the totals.  The
 phnn binary: $PHNN, else build/phnn.
 """
+import argparse
 import statistics
 import sys
 
@@ -62,9 +63,12 @@ def table(cells, incomplete):
 
 
 def main(argv):
-    if len(argv) != 3:
-        print(__doc__, file=sys.stderr)
-        return 2
+    parser = argparse.ArgumentParser(
+        description="The cost model's estimate of each cell against its measured time.")
+    parser.add_argument("sweep", help="sweep file")
+    parser.add_argument("results", help="its results file")
+    args = parser.parse_args(argv[1:])
+    argv = [argv[0], args.sweep, args.results]
     estimates = run_csv("sweep", argv[1], "--dry-run", "--cell-costs")
     runs = run_csv("reduce", argv[2], "--format", "csv", "--per-run")
     cells, incomplete = measured_cells(estimates, runs)

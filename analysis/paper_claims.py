@@ -24,6 +24,7 @@ Medians, IQRs and intervals come from `phnn reduce --format csv` (the reducer's 
 the per-run Jacobian quantities from `phnn reduce --format csv --per-run`.  The phnn binary: $PHNN,
 else build/phnn.  A study or cell missing from the file is skipped and said so.
 """
+import argparse
 import math
 import os
 import statistics
@@ -414,10 +415,40 @@ def across_studies(res):
     return out
 
 
-def report(results, path):
+PAPER_STEPS, PAPER_SEEDS = 50000, 10
+
+
+def detail_line(c):
+    """One comparison as a Markdown bullet that does not nest ("- - x" would)."""
+    return f"- {'for' if c.ok else 'against'} the paper: {c.label}"
+
+
+def setting_problems(run_rows):
+    """How the file's runs differ from the paper's training budget and seed count (empty: they
+    do not): 50 000 Adam steps and 10 seeds per cell."""
+    problems = []
+    steps = sorted({int(r["steps"]) for r in run_rows if r.get("steps", "") != ""})
+    if steps and steps != [PAPER_STEPS]:
+        problems.append(f"{'/'.join(map(str, steps))} Adam steps per run (paper: {PAPER_STEPS})")
+    seeds = {}
+    for r in run_rows:
+        if r["status"] not in ("done", "diverged"):
+            continue  # the verdicts rest on finished runs only
+        key = (r["system"], r["model_label"], r["n_train"], r["size"], r["regularizer"])
+        seeds.setdefault(key, set()).add(r["seed"])
+    fewest = min((len(v) for v in seeds.values()), default=PAPER_SEEDS)
+    if fewest < PAPER_SEEDS:
+        problems.append(f"as few as {fewest} finished seeds per cell (paper: {PAPER_SEEDS})")
+    return problems
+
+
+def report(results, path, problems=()):
     claims = study_one(results) + study_two(results) + study_three(results) + across_studies(results)
-    lines = [f"# The paper's statements checked on {os.path.basename(path)}", "",
-             "| # | the paper says | our evidence | verdict |", "|---|---|---|---|"]
+    lines = [f"# The paper's statements checked on {os.path.basename(path)}", ""]
+    if problems:
+        lines += [f"**Not the paper's settings: {'; '.join(problems)}.** The verdicts below describe "
+                  "this file only; they do not confirm or contradict the paper.", ""]
+    lines += ["| # | the paper says | our evidence | verdict |", "|---|---|---|---|"]
     details = ["", "## Details", ""]
     for tag, text, comps in claims:
         if not comps:
@@ -425,7 +456,7 @@ def report(results, path):
         v, counts = verdict(comps)
         lines.append(f"| {tag} | {text} | {counts} | {v} |")
         details.append(f"**{tag}** {text}: {v}")
-        details.extend(f"- {'+' if c.ok else '-'} {c.label}" for c in comps)
+        details.extend(detail_line(c) for c in comps)
         details.append("")
     missing = [s for s in ("I", "II", "III") if not results.has(s)]
     if missing:
@@ -433,14 +464,30 @@ def report(results, path):
     return "\n".join(lines + details)
 
 
-def main(argv):
-    if len(argv) != 2:
-        print(__doc__, file=sys.stderr)
-        return 2
-    results = Results(reduce_csv(argv[1]), reduce_csv(argv[1], "--per-run"))
-    print(report(results, argv[1]))
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        description="The paper's statements (§6 and conclusion) checked on a results file of "
+        "sweeps/paper.toml: comparisons with intervals and a verdict per statement, as Markdown.",
+        epilog="Verdicts: holds, same direction, partly, not supported, contradicted / mixed "
+        "(the module's docstring says when). A file trained with fewer steps or seeds than the "
+        "paper's is flagged at the top; --strict refuses it.")
+    parser.add_argument("results", help="results file written by `phnn sweep sweeps/paper.toml`")
+    parser.add_argument("--strict", action="store_true",
+                        help="exit 1 without verdicts if the steps or seeds differ from the paper's")
+    args = parser.parse_args(argv)
+    if not os.path.exists(args.results):
+        parser.error(f"{args.results}: no such file")
+    run_rows = reduce_csv(args.results, "--per-run")
+    problems = setting_problems(run_rows)
+    for p in problems:
+        print(f"paper_claims.py: warning: {args.results}: {p}", file=sys.stderr)
+    if problems and args.strict:
+        print("paper_claims.py: --strict: not the paper's settings; no verdicts", file=sys.stderr)
+        return 1
+    results = Results(reduce_csv(args.results), run_rows)
+    print(report(results, args.results, problems))
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    sys.exit(main())

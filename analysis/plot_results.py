@@ -59,6 +59,7 @@ tests/analysis/test_plot_results.py.
 The integrator work-precision figure comes from bench/ via analysis/plot_work_precision.py, not
 from a results file.
 """
+import argparse
 import os
 import subprocess
 import sys
@@ -731,9 +732,12 @@ def time_vs_error(runs, name, out):
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    path, out = sys.argv[1], sys.argv[2]
+    parser = argparse.ArgumentParser(
+        description="The figures of a results file (the module's docstring lists them).")
+    parser.add_argument("results", help="results file written by `phnn sweep` or `phnn train`")
+    parser.add_argument("outdir", help="directory for the figures (created)")
+    args = parser.parse_args()
+    path, out = args.results, args.outdir
     if not os.path.exists(path):
         sys.exit(f"{path}: no such file; run `phnn sweep` first")
     os.makedirs(out, exist_ok=True)

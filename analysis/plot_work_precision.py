@@ -13,6 +13,7 @@ whole sequence of pairwise orders beside it (coarse to fine; errors below
 1e-11, i.e. near round-off, left out) so the pre-asymptotic range of the
 explicit methods on the stiff phases is visible.
 """
+import argparse
 import csv
 import math
 import os
@@ -52,8 +53,12 @@ def pairwise_orders(points):
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: plot_work_precision.py WP.csv OUTDIR")
+    parser = argparse.ArgumentParser(
+        description="Work-precision figure and observed orders from build/work_precision's CSV.")
+    parser.add_argument("csv", help="output of build/work_precision")
+    parser.add_argument("outdir", help="directory for the figure (created)")
+    args = parser.parse_args()
+    sys.argv[1:] = [args.csv, args.outdir]
     rows = read(sys.argv[1])
     systems = []
     for system, _ in rows:

@@ -18,6 +18,7 @@ costs) / (ranks x makespan), as in `--dry-run`.  The measured sweep may be the s
 paper grid at 2 seeds and 10 000 steps); the ratio then assumes the fixed and member parts of a
 cell scale alike.  The phnn binary: $PHNN, else build/phnn.
 """
+import argparse
 import heapq
 import sys
 
@@ -76,10 +77,15 @@ def replay(items, cells, ratios, ranks):
 
 
 def main(argv):
-    if len(argv) != 5:
-        print(__doc__, file=sys.stderr)
-        return 2
-    sweep, rank_list, measured_sweep, measured_results = argv[1:]
+    parser = argparse.ArgumentParser(
+        description="Replays a sweep's work plan with cell costs measured on another sweep.")
+    parser.add_argument("sweep", help="the sweep file to plan")
+    parser.add_argument("ranks", help="rank counts, e.g. 16,128")
+    parser.add_argument("measured_sweep", help="a sweep file whose results give measured costs")
+    parser.add_argument("measured_results", help="its results file")
+    args = parser.parse_args(argv[1:])
+    sweep, rank_list = args.sweep, args.ranks
+    measured_sweep, measured_results = args.measured_sweep, args.measured_results
     measured_estimates = run_csv("sweep", measured_sweep, "--dry-run", "--cell-costs")
     runs = run_csv("reduce", measured_results, "--format", "csv", "--per-run")
     measured, incomplete = measured_cells(measured_estimates, runs)

@@ -23,6 +23,7 @@ Runs are grouped by (system, n_train, model label). Only runs with status done o
 used. A diverged rollout has MSE +inf, which the medians keep: a median of +inf is printed as inf
 and is left off the plot.
 """
+import argparse
 import math
 import os
 import sys
@@ -176,8 +177,13 @@ def plot(table, budgets, outdir):
 
 
 def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: time_vs_error.py RESULTS.h5 OUTDIR")
+    parser = argparse.ArgumentParser(
+        description="Training cost against inference MSE at each step budget of a results file "
+        "of sweeps/time-vs-error.toml: a Markdown table and one figure per system.")
+    parser.add_argument("results", help="results file with [training] checkpoints")
+    parser.add_argument("outdir", help="directory for the table and figures (created)")
+    args = parser.parse_args()
+    sys.argv[1:] = [args.results, args.outdir]
     runs = load(sys.argv[1])
     os.makedirs(sys.argv[2], exist_ok=True)
     table = summarize(runs)

@@ -102,5 +102,36 @@ class StudyOne(unittest.TestCase):
         self.assertEqual(len(res.by_config), len(pc.PHNN_MODELS))
 
 
+class Settings(unittest.TestCase):
+    @staticmethod
+    def run_row(seed, steps="50000", status="done", model="NODE-RK2"):
+        return {"system": "duffing", "model_label": model, "n_train": "25", "size": "small",
+                "regularizer": "none", "seed": str(seed), "steps": steps, "status": status}
+
+    def test_the_papers_settings_pass(self):
+        rows = [self.run_row(s) for s in range(10)] + [self.run_row(s, model="PHNN-S-DG")
+                                                        for s in range(12)]
+        self.assertEqual(pc.setting_problems(rows), [])
+
+    def test_fewer_steps_or_finished_seeds_are_named(self):
+        rows = [self.run_row(s, steps="600") for s in range(2)]
+        problems = pc.setting_problems(rows)
+        self.assertEqual(len(problems), 2)
+        self.assertIn("600 Adam steps per run (paper: 50000)", problems[0])
+        self.assertIn("as few as 2 finished seeds per cell", problems[1])
+        pending = [self.run_row(s, status="pending" if s > 3 else "done") for s in range(10)]
+        self.assertEqual(pc.setting_problems(pending),
+                         ["as few as 4 finished seeds per cell (paper: 10)"])
+
+    def test_the_report_flags_them_and_bullets_do_not_nest(self):
+        a, b = cell(1.0, 0.5, 1.5), cell(3.0, 2.0, 4.0)
+        res = pc.Results([], [])
+        text = pc.report(res, "x.h5", ["600 Adam steps per run (paper: 50000)"])
+        self.assertIn("**Not the paper's settings: 600 Adam steps", text)
+        self.assertEqual(pc.detail_line(pc.compare("x", b, a)),
+                         "- against the paper: x: 3 (2, 4) >= 1 (0.5, 1.5) [resolved]")
+        self.assertTrue(pc.detail_line(pc.compare("x", a, b)).startswith("- for the paper: x: "))
+
+
 if __name__ == "__main__":
     unittest.main()
