@@ -1,17 +1,24 @@
 #!/usr/bin/env bash
 # Runs a sweep on N local cores, then prints its tables.
 #   jobs/local.sh [SWEEP_FILE] [RANKS] [extra phnn sweep options...]
-# Defaults: sweeps/demo.toml on 2 ranks, results in results/<sweep name>.h5
-# (override with OUT=path). Re-running the same command resumes.
+# Defaults: the repository's sweeps/demo.toml on 2 ranks, results in
+# results/<sweep file name>.h5 under the current directory (override with
+# OUT=path). Paths are taken from where you run it, so it works from your own
+# study directory too. Re-running the same command resumes.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-SWEEP=${1:-sweeps/demo.toml}
+REPO=$(cd "$(dirname "$0")/.." && pwd)
+SWEEP=${1:-$REPO/sweeps/demo.toml}
 RANKS=${2:-2}
 shift $(( $# > 2 ? 2 : $# ))
-PHNN=${PHNN:-build/phnn}
+PHNN=${PHNN:-$REPO/build/phnn}
 if [[ ! -x $PHNN ]]; then
   echo "jobs/local.sh: $PHNN not built; run scripts/build.sh first" >&2
   exit 1
+fi
+if [[ ! -f $SWEEP ]]; then
+  echo "jobs/local.sh: $SWEEP: no such sweep file (from $(pwd)); give its path, e.g." \
+       "jobs/local.sh sweeps/demo.toml 2" >&2
+  exit 2
 fi
 # One LibTorch / BLAS thread per rank: two ranks x two threads on two cores
 # measured 3-4x slower.

@@ -5,8 +5,10 @@
 # USR1 once a first run is journaled (what --signal=B:USR1 does before the
 # time limit), lets the job requeue itself, requeues it once more by hand
 # mid-run (scontrol requeue), waits for it to finish and checks the table.
-# Then array mode: the same sweep as a 2-task job array (one shard each) and
-# a merge job that depends on it; the merged runs must equal the first job's.
+# Then array mode with PHNN_SHARDS=4: an array task without it refuses; a
+# strided array (--array=0-3:2) trains exactly shards 0 and 2; two resubmitted
+# single tasks (--array=1, --array=3) train shards 1 and 3; a merge job that
+# depends on them; the merged runs must equal the first job's.
 #
 #   bash jobs/test-slurm.sh            # from the repository root, after scripts/build.sh
 #
@@ -133,18 +135,38 @@ grep "finished before" "$WORK/job-$JOB.log" | tail -1 | grep -qE "; [1-9] finish
   die "the last start had nothing left to do: scontrol requeue did not interrupt the sweep"
 log "PASSED: submit -> USR1 -> requeue -> scontrol requeue -> finished table"
 
-# --- array mode: 2 shards, then a merge job that depends on them ---------------
+# --- array mode: 4 shards as a strided array, then two resubmitted single tasks,
+# --- then a merge job that depends on them -----------------------------------
 job_state() { scontrol show job "$1" 2>/dev/null | grep -o 'JobState=[A-Z]*' | sort -u | tr '\n' ' '; }
-ARRAY=$(cd "$WORK" && PHNN=$PHNN sbatch --parsable --array=0-1 --ntasks=1 --time=60 \
-        --output="$WORK/array-%j.log" "$REPO/jobs/phnn-sweep.sbatch" "$WORK/sweep.toml" --quiet)
-MERGE=$(cd "$WORK" && sbatch --parsable --dependency=afterok:"$ARRAY" --ntasks=1 --time=10 \
+array_job() {  # array_job SPEC: one task per shard of PHNN_SHARDS=4
+  (cd "$WORK" && PHNN=$PHNN PHNN_SHARDS=4 sbatch --parsable --array="$1" --ntasks=1 --time=60 \
+     --output="$WORK/array-%A_%a.log" "$REPO/jobs/phnn-sweep.sbatch" "$WORK/sweep.toml" --quiet)
+}
+done_state() { [[ $(job_state "$1") == "JobState=COMPLETED " ]]; }
+# An array task without PHNN_SHARDS refuses to guess (exit 2, the fix named).
+BAD=$(cd "$WORK" && PHNN=$PHNN sbatch --parsable --array=1 --ntasks=1 --time=5 \
+      --output="$WORK/bad-%A_%a.log" "$REPO/jobs/phnn-sweep.sbatch" "$WORK/sweep.toml" --quiet)
+wait_for 120 "the array task without PHNN_SHARDS" bash -c "[[ \$(scontrol show job $BAD | grep -o 'JobState=[A-Z]*') == JobState=FAILED ]]"
+grep -q "set PHNN_SHARDS to the number of shards" "$WORK"/bad-*.log || die "no PHNN_SHARDS message"
+STRIDED=$(array_job 0-3:2)
+wait_for 600 "the strided array 0-3:2" done_state "$STRIDED"
+shards() { ls "$WORK"/results/slurm-test.shard-*-of-4.h5 2>/dev/null | sed 's/.*shard-\([0-9]\)-of-4.h5/\1/' | tr '\n' ' '; }
+[[ $(shards) == "0 2 " ]] || die "the strided array 0-3:2 wrote shards '$(shards)', expected '0 2 '"
+log "strided array $STRIDED (--array=0-3:2) trained shards 0 and 2 of 4, nothing else"
+ONE=$(array_job 1)
+THREE=$(array_job 3)
+MERGE=$(cd "$WORK" && sbatch --parsable --dependency=afterok:"$ONE":"$THREE" --ntasks=1 --time=10 \
         --output="$WORK/merge-%j.log" --wrap "$PHNN merge $WORK/merged.h5 \
-        $WORK/results/slurm-test.shard-0-of-2.h5 $WORK/results/slurm-test.shard-1-of-2.h5")
-log "submitted job array $ARRAY (2 shards) and merge job $MERGE (afterok:$ARRAY)"
+        $WORK/results/slurm-test.shard-{0,1,2,3}-of-4.h5")
+log "resubmitted single tasks $ONE (--array=1) and $THREE (--array=3); merge job $MERGE"
 wait_for 600 "the merge job" bash -c "[[ \$(scontrol show job $MERGE | grep -o 'JobState=[A-Z]*') == JobState=COMPLETED ]]"
-log "array $ARRAY: $(job_state "$ARRAY"); merge job $MERGE COMPLETED; logs:"
+[[ $(shards) == "0 1 2 3 " ]] || die "shards '$(shards)' after the resubmits, expected '0 1 2 3 '"
+for s in 0 1 2 3; do
+  grep -q "shard $s/4" "$WORK"/array-*.log || die "no log line of shard $s/4"
+done
+log "arrays: $(job_state "$STRIDED") $(job_state "$ONE") $(job_state "$THREE"); merge COMPLETED; logs:"
 sed 's/^/    /' "$WORK"/array-*.log "$WORK"/merge-*.log
-grep -q "2 shards merged: 10 of 10 runs with results" "$WORK"/merge-*.log || die "the merge is incomplete"
+grep -q "4 shards merged: 10 of 10 runs with results" "$WORK"/merge-*.log || die "the merge is incomplete"
 mse_column() {  # the run ids and MSEs of a results file, sorted by id
   "$PHNN" reduce "$1" --format csv --per-run |
     awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "mse") c = i; next } { print $1, $c }' | sort
@@ -152,4 +174,4 @@ mse_column() {  # the run ids and MSEs of a results file, sorted by id
 [[ -n $(mse_column "$OUT") && $(mse_column "$WORK/merged.h5") == "$(mse_column "$OUT")" ]] ||
   die "the merged shards differ from the single job's results"
 "$PHNN" reduce "$WORK/merged.h5" | sed 's/^/    /'
-log "PASSED: job array of 2 shards -> dependent merge job -> the single job's results, run for run"
+log "PASSED: strided array + resubmitted tasks (PHNN_SHARDS=4) -> merge -> the single job's results, run for run"

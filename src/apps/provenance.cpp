@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <ctime>
+#include <cstdlib>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -107,13 +108,29 @@ Provenance session_provenance(MPI_Comm comm, int argc, char** argv) {
   p.emplace_back("ranks", std::to_string(size));
   p.emplace_back("command_line", quoted_command_line(argc, argv));
   p.emplace_back("started", utc_now());
+  // Which Slurm job, array task and restart wrote this session (when set).
+  auto env = [](const char* name) { const char* v = std::getenv(name); return v ? v : ""; };
+  if (*env("SLURM_JOB_ID")) p.emplace_back("slurm_job", env("SLURM_JOB_ID"));
+  if (*env("SLURM_ARRAY_JOB_ID")) {
+    p.emplace_back("slurm_array",
+                   std::string(env("SLURM_ARRAY_JOB_ID")) + "_" + env("SLURM_ARRAY_TASK_ID"));
+  }
+  if (*env("SLURM_RESTART_COUNT")) p.emplace_back("slurm_restarts", env("SLURM_RESTART_COUNT"));
   if (comm == MPI_COMM_NULL) return p;
-  // Rank 0's values everywhere (the start second may differ between ranks).
-  for (auto& [key, value] : p) {
-    unsigned long long n = value.size();
+  // Rank 0's entries everywhere (the start second, even which Slurm
+  // variables are set, may differ between ranks).
+  auto broadcast = [&](std::string* text) {
+    unsigned long long n = text->size();
     MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
-    value.resize(n);
-    if (n > 0) MPI_Bcast(value.data(), static_cast<int>(n), MPI_CHAR, 0, comm);
+    text->resize(n);
+    if (n > 0) MPI_Bcast(text->data(), static_cast<int>(n), MPI_CHAR, 0, comm);
+  };
+  unsigned long long entries = p.size();
+  MPI_Bcast(&entries, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
+  p.resize(entries);
+  for (auto& [key, value] : p) {
+    broadcast(&key);
+    broadcast(&value);
   }
   return p;
 }

@@ -1,5 +1,8 @@
-// src/sweep/version.cpp — build facts baked in by CMake (CMakeLists.txt).
+// src/sweep/version.cpp — build facts baked in by CMake (CMakeLists.txt;
+// the commit from cmake/git_commit.cmake at build time).
 #include "phnn/sweep/version.h"
+
+#include "git_commit.h"
 
 #ifndef PHNN_VERSION
 #define PHNN_VERSION "unknown"
