@@ -4,7 +4,9 @@
     /usr/bin/python3 analysis/plot_results.py results/paper.h5 figures/
 
 Writes into OUTDIR, per system <sys> and study <st> (the file's [study.*] tables; a file without
-studies has one pseudo-study, e.g. "grid"):
+studies has one pseudo-study, e.g. "grid"), each figure as <name>.png (300 dpi), <name>.pdf
+(vector) and <name>.caption.txt (a one-line title is on the figure; the details are in the
+caption):
 
   mse_<st>_<sys>.png          inference MSE (Eq. 31) per model and study column (paper Figs. 6, 8,
                               11): box = quartiles of the finite MSEs, every seed a jittered point,
@@ -63,7 +65,6 @@ import argparse
 import os
 import subprocess
 import sys
-import textwrap
 import warnings
 from collections import Counter
 
@@ -92,7 +93,7 @@ MODEL_ORDER = list(MODEL_COLOURS)
 KNOWN_ORDER = {"size": ["small", "medium", "large"], "regularizer": ["none", "cn", "sn", "sr"],
                "system": ["harmonic", "duffing", "self-sustained"]}
 STUDY_KEYS = {"n_train": "n_train", "sizes": "size", "regularizers": "regularizer"}
-AXIS_LABEL = {"n_train": "N_train (training pairs)", "size": "model size",
+AXIS_LABEL = {"n_train": r"$N_\mathrm{train}$ (training pairs)", "size": "model size",
               "regularizer": "Jacobian regularizer"}
 TRAJECTORY_N_TRAIN = {"harmonic": 25, "duffing": 100, "self-sustained": 25}
 # Paper Fig. 9: the DG model of the family that does best on each system, across sizes, N_train 25.
@@ -100,7 +101,7 @@ SIZE_TRAJECTORY_MODEL = {"harmonic": "PHNN-S-DG", "duffing": "PHNN-S-DG",
                          "self-sustained": "PHNN-JR-DG"}
 SIZE_STYLES = {"small": "--", "medium": "-.", "large": ":"}
 TRACE_COLUMNS = {"kappa": 4, "sigma_max": 5, "rho": 6, "train": 2, "validation": 3}
-DPI = 110
+DPI = 300  # PNG; every figure is also written as PDF (vector)
 
 
 def text(column):
@@ -165,14 +166,18 @@ def system_states(f, name):
 
 
 def state_label(states, k):
-    return f"{states['names'][k]} [{states['units'][k]}]"
+    """Mathtext: the state's name in italics (a subscript after "_"), its unit upright."""
+    name = states["names"][k]
+    base, _, sub = name.partition("_")
+    math = f"${base}_{{{sub}}}$" if sub else (f"${name}$" if name.isalnum() else name)
+    return f"{math} [{states['units'][k]}]"
 
 
 def figure_label(states, energy):
     """Row label of a figure trajectory: its initial energy, or a system file's trajectory."""
     if states["file"]:
         return f"inference trajectory {0 if energy == '05' else 1}"
-    return f"H(x0) = {0.5 if energy == '05' else 0.75} J"
+    return f"$H(x_0)$ = {0.5 if energy == '05' else 0.75} J"
 
 
 def parse_sweep(sweep_text):
@@ -274,18 +279,26 @@ def study_names(runs, rows):
 
 
 def save(fig, out, filename):
-    """Lays out, writes OUTDIR/filename and closes the figure; returns the path."""
+    """Lays out and writes OUTDIR/filename (PNG, 300 dpi), the same figure as PDF (vector) and its
+    caption (the details suptitle() keeps out of the title) as <stem>.caption.txt; closes the
+    figure; returns the PNG's path."""
     fig.tight_layout()
     path = os.path.join(out, filename)
+    stem = os.path.splitext(path)[0]
     fig.savefig(path, dpi=DPI)
+    fig.savefig(stem + ".pdf")
+    caption = getattr(fig, "phnn_caption", "")
+    if caption:
+        with open(stem + ".caption.txt", "w") as f:
+            f.write(caption + "\n")
     plt.close(fig)
     return path
 
 
 def suptitle(fig, *lines):
-    """Figure title, each line wrapped to the figure's width."""
-    width = int(fig.get_figwidth() * 13)
-    fig.suptitle("\n".join(textwrap.fill(line, width) for line in lines), fontsize=9)
+    """A one-line title (the first line); every line goes to the caption file save() writes."""
+    fig.suptitle(lines[0], fontsize=10)
+    fig.phnn_caption = "\n".join(lines)
 
 
 def ordered_systems(runs, rows):
@@ -332,11 +345,15 @@ def mse_box_figure(runs, sel, axis, cols):
     ax.set_xlim(-1, len(cols) * width - 1)
     ax.set_xlabel(AXIS_LABEL.get(axis, "") + ("  (grey numbers: seeds per box)" if axis else
                                               "grey numbers: seeds per box"))
-    ax.set_ylabel("inference MSE [m², (kg m/s)² mixed]")
-    handles = [plt.Rectangle((0, 0), 1, 1, fc=colour(m), alpha=0.5, ec=colour(m)) for m in models]
-    handles.append(plt.Line2D([], [], marker="^", ls="", color="0.5", mec="black"))
-    ax.legend(handles, models + ["diverged (count below)"], fontsize=7,
-              loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    ax.set_ylabel(r"inference MSE $\mathcal{E}$ [m², (kg m/s)² mixed]")
+    # Legend entries only for what is drawn: models with runs, the marker if a run diverged.
+    shown = [m for m in models if any(model == m and vals for _, model, vals in cells)]
+    handles = [plt.Rectangle((0, 0), 1, 1, fc=colour(m), alpha=0.5, ec=colour(m)) for m in shown]
+    labels = list(shown)
+    if any_diverged:
+        handles.append(plt.Line2D([], [], marker="^", ls="", color="0.5", mec="black"))
+        labels.append("diverged (count below)")
+    ax.legend(handles, labels, fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     return fig
 
 
@@ -524,6 +541,18 @@ def draw_reference(runs, axes, i, energy):
         if yl:
             ax.set_ylabel(yl)
         ax.grid(alpha=0.3)
+    # Phase portraits: the reference's extent (+15 %), equal aspect; a prediction that leaves it
+    # is clipped there rather than shrinking the reference to a dot.
+    for ax, (a, b) in zip(axes[n:], states["pairs"]):
+        finite = ref[np.all(np.isfinite(ref[:, [a, b]]), axis=1)]
+        if len(finite) == 0:
+            continue
+        lo, hi = finite[:, [a, b]].min(axis=0), finite[:, [a, b]].max(axis=0)
+        pad = 0.15 * np.maximum(hi - lo, 1e-12)
+        ax.set_xlim(lo[0] - pad[0], hi[0] + pad[0])
+        ax.set_ylim(lo[1] - pad[1], hi[1] + pad[1])
+        ax.set_autoscale_on(False)
+        ax.set_aspect("equal", adjustable="box")
 
 
 def draw_prediction(runs, axes, i, energy, model, median, label_prefix="", linestyle="--"):
@@ -584,14 +613,14 @@ def energies(runs, path, name, out):
             ax.plot(rows["t"], rows["H_true_ref"], color="black", lw=2.2,
                     label="H along the reference")
             ax.plot(rows["t"], rows["H_model_ref"], color="grey", lw=1.3, ls=":",
-                    label="H_theta along the reference")
+                    label=r"$H_\theta$ along the reference")
             ax.plot(rows["t"], rows["H_true"], color=c, lw=1.3, ls="--",
                     label=f"H along the {picks[0]} rollout")
             ax.plot(rows["t"], rows["H_model"], color=c, lw=1.3, ls=":",
-                    label=f"H_theta along the {picks[0]} rollout")
+                    label=rf"$H_\theta$ along the {picks[0]} rollout")
             ax.set_title(figure_label(states, energy))
             ax.set_xlabel("t [s]")
-            ax.set_ylabel("energy [J]")
+            ax.set_ylabel(r"energy $H$, $H_\theta$ [J]")
             ax.grid(alpha=0.3)
         axes[1].legend(fontsize=7)
         suptitle(fig, f"{name}: {system}, N_train = {n_train}: learned vs true energy",
@@ -675,16 +704,16 @@ def trace_figure(runs, name, system, out, panels, stem, what):
 
 def jacobian_traces(runs, name, out):
     """Paper Figs. 10/12: kappa, sigma_max and rho of the learned field's Jacobian."""
-    panels = [("kappa", "condition number κ [1]", True),
-              ("sigma_max", "spectral norm σ_max [1/s]", True),
-              ("rho", "stiffness ratio ρ [1]", False)]
+    panels = [("kappa", r"condition number $\kappa$ [1]", True),
+              ("sigma_max", r"spectral norm $\sigma_{\max}$ [1/s]", True),
+              ("rho", r"stiffness ratio $\rho$ [1]", False)]
     return [p for s in ordered_systems(runs, runs["rows"]) if (p := trace_figure(
         runs, name, s, out, panels, "jacobian", "Jacobian of the learned field at validation points"))]
 
 
 def loss_curves(runs, name, out):
     """Training and validation loss L_d per validation point (the regularizer term included)."""
-    panels = [("train", "training loss [L_d]", True), ("validation", "validation loss [L_d]", True)]
+    panels = [("train", r"training loss $L_d$", True), ("validation", r"validation loss $L_d$", True)]
     return [p for s in ordered_systems(runs, runs["rows"]) if (p := trace_figure(
         runs, name, s, out, panels, "loss",
         "training / validation loss, L_d = mean |x_{n+1} − x̂_{n+1}| / h (m/s and kg m/s² mixed; "
@@ -720,7 +749,7 @@ def time_vs_error(runs, name, out):
             ax.set_yscale("log")
             label_minor_log_ticks(ax.yaxis)
         ax.set_xlabel("wall time per run [s] (stack time / seeds trained together)")
-        ax.set_ylabel("inference MSE [m², (kg m/s)² mixed]")
+        ax.set_ylabel(r"inference MSE $\mathcal{E}$ [m², (kg m/s)² mixed]")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
         suptitle(fig, f"{name}: {system}, all studies: wall time vs inference MSE, every run a "

@@ -46,6 +46,10 @@ CONF=/etc/slurm/slurm.conf
 MARK="# written by phnn jobs/test-slurm.sh"
 if [[ ! -f $CONF ]] || head -1 "$CONF" | grep -qF "$MARK"; then
   mkdir -p /etc/slurm /var/spool/slurmctld /var/spool/slurmd /var/log/slurm
+  old_conf=$(cat "$CONF" 2>/dev/null || true)
+  # The node's memory as Slurm may hand it out (90 % of RAM): the job script
+  # asks --mem-per-cpu=2G per task.
+  MEM_MB=$(awk '/^MemTotal:/ { print int($2 / 1024 * 0.9) }' /proc/meminfo)
   cat > "$CONF" <<CONF
 $MARK
 ClusterName=phnn-test
@@ -66,9 +70,13 @@ SlurmdPidFile=/run/slurmd.pid
 ReturnToService=2
 JobRequeue=1
 MpiDefault=none
-NodeName=$HOST CPUs=$(nproc) RealMemory=2000 State=UNKNOWN
+NodeName=$HOST CPUs=$(nproc) RealMemory=$MEM_MB State=UNKNOWN
 PartitionName=debug Nodes=$HOST Default=YES MaxTime=INFINITE State=UP
 CONF
+  if [[ $(cat "$CONF") != "$old_conf" ]] && pgrep -x 'slurmctld|slurmd' >/dev/null; then
+    log "slurm.conf changed: restarting slurmctld and slurmd"
+    pkill -x slurmd; pkill -x slurmctld; sleep 2
+  fi
 else
   log "using the existing $CONF (not written by this script)"
 fi
@@ -157,7 +165,7 @@ ONE=$(array_job 1)
 THREE=$(array_job 3)
 MERGE=$(cd "$WORK" && sbatch --parsable --dependency=afterok:"$ONE":"$THREE" --ntasks=1 --time=10 \
         --output="$WORK/merge-%j.log" --wrap "$PHNN merge $WORK/merged.h5 \
-        $WORK/results/slurm-test.shard-{0,1,2,3}-of-4.h5")
+        $(echo "$WORK"/results/slurm-test.shard-{0,1,2,3}-of-4.h5)")
 log "resubmitted single tasks $ONE (--array=1) and $THREE (--array=3); merge job $MERGE"
 wait_for 600 "the merge job" bash -c "[[ \$(scontrol show job $MERGE | grep -o 'JobState=[A-Z]*') == JobState=COMPLETED ]]"
 [[ $(shards) == "0 1 2 3 " ]] || die "shards '$(shards)' after the resubmits, expected '0 1 2 3 '"

@@ -152,6 +152,16 @@ int Parser::get_int_in(const std::string& name, int lo, int hi) const {
   return static_cast<int>(v);
 }
 
+double Parser::get_double_in(const std::string& name, double lo, double hi) const {
+  const double v = get_double(name);
+  if (v < lo || v > hi) {
+    std::ostringstream range;
+    range << "[" << lo << ", " << hi << "]";
+    throw usage("--" + name + " = " + get(name) + " is outside " + range.str());
+  }
+  return v;
+}
+
 std::vector<std::int64_t> parse_int_list(const std::string& option, const std::string& text) {
   const std::string where = "--" + option + " = \"" + text + "\": ";
   const UsageError bad{where + "expected integers in [0, 2147483647] like 0-9 or 0,3,5"};

@@ -19,6 +19,12 @@ class App;
 namespace phnn {
 namespace cli {
 
+/// `prefix + text`, or `text` if it already starts with `prefix` (an error
+/// passed up through two layers says "phnn sweep: " once).
+inline std::string with_prefix(const std::string& prefix, const std::string& text) {
+  return text.compare(0, prefix.size(), prefix) == 0 ? text : prefix + text;
+}
+
 /// Exit status for bad usage (like sysexits' EX_USAGE, but the common 2).
 constexpr int kUsageError = 2;
 
@@ -66,6 +72,8 @@ class Parser {
   std::int64_t get_int(const std::string& name) const;  // base 10
   /// get_int within [lo, hi] (a C++ int), or a UsageError naming the range.
   int get_int_in(const std::string& name, int lo, int hi) const;
+  /// get_double within [lo, hi], or a UsageError naming the range.
+  double get_double_in(const std::string& name, double lo, double hi) const;
 
  private:
   UsageError usage(const std::string& what) const;  // "phnn COMMAND: what"

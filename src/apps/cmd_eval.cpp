@@ -25,24 +25,34 @@ namespace {
 
 // The row of the run (of `ids`, the file's) whose id is `id` or starts with
 // it (unique).
+// The row whose id starts with `id`, and has seed `seed` if seed >= 0. The
+// seeds of one cell share their ids' first digits (FNV-1a of canonical keys
+// that differ in the seed only), so --seed picks one among them.
 int find_row(const ResultsFile& results, const std::vector<std::string>& ids,
-             const std::string& id) {
-  int row = -1;
+             const std::string& id, std::int64_t seed) {
+  const std::vector<std::int64_t> seeds = results.read_seeds();
+  std::vector<std::size_t> matches;
   for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (ids[i].compare(0, id.size(), id) != 0) continue;
-    if (row >= 0) {
-      throw cli::UsageError{"phnn eval: --run " + id + " matches several runs (" +
-                            ids[static_cast<std::size_t>(row)] + ", " + ids[i] +
-                            ", ...); give more digits"};
+    if (ids[i].compare(0, id.size(), id) == 0 && (seed < 0 || seeds[i] == seed)) {
+      matches.push_back(i);
     }
-    row = static_cast<int>(i);
   }
-  if (row < 0 || id.empty()) {
-    throw cli::UsageError{"phnn eval: no run with id " + id + " in " + results.path() +
-                          "; `phnn reduce " + results.path() +
-                          " --format csv --per-run` lists the ids"};
+  if (matches.empty() || id.empty()) {
+    throw cli::UsageError{"phnn eval: no run with id " + id +
+                          (seed >= 0 ? " and seed " + std::to_string(seed) : std::string()) +
+                          " in " + results.path() + "; `phnn reduce " + results.path() +
+                          " --per-run` lists the ids and seeds"};
   }
-  return row;
+  if (matches.size() > 1) {
+    std::string listed;
+    for (std::size_t k = 0; k < matches.size() && k < 4; ++k) {
+      listed += (k ? ", " : "") + ids[matches[k]] + " (seed " + std::to_string(seeds[matches[k]]) + ")";
+    }
+    throw cli::UsageError{"phnn eval: --run " + id + " matches " + std::to_string(matches.size()) +
+                          " runs (" + listed + (matches.size() > 4 ? ", ..." : "") +
+                          "); add --seed N, or give more digits"};
+  }
+  return static_cast<int>(matches.front());
 }
 
 // The run's configuration, rebuilt from the sweep text stored in the file.
@@ -106,6 +116,8 @@ int run_eval(int argc, char** argv, int first) {
       "learned energy along the figure trajectories to --out (CSV).");
   parser.positional("RESULTS", "results file of `phnn sweep` or `phnn train --out`");
   parser.option("run", "run id (or a unique prefix of it), as in `phnn reduce --per-run`", "");
+  parser.option("seed", "with --run PREFIX: the run of this seed among those it matches (the "
+                "seeds of one cell share their ids' first digits)", "");
   parser.option("out", "CSV of t, states and energies along the figure trajectories", "");
   if (!parser.parse(argc, argv, first)) return 0;
   if (parser.get("run").empty()) throw cli::UsageError{"phnn eval: --run ID is required"};
@@ -116,7 +128,8 @@ int run_eval(int argc, char** argv, int first) {
   }
   const ResultsFile results = ResultsFile::open_read_only(parser.get("RESULTS"));
   const std::vector<std::string> ids = results.read_run_ids();
-  const int row = find_row(results, ids, parser.get("run"));
+  const int row = find_row(results, ids, parser.get("run"),
+                           parser.has("seed") ? parser.get_int_in("seed", 0, 1 << 30) : -1);
   const std::string& id = ids[static_cast<std::size_t>(row)];
   const RunResult stored = results.read_run(row);
   if (stored.weights.empty()) {

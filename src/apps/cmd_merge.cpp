@@ -21,8 +21,10 @@ int run_merge(int argc, char** argv, int first) {
   parser.positional("OUT", "new results file (must not exist)");
   parser.positional_rest("SHARD", "shard results files of one sweep file");
   if (!parser.parse(argc, argv, first)) return 0;
-  std::cout << "phnn merge: " << merge_shards(parser.rest(), parser.get("OUT"), program_version())
-            << "\n";
+  // The summary first: a merge that throws must not leave "phnn merge: " on
+  // stdout before the error (it read as a doubled prefix in a job log).
+  const std::string summary = merge_shards(parser.rest(), parser.get("OUT"), program_version());
+  std::cout << "phnn merge: " << summary << "\n";
   return 0;
 }
 

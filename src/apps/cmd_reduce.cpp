@@ -172,13 +172,17 @@ int run_reduce(int argc, char** argv, int first) {
               "instead of the statistics, count per cell the seeds below / above the column's "
               "geometric midpoint of the MSE (shows bimodal cells)");
   parser.flag("per-run",
-              "with --format csv: one row per run (every configuration key, status, MSE, best "
-              "step, wall time, ...) instead of the tables");
+              "one row per run as CSV (every configuration key, status, MSE, best step, wall "
+              "time, ...) instead of the tables");
   if (!parser.parse(argc, argv, first)) return 0;
-  const TableFormat format = parse_table_format(parser.get("format"));
   const bool per_run = parser.flag_set("per-run"), seeds_summary = parser.flag_set("seeds-summary");
+  // --per-run writes CSV: it needs no --format csv, only refuses another one.
+  const TableFormat format = per_run && !parser.has("format")
+                                 ? TableFormat::kCsv
+                                 : parse_table_format(parser.get("format"));
   if (per_run && format != TableFormat::kCsv) {
-    throw cli::UsageError{"phnn reduce: --per-run writes CSV only; add --format csv"};
+    throw cli::UsageError{"phnn reduce: --per-run writes CSV only; drop --format " +
+                          parser.get("format") + " (or give --format csv)"};
   }
   if (per_run && seeds_summary) {
     throw cli::UsageError{"phnn reduce: --per-run and --seeds-summary exclude each other; "

@@ -72,7 +72,7 @@ SplitOptions split_options(const cli::Parser& parser) {
   SplitOptions options;
   try {
     options.mode = parse_split_mode(parser.get("split"));
-    options.max_group_size = static_cast<int>(parser.get_int("max-group-size"));
+    options.max_group_size = parser.get_int_in("max-group-size", 0, 1 << 30);
     options.validate();
   } catch (const std::invalid_argument& e) {
     throw cli::UsageError{"phnn sweep: --split/--max-group-size: " + std::string(e.what())};
@@ -175,7 +175,7 @@ class SweepRun {
       }
       return 0;
     }
-    torch::set_num_threads(static_cast<int>(parser_.get_int("threads")));
+    torch::set_num_threads(parser_.get_int_in("threads", 1, 4096));
     const Provenance session = session_provenance(MPI_COMM_WORLD, argc_, argv_);
     // Rank 0 alone creates or updates the file, serially; the other ranks open
     // it only to write their rows (docs/DECISIONS.md, "No rank waits forever").
@@ -199,12 +199,9 @@ class SweepRun {
     if (!parser_.parse(argc_, argv_, first_)) return false;
     spec_ = parse_sweep_file(parser_.get("FILE"));
     grid_ = expand_grid(spec_);
-    if (parser_.get_int("threads") < 1) throw cli::UsageError{"phnn sweep: --threads must be >= 1"};
-    checkpoint_every_ = parser_.get_double("checkpoint-every");
-    if (checkpoint_every_ < 0) {
-      throw cli::UsageError{"phnn sweep: --checkpoint-every must be >= 0 seconds (0: save the "
-                            "training state only when stopped by a signal)"};
-    }
+    parser_.get_int_in("threads", 1, 4096);
+    // 0: save a cell's training state only when stopped by a signal.
+    checkpoint_every_ = parser_.get_double_in("checkpoint-every", 0, 1e9);
     if (parser_.flag_set("cell-costs") && !parser_.flag_set("dry-run")) {
       throw cli::UsageError{"phnn sweep: --cell-costs prints the cost model's estimates and trains "
                             "nothing: add --dry-run"};
@@ -219,7 +216,7 @@ class SweepRun {
       try {
         shard_ = Shard::parse(parser_.get("shard"));
       } catch (const std::invalid_argument& e) {
-        throw cli::UsageError{std::string("phnn sweep: ") + e.what()};
+        throw cli::UsageError{cli::with_prefix("phnn sweep: ", e.what())};
       }
     }
     ranks_ = dry_run_ranks(parser_, size_);
@@ -386,7 +383,7 @@ std::string record_item(const Grid& grid, const WorkItem& item,
     try {
       write();
     } catch (const std::exception& e) {
-      if (error.empty()) error = std::string("phnn sweep: ") + e.what();
+      if (error.empty()) error = cli::with_prefix("phnn sweep: ", e.what());
     }
   };
   for (std::size_t k = 0; k < item.runs.size(); ++k) {
@@ -425,7 +422,7 @@ int SweepRun::close_and_report(std::string io_error, bool stopped, int total_run
                   failed ? StopReason::kError : stopped ? StopReason::kSignal : StopReason::kNone,
                   shard_);
   } catch (const std::exception& e) {
-    std::cerr << "phnn sweep: " << e.what() << "\n";
+    std::cerr << cli::with_prefix("phnn sweep: ", e.what()) << "\n";
   }
   return failed;
 }

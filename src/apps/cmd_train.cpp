@@ -15,7 +15,10 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/provenance.h"
+#include "apps/sweep_report.h"
 #include "phnn/common/check.h"
+#include "phnn/common/closest_name.h"
+#include "phnn/common/utc_time.h"
 #include "phnn/report/tables.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/ph_dataset_file.h"
@@ -184,8 +187,15 @@ void parse_model_option(const cli::Parser& parser, CellSpec* cell) {
   try {
     cell->model = parse_model(name);
   } catch (const std::invalid_argument&) {
-    throw cli::UsageError{"phnn train: --model \"" + name + "\": expected formulation-integrator "
-                          "as in sweep files, e.g. phnn-jr-rk2 or node-rk4 (see --help)"};
+    std::vector<std::string> labels;
+    for (const char* f : {"node", "phnn-s", "phnn-jr"}) {
+      for (const char* i : {"rk2", "rk4", "dg", "dg4"}) labels.push_back(std::string(f) + "-" + i);
+    }
+    const std::string near = closest_name(name, labels);
+    throw cli::UsageError{"phnn train: --model \"" + name + "\"" +
+                          (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
+                          ": expected formulation-integrator as in sweep files, e.g. phnn-jr-rk2 "
+                          "or node-rk4 (see --help)"};
   }
   cell->integrator = parse_integrator(parser.get("integrator"));
   std::cerr << "phnn train: note: --model " << name << " --integrator " << parser.get("integrator")
@@ -239,18 +249,37 @@ SystemData data_from_options(const cli::Parser& parser, SystemKind system, int n
   return make_system_data(physics, options, n_train);
 }
 
+// The cost model's estimate of the cell (the one-cell sweep `text`, as
+// `phnn sweep --dry-run` would give it), on stdout; a note on stderr when it
+// is long for one command, which saves nothing until it ends.
+void print_estimate(const std::string& text, const SystemFileReader& read) {
+  const Grid grid = expand_grid(parse_sweep_text(text, "phnn train", read));
+  const double seconds = grid.cells.front().estimated_cost_s;
+  std::cout << "phnn train: estimated " << format_duration(seconds)
+            << " on one core (the sweep cost model)" << std::endl;
+  if (seconds > 600) {
+    std::cerr << "phnn train: note: a long run for one command: nothing is saved until it ends; "
+                 "a sweep file run by `phnn sweep` saves each cell's state and resumes"
+              << std::endl;
+  }
+}
+
 // A terminal gets one self-overwriting progress line, a log file a plain
-// line per tenth of the run (no carriage returns in logs).
+// line per tenth of the run with the time (no carriage returns in logs).
 ProgressCallback progress_printer(bool quiet) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   return [quiet, terminal](const TrainProgress& p) {
     if (quiet) return;
     const int tenth = std::max(1, p.total_steps / 10);
     if (!terminal && p.step % tenth != 0 && p.step != p.total_steps) return;
-    const double eta = p.step > 0 ? p.elapsed_s / p.step * (p.total_steps - p.step) : 0.0;
-    std::fprintf(stderr, "%s  step %d/%d  best val %.3e  elapsed %.0f s  ETA %.0f s   %s",
-                 terminal ? "\r" : "", p.step, p.total_steps, p.best_validation_loss, p.elapsed_s,
-                 eta, terminal && p.step != p.total_steps ? "" : "\n");
+    // No ETA before the first step (it would say 0 s).
+    const std::string eta =
+        p.step > 0 ? format_duration(p.elapsed_s / p.step * (p.total_steps - p.step)) : "--";
+    std::fprintf(stderr, "%s  step %d/%d  best val %.3e  elapsed %s  ETA %s  %s%s",
+                 terminal ? "\r" : "", p.step, p.total_steps, p.best_validation_loss,
+                 format_duration(p.elapsed_s).c_str(), eta.c_str(),
+                 terminal ? "" : ("(" + utc_now() + ")").c_str(),
+                 terminal && p.step != p.total_steps ? "" : "\n");
   };
 }
 
@@ -307,7 +336,9 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int a
             << system->n_w() << " ports, " << system->n_u() << " inputs) "
             << model_label(cell.model, cell.integrator) << " size=" << to_string(cell.size)
             << " n_train=" << cell.n_train << " reg=" << to_string(cell.regularizer)
-            << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << "\n";
+            << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << std::endl;
+  print_estimate(cell_sweep_text(cell, data, path),
+                 [&](const std::string&) { return SystemFileText{path, system->source_text()}; });
   const auto results = train_cell(cell, data, *system, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
   if (parser.has("out")) {
@@ -331,9 +362,7 @@ int run_train(int argc, char** argv, int first) {
   declare_train_options(&parser);
   if (!parser.parse(argc, argv, first)) return 0;
   const CellSpec cell = cell_from_options(parser);
-  const auto threads = parser.get_int("threads");
-  if (threads < 1) throw cli::UsageError{"phnn train: --threads must be >= 1"};
-  torch::set_num_threads(static_cast<int>(threads));
+  torch::set_num_threads(parser.get_int_in("threads", 1, 4096));
   if (is_system_file_argument(parser.get("system"))) return run_train_file_system(parser, cell, argc, argv);
   const SystemKind system = parse_system(parser.get("system"));
   const SystemData data = data_from_options(parser, system, cell.n_train);
@@ -341,9 +370,10 @@ int run_train(int argc, char** argv, int first) {
   std::cout << "phnn train: " << to_string(system) << " " << model_label(cell.model, cell.integrator)
             << " size=" << to_string(cell.size) << " n_train=" << cell.n_train
             << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
-            << " steps=" << cell.training.steps << "\n";
+            << " steps=" << cell.training.steps << std::endl;
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
   if (parser.has("out")) require_new_output(parser);
+  print_estimate(cell_sweep_text(cell, data), {});
   const auto results = train_cell(cell, data, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
   if (parser.has("out")) {

@@ -89,10 +89,14 @@ int main(int argc, char** argv) {
     std::cerr << e.message << "\n";
     return phnn::cli::kUsageError;
   } catch (const std::invalid_argument& e) {
-    std::cerr << "phnn " << command << ": " << e.what() << "\n";
+    std::cerr << phnn::cli::with_prefix("phnn " + command + ": ", e.what()) << "\n";
     return phnn::cli::kUsageError;
   } catch (const std::exception& e) {
-    std::cerr << "phnn " << command << ": error: " << e.what() << "\n";
+    const std::string prefix = "phnn " + command + ": ";
+    const std::string text = e.what();
+    // Said once: a message that names the command already keeps its words.
+    std::cerr << (text.compare(0, prefix.size(), prefix) == 0 ? text : prefix + "error: " + text)
+              << "\n";
     return 1;
   }
 }

@@ -84,10 +84,11 @@ int prepare_output(const std::string& out, const std::string& sweep_path, const 
       return 1;
     case OutputState::kOtherText:
       try {
-        std::cout << "phnn sweep: " << write_grown_results(out, spec, grid, program_version())
-                  << "\n";
+        // Computed first: an error must not follow a half-printed line.
+        const std::string grown = write_grown_results(out, spec, grid, program_version());
+        std::cout << "phnn sweep: " << grown << "\n";
       } catch (const RunSetRefused& e) {
-        throw cli::UsageError{std::string("phnn sweep: ") + e.what()};
+        throw cli::UsageError{cli::with_prefix("phnn sweep: ", e.what())};
       }
       return 1;
     case OutputState::kEmpty:

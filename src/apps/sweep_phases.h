@@ -44,10 +44,10 @@ int agreed(const boost::mpi::communicator& world, bool here, Body&& body) {
       message = e.message;
     } catch (const std::invalid_argument& e) {
       code = cli::kUsageError;
-      message = std::string("phnn sweep: ") + e.what();
+      message = cli::with_prefix("phnn sweep: ", e.what());
     } catch (const std::exception& e) {
       code = kExitFailed;
-      message = std::string("phnn sweep: ") + e.what();
+      message = cli::with_prefix("phnn sweep: ", e.what());
     }
   }
   return agree(world, code, message);

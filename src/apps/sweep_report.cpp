@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <sstream>
+#include <vector>
 
 #include "phnn/common/utc_time.h"
 #include "phnn/store/journal.h"
@@ -69,7 +70,12 @@ void print_plan(const SweepSpec& spec, const Grid& grid, const Shard& shard,
 
 void print_item(const char* format, const std::string& prefix, int item_number,
                 std::size_t items, const std::string& what) {
-  std::printf(format, prefix.c_str(), item_number, items, what.c_str());
+  std::vector<char> line(512 + prefix.size() + what.size());
+  std::snprintf(line.data(), line.size(), format, prefix.c_str(), item_number, items, what.c_str());
+  std::string text = line.data();
+  if (!text.empty() && text.back() == '\n') text.pop_back();
+  // Each rank's line with its time: logs of long sweeps read as a timeline.
+  std::printf("%s  (%s)\n", text.c_str(), utc_now().c_str());
   std::fflush(stdout);
 }
 

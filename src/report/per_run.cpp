@@ -2,6 +2,7 @@
 #include "phnn/report/per_run.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -38,13 +39,26 @@ namespace {
 
 using internal::csv_field;
 
-// "%.17g"; "inf", "-inf", "nan" spelled the same on every libc (no "-nan").
+// The shortest text that reads back to the same double (std::to_chars:
+// 0.0025, not %.17g's 0.0025000000000000001); "inf", "-inf", "nan" spelled
+// the same on every libc (no "-nan").
 std::string csv_double(double value) {
   if (std::isnan(value)) return "nan";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", value);
-  return buf;
+  const auto end = std::to_chars(buf, buf + sizeof buf, value).ptr;
+  return std::string(buf, end);
+}
+
+// A configuration value as the canonical key spells it (%.17g numbers): a
+// value that is exactly one number is re-spelled by csv_double, the same
+// double; anything else (names, lists) is kept.
+std::string config_value(const std::string& text) {
+  if (text.empty() || text.find_first_not_of("0123456789.eE+-") != std::string::npos) return text;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size() || !std::isfinite(value)) return text;
+  return csv_double(value);
 }
 
 // Canonical keys (RunConfig::canonical(), short) -> sweep-file names
@@ -94,12 +108,12 @@ std::vector<std::pair<std::string, std::string>> config_columns(const std::strin
       rename = !names.count(it->second[i]);
     }
     if (!rename) {
-      out.emplace_back(key, value);
+      out.emplace_back(key, config_value(value));
       continue;
     }
     for (std::size_t i = 0; i < parts.size(); ++i) {
       names.insert(it->second[i]);
-      out.emplace_back(it->second[i], parts[i]);
+      out.emplace_back(it->second[i], config_value(parts[i]));
     }
   }
   return out;

@@ -97,11 +97,17 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
   return s;
 }
 
+bool CellSummary::has_interval() const { return finished() >= kMinSeedsForInterval; }
+
 namespace {
 
 const char* const kTieNote =
     "(tie): no clear best in this column: the bootstrap 95 % interval of its smallest median "
     "overlaps the intervals of the other cells marked (tie), so none is bold.";
+
+const std::string kFewSeedsNote =
+    "Cells with fewer than " + std::to_string(kMinSeedsForInterval) +
+    " finished seeds show median [IQR] without an interval.";
 
 std::string annotations(const CellSummary& s) {
   return table_text::annotations(s.finished(), s.diverged, s.missing, s.expected);
@@ -109,17 +115,32 @@ std::string annotations(const CellSummary& s) {
 
 enum class Mark { kNone, kBest, kTie };
 
-// Best of one column (CellSummary order = rows): the smallest finite median
-// is best if its interval overlaps no other finished cell's interval; else it
-// and every cell overlapping it (or with an equal median) are a tie. A cell
-// whose interval is [+inf, +inf] (all or nearly all runs diverged) cannot be
-// smaller than anything: sharing the point +inf is no tie.
+// Why a column marks no best (empty: it may): a row without runs or with
+// fewer than kMinSeedsForInterval finished ones.
+std::string unmarkable(const std::vector<CellSummary>& column, const std::vector<std::string>& rows) {
+  for (std::size_t r = 0; r < column.size(); ++r) {
+    if (column[r].finished() == 0) return rows[r] + " has no finished runs";
+  }
+  for (std::size_t r = 0; r < column.size(); ++r) {
+    if (!column[r].has_interval()) {
+      return rows[r] + " has " + std::to_string(column[r].finished()) + " finished seed" +
+             (column[r].finished() == 1 ? "" : "s");
+    }
+  }
+  return "";
+}
+
+// Best of one column (CellSummary order = rows), if unmarkable() allows: the
+// smallest finite median is best if its interval overlaps no other cell's
+// interval; else it and every cell overlapping it (or with an equal median)
+// are a tie. A cell whose interval is [+inf, +inf] (all or nearly all runs
+// diverged) cannot be smaller than anything: sharing the point +inf is no tie.
 std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   std::vector<Mark> marks(column.size(), Mark::kNone);
   int best = -1;
   for (std::size_t r = 0; r < column.size(); ++r) {
     const CellSummary& s = column[r];
-    if (s.finished() == 0 || !std::isfinite(s.median)) continue;
+    if (!std::isfinite(s.median)) continue;
     if (best < 0 || s.median < column[best].median) best = static_cast<int>(r);
   }
   if (best < 0) return marks;
@@ -127,7 +148,7 @@ std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   bool tied = false;
   for (std::size_t r = 0; r < column.size(); ++r) {
     const CellSummary& s = column[r];
-    if (static_cast<int>(r) == best || s.finished() == 0) continue;
+    if (static_cast<int>(r) == best) continue;
     if (std::isinf(s.median_interval.low)) continue;
     if (s.median_interval.overlaps(b.median_interval) || s.median == b.median) {
       marks[r] = Mark::kTie;
@@ -145,9 +166,11 @@ std::string summary_cell_text(const CellSummary& s, Mark mark, TableFormat forma
   if (s.done == 0 && std::isinf(s.median) && std::isinf(s.median_interval.low)) {
     return "inf" + annotations(s);
   }
-  std::string value = format_number("%.2e", s.median) + " [" + format_number("%.2e", s.iqr()) +
-                      "] (" + format_number("%.2e", s.median_interval.low) + ", " +
-                      format_number("%.2e", s.median_interval.high) + ")";
+  std::string value = format_number("%.2e", s.median) + " [" + format_number("%.2e", s.iqr()) + "]";
+  if (s.has_interval()) {
+    value += " (" + format_number("%.2e", s.median_interval.low) + ", " +
+             format_number("%.2e", s.median_interval.high) + ")";
+  }
   if (mark == Mark::kBest) {
     value = format == TableFormat::kMarkdown ? "**" + value + "**" : "\\textbf{" + value + "}";
   }
@@ -163,11 +186,12 @@ void render_summary_csv(const TableEntries& t, const std::vector<std::vector<Cel
       const auto number = [&](double v) {
         return s.finished() > 0 ? format_number("%.6e", v) : std::string();
       };
+      const auto bound = [&](double v) { return s.has_interval() ? number(v) : std::string(); };
       out << csv_field(t.study->name) << "," << t.system << ","
           << csv_field(t.study->rows[r]) << "," << csv_field(t.study->varied_axis) << ","
           << csv_field(t.study->columns[c]) << "," << number(s.median) << "," << number(s.q25)
           << "," << number(s.q75) << "," << number(s.iqr()) << ","
-          << number(s.median_interval.low) << "," << number(s.median_interval.high) << ","
+          << bound(s.median_interval.low) << "," << bound(s.median_interval.high) << ","
           << s.done << "," << s.diverged << "," << s.missing << "," << s.expected << ","
           << (marks[r][c] == Mark::kBest ? 1 : 0) << "," << (marks[r][c] == Mark::kTie ? 1 : 0)
           << "\n";
@@ -180,10 +204,16 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
   const std::size_t rows = t.study->rows.size(), cols = t.study->columns.size();
   std::vector<std::vector<CellSummary>> cells(rows, std::vector<CellSummary>(cols));
   std::vector<std::vector<Mark>> marks(rows, std::vector<Mark>(cols, Mark::kNone));
+  std::vector<std::string> unmarked;  // "column: why", for the note under the table
   for (std::size_t c = 0; c < cols; ++c) {
     std::vector<CellSummary> column(rows);
     for (std::size_t r = 0; r < rows; ++r) {
       column[r] = cells[r][c] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap);
+    }
+    const std::string why = unmarkable(column, t.study->rows);
+    if (!why.empty()) {
+      unmarked.push_back((cols > 1 ? t.study->columns[c] + ": " : std::string()) + why);
+      continue;
     }
     const std::vector<Mark> column_marks = mark_column(column);
     for (std::size_t r = 0; r < rows; ++r) marks[r][c] = column_marks[r];
@@ -201,6 +231,17 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
     }
   }
   if (any_tie) text.notes.push_back(kTieNote);
+  if (!unmarked.empty()) {
+    std::string note = "No best marked where a row has fewer than " +
+                       std::to_string(kMinSeedsForInterval) + " finished seeds (";
+    for (std::size_t k = 0; k < unmarked.size(); ++k) note += (k ? "; " : "") + unmarked[k];
+    text.notes.push_back(note + ").");
+  }
+  bool few = false;
+  for (const auto& row : cells) {
+    for (const CellSummary& s : row) few = few || (s.finished() > 0 && !s.has_interval());
+  }
+  if (few) text.notes.push_back(kFewSeedsNote);
   render_text(text, format, out);
 }
 

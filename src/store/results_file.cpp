@@ -99,9 +99,19 @@ std::string results_file_problem(const std::string& path, const std::string* exp
                : path + ": no such results file; check the path (results files are written "
                         "by `phnn sweep` and `phnn train --out`)";
   }
+  // Resuming (expected_hash): the file is in the way of a new one. Reading:
+  // the user named the wrong file; never advise deleting it.
+  const std::string fix = expected_hash != nullptr
+                              ? "; pass a new --out path or delete the file"
+                              : "; give a results file written by `phnn sweep` or `phnn train "
+                                "--out`";
   if (!h5::File::is_hdf5(path)) {
-    return path + ": not an HDF5 file, so not a phnn results file; pass a new --out "
-                  "path or delete the file";
+    const bool toml = path.size() > 5 && path.compare(path.size() - 5, 5, ".toml") == 0;
+    return path + ": not an HDF5 file, so not a phnn results file" +
+           (toml && expected_hash == nullptr
+                ? "; this looks like a sweep file: give the results file its sweep wrote "
+                  "(its `output`, e.g. results/<name>.h5)"
+                : fix);
   }
   const h5::File file = h5::File::open(path, h5::Access::kReadOnly);
   const std::string format = file.has_attribute("/", "format")
@@ -110,7 +120,7 @@ std::string results_file_problem(const std::string& path, const std::string* exp
   if (format != ResultsFile::kFormat) {
     return path + ": not a phnn results file (attribute format = \"" + format +
            "\", expected \"" + ResultsFile::kFormat +
-           "\"); pass a new --out path or delete the file";
+           "\")" + fix;
   }
   const std::int64_t version = file.int_attribute("/", "format_version");
   if (version != ResultsFile::kFormatVersion) {

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "phnn/common/check.h"
+#include "phnn/common/closest_name.h"
 
 namespace phnn {
 
@@ -22,9 +23,11 @@ SystemKind parse_system(const std::string& name) {
   for (SystemKind kind : all_systems()) {
     if (name == to_string(kind)) return kind;
   }
-  throw std::invalid_argument("unknown system \"" + name +
-                              "\"; expected one of: harmonic, duffing, "
-                              "self-sustained");
+  const std::string near = closest_name(name, {"harmonic", "duffing", "self-sustained"});
+  throw std::invalid_argument("unknown system \"" + name + "\"" +
+                              (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
+                              "; expected one of: harmonic, duffing, self-sustained, or a "
+                              "system file (a path ending in .toml)");
 }
 
 std::vector<SystemKind> all_systems() {

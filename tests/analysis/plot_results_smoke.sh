@@ -26,7 +26,10 @@ trap 'rm -rf "$out"' EXIT
 for f in mse_I_harmonic mse_II_duffing mse_III_duffing trajectories_harmonic \
          trajectories_sizes_duffing jacobian_duffing loss_harmonic time_vs_error_duffing; do
     test -s "$out/fig/$f.png" || { echo "missing $f.png" >&2; exit 1; }
+    test -s "$out/fig/$f.pdf" || { echo "missing $f.pdf" >&2; exit 1; }
+    test -s "$out/fig/$f.caption.txt" || { echo "missing $f.caption.txt" >&2; exit 1; }
 done
+head -c 5 "$out/fig/mse_I_harmonic.pdf" | grep -q '%PDF-' || { echo "mse_I_harmonic.pdf: not a PDF" >&2; exit 1; }
 if [ $# -ge 2 ]; then
     "$2" train --system duffing --model phnn-s-dg --n-train 25 --seeds 0-2 --steps 20 \
         --eval-every 10 --quiet --out "$out/trained.h5" > /dev/null

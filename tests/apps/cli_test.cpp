@@ -3,6 +3,8 @@
 // then the `phnn` binary's command dispatch and --help.
 #include "apps/cli.h"
 
+#include <unistd.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -267,4 +269,30 @@ TEST(PhnnCommandLineTest, EveryCommandHasItsHelp) {
 
 }  // namespace
 }  // namespace cli
+}  // namespace phnn
+
+namespace phnn {
+namespace {
+
+// "phnn sweep: phnn sweep: ..." no more: a message already prefixed keeps one.
+TEST(WithPrefixTest, PrefixesOnce) {
+  EXPECT_EQ(cli::with_prefix("phnn sweep: ", "x.toml:3: bad"), "phnn sweep: x.toml:3: bad");
+  EXPECT_EQ(cli::with_prefix("phnn sweep: ", "phnn sweep: x.toml:3: bad"), "phnn sweep: x.toml:3: bad");
+  EXPECT_EQ(cli::with_prefix("phnn sweep: ", "phnn sweepx"), "phnn sweep: phnn sweepx");
+}
+
+// A failing merge printed "phnn merge: " on stdout before its error (the
+// summary's first words, flushed at exit): one prefix, in a job log too.
+TEST(WithPrefixTest, AFailedMergeSaysItsNameOnce) {
+  std::string log;
+  const std::string out = ::testing::TempDir() + "phnn_merge_prefix_" + std::to_string(::getpid());
+  EXPECT_EQ(testing_util::run_shell(std::string(PHNN_BINARY) + " merge " + out +
+                                        ".h5 /nonexistent/shard.h5",
+                                    &log),
+            1);
+  EXPECT_THAT(log, ::testing::HasSubstr("/nonexistent/shard.h5: no such results file"));
+  EXPECT_EQ(log.find("phnn merge:"), log.rfind("phnn merge:")) << log;
+}
+
+}  // namespace
 }  // namespace phnn

@@ -79,6 +79,25 @@ TEST_F(EvalCommandTest, ReloadedRunsReproduceTheirStoredMseBitwise) {
   }
 }
 
+// The seeds of one cell share their ids' first digits: a short prefix names
+// them all and says so; --seed picks one of them.
+TEST_F(EvalCommandTest, AnAmbiguousPrefixIsResolvedBySeed) {
+  const std::vector<std::string> ids = train("harmonic", "node-rk2");
+  ASSERT_EQ(ids.size(), 2u);
+  std::size_t common = 0;
+  while (common < ids[0].size() && ids[0][common] == ids[1][common]) ++common;
+  ASSERT_GE(common, 1u) << ids[0] << " " << ids[1];
+  const std::string prefix = ids[0].substr(0, common);
+  std::string log;
+  EXPECT_EQ(run("eval " + out_ + " --run " + prefix, &log), 2);
+  EXPECT_THAT(log, HasSubstr("matches 2 runs (" + ids[0] + " (seed 0), " + ids[1] + " (seed 1))"));
+  EXPECT_THAT(log, HasSubstr("add --seed N"));
+  ASSERT_EQ(run("eval " + out_ + " --run " + prefix + " --seed 1", &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr(ids[1]));
+  EXPECT_EQ(run("eval " + out_ + " --run " + prefix + " --seed 7", &log), 2);
+  EXPECT_THAT(log, HasSubstr("no run with id " + prefix + " and seed 7"));
+}
+
 // The CSV: both figure trajectories from t = 0, the true H(x0) of each
 // (0.5 J and 0.75 J by construction), and no learned energy for NODE.
 TEST_F(EvalCommandTest, EnergyCsvStartsAtTheFigureEnergies) {

@@ -177,12 +177,28 @@ TEST_F(ReduceCommandTest, TablesShowIntervalsAndNeverNan) {
   EXPECT_THAT(out, StartsWith("study,system,model,axis,column,midpoint,below,above,"));
 }
 
-TEST_F(ReduceCommandTest, PerRunNeedsCsvAndExcludesSeedsSummary) {
-  std::string out;
-  EXPECT_EQ(reduce("--per-run", &out), 2);
-  EXPECT_THAT(out, HasSubstr("--per-run writes CSV only; add --format csv"));
+TEST_F(ReduceCommandTest, PerRunIsCsvAndExcludesSeedsSummary) {
+  std::string out, csv;
+  ASSERT_EQ(reduce("--per-run", &out), 0) << out;  // no --format csv needed
+  ASSERT_EQ(reduce("--per-run --format csv", &csv), 0) << csv;
+  EXPECT_EQ(out, csv);
+  EXPECT_THAT(out, StartsWith("run_id,"));
+  EXPECT_EQ(reduce("--per-run --format latex", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--per-run writes CSV only; drop --format latex"));
   EXPECT_EQ(reduce("--per-run --format csv --seeds-summary", &out), 2);
   EXPECT_THAT(out, HasSubstr("exclude each other"));
+}
+
+// A sweep file given instead of its results file: named as such, and no
+// advice to delete it or to pass an --out that reduce does not have.
+TEST(ReduceCommandMissingFileTest, ASweepFileIsNamedWithoutDeleteAdvice) {
+  std::string out;
+  const std::string sweep = std::string(PHNN_SOURCE_DIR) + "/sweeps/tiny.toml";
+  EXPECT_EQ(testing_util::run_shell(std::string(PHNN_BINARY) + " reduce " + sweep, &out), 1);
+  EXPECT_THAT(out, HasSubstr("this looks like a sweep file: give the results file its sweep "
+                             "wrote"));
+  EXPECT_THAT(out, Not(HasSubstr("delete")));
+  EXPECT_THAT(out, Not(HasSubstr("--out")));
 }
 
 // A missing file gets a reducer's hint, not the sweep's "start a new sweep

@@ -65,11 +65,16 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 1,1 --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("seed 1 listed twice"));
   EXPECT_EQ(run("train --system harmonic --model mlp", &log), 2);
-  EXPECT_THAT(log, HasSubstr("--model \"mlp\": expected formulation-integrator"));
+  EXPECT_THAT(log, HasSubstr("--model \"mlp\": expected formulation-integrator"));  // nothing near
   EXPECT_EQ(run("train --system harmonic --model node-dg --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("integrator = dg with model = node"));
   EXPECT_EQ(run("train --system harmonic --model phnn-jr-rk2 --integrator dg --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("already names the integrator rk2"));
+  // "Did you mean" for a system and a model a letter away.
+  EXPECT_EQ(run("train --system duffin --model phnn-jr-rk2 --steps 1", &log), 2);
+  EXPECT_THAT(log, HasSubstr("unknown system \"duffin\" (did you mean \"duffing\"?)"));
+  EXPECT_EQ(run("train --system duffing --model phnn-jr-rk3 --steps 1", &log), 2);
+  EXPECT_THAT(log, HasSubstr("--model \"phnn-jr-rk3\" (did you mean \"phnn-jr-rk2\"?)"));
 }
 
 // One name for a model and its integrator, as in sweep files; the older
@@ -106,6 +111,12 @@ TEST(TrainCommandTest, ProgressInALogFileHasNoCarriageReturns) {
   EXPECT_EQ(log.find('\r'), std::string::npos);
   EXPECT_THAT(log, HasSubstr("step 100/100"));
   EXPECT_THAT(log, HasSubstr("step 50/100"));
+  // Header and estimate first even when stdout is a file (flushed), no
+  // "ETA 0 s" before the first step, and each logged line has its time.
+  EXPECT_LT(log.find("phnn train: harmonic"), log.find("step 0/100"));
+  EXPECT_LT(log.find("phnn train: estimated "), log.find("step 0/100"));
+  EXPECT_THAT(log, HasSubstr("step 0/100  best val"));
+  EXPECT_THAT(log, ::testing::ContainsRegex("step 0/100 .* ETA --  \\(20[0-9-]+T[0-9:]+Z\\)"));
 }
 
 }  // namespace

@@ -65,10 +65,12 @@ TEST(PerRunCsvTest, OneRowPerRunWithEveryConfigKeyAndFullPrecision) {
                               "newton_failures,trace_points,initial_validation_loss,"
                               "final_train_loss,final_validation_loss,final_kappa,"
                               "final_sigma_max,final_rho,message\n"));
-  // %.17g round-trips: 1/3 and 0.1 print 17 digits; a key the run lacks is empty.
+  // The shortest text that reads back to the double: 1/3 needs 16 digits,
+  // 0.1 one; a key the run lacks is empty.
   EXPECT_THAT(csv, HasSubstr("\n00000000000000ab,\"I,II\",PHNN-S-DG,harmonic,phnn-s,0.5,0,,done,"
-                             "0.33333333333333331,49000,0.10000000000000001,12.5,50000,852,0,3,"
+                             "0.3333333333333333,49000,0.1,12.5,50000,852,0,3,"
                              "101,0.5,0.25,0.125,1000,2,0.0625,\n"));
+  EXPECT_EQ(std::stod("0.3333333333333333"), 1.0 / 3.0);
   EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,duffing,phnn-s,0.5,1,1,done,0.002,"));
 }
 
@@ -99,7 +101,9 @@ TEST(PerRunCsvTest, NamesColumnsAsTheSweepFileAndSplitsMultiNumberKeys) {
   EXPECT_THAT(csv, StartsWith("run_id,studies,model_label,lr,energy_min,energy_max,z1,z2,z3,"
                               "newton_tolerance,newton_max_iterations,adam,learning_rate,"
                               "future_axis,seed,status,"));
-  EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,0.001,0.10000000000000001,1,3,-4,1.3,1e-12,20,"
+  // Configuration numbers too: the canonical key's %.17g spelling of 0.1
+  // becomes 0.1 (the same double); lists keep their text.
+  EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,0.001,0.1,1,3,-4,1.3,1e-12,20,"
                              "\"0.9,0.999\",5,\"a,b\",0,done,1,"));
 }
 

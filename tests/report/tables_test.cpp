@@ -32,6 +32,8 @@ TEST(TableFormatTest, ParsesTheThreeFormatsAndListsThemOnError) {
 //            25                              100
 // NODE-RK2   1..5e-3 (done)                  5,6,7e-3 + pending + failed
 // PHNN-JR-DG 1,2,3e-4 + 2 diverged           (nothing)
+// Column 25 has 5 finished seeds in every row; column 100 has 3 and 0: no
+// interval for 3 seeds, no best marked in that column.
 class TableTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -75,8 +77,9 @@ TEST_F(TableTest, MarkdownShowsMedianIqrIntervalTieDivergedAndMissing) {
   // PHNN-JR-DG/25: {1, 2, 3}e-4 + 2 x inf: median 3e-4, q75 inf, interval
   //   [1e-4, inf] (P(median = inf) = P(>= 3 of 5 draws diverged) = 0.32):
   //   smallest median, but its interval overlaps NODE-RK2's: a tie.
-  // NODE-RK2/100: {5, 6, 7}e-3 -> 6e-3 [1e-3] (5e-3, 7e-3), 3 of 5 finished;
-  //   best (alone).
+  // NODE-RK2/100: {5, 6, 7}e-3 -> 6e-3 [1e-3], 3 of 5 finished: no interval,
+  //   and no best in a column where PHNN-JR-DG has no run (it was bold from
+  //   3 seeds before the honest-tables rule).
   EXPECT_EQ(render(TableFormat::kMarkdown),
             "### Study I — harmonic (columns: n_train)\n"
             "\n"
@@ -85,11 +88,16 @@ TEST_F(TableTest, MarkdownShowsMedianIqrIntervalTieDivergedAndMissing) {
             "| model | 25 | 100 |\n"
             "|---|---|---|\n"
             "| NODE-RK2 | 3.00e-03 [2.00e-03] (1.00e-03, 5.00e-03) (tie) | "
-            "**6.00e-03 [1.00e-03] (5.00e-03, 7.00e-03)** (n=3/5) |\n"
+            "6.00e-03 [1.00e-03] (n=3/5) |\n"
             "| PHNN-JR-DG | 3.00e-04 [inf] (1.00e-04, inf) (tie) (d=2) | — |\n"
             "\n"
             "(tie): no clear best in this column: the bootstrap 95 % interval of its smallest "
             "median overlaps the intervals of the other cells marked (tie), so none is bold.\n"
+            "\n"
+            "No best marked where a row has fewer than 5 finished seeds (100: PHNN-JR-DG has no "
+            "finished runs).\n"
+            "\n"
+            "Cells with fewer than 5 finished seeds show median [IQR] without an interval.\n"
             "\n");
 }
 
@@ -97,12 +105,14 @@ TEST_F(TableTest, BestIsBoldOnlyWhenItsIntervalOverlapsNoOther) {
   entries_.clear();
   // Constant sample: interval [2e-4, 2e-4]; the runner-up's is [1e-3, 3e-3].
   for (int seed = 0; seed < 5; ++seed) add("PHNN-JR-DG", "25", RunStatus::kDone, 2e-4);
-  for (double mse : {3e-3, 1e-3, 2e-3}) add("NODE-RK2", "25", RunStatus::kDone, mse);
+  for (double mse : {3e-3, 1e-3, 2e-3, 2.5e-3, 1.5e-3}) add("NODE-RK2", "25", RunStatus::kDone, mse);
   std::string markdown = render(TableFormat::kMarkdown);
   EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04)** |"));
-  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 2.00e-03 [1.00e-03] (1.00e-03, 3.00e-03) (n=3/5) |"));
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 2.00e-03 [1.00e-03] (1.00e-03, 3.00e-03) |"));
   EXPECT_THAT(markdown, Not(HasSubstr("(tie)")));
-  // One run of the runner-up as low as the best: the intervals now touch.
+  // Two runs of the runner-up as low as the best: the intervals now touch
+  // (7 values, 2 of them 2e-4: P(bootstrap median = 2e-4) = 0.11 > 2.5 %).
+  add("NODE-RK2", "25", RunStatus::kDone, 2e-4);
   add("NODE-RK2", "25", RunStatus::kDone, 2e-4);
   markdown = render(TableFormat::kMarkdown);
   EXPECT_THAT(markdown, Not(HasSubstr("**")));
@@ -116,7 +126,8 @@ TEST_F(TableTest, LatexBoldsTheBestMarksTiesAndEscapesLabels) {
   EXPECT_THAT(latex, HasSubstr("Study I --- harmonic (columns: n\\_train)"));
   EXPECT_THAT(latex, HasSubstr("Model & 25 & 100 \\\\"));
   EXPECT_THAT(latex, HasSubstr("NODE-RK2 & 3.00e-03 [2.00e-03] (1.00e-03, 5.00e-03) (tie) & "
-                               "\\textbf{6.00e-03 [1.00e-03] (5.00e-03, 7.00e-03)} (n=3/5) \\\\"));
+                               "6.00e-03 [1.00e-03] (n=3/5) \\\\"));
+  EXPECT_THAT(latex, Not(HasSubstr("\\textbf")));  // no best: a tie, and a column without
   EXPECT_THAT(latex, HasSubstr("PHNN-JR-DG & 3.00e-04 [inf] (1.00e-04, inf) (tie) (d=2) & -- \\\\"));
   EXPECT_THAT(latex, HasSubstr("\\par\\smallskip{\\footnotesize (tie): no clear best in this "
                                "column: the bootstrap 95 \\% interval"));
@@ -132,8 +143,9 @@ TEST_F(TableTest, CsvHasOneLinePerCellWithIntervalBestAndTieColumns) {
                              "4.000000e-03,2.000000e-03,1.000000e-03,5.000000e-03,5,0,0,5,0,1\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,25,3.000000e-04,2.000000e-04,"
                              "inf,inf,1.000000e-04,inf,3,2,0,5,0,1\n"));
+  // 3 finished seeds: no interval, and no best in the column.
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,100,6.000000e-03,5.500000e-03,"
-                             "6.500000e-03,1.000000e-03,5.000000e-03,7.000000e-03,3,0,2,5,1,0\n"));
+                             "6.500000e-03,1.000000e-03,,,3,0,2,5,0,0\n"));
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,100,,,,,,,0,0,5,5,0,0\n"));
   // Header + 4 cells.
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
@@ -142,12 +154,11 @@ TEST_F(TableTest, CsvHasOneLinePerCellWithIntervalBestAndTieColumns) {
 TEST_F(TableTest, AllDivergedCellShowsInfinityAndCountNeverNan) {
   entries_.clear();
   for (int i = 0; i < 5; ++i) add("NODE-RK2", "25", RunStatus::kDiverged, kInf);
-  add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-3);
+  for (int i = 0; i < 5; ++i) add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-3);
   const std::string markdown = render(TableFormat::kMarkdown);
   EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | inf (d=5) | — |"));
   // The diverged cell's interval [inf, inf] overlaps nothing finite.
-  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **1.00e-03 [0.00e+00] (1.00e-03, 1.00e-03)** "
-                                  "(n=1/5) |"));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **1.00e-03 [0.00e+00] (1.00e-03, 1.00e-03)** |"));
   const std::string csv = render(TableFormat::kCsv);
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,25,inf,inf,inf,inf,inf,inf,0,5,0,5,0,0\n"));
   EXPECT_THAT(markdown + csv + render(TableFormat::kLatex), Not(HasSubstr("nan")));
@@ -155,12 +166,13 @@ TEST_F(TableTest, AllDivergedCellShowsInfinityAndCountNeverNan) {
 
 TEST_F(TableTest, AllDivergedCellIsNoTieForABestWhoseIntervalReachesInfinity) {
   entries_.clear();
-  // {1, 2}e-3 + inf: median 2e-3, interval [1e-3, inf] (P(median = inf) = 7/27).
-  for (double mse : {1e-3, 2e-3, kInf}) add("NODE-RK2", "25", RunStatus::kDone, mse);
-  for (int i = 0; i < 3; ++i) add("PHNN-JR-DG", "25", RunStatus::kDiverged, kInf);
-  const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 3);
-  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **2.00e-03 [inf] (1.00e-03, inf)** (d=1) | — |"));
-  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | inf (d=3) | — |"));
+  // {1, 1.5, 2, 2.5}e-3 + inf: median 2e-3, IQR 1e-3, interval [1e-3, inf]
+  // (P(median = inf) = P(median = 1e-3) = 0.058).
+  for (double mse : {1e-3, 1.5e-3, 2e-3, 2.5e-3, kInf}) add("NODE-RK2", "25", RunStatus::kDone, mse);
+  for (int i = 0; i < 5; ++i) add("PHNN-JR-DG", "25", RunStatus::kDiverged, kInf);
+  const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 5);
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **2.00e-03 [1.00e-03] (1.00e-03, inf)** (d=1) | — |"));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | inf (d=5) | — |"));
   EXPECT_THAT(markdown, Not(HasSubstr("(tie)")));
 }
 
@@ -168,8 +180,8 @@ TEST_F(TableTest, DivergedRunsWithAFiniteMseShowTheirNumbers) {
   entries_.clear();
   add("NODE-RK2", "25", RunStatus::kDiverged, 5e-3);  // e.g. a training loss that went NaN
   const std::string markdown = render(TableFormat::kMarkdown);
-  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | **5.00e-03 [0.00e+00] (5.00e-03, 5.00e-03)** "
-                                  "(n=1/5) (d=1) |"));
+  // One seed: its numbers, no interval, not bold.
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 5.00e-03 [0.00e+00] (n=1/5) (d=1) |"));
 }
 
 // Every way +inf meets a quantile: neighbours both +inf, a median between a
@@ -186,8 +198,8 @@ TEST_F(TableTest, InfiniteMsesNeverPrintNan) {
   add("NODE-RK2", "100", RunStatus::kDone, std::nan(""));
   add("NODE-RK2", "100", RunStatus::kDone, 1e-3);
   const std::string markdown = render(TableFormat::kMarkdown);
-  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | inf [inf] (1.00e-03, inf) (n=4/5) (d=2) | "
-                                  "inf [inf] (1.00e-03, inf) (n=2/5) (d=1) |"));
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | inf [inf] (n=4/5) (d=2) | "
+                                  "inf [inf] (n=2/5) (d=1) |"));
   EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | inf [inf] (1.00e-03, inf) (d=4) | — |"));
   EXPECT_THAT(markdown + render(TableFormat::kCsv) + render(TableFormat::kLatex),
               Not(HasSubstr("nan")));
@@ -195,12 +207,38 @@ TEST_F(TableTest, InfiniteMsesNeverPrintNan) {
 
 TEST_F(TableTest, EqualBestMediansAreATie) {
   entries_.clear();
-  add("NODE-RK2", "25", RunStatus::kDone, 1e-3);
-  add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-3);
-  const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 1);
+  for (int i = 0; i < 5; ++i) {
+    add("NODE-RK2", "25", RunStatus::kDone, 1e-3);
+    add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-3);
+  }
+  const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 5);
   EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 1.00e-03 [0.00e+00] (1.00e-03, 1.00e-03) (tie) | — |"));
   EXPECT_THAT(markdown,
               HasSubstr("| PHNN-JR-DG | 1.00e-03 [0.00e+00] (1.00e-03, 1.00e-03) (tie) | — |"));
+}
+
+// Honest tables: a best from 1 seed with a zero-width "interval", or a best
+// in a column where another model has no runs, was bold; neither is now, and
+// the note says why. With 5 seeds in every row the best is bold again.
+TEST_F(TableTest, NoBestFromFewSeedsOrBesideAMissingRow) {
+  entries_.clear();
+  add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-4);  // 1 seed, far below the other row
+  for (int i = 0; i < 5; ++i) add("NODE-RK2", "25", RunStatus::kDone, 1e-2 * (i + 1));
+  for (int i = 0; i < 5; ++i) add("NODE-RK2", "100", RunStatus::kDone, 1e-3);  // alone in 100
+  std::string markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, Not(HasSubstr("**")));
+  EXPECT_THAT(markdown, Not(HasSubstr("(tie)")));
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | 1.00e-04 [0.00e+00] (n=1/5) | — |"));
+  EXPECT_THAT(markdown, HasSubstr("No best marked where a row has fewer than 5 finished seeds "
+                                  "(25: PHNN-JR-DG has 1 finished seed; 100: PHNN-JR-DG has no "
+                                  "finished runs)."));
+  for (int i = 0; i < 4; ++i) add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-4);
+  markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **1.00e-04 [0.00e+00] (1.00e-04, 1.00e-04)** | — |"));
+  EXPECT_THAT(markdown, HasSubstr("(100: PHNN-JR-DG has no finished runs)"));
+  const std::string csv = render(TableFormat::kCsv);
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,100,1.000000e-03,1.000000e-03,"
+                             "1.000000e-03,0.000000e+00,1.000000e-03,1.000000e-03,5,0,0,5,0,0\n"));
 }
 
 TEST_F(TableTest, SeedsSummaryCountsSeedsBelowAndAboveTheColumnMidpoint) {

@@ -395,6 +395,13 @@ TEST(SweepCommandTest, DryRunPrintsTheScheduleForSeveralRankCounts) {
   EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --ranks 0", &log), 2);
   EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --split off --max-group-size 2", &log), 2);
   EXPECT_THAT(log, HasSubstr("needs mode auto"));
+  // Numbers out of range are refused with the range, never wrapped.
+  for (const char* bad : {"--threads 0", "--threads 4294967297", "--max-group-size 4294967297",
+                          "--max-group-size -1", "--checkpoint-every -1"}) {
+    EXPECT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run " + bad, &log), 2)
+        << bad;
+    EXPECT_THAT(log, HasSubstr("is outside [")) << bad;
+  }
   ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + paper + " --dry-run --cell-costs", &log), 0)
       << log;
   EXPECT_THAT(log, StartsWith("cell,system,model,size,n_train,regularizer,members,"));

@@ -42,6 +42,11 @@ TableFormat parse_table_format(const std::string& name);
 std::string to_string(TableFormat format);
 
 /// Statistics of one table cell.
+/// Fewest finished seeds for which a table prints a cell's bootstrap
+/// interval; a column marks a best (or a tie) only if every row has as
+/// many. A bootstrap interval of 1-4 values says little (of 1: zero width).
+constexpr int kMinSeedsForInterval = 5;
+
 struct CellSummary {
   /// Runs with status done (and a finite MSE).
   int done = 0;
@@ -62,6 +67,9 @@ struct CellSummary {
 
   /// Runs whose MSE enters the statistics.
   int finished() const { return done + diverged; }
+  /// Whether the tables show the interval (and may mark a best): at least
+  /// kMinSeedsForInterval finished runs.
+  bool has_interval() const;
   /// q75 - q25; +inf if q75 is +inf (also when q25 is: the spread of a cell
   /// with that many diverged runs is unbounded, never NaN).
   double iqr() const;
