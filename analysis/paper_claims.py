@@ -416,6 +416,7 @@ def across_studies(res):
 
 
 PAPER_STEPS, PAPER_SEEDS = 50000, 10
+STABLE = 0.9  # share of resamples with the same verdict below which a verdict is unstable
 
 
 def detail_line(c):
@@ -442,22 +443,110 @@ def setting_problems(run_rows):
     return problems
 
 
-def report(results, path, problems=()):
-    claims = study_one(results) + study_two(results) + study_three(results) + across_studies(results)
+def all_claims(results):
+    return study_one(results) + study_two(results) + study_three(results) + across_studies(results)
+
+
+# ------------------------------------------------------------------ verdict stability
+def quantile(sorted_values, q):
+    """Linear-interpolation quantile along the last axis of sorted values, +inf exact (as the
+    reducer: equal neighbours give their value, a positive weight on +inf gives +inf)."""
+    import numpy as np
+    n = sorted_values.shape[-1]
+    pos = q * (n - 1)
+    lo, frac = int(math.floor(pos)), pos - math.floor(pos)
+    a = sorted_values[..., lo]
+    b = sorted_values[..., min(lo + 1, n - 1)]
+    with np.errstate(invalid="ignore"):
+        return np.where((frac == 0) | (a == b), a, a + frac * (b - a))
+
+
+def resampled_stat_row(row, values, rng, inner):
+    """The reducer's statistics of one cell (a stat row) recomputed on `values`: median, q25, q75,
+    IQR and a percentile-bootstrap 95 % interval of the median from `inner` resamples."""
+    import numpy as np
+    v = np.sort(values)
+    median, q25, q75 = (float(quantile(v, q)) for q in (0.5, 0.25, 0.75))
+    boot = np.sort(rng.choice(v, size=(inner, len(v)), replace=True), axis=1)
+    medians = np.sort(quantile(boot, 0.5))
+    lo = medians[int(math.floor(0.025 * (inner - 1)))]
+    hi = medians[int(math.ceil(0.975 * (inner - 1)))]
+    iqr = math.inf if math.isinf(q75) else q75 - q25
+    out = dict(row)
+    out.update(median=repr(median), q25=repr(q25), q75=repr(q75), iqr=repr(iqr),
+               ci_low=repr(float(lo)), ci_high=repr(float(hi)),
+               done=str(int(np.sum(np.isfinite(v)))), diverged=str(int(np.sum(~np.isfinite(v)))))
+    return out
+
+
+def run_value(r):
+    """A finished run's MSE as the reducer counts it (NaN -> +inf)."""
+    v = float(r["mse"]) if r["mse"] not in ("", "nan") else math.inf
+    return math.inf if math.isnan(v) else v
+
+
+def stability(stat_rows, run_rows, resamples, seed=0, inner=1000):
+    """Per statement tag, the share of `resamples` bootstrap resamples of every cell's finished
+    seeds (each cell resampled once per round, shared by every study that shows it) that give the
+    verdict the file gives. Per-run quantities (the Jacobian statement) use the same resample."""
+    import numpy as np
+    rng = np.random.default_rng(seed)
+    base = {tag: verdict(comps)[0] for tag, _, comps in all_claims(Results(stat_rows, run_rows))}
+    cells = {}
+    for r in run_rows:
+        if r["status"] in ("done", "diverged"):
+            key = (r["system"], r["model_label"], r["n_train"], r["size"], r["regularizer"])
+            cells.setdefault(key, []).append(r)
+    same = {tag: 0 for tag in base}
+    for _ in range(resamples):
+        drawn = {key: [rows[i] for i in rng.integers(0, len(rows), len(rows))]
+                 for key, rows in cells.items()}
+        new_stats = []
+        for row in stat_rows:
+            config = dict(DEFAULTS, **{row["axis"]: row["column"]})
+            key = (row["system"], row["model"], config["n_train"], config["size"],
+                   config["regularizer"])
+            if key in drawn:
+                values = [run_value(r) for r in drawn[key]]
+                new_stats.append(resampled_stat_row(row, values, rng, inner))
+            else:
+                new_stats.append(row)
+        new_runs = [r for rows in drawn.values() for r in rows]
+        for tag, _, comps in all_claims(Results(new_stats, new_runs)):
+            if tag in same and verdict(comps)[0] == base[tag]:
+                same[tag] += 1
+    return {tag: same[tag] / resamples for tag in base}
+
+
+def report(results, path, problems=(), stable=None):
+    claims = all_claims(results)
     lines = [f"# The paper's statements checked on {os.path.basename(path)}", ""]
     if problems:
         lines += [f"**Not the paper's settings: {'; '.join(problems)}.** The verdicts below describe "
                   "this file only; they do not confirm or contradict the paper.", ""]
-    lines += ["| # | the paper says | our evidence | verdict |", "|---|---|---|---|"]
+    if stable is None:
+        lines += ["| # | the paper says | our evidence | verdict |", "|---|---|---|---|"]
+    else:
+        lines += ["| # | the paper says | our evidence | verdict | same verdict in resamples |",
+                  "|---|---|---|---|---|"]
     details = ["", "## Details", ""]
     for tag, text, comps in claims:
         if not comps:
             continue
         v, counts = verdict(comps)
-        lines.append(f"| {tag} | {text} | {counts} | {v} |")
+        if stable is None:
+            lines.append(f"| {tag} | {text} | {counts} | {v} |")
+        else:
+            share = stable.get(tag, math.nan)
+            mark = " **unstable**" if share < STABLE else ""
+            lines.append(f"| {tag} | {text} | {counts} | {v} | {100 * share:.0f} %{mark} |")
         details.append(f"**{tag}** {text}: {v}")
         details.extend(detail_line(c) for c in comps)
         details.append("")
+    if stable is not None:
+        lines.append(f"\nLast column: the share of bootstrap resamples of every cell's finished "
+                     f"seeds that give the same verdict; below {100 * STABLE:.0f} % the verdict "
+                     "is marked unstable (it rests on seeds at the margin).")
     missing = [s for s in ("I", "II", "III") if not results.has(s)]
     if missing:
         lines.append(f"\nNot in the file (statements skipped): Study {', '.join(missing)}.")
@@ -472,6 +561,9 @@ def main(argv=None):
         "(the module's docstring says when). A file trained with fewer steps or seeds than the "
         "paper's is flagged at the top; --strict refuses it.")
     parser.add_argument("results", help="results file written by `phnn sweep sweeps/paper.toml`")
+    parser.add_argument("--stability", type=int, default=0, metavar="N",
+                        help="recompute every verdict on N bootstrap resamples of each cell's "
+                        "seeds and show the share that agrees (below 90 %%: unstable)")
     parser.add_argument("--strict", action="store_true",
                         help="exit 1 without verdicts if the steps or seeds differ from the paper's")
     args = parser.parse_args(argv)
@@ -484,8 +576,12 @@ def main(argv=None):
     if problems and args.strict:
         print("paper_claims.py: --strict: not the paper's settings; no verdicts", file=sys.stderr)
         return 1
-    results = Results(reduce_csv(args.results), run_rows)
-    print(report(results, args.results, problems))
+    if args.stability < 0:
+        parser.error("--stability N needs N >= 0")
+    stat_rows = reduce_csv(args.results)
+    results = Results(stat_rows, run_rows)
+    stable = stability(stat_rows, run_rows, args.stability) if args.stability else None
+    print(report(results, args.results, problems, stable))
     return 0
 
 

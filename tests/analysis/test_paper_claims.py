@@ -4,6 +4,7 @@ Study I statements on a synthetic reducer output (no phnn binary needed).
 
     /usr/bin/python3 tests/analysis/test_paper_claims.py
 """
+import math
 import os
 import sys
 import unittest
@@ -131,6 +132,48 @@ class Settings(unittest.TestCase):
         self.assertEqual(pc.detail_line(pc.compare("x", b, a)),
                          "- against the paper: x: 3 (2, 4) >= 1 (0.5, 1.5) [resolved]")
         self.assertTrue(pc.detail_line(pc.compare("x", a, b)).startswith("- for the paper: x: "))
+
+
+class Stability(unittest.TestCase):
+    @staticmethod
+    def cell_rows(column, values):
+        """Per-run rows of harmonic NODE-RK2 at N_train `column`, and its stat row (the stats
+        as the reducer would give them, from resampled_stat_row on the values themselves)."""
+        import numpy as np
+        runs = [{"system": "harmonic", "model_label": "NODE-RK2", "n_train": column,
+                 "size": "small", "regularizer": "none", "seed": str(k), "steps": "50000",
+                 "status": "done", "mse": repr(v)} for k, v in enumerate(values)]
+        base = {"study": "I", "system": "harmonic", "model": "NODE-RK2", "axis": "n_train",
+                "column": column, "expected": str(len(values))}
+        return runs, pc.resampled_stat_row(base, values, np.random.default_rng(1), 2000)
+
+    def stability_of(self, low_n, high_n):
+        r25, s25 = self.cell_rows("25", low_n)
+        r100, s100 = self.cell_rows("100", high_n)
+        return pc.stability([s25, s100], r25 + r100, resamples=60, inner=300)["I.1"]
+
+    def test_quantiles_follow_the_reducer_with_infinity(self):
+        import numpy as np
+        v = np.array([1.0, 2.0, math.inf, math.inf])
+        self.assertEqual(float(pc.quantile(v, 0.5)), math.inf)   # between 2 and +inf
+        self.assertEqual(float(pc.quantile(v, 0.25)), 1.75)
+        self.assertEqual(float(pc.quantile(v, 0.75)), math.inf)   # equal neighbours
+        self.assertEqual(float(pc.quantile(np.arange(1.0, 6.0), 0.5)), 3.0)
+
+    def test_a_clear_comparison_is_stable_a_marginal_one_is_not(self):
+        clear = self.stability_of([10.0 + k for k in range(10)], [1.0 + k * 0.1 for k in range(10)])
+        self.assertEqual(clear, 1.0)
+        # N_train 100 a hair below 25 on most seeds: the direction flips in some resamples.
+        marginal = self.stability_of([1.0 + k for k in range(10)], [0.9 + k for k in range(10)])
+        self.assertLess(marginal, 0.9)
+
+    def test_the_report_shows_the_share_and_marks_unstable_ones(self):
+        r25, s25 = self.cell_rows("25", [1.0 + k for k in range(10)])
+        r100, s100 = self.cell_rows("100", [0.9 + k for k in range(10)])
+        res = pc.Results([s25, s100], r25 + r100)
+        text = pc.report(res, "x.h5", (), {"I.1": 0.5})
+        self.assertIn("| same verdict in resamples |", text)
+        self.assertIn("| 50 % **unstable** |", text)
 
 
 if __name__ == "__main__":

@@ -66,6 +66,24 @@ class Loader(unittest.TestCase):
                                            "validation_loss", "kappa", "sigma_max", "rho"])
         self.assertEqual(sorted(set(t.step)), [0, 10, 20])
 
+    def test_the_reducers_quantiles_are_the_stability_checks(self):
+        # analysis/paper_claims.py --stability recomputes the reducer's median/IQR per resample:
+        # on the original seeds it must give the reducer's numbers (printed to 7 digits).
+        sys.path.insert(0, os.path.join(ROOT, "analysis"))
+        import paper_claims as pc
+        runs = load(self.path)
+        stats = pc.reduce_csv(self.path)
+        checked = 0
+        for row in stats:
+            if row["median"] in ("", "nan"):
+                continue
+            cell = runs[(runs.model_label == row["model"]) & runs.status.isin(["done", "diverged"])]
+            values = np.sort(cell.mse.to_numpy(dtype=float))
+            for q, key in ((0.5, "median"), (0.25, "q25"), (0.75, "q75")):
+                self.assertAlmostEqual(float(pc.quantile(values, q)) / float(row[key]), 1.0, 6)
+            checked += 1
+        self.assertEqual(checked, 1)
+
     def test_a_missing_file_is_named(self):
         with self.assertRaisesRegex(FileNotFoundError, "nowhere.h5"):
             load(os.path.join(self.dir.name, "nowhere.h5"))
