@@ -18,6 +18,7 @@ quartiles, percentile bootstrap, fixed key); the seed counts from `phnn reduce -
 --per-run`, over the runs of the row's study. The phnn binary: $PHNN, else build/phnn.
 """
 import argparse
+import math
 import sys
 
 from phnn_tool import run_csv
@@ -57,9 +58,14 @@ def cells(path, threshold):
             continue
         counted = (r["study"], r["system"], r["model"], axis, column)
         out[(r["system"], r["model"], axis, column)] = (
-            float(r["median"]), float(r["ci_low"]), float(r["ci_high"]),
+            float(r["median"]), number(r["ci_low"]), number(r["ci_high"]),
             above.get(counted, 0), finished.get(counted, 0))
     return out
+
+
+def number(text):
+    """A reducer CSV number; an empty field (no interval: fewer than 5 finished seeds) is NaN."""
+    return float(text) if text not in ("", "nan") else math.nan
 
 
 def column_text(axis, column):
@@ -73,10 +79,12 @@ def sort_key(key):
 
 def text(cell):
     median, low, high, above, n = cell
-    return f"{median:.3g} ({low:.2g}, {high:.2g}) [{above}/{n}]"
+    interval = f"({low:.2g}, {high:.2g})" if not math.isnan(low) else "(no interval)"
+    return f"{median:.3g} {interval} [{above}/{n}]"
 
 
 def verdict(base, cell):
+    """better / worse when the intervals do not overlap; ~ otherwise or without intervals."""
     if cell[2] < base[1]:
         return " better"
     if cell[1] > base[2]:

@@ -10,6 +10,7 @@ result.
     done = runs[runs.status == "done"]
     done.groupby(["system", "model_label", "n_train"]).mse.median()
     t = traces("results/paper.h5")              # one row per validation point of every run
+    w = weights("results/paper.h5", "3f2a")      # {"l_h.0.weight": array (2, 16), ...}
 
 The columns are those of `phnn reduce FILE --per-run --format csv` (docs/RESULTS_FORMAT.md,
 "Per-run CSV"): `run_id`; every setting of the run (`system`, `model`, `integrator`, `size`,
@@ -86,6 +87,42 @@ def traces(path):
         return pd.DataFrame(columns=["run_id", *columns])
     out = pd.concat(parts, ignore_index=True)
     out["step"] = out["step"].astype(np.int64)
+    return out
+
+
+def weights(path, run_id):
+    """One run's stored weights (the best-validation weights inference used) as a dict of named
+    numpy arrays in storage order, e.g. {"l_h.0.weight": (2, 16) array, "l_h.0.bias": (16,), ...}:
+    per network layer its weight [fan_in, fan_out] (x @ W + b) and bias. `run_id` may be a unique
+    prefix. Reads /weights and /runs/weights_layout with h5py (docs/RESULTS_FORMAT.md)."""
+    import h5py
+    import numpy as np
+    with h5py.File(path, "r") as f:
+        runs = f["runs"]
+        ids = [s.decode().rstrip("\0") for s in runs["id"][:]]
+        rows = [k for k, i in enumerate(ids) if i.startswith(run_id)]
+        if len(rows) != 1:
+            raise KeyError(f"{path}: {len(rows)} runs match id {run_id!r}; give a unique prefix")
+        row = rows[0]
+        if "weights_layout" not in runs:
+            raise KeyError(f"{path}: written before weight names and shapes were stored; "
+                           "`phnn eval` reloads its weights")
+        length = int(runs["weights_length"][row])
+        if length == 0:
+            raise KeyError(f"{path}: run {ids[row]} has no stored weights (status "
+                           f"{int(runs['status'][row])})")
+        offset = int(runs["weights_offset"][row])
+        flat = f["weights"][offset:offset + length]
+        layout = runs["weights_layout"][row].decode().rstrip("\0")
+    out, at = {}, 0
+    for entry in layout.split("; "):
+        name, shape_text = entry.split(" ")
+        shape = tuple(int(d) for d in shape_text.split("x"))
+        n = int(np.prod(shape))
+        out[name] = np.asarray(flat[at:at + n]).reshape(shape)
+        at += n
+    if at != length:
+        raise ValueError(f"{path}: run {ids[row]}: the layout holds {at} weights, the row {length}")
     return out
 
 

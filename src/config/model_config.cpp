@@ -116,6 +116,50 @@ long parameter_count(ModelKind kind, ModelSize size, int n_x, int n_w, int n_u) 
   return 0;
 }
 
+namespace {
+
+// An MLP's tensors: per layer its weight [fan_in, fan_out] and bias [fan_out].
+void add_mlp(const std::string& net, int in, const std::vector<int>& hidden, int out,
+             std::vector<WeightTensor>* layout) {
+  int prev = in;
+  std::vector<int> widths = hidden;
+  widths.push_back(out);
+  for (std::size_t l = 0; l < widths.size(); ++l) {
+    const std::string layer = net + "." + std::to_string(l);
+    layout->push_back({layer + ".weight", {prev, widths[l]}});
+    layout->push_back({layer + ".bias", {widths[l]}});
+    prev = widths[l];
+  }
+}
+
+}  // namespace
+
+std::vector<WeightTensor> weight_layout(ModelKind kind, ModelSize size, int n_x, int n_w, int n_u) {
+  const NetworkWidths w = network_widths(size);
+  const int m = n_x + n_u;
+  std::vector<WeightTensor> layout;
+  if (kind == ModelKind::kNode) {
+    add_mlp("node", m, w.node, n_x, &layout);
+    return layout;
+  }
+  add_mlp("l_h", n_x, w.l_h, n_x * (n_x + 1) / 2, &layout);
+  if (kind == ModelKind::kPhnnJr) add_mlp("l_r", m, w.l_r, m * (m + 1) / 2, &layout);
+  if (kind == ModelKind::kPhnnS && n_w > 0) add_mlp("l_z", n_w, w.l_z, n_w * n_w, &layout);
+  return layout;
+}
+
+std::string weight_layout_text(const std::vector<WeightTensor>& layout) {
+  std::string text;
+  for (const WeightTensor& t : layout) {
+    if (!text.empty()) text += "; ";
+    text += t.name + " ";
+    for (std::size_t d = 0; d < t.shape.size(); ++d) {
+      text += (d ? "x" : "") + std::to_string(t.shape[d]);
+    }
+  }
+  return text;
+}
+
 std::string model_label(ModelKind kind, IntegratorKind integrator) {
   std::string m = kind == ModelKind::kNode ? "NODE" : kind == ModelKind::kPhnnS ? "PHNN-S" : "PHNN-JR";
   std::string i = to_string(integrator);

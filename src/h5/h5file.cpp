@@ -172,8 +172,14 @@ void write_attribute(hid_t file, const std::string& fname, const std::string& ob
     // The same type and size: overwrite the value in place (no allocation).
     Handle old(H5Aopen(obj.get(), name.c_str(), H5P_DEFAULT), H5Aclose);
     Handle old_type(H5Aget_type(old.get()), H5Tclose);
-    if (old.ok() && old_type.ok() && H5Tequal(old_type.get(), type) > 0) {
-      if (H5Awrite(old.get(), type, value) < 0) {
+    // A fixed-length string of the same size also stays in place, written in
+    // the old type (an ASCII attribute of a file made before UTF-8 strings).
+    const bool same_string = old_type.ok() && H5Tget_class(old_type.get()) == H5T_STRING &&
+                             H5Tget_class(type) == H5T_STRING &&
+                             H5Tis_variable_str(old_type.get()) <= 0 &&
+                             H5Tget_size(old_type.get()) == H5Tget_size(type);
+    if (old.ok() && old_type.ok() && (same_string || H5Tequal(old_type.get(), type) > 0)) {
+      if (H5Awrite(old.get(), same_string ? old_type.get() : type, value) < 0) {
         fail(fname, "cannot write attribute " + object + "@" + name);
       }
       return;
@@ -195,6 +201,7 @@ void File::set_attribute(const std::string& object, const std::string& name,
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
   H5Tset_size(type.get(), std::max<std::size_t>(value.size(), 1));
   H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
+  H5Tset_cset(type.get(), H5T_CSET_UTF8);  // names and prose may hold any Unicode
   std::string padded = value.empty() ? std::string(1, '\0') : value;
   write_attribute(id_, path_, object, name, type.get(), padded.data());
 }
@@ -237,6 +244,7 @@ std::string File::string_attribute(const std::string& object,
     char* buffer = nullptr;
     Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(mem.get(), H5T_VARIABLE);
+    H5Tset_cset(mem.get(), H5Tget_cset(type.get()));  // ASCII or UTF-8, as stored
     if (H5Aread(attr.get(), mem.get(), &buffer) < 0) fail(path_, "cannot read " + name);
     std::string out = buffer ? buffer : "";
     H5free_memory(buffer);

@@ -85,6 +85,11 @@ class File {
   void create_dataset(const std::string& path, Type type,
                       const std::vector<std::uint64_t>& dims,
                       std::size_t string_length = 0, double fill_value = 0.0);
+  /// A dataset of 64-bit integers with names (an HDF5 enum: value k is
+  /// names[k]), allocated and filled with 0 like create_dataset; its rows
+  /// are written and read as int64 (write_rows, read_ints).
+  void create_enum_dataset(const std::string& path, const std::vector<std::uint64_t>& dims,
+                           const std::vector<std::string>& names);
   std::vector<std::uint64_t> dims(const std::string& path) const;
 
   /// Writes rows [row, row + count) of a dataset (all trailing dimensions),

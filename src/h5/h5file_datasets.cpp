@@ -17,9 +17,34 @@ Handle string_type(std::size_t length) {
   Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
   H5Tset_size(type.get(), std::max<std::size_t>(length, 1));
   H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
+  H5Tset_cset(type.get(), H5T_CSET_UTF8);  // reads use the stored type: old ASCII files too
   return type;
 }
 }  // namespace
+
+void File::create_enum_dataset(const std::string& path, const std::vector<std::uint64_t>& dims,
+                               const std::vector<std::string>& names) {
+  const auto slash = path.rfind('/');
+  if (slash != std::string::npos && slash > 0) create_group(path.substr(0, slash));
+  Handle type(H5Tenum_create(H5T_STD_I64LE), H5Tclose);
+  for (std::size_t v = 0; v < names.size(); ++v) {
+    const std::int64_t value = static_cast<std::int64_t>(v);
+    if (H5Tenum_insert(type.get(), names[v].c_str(), &value) < 0) {
+      fail(path_, "cannot define enum value " + names[v] + " of " + path);
+    }
+  }
+  std::vector<hsize_t> hdims(dims.begin(), dims.end());
+  Handle space(H5Screate_simple(static_cast<int>(hdims.size()), hdims.data(), nullptr),
+               H5Sclose);
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS);
+  H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY);
+  H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_ALLOC);  // zeros: the first name
+  Handle dset(H5Dcreate2(id_, path.c_str(), type.get(), space.get(), H5P_DEFAULT, dcpl.get(),
+                         H5P_DEFAULT),
+              H5Dclose);
+  if (!dset.ok()) fail(path_, "cannot create dataset " + path);
+}
 
 void File::create_dataset(const std::string& path, Type type,
                           const std::vector<std::uint64_t>& dims,
@@ -80,6 +105,17 @@ void rows_io(hid_t file, const std::string& fname, const std::string& path,
   Handle mspace(H5Screate_simple(static_cast<int>(extent.size()), extent.data(), nullptr),
                 H5Sclose);
   Handle dxpl(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
+  // An enum of 64-bit integers (create_enum_dataset) moves as int64: HDF5
+  // converts no integers to enums, so the memory type is the enum itself
+  // (same bytes as int64_t).
+  Handle stored(H5Dget_type(dset.get()), H5Tclose);
+  hid_t enum_type = -1;
+  if (memtype == H5T_NATIVE_INT64 && H5Tget_class(stored.get()) == H5T_ENUM &&
+      H5Tget_size(stored.get()) == sizeof(std::int64_t)) {
+    enum_type = H5Tget_native_type(stored.get(), H5T_DIR_ASCEND);
+    memtype = enum_type;
+  }
+  const Handle native_enum(enum_type, H5Tclose);  // closed on return (if opened)
   const herr_t status =
       write ? H5Dwrite(dset.get(), memtype, mspace.get(), fspace.get(), dxpl.get(), data)
             : H5Dread(dset.get(), memtype, mspace.get(), fspace.get(), dxpl.get(), data);

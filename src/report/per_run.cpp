@@ -10,30 +10,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "phnn/config/setting_columns.h"
 #include "report/csv.h"
 
 namespace phnn {
-
-std::vector<std::pair<std::string, std::string>> parse_canonical(const std::string& canonical) {
-  std::vector<std::pair<std::string, std::string>> out;
-  std::set<std::string> seen;
-  std::stringstream parts(canonical);
-  std::string part;
-  while (std::getline(parts, part, ';')) {
-    const auto eq = part.find('=');
-    if (eq == std::string::npos || eq == 0) {
-      throw std::invalid_argument("parse_canonical: part \"" + part + "\" of \"" + canonical +
-                                  "\" is not key=value; is the results file damaged?");
-    }
-    std::string key = part.substr(0, eq);
-    if (!seen.insert(key).second) {
-      throw std::invalid_argument("parse_canonical: key \"" + key + "\" repeats in \"" +
-                                  canonical + "\"; is the results file damaged?");
-    }
-    out.emplace_back(std::move(key), part.substr(eq + 1));
-  }
-  return out;
-}
 
 namespace {
 
@@ -61,75 +41,11 @@ std::string config_value(const std::string& text) {
   return csv_double(value);
 }
 
-// Canonical keys (RunConfig::canonical(), short) -> sweep-file names
-// (sweeps/FORMAT.md); a value of several comma-separated numbers gets one
-// name per part. Keys not listed, or with another number of parts, keep their
-// canonical name and value.
-const std::map<std::string, std::vector<std::string>>& column_names() {
-  static const std::map<std::string, std::vector<std::string>> names = {
-      {"h_gen", {"generation_step"}},
-      {"e0", {"energy_min", "energy_max"}},
-      {"eeq", {"equilibrium_energy_min", "equilibrium_energy_max"}},
-      {"n_traj", {"num_trajectories"}},
-      {"splits", {"num_train_max", "num_validation", "num_inference"}},
-      {"gen_tol", {"generation_newton_tolerance"}},
-      {"lr", {"learning_rate"}},
-      {"adam", {"adam_beta1", "adam_beta2", "adam_eps"}},
-      {"batch", {"batch_size"}},
-      {"jac_eps", {"jacobian_eps"}},
-      {"newton", {"newton_tolerance", "newton_max_iterations"}},
-      {"tau", {"dg_min_dx_norm"}},
-      {"divergence", {"divergence_norm"}},
-      {"z", {"z1", "z2", "z3"}},
-  };
-  return names;
-}
-
-std::vector<std::string> split_commas(const std::string& text) {
-  std::vector<std::string> parts;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, ',')) parts.push_back(part);
-  if (text.empty() || text.back() == ',') parts.emplace_back();
-  return parts;
-}
-
-// One run's configuration columns: canonical pairs under sweep-file names.
+// One run's setting columns in the CSV's spelling (numbers re-spelled).
 std::vector<std::pair<std::string, std::string>> config_columns(const std::string& canonical) {
-  const auto pairs = parse_canonical(canonical);
-  std::set<std::string> names;
-  for (const auto& kv : pairs) names.insert(kv.first);
-  std::vector<std::pair<std::string, std::string>> out;
-  for (const auto& [key, value] : pairs) {
-    const auto it = column_names().find(key);
-    const std::vector<std::string> parts = split_commas(value);
-    bool rename = it != column_names().end() && it->second.size() == parts.size();
-    for (std::size_t i = 0; rename && i < parts.size(); ++i) {
-      rename = !names.count(it->second[i]);
-    }
-    if (!rename) {
-      out.emplace_back(key, config_value(value));
-      continue;
-    }
-    for (std::size_t i = 0; i < parts.size(); ++i) {
-      names.insert(it->second[i]);
-      out.emplace_back(it->second[i], config_value(parts[i]));
-    }
-  }
-  return out;
-}
-
-// Configuration columns of all records, in order of first appearance.
-std::vector<std::string> config_keys(
-    const std::vector<std::vector<std::pair<std::string, std::string>>>& configs) {
-  std::vector<std::string> keys;
-  std::set<std::string> seen;
-  for (const auto& config : configs) {
-    for (const auto& kv : config) {
-      if (seen.insert(kv.first).second) keys.push_back(kv.first);
-    }
-  }
-  return keys;
+  auto columns = setting_columns(canonical);
+  for (auto& kv : columns) kv.second = config_value(kv.second);
+  return columns;
 }
 
 }  // namespace
@@ -137,7 +53,7 @@ std::vector<std::string> config_keys(
 std::string render_per_run_csv(const std::vector<RunRecord>& records) {
   std::vector<std::vector<std::pair<std::string, std::string>>> configs;
   for (const RunRecord& r : records) configs.push_back(config_columns(r.canonical));
-  const std::vector<std::string> keys = config_keys(configs);
+  const std::vector<std::string> keys = setting_keys(configs);
   std::set<std::int64_t> budget_set;
   for (const RunRecord& r : records) budget_set.insert(r.checkpoint_steps.begin(), r.checkpoint_steps.end());
   const std::vector<std::int64_t> budgets(budget_set.begin(), budget_set.end());

@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 
 #include "phnn/common/utc_time.h"
 #include "phnn/config/model_config.h"
+#include "phnn/config/setting_columns.h"
 #include "phnn/store/scratch_file.h"
 #include "store/results_file_internal.h"
 
@@ -29,6 +31,9 @@ struct ConfigColumns {
   // Where each run's weights start in /weights, and their total count.
   std::vector<std::int64_t> weights_offset;
   std::int64_t weights_total = 0;
+  // Names and shapes of each run's weights, and the longest such text.
+  std::vector<std::string> weights_layout;
+  std::size_t weights_layout_length = 1;
 
   ConfigColumns(const std::vector<RunConfig>& runs, const std::vector<std::string>& run_studies,
                 const std::string& where) {
@@ -58,29 +63,39 @@ struct ConfigColumns {
       seeds.push_back(run.seed);
       weights_offset.push_back(weights_total);
       weights_total += parameter_count(run.model, run.size, run.n_x, run.n_w, run.n_u);
+      weights_layout.push_back(
+          weight_layout_text(weight_layout(run.model, run.size, run.n_x, run.n_w, run.n_u)));
+      weights_layout_length = std::max(weights_layout_length, weights_layout.back().size());
     }
   }
 };
 
-// Creates datasets of R rows with their `units` attribute.
+// Creates datasets of R rows with a `units` attribute (a unit: "s", "1" for
+// counts and dimensionless numbers, "m^2 and (kg m/s)^2" where states of
+// two units mix, "" for text and codes) and a `description` (prose).
 struct DatasetMaker {
   h5::File& file;
   std::uint64_t rows;
 
-  void text(const std::string& name, std::size_t length, const std::string& units) const {
-    file.create_dataset(name, h5::Type::kString, {rows}, length);
+  void describe(const std::string& name, const std::string& units,
+                const std::string& description) const {
     file.set_attribute(name, "units", units);
+    file.set_attribute(name, "description", description);
+  }
+  void text(const std::string& name, std::size_t length, const std::string& description) const {
+    file.create_dataset(name, h5::Type::kString, {rows}, length);
+    describe(name, "", description);
   }
   void ints(const std::string& name, std::vector<std::uint64_t> dims,
-            const std::string& units) const {
+            const std::string& description, const std::string& units = "1") const {
     file.create_dataset(name, h5::Type::kInt64, dims);
-    file.set_attribute(name, "units", units);
+    describe(name, units, description);
   }
   // Filled with NaN: a pending row reads as NaN.
-  void floats(const std::string& name, std::vector<std::uint64_t> dims,
-              const std::string& units) const {
+  void floats(const std::string& name, std::vector<std::uint64_t> dims, const std::string& units,
+              const std::string& description) const {
     file.create_dataset(name, h5::Type::kFloat64, dims, /*string_length=*/0, /*fill_value=*/kNaN);
-    file.set_attribute(name, "units", units);
+    describe(name, units, description);
   }
 };
 
@@ -102,18 +117,20 @@ void create_config_datasets(const DatasetMaker& make) {
 void create_result_datasets(const DatasetMaker& make, const ResultsLayout& layout) {
   const std::uint64_t R = make.rows;
   const auto I = static_cast<std::uint64_t>(layout.num_inference);
-  make.ints(kStatus, {R}, "0 pending, 1 done, 2 diverged, 3 failed");
+  // An HDF5 enum (h5py shows its names); read and written as int64 codes.
+  make.file.create_enum_dataset(kStatus, {R}, {"pending", "done", "diverged", "failed"});
+  make.describe(kStatus, "", "0 pending, 1 done, 2 diverged, 3 failed");
   make.ints(kChecksum, {R},
             "FNV-1a 64 of the row as stored (id, configuration, result, weights; clocks of "
-            "started_utc/finished_utc excepted), written after the status; 0: none yet");
+            "started_utc/finished_utc excepted), written after the status; 0: none yet", "");
   make.text(kMessage, kMessageLength, "why a run diverged or failed (truncated)");
-  make.floats(kMse, {R}, kMseUnits);
-  make.floats(kTrajectoryErrors, {R, I}, kMseUnits + "; per inference trajectory");
+  make.floats(kMse, {R}, kMseUnit, kMseUnits);
+  make.floats(kTrajectoryErrors, {R, I}, kMseUnit, kMseUnits + "; per inference trajectory");
   make.ints(kTrajectoryErrorsLength, {R}, "valid entries of trajectory_errors");
   make.ints(kDivergedRollouts, {R}, "inference rollouts that diverged");
   make.ints(kBestStep, {R}, "Adam step of the best validation loss");
-  make.floats(kBestValidationLoss, {R}, kLossUnits);
-  make.floats(kWallTime, {R}, "s");
+  make.floats(kBestValidationLoss, {R}, kLossUnit, kLossUnits);
+  make.floats(kWallTime, {R}, "s", "wall time of the run's share of its work item");
   make.ints(kSteps, {R}, "Adam steps");
   make.ints(kParameterCount, {R}, "trainable parameters");
   make.ints(kNewtonFailures, {R}, "DG inference steps whose Newton did not converge");
@@ -128,8 +145,9 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
   const auto T = static_cast<std::uint64_t>(layout.trace_points);
   const auto F = static_cast<std::uint64_t>(layout.figure_points);
   make.floats(kTrace, {R, T, kTraceColumns},
-              "step [1], elapsed_s [s], train_loss and validation_loss [" + kLossUnits +
-                  "], kappa [1], sigma_max [1/s], rho [1]; NaN after trace_length");
+              "1, s, " + kLossUnit + ", " + kLossUnit + ", 1, 1/s, 1",
+              "per column: step [1], elapsed_s [s], train_loss and validation_loss [" +
+                  kLossUnits + "], kappa [1], sigma_max [1/s], rho [1]; NaN after trace_length");
   make.file.set_attribute(kTrace, "columns",
                           std::string("step, elapsed_s, train_loss, validation_loss, kappa, "
                                       "sigma_max, rho"));
@@ -143,10 +161,12 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
                             "trajectory 0 (system file)";
   const std::string second = "; model rollout from H(x0) = 0.75 J (built-in) or of inference "
                              "trajectory 1 (system file)";
-  make.floats(kPrediction05, {R, F, W}, figure + first);
-  make.floats(kPrediction075, {R, F, W}, figure + second);
-  make.floats(kReference05, {R, F, W}, figure + "; the true trajectory of prediction_05");
-  make.floats(kReference075, {R, F, W}, figure + "; the true trajectory of prediction_075");
+  const std::string state_units = "the states' units (built-in: " + kStateUnits + ")";
+  make.floats(kPrediction05, {R, F, W}, state_units, figure + first);
+  make.floats(kPrediction075, {R, F, W}, state_units, figure + second);
+  make.floats(kReference05, {R, F, W}, state_units, figure + "; the true trajectory of prediction_05");
+  make.floats(kReference075, {R, F, W}, state_units,
+              figure + "; the true trajectory of prediction_075");
   make.ints(kFigureLength, {R, 4}, "valid points of each figure trajectory");
   make.file.set_attribute(kFigureLength, "columns",
                           std::string("prediction_05, prediction_075, reference_05, "
@@ -155,10 +175,10 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
     const auto K = static_cast<std::uint64_t>(layout.checkpoints);
     make.ints(kCheckpointSteps, {R, K}, "step budgets (TrainerOptions::checkpoints); 0 after the "
                                         "run's own count");
-    make.floats(kCheckpointMse, {R, K},
+    make.floats(kCheckpointMse, {R, K}, kMseUnit,
                 kMseUnits + "; of the best-validation weights up to each budget");
-    make.floats(kCheckpointTrainSeconds, {R, K},
-                "s; training wall time to each budget, this run's share of its stack, inference "
+    make.floats(kCheckpointTrainSeconds, {R, K}, "s",
+                "training wall time to each budget, this run's share of its stack, inference "
                 "excluded");
   }
 }
@@ -166,12 +186,16 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
 // /weights holds every run's best-validation weights back to back (a run's
 // parameter count is known from its model and size), so a file of large
 // models is not padded to their size in every row.
-void create_weight_datasets(const DatasetMaker& make, std::int64_t total) {
+void create_weight_datasets(const DatasetMaker& make, std::int64_t total,
+                            std::size_t layout_length) {
   const std::uint64_t R = make.rows;
   make.ints(kWeightsOffset, {R}, "index in /weights of the run's first weight");
   make.ints(kWeightsLength, {R}, "weights stored for the run (0: none, e.g. pending or failed)");
+  make.text(kWeightsLayout, layout_length,
+            "names and shapes of the run's weights in /weights order, e.g. \"l_h.0.weight 2x16; "
+            "l_h.0.bias 16; ...\" (weight [fan_in, fan_out] row-major, then bias)");
   const auto n = static_cast<std::uint64_t>(std::max<std::int64_t>(total, 1));
-  make.floats(kWeights, {n},
+  make.floats(kWeights, {n}, "1",
               "best-validation weights of every run, back to back: DynamicsModel::parameters() "
               "order, each tensor row-major without its member axis; NaN where none stored");
 }
@@ -191,7 +215,51 @@ void write_config_columns(h5::File& file, const ConfigColumns& c,
   file.write_rows(kNTrain, 0, R, c.n_train.data());
   file.write_rows(kSeed, 0, R, c.seeds.data());
   file.write_rows(kStates, 0, R, c.states.data());
-  if (file.exists(kWeightsOffset)) file.write_rows(kWeightsOffset, 0, R, c.weights_offset.data());
+  if (file.exists(kWeightsOffset)) {
+    file.write_rows(kWeightsOffset, 0, R, c.weights_offset.data());
+    file.write_string_rows(kWeightsLayout, 0, c.weights_layout);
+  }
+}
+
+// /runs/config/<name>: every run setting its own column, named as in the
+// per-run CSV (setting_columns()): float64 where each run that has the
+// setting has one number (NaN where a run lacks it), else a NUL-padded
+// string (empty where it lacks it). The canonical key stays the identity.
+void write_setting_columns(h5::File& file, const std::vector<std::string>& canonical) {
+  std::vector<std::vector<std::pair<std::string, std::string>>> columns;
+  for (const std::string& c : canonical) columns.push_back(setting_columns(c));
+  const auto R = static_cast<std::uint64_t>(canonical.size());
+  file.create_group(kSettings);
+  for (const std::string& key : setting_keys(columns)) {
+    std::vector<std::string> text(R);
+    std::vector<double> numbers(R, kNaN);
+    bool numeric = true;
+    for (std::size_t r = 0; r < R; ++r) {
+      for (const auto& [name, value] : columns[r]) {
+        if (name != key) continue;
+        text[r] = value;
+        char* end = nullptr;
+        numbers[r] = std::strtod(value.c_str(), &end);
+        numeric = numeric && !value.empty() && end == value.c_str() + value.size();
+      }
+    }
+    std::string name = key;
+    std::replace(name.begin(), name.end(), '/', '_');
+    const std::string path = kSettings + "/" + name;
+    if (numeric) {
+      file.create_dataset(path, h5::Type::kFloat64, {R}, 0, kNaN);
+      file.write_rows(path, 0, R, numbers.data());
+    } else {
+      std::size_t length = 1;
+      for (const std::string& t : text) length = std::max(length, t.size());
+      file.create_dataset(path, h5::Type::kString, {R}, length);
+      file.write_string_rows(path, 0, text);
+    }
+    file.set_attribute(path, "description",
+                       "run setting `" + key + "` of each run (sweeps/FORMAT.md; per-run CSV "
+                       "column of the same name)" +
+                           (numeric ? "; NaN: the run has no such setting" : std::string()));
+  }
 }
 
 struct FileAttributes {
@@ -221,8 +289,11 @@ void write_new_file(const std::string& path, const ConfigColumns& columns,
     create_config_datasets(make);
     create_result_datasets(make, layout);
     create_trace_and_figure_datasets(make, layout);
-    if (layout.weights) create_weight_datasets(make, columns.weights_total);
+    if (layout.weights) {
+      create_weight_datasets(make, columns.weights_total, columns.weights_layout_length);
+    }
     write_config_columns(file, columns, run_studies);
+    write_setting_columns(file, columns.canonical);
     file.close();  // throws if the metadata cannot be written
   });
 }

@@ -41,6 +41,8 @@ inline const std::string kSeed = "/runs/seed";
 // Added with system files; files written before have 2 states per run.
 inline const std::string kStates = "/runs/n_x";
 inline const std::string kStudies = "/runs/studies";
+// One dataset per run setting, named as in the per-run CSV (config/setting_columns.h).
+inline const std::string kSettings = "/runs/config";
 inline const std::string kStatus = "/runs/status";
 inline const std::string kChecksum = "/runs/checksum";
 inline const std::string kMessage = "/runs/message";
@@ -67,6 +69,8 @@ inline const std::string kCheckpointMse = "/runs/checkpoint_mse";
 inline const std::string kWeights = "/weights";
 inline const std::string kWeightsOffset = "/runs/weights_offset";
 inline const std::string kWeightsLength = "/runs/weights_length";
+// Names and shapes of a run's stored weights (weight_layout_text()).
+inline const std::string kWeightsLayout = "/runs/weights_layout";
 inline const std::string kCheckpointTrainSeconds = "/runs/checkpoint_train_seconds";
 // Added with provenance; files written before them have neither.
 inline const std::string kStartedUtc = "/runs/started_utc";
@@ -75,6 +79,9 @@ inline const std::string kProvenance = "/provenance";
 inline constexpr std::size_t kUtcLength = 20;  // "2024-05-01T12:00:00Z"
 
 inline const std::string kStateUnits = "q [m], p [kg m/s]";
+// Units of the MSE and of the loss L_d: states of two units mix.
+inline const std::string kMseUnit = "m^2 and (kg m/s)^2";
+inline const std::string kLossUnit = "m/s and kg m/s^2";
 inline const std::string kMseUnits =
     "m^2 and (kg m/s)^2 mixed: mean of ||x - x_hat||^2 over the inference "
     "trajectories and steps (docs/METHOD.md section 5); +inf if a rollout diverged";
@@ -84,7 +91,8 @@ inline const std::string kFileUnits =
     "SI units. States q [m], p [kg m/s]; time [s]; energy [J]; mse in m^2 and "
     "(kg m/s)^2 mixed (mean of ||x - x_hat||^2); losses in m/s and kg m/s^2 mixed "
     "(mean |x_{n+1} - x_hat_{n+1}| / h); kappa and rho dimensionless; sigma_max in "
-    "1/s. Every dataset of /runs has a units attribute.";
+    "1/s. Every dataset of /runs outside /runs/config has a units attribute (a unit; "
+    "\"1\": counts and dimensionless; empty: text and codes) and a description.";
 
 
 int comm_rank(MPI_Comm comm);

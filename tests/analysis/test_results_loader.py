@@ -55,6 +55,15 @@ class Loader(unittest.TestCase):
                 self.assertEqual(row.mse, mse[row.run_id])
             else:
                 self.assertTrue(np.isnan(row.mse))
+        # The file's own columns, one per setting (h5py alone): the loader's values, bitwise.
+        with h5py.File(self.path, "r") as f:
+            order = {rid: k for k, rid in enumerate(ids)}
+            for key in ("learning_rate", "n_train", "seed", "damping"):
+                stored = f["runs/config/" + key][:]
+                for row in runs.itertuples():
+                    self.assertEqual(stored[order[row.run_id]], getattr(row, key), key)
+            self.assertEqual(f["runs/config/model"][0].decode().rstrip("\0") in ("phnn-jr", "node"),
+                             True)
         medians = runs.groupby(["model", "n_train"]).mse.median()
         self.assertEqual(int(medians.notna().sum()), 1)  # the pending cell has no median
 
@@ -83,6 +92,44 @@ class Loader(unittest.TestCase):
                 self.assertAlmostEqual(float(pc.quantile(values, q)) / float(row[key]), 1.0, 6)
             checked += 1
         self.assertEqual(checked, 1)
+
+    def test_weights_come_named_and_shaped(self):
+        from analysis.results import weights
+        runs = load(self.path)
+        done = runs[runs.status == "done"]
+        with h5py.File(self.path, "r") as f:
+            ids = [s.decode().rstrip("\0") for s in f["runs/id"][:]]
+            offsets, lengths = f["runs/weights_offset"][:], f["runs/weights_length"][:]
+            flat = f["weights"][:]
+        for row in done.itertuples():
+            w = weights(self.path, row.run_id)
+            k = ids.index(row.run_id)
+            self.assertEqual(sum(a.size for a in w.values()), lengths[k])
+            self.assertEqual(lengths[k], row.parameter_count)
+            joined = np.concatenate([a.reshape(-1) for a in w.values()])
+            self.assertTrue(np.array_equal(joined, flat[offsets[k]:offsets[k] + lengths[k]]))
+            first = next(iter(w))
+            self.assertEqual(first, "l_h.0.weight" if row.model == "phnn-jr" else "node.0.weight")
+            self.assertEqual(w[first].shape[0], 2 if row.model == "phnn-jr" else 3)  # fan_in
+        pending = runs[runs.status == "pending"].run_id.iloc[0]
+        with self.assertRaisesRegex(KeyError, "no stored weights"):
+            weights(self.path, pending)
+
+    def test_status_is_an_enum_and_strings_are_utf8(self):
+        with h5py.File(self.path, "r") as f:
+            self.assertEqual(h5py.check_enum_dtype(f["runs/status"].dtype),
+                             {"pending": 0, "done": 1, "diverged": 2, "failed": 3})
+            self.assertEqual(f["runs/system"].id.get_type().get_cset(), h5py.h5t.CSET_UTF8)
+
+    def test_a_file_of_the_earlier_format_loads(self):
+        from analysis.results import weights
+        old = os.path.join(ROOT, "tests", "fixtures", "results-2026-11-25.h5")
+        runs = load(old)
+        self.assertEqual(len(runs), 4)
+        self.assertEqual(list(runs.status.unique()), ["done"])
+        self.assertEqual(sorted(runs.model_label.unique()), ["NODE-RK2", "PHNN-JR-RK2"])
+        with self.assertRaisesRegex(KeyError, "written before weight names"):
+            weights(old, runs.run_id.iloc[0])
 
     def test_a_missing_file_is_named(self):
         with self.assertRaisesRegex(FileNotFoundError, "nowhere.h5"):

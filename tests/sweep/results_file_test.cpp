@@ -205,6 +205,76 @@ TEST_F(ResultsFileTest, StoresConfigColumnsAndFileAttributes) {
   EXPECT_THAT(raw.string_attribute("/", "units"), HasSubstr("q [m], p [kg m/s]"));
   EXPECT_THAT(raw.string_attribute("/runs/mse", "units"), HasSubstr("m^2 and (kg m/s)^2"));
   EXPECT_EQ(raw.string_attribute("/runs/wall_time_s", "units"), "s");
+  // Units are units; the prose is the description.
+  EXPECT_EQ(raw.string_attribute("/runs/mse", "units"), "m^2 and (kg m/s)^2");
+  EXPECT_THAT(raw.string_attribute("/runs/mse", "description"), HasSubstr("+inf if a rollout"));
+  EXPECT_EQ(raw.string_attribute("/runs/n_train", "units"), "1");
+  EXPECT_EQ(raw.string_attribute("/runs/status", "units"), "");
+  EXPECT_THAT(raw.string_attribute("/runs/status", "description"), HasSubstr("2 diverged"));
+}
+
+// Every run setting is its own column under /runs/config (the per-run CSV's
+// names): numbers as float64, names as strings, NaN where a run lacks one.
+TEST_F(ResultsFileTest, EverySettingIsItsOwnColumn) {
+  create().close();
+  const std::vector<RunConfig> runs = sample_runs(kNumRuns);
+  const h5::File raw = h5::File::open(path_, h5::Access::kReadOnly);
+  const std::vector<double> n_train = raw.read_doubles("/runs/config/n_train");
+  const std::vector<double> seed = raw.read_doubles("/runs/config/seed");
+  const std::vector<double> lr = raw.read_doubles("/runs/config/learning_rate");
+  const std::vector<double> e_max = raw.read_doubles("/runs/config/energy_max");
+  const std::vector<std::string> system = raw.read_strings("/runs/config/system");
+  ASSERT_EQ(n_train.size(), static_cast<std::size_t>(kNumRuns));
+  for (int r = 0; r < kNumRuns; ++r) {
+    const RunConfig& run = runs[static_cast<std::size_t>(r)];
+    EXPECT_EQ(n_train[r], run.n_train) << r;
+    EXPECT_EQ(seed[r], run.seed) << r;
+    EXPECT_EQ(lr[r], run.training.learning_rate) << r;  // bitwise: %.17g read back
+    EXPECT_EQ(e_max[r], run.data.energy_max) << r;
+    EXPECT_EQ(system[r], run.system_name()) << r;
+  }
+  EXPECT_THAT(raw.string_attribute("/runs/config/learning_rate", "description"),
+              HasSubstr("run setting `learning_rate`"));
+  // Damping exists for every built-in system; the Duffing-only cubic
+  // stiffness is NaN in the other rows (or absent when no run has it).
+  if (raw.exists("/runs/config/cubic_stiffness")) {
+    const std::vector<double> k3 = raw.read_doubles("/runs/config/cubic_stiffness");
+    for (int r = 0; r < kNumRuns; ++r) {
+      EXPECT_EQ(std::isnan(k3[r]), runs[static_cast<std::size_t>(r)].system != SystemKind::kDuffing)
+          << r;
+    }
+  }
+}
+
+// Strings are UTF-8 (a sweep file's comments, a system file's state names):
+// any text round-trips, and the session attribute still changes in place.
+TEST_F(ResultsFileTest, Utf8TextRoundTrips) {
+  const std::string text = "name = \"θ-sweep\"  # Größe, 質量\n";
+  ResultsFile::create(path_, MPI_COMM_NULL, sample_runs(3), sample_studies(3), "θ-sweep", text,
+                      kSweepHash, "v", sample_layout())
+      .close();
+  const ResultsFile file = ResultsFile::open_read_only(path_);
+  EXPECT_EQ(file.sweep_text(), text);
+  EXPECT_EQ(file.sweep_name(), "θ-sweep");
+}
+
+// A results file written by the build before /runs/config, the weights
+// layout, UTF-8 strings and the status enum (tests/fixtures): still read,
+// row for row, and its session can still be ended in place.
+TEST(ResultsFileFixtureTest, AFileOfTheEarlierFormatIsRead) {
+  const std::string fixture = std::string(PHNN_SOURCE_DIR) + "/tests/fixtures/results-2026-11-25.h5";
+  const ResultsFile file = ResultsFile::open_read_only(fixture);
+  EXPECT_EQ(file.num_runs(), 4);
+  EXPECT_EQ(file.read_statuses(), std::vector<RunStatus>(4, RunStatus::kDone));
+  EXPECT_TRUE(file.damaged_rows().empty());
+  for (int row = 0; row < 4; ++row) {
+    const RunResult r = file.read_run(row);
+    EXPECT_TRUE(std::isfinite(r.mse)) << row;
+    EXPECT_EQ(static_cast<long>(r.weights.size()), r.parameter_count) << row;
+  }
+  const h5::File raw = h5::File::open(fixture, h5::Access::kReadOnly);
+  EXPECT_FALSE(raw.exists("/runs/config"));
+  EXPECT_FALSE(raw.exists("/runs/weights_layout"));
 }
 
 TEST_F(ResultsFileTest, StatusesDefaultToPendingUntilWritten) {

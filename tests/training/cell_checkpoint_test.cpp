@@ -4,6 +4,7 @@
 // checkpoints, frozen members), on built-in and file-defined systems, in
 // float64 and float32; a state that does not fit the cell is refused.
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -18,23 +19,19 @@ namespace {
 
 using ::testing::HasSubstr;
 
-const SystemData& duffing() {
-  static const SystemData d = [] {
+// Small data sets of the built-in systems (4 inference trajectories), made once.
+const SystemData& data_of(SystemKind kind) {
+  static std::map<SystemKind, SystemData> made;
+  auto it = made.find(kind);
+  if (it == made.end()) {
     DatasetOptions options;
     options.num_inference = 4;
-    return make_system_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 100);
-  }();
-  return d;
+    it = made.emplace(kind, make_system_data(OscillatorOptions::defaults(kind), options, 100)).first;
+  }
+  return it->second;
 }
-
-const SystemData& harmonic() {
-  static const SystemData d = [] {
-    DatasetOptions options;
-    options.num_inference = 4;
-    return make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic), options, 100);
-  }();
-  return d;
-}
+const SystemData& duffing() { return data_of(SystemKind::kDuffing); }
+const SystemData& harmonic() { return data_of(SystemKind::kHarmonic); }
 
 using Train = std::function<std::vector<RunResult>(const CellCheckpointing*)>;
 

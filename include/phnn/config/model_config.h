@@ -71,6 +71,25 @@ long parameter_count(ModelKind kind, ModelSize size, int n_x, int n_w, int n_u);
 /// Parameters of an MLP with the given input, hidden widths and output.
 long mlp_parameter_count(int in, const std::vector<int>& hidden, int out);
 
+/// One stored weight tensor of a member: `name` ("l_h.0.weight"), its shape
+/// ({fan_in, fan_out} for a weight, {fan_out} for a bias).
+struct WeightTensor {
+  std::string name;
+  std::vector<int> shape;
+};
+
+/// The member's weights in the order RunResult::weights stores them
+/// (DynamicsModel::parameters(): each network, then per layer its weight
+/// [fan_in, fan_out] row-major and its bias): NODE `node`; PHNN-S `l_h`, then
+/// `l_z` (if n_w > 0); PHNN-JR `l_h`, then `l_r`; with the input and output
+/// widths of parameter_count(kind, size, n_x, n_w, n_u) (the built-in
+/// systems: n_x = 2, n_w = n_u = 1). Sizes sum to that count.
+std::vector<WeightTensor> weight_layout(ModelKind kind, ModelSize size, int n_x, int n_w, int n_u);
+
+/// weight_layout as text, "l_h.0.weight 2x16; l_h.0.bias 16; ..." (the
+/// results file's /runs/weights_layout).
+std::string weight_layout_text(const std::vector<WeightTensor>& layout);
+
 /// Paper's label, e.g. "PHNN-JR-DG", "NODE-RK2".
 std::string model_label(ModelKind kind, IntegratorKind integrator);
 

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "phnn/config/setting_columns.h"  // parse_canonical
+
 #include "phnn/config/run_result.h"
 
 namespace phnn {
@@ -47,11 +49,6 @@ struct RunRecord {
   double final_train_loss = 0.0, final_validation_loss = 0.0;
   double final_kappa = 0.0, final_sigma_max = 0.0, final_rho = 0.0;
 };
-
-/// Splits "a=1;b=x,y;c=" into {{"a", "1"}, {"b", "x,y"}, {"c", ""}} (each
-/// part at its first '='). Throws std::invalid_argument naming the part if
-/// one has no '=' or an empty key, or a key repeats.
-std::vector<std::pair<std::string, std::string>> parse_canonical(const std::string& canonical);
 
 /// A tidy CSV, one line per record (in order) after a header:
 ///
