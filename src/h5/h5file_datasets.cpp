@@ -20,6 +20,16 @@ Handle string_type(std::size_t length) {
   H5Tset_cset(type.get(), H5T_CSET_UTF8);  // reads use the stored type: old ASCII files too
   return type;
 }
+
+// Contiguous, allocated and filled at creation, so independent writes of
+// rows later never change file metadata.
+Handle early_allocated_layout() {
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS);
+  H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY);
+  H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_ALLOC);
+  return dcpl;
+}
 }  // namespace
 
 void File::create_enum_dataset(const std::string& path, const std::vector<std::uint64_t>& dims,
@@ -36,10 +46,7 @@ void File::create_enum_dataset(const std::string& path, const std::vector<std::u
   std::vector<hsize_t> hdims(dims.begin(), dims.end());
   Handle space(H5Screate_simple(static_cast<int>(hdims.size()), hdims.data(), nullptr),
                H5Sclose);
-  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-  H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS);
-  H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY);
-  H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_ALLOC);  // zeros: the first name
+  Handle dcpl = early_allocated_layout();  // filled with zeros: the first name
   Handle dset(H5Dcreate2(id_, path.c_str(), type.get(), space.get(), H5P_DEFAULT, dcpl.get(),
                          H5P_DEFAULT),
               H5Dclose);
@@ -54,11 +61,7 @@ void File::create_dataset(const std::string& path, Type type,
   std::vector<hsize_t> hdims(dims.begin(), dims.end());
   Handle space(H5Screate_simple(static_cast<int>(hdims.size()), hdims.data(), nullptr),
                H5Sclose);
-  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-  H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS);
-  // Allocate at creation so independent writes never change file metadata.
-  H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY);
-  H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_ALLOC);
+  Handle dcpl = early_allocated_layout();
   hid_t h5type = H5T_NATIVE_DOUBLE;
   Handle stype = string_type(string_length);
   if (type == Type::kInt64) h5type = H5T_NATIVE_INT64;

@@ -4,7 +4,6 @@
 // checkpoints, frozen members), on built-in and file-defined systems, in
 // float64 and float32; a state that does not fit the cell is refused.
 #include <functional>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -13,25 +12,15 @@
 
 #include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"
+#include "training/small_data.h"
 
 namespace phnn {
 namespace {
 
 using ::testing::HasSubstr;
 
-// Small data sets of the built-in systems (4 inference trajectories), made once.
-const SystemData& data_of(SystemKind kind) {
-  static std::map<SystemKind, SystemData> made;
-  auto it = made.find(kind);
-  if (it == made.end()) {
-    DatasetOptions options;
-    options.num_inference = 4;
-    it = made.emplace(kind, make_system_data(OscillatorOptions::defaults(kind), options, 100)).first;
-  }
-  return it->second;
-}
-const SystemData& duffing() { return data_of(SystemKind::kDuffing); }
-const SystemData& harmonic() { return data_of(SystemKind::kHarmonic); }
+const SystemData& duffing() { return testing_util::small_data(SystemKind::kDuffing); }
+const SystemData& harmonic() { return testing_util::small_data(SystemKind::kHarmonic); }
 
 using Train = std::function<std::vector<RunResult>(const CellCheckpointing*)>;
 

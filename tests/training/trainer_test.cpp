@@ -13,22 +13,15 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include "training/small_data.h"
+
 namespace phnn {
 namespace {
 
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-const SystemData& small_data(SystemKind kind) {
-  static std::map<SystemKind, SystemData> cache;
-  auto it = cache.find(kind);
-  if (it == cache.end()) {
-    DatasetOptions options;
-    options.num_inference = 4;
-    it = cache.emplace(kind, make_system_data(OscillatorOptions::defaults(kind), options, 100)).first;
-  }
-  return it->second;
-}
+using testing_util::small_data;
 
 double rel(double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); }
 
