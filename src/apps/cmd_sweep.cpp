@@ -496,6 +496,7 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     const std::vector<RunResult> cell_results =
         train_item(cell, &data_, head.system_name(), [&] {
           post_stop();
+          queue.progress();  // rank 0's window answers the others mid-cell too
           report_progress(false);
         }, &checkpoints, prefix_, i + 1, &interrupted);
     if (interrupted) {

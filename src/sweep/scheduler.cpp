@@ -75,6 +75,12 @@ bool WorkQueue::stop_requested() {
   return stop_seen_;
 }
 
+void WorkQueue::progress() const {
+  if (window_ == MPI_WIN_NULL) return;
+  int flag = 0;
+  MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, comm_, &flag, MPI_STATUS_IGNORE);
+}
+
 void WorkQueue::mark_done() {
   ++local_done_;
   if (mode_ == ScheduleMode::kDynamic) fetch_and_add(1, 1, MPI_SUM);

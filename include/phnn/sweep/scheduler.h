@@ -43,6 +43,12 @@ class WorkQueue {
   void request_stop();
   /// True once any rank called request_stop() (seen here by now).
   bool stop_requested();
+  /// Lets MPI serve the other ranks' requests on this rank's window (an
+  /// MPI_Iprobe): call it now and then while busy. Where one-sided
+  /// operations need the target to enter MPI (Open MPI's osc/pt2pt over TCP,
+  /// as between nodes without RDMA), rank 0 otherwise answers only at its
+  /// next item (docs/SLURM.md, measured). Cheap; a no-op without a window.
+  void progress() const;
   /// Collective: frees the window. Called by the destructor if needed.
   void close();
 
