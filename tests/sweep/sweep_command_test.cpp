@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "phnn/store/journal.h"
+#include "h5/h5file.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
@@ -241,6 +242,32 @@ std::string run_sweep(const std::string& sweep, const std::string& out, int rank
 void expect_same_file(const ResultsFile& a, const ResultsFile& b) {
   ASSERT_EQ(a.read_run_ids(), b.read_run_ids());
   for (int row = 0; row < a.num_runs(); ++row) expect_same_run(a.read_run(row), b.read_run(row), row);
+}
+
+// Under Slurm a session records which job, array task and restart wrote it
+// (one rank, as in an array task of one task).
+TEST(SweepCommandTest, ProvenanceNamesTheSlurmJobArrayTaskAndRestart) {
+  const std::string dir = temp_dir("slurm_ids");
+  const std::string sweep = write_sweep(dir, kSweep);
+  const std::string out = dir + "/r.h5";
+  std::string log;
+  ASSERT_EQ(shell("SLURM_JOB_ID=4242 SLURM_ARRAY_JOB_ID=4240 SLURM_ARRAY_TASK_ID=2 "
+                  "SLURM_RESTART_COUNT=1 SLURM_NTASKS=1 " + std::string(PHNN_BINARY) +
+                      " sweep " + sweep + " --quiet --out " + out + " --shard 0/2",
+                  &log),
+            0)
+      << log;
+  const h5::File raw = h5::File::open(out, h5::Access::kReadOnly);
+  EXPECT_EQ(raw.string_attribute("/provenance/session_0", "slurm_job"), "4242");
+  EXPECT_EQ(raw.string_attribute("/provenance/session_0", "slurm_array"), "4240_2");
+  EXPECT_EQ(raw.string_attribute("/provenance/session_0", "slurm_restarts"), "1");
+  ASSERT_EQ(shell(std::string(PHNN_BINARY) + " sweep " + sweep + " --quiet --out " + out +
+                      " --shard 0/2",
+                  &log),
+            0)
+      << log;
+  const h5::File again = h5::File::open(out, h5::Access::kReadOnly);
+  EXPECT_FALSE(again.has_attribute("/provenance/session_1", "slurm_job"));  // not under Slurm
 }
 
 // Stacking is exact: member groups of 1 or 2 seeds give bitwise the results
