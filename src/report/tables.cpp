@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -159,12 +160,20 @@ std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   return marks;
 }
 
-std::string summary_cell_text(const CellSummary& s, Mark mark, TableFormat format) {
+// " (n=k)" when `counts` and the cell is complete (an incomplete one says
+// " (n=k/N)" in its annotations).
+std::string own_count(const CellSummary& s, bool counts) {
+  return counts && s.missing == 0 ? " (n=" + std::to_string(s.finished()) + ")" : "";
+}
+
+// `counts`: the table's cells hold different numbers of seeds (e.g. an
+// adaptive sweep's), so every cell says its own " (n=k)".
+std::string summary_cell_text(const CellSummary& s, Mark mark, TableFormat format, bool counts) {
   const std::string none = format == TableFormat::kMarkdown ? "—" : "--";
   if (s.finished() == 0) return none;                        // all missing
   // All diverged at +inf: median and interval say nothing more than the count.
   if (s.done == 0 && std::isinf(s.median) && std::isinf(s.median_interval.low)) {
-    return "inf" + annotations(s);
+    return "inf" + own_count(s, counts) + annotations(s);
   }
   std::string value = format_number("%.2e", s.median) + " [" + format_number("%.2e", s.iqr()) + "]";
   if (s.has_interval()) {
@@ -175,7 +184,7 @@ std::string summary_cell_text(const CellSummary& s, Mark mark, TableFormat forma
     value = format == TableFormat::kMarkdown ? "**" + value + "**" : "\\textbf{" + value + "}";
   }
   if (mark == Mark::kTie) value += " (tie)";
-  return value + annotations(s);
+  return value + own_count(s, counts) + annotations(s);
 }
 
 void render_summary_csv(const TableEntries& t, const std::vector<std::vector<CellSummary>>& cells,
@@ -222,15 +231,26 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
   TextTable text{t.study, t.system, t.study->columns, {}, {}, {}};
   text.caption_tail =
       "Median [IQR] (bootstrap 95~\\% interval of the median) of the inference MSE over seeds.";
+  std::set<int> seed_counts;
+  for (const auto& row : cells) {
+    for (const CellSummary& s : row) {
+      if (s.finished() > 0) seed_counts.insert(s.expected);
+    }
+  }
+  const bool counts = seed_counts.size() > 1;
   bool any_tie = false;
   for (std::size_t r = 0; r < rows; ++r) {
     text.cells.emplace_back();
     for (std::size_t c = 0; c < cols; ++c) {
-      text.cells[r].push_back(summary_cell_text(cells[r][c], marks[r][c], format));
+      text.cells[r].push_back(summary_cell_text(cells[r][c], marks[r][c], format, counts));
       any_tie = any_tie || marks[r][c] == Mark::kTie;
     }
   }
   if (any_tie) text.notes.push_back(kTieNote);
+  if (counts) {
+    text.notes.push_back("Cells hold different numbers of seeds: (n=k) gives each cell's; its "
+                         "median, IQR and interval use every one of them.");
+  }
   if (!unmarked.empty()) {
     std::string note = "No best marked where a row has fewer than " +
                        std::to_string(kMinSeedsForInterval) + " finished seeds (";

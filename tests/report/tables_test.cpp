@@ -116,7 +116,9 @@ TEST_F(TableTest, BestIsBoldOnlyWhenItsIntervalOverlapsNoOther) {
   add("NODE-RK2", "25", RunStatus::kDone, 2e-4);
   markdown = render(TableFormat::kMarkdown);
   EXPECT_THAT(markdown, Not(HasSubstr("**")));
-  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | 2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04) (tie) |"));
+  // (7 seeds against 5 now: each cell says its count.)
+  EXPECT_THAT(markdown,
+              HasSubstr("| PHNN-JR-DG | 2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04) (tie) (n=5) |"));
   EXPECT_THAT(markdown, HasSubstr("(tie): no clear best in this column"));
 }
 
@@ -239,6 +241,23 @@ TEST_F(TableTest, NoBestFromFewSeedsOrBesideAMissingRow) {
   const std::string csv = render(TableFormat::kCsv);
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,100,1.000000e-03,1.000000e-03,"
                              "1.000000e-03,0.000000e+00,1.000000e-03,1.000000e-03,5,0,0,5,0,0\n"));
+}
+
+// Cells with different seed counts (an adaptive sweep's) each say theirs,
+// and the statistics use every seed.
+TEST_F(TableTest, CellsWithDifferentSeedCountsSayTheirs) {
+  entries_.clear();
+  for (int i = 0; i < 5; ++i) add("NODE-RK2", "25", RunStatus::kDone, 1e-3 * (i + 1));
+  for (int i = 0; i < 8; ++i) add("PHNN-JR-DG", "25", RunStatus::kDone, 1e-4 * (i + 1));
+  const std::string markdown = render(TableFormat::kMarkdown);
+  EXPECT_THAT(markdown, HasSubstr("| NODE-RK2 | 3.00e-03 [2.00e-03] (1.00e-03, 5.00e-03) (n=5) |"));
+  // Median of 1..8 (x 1e-4) = 4.5e-4: all eight seeds enter.
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | **4.50e-04 [3.50e-04] "));
+  EXPECT_THAT(markdown, HasSubstr("(n=8) |"));
+  EXPECT_THAT(markdown, HasSubstr("Cells hold different numbers of seeds"));
+  // Equal counts: no (n=k) anywhere.
+  for (int i = 0; i < 3; ++i) add("NODE-RK2", "25", RunStatus::kDone, 1e-3);
+  EXPECT_THAT(render(TableFormat::kMarkdown), Not(HasSubstr("(n=8)")));
 }
 
 TEST_F(TableTest, SeedsSummaryCountsSeedsBelowAndAboveTheColumnMidpoint) {
