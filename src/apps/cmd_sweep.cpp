@@ -202,6 +202,7 @@ class SweepRun {
     parser_.get_int_in("threads", 1, 4096);
     // 0: save a cell's training state only when stopped by a signal.
     checkpoint_every_ = parser_.get_double_in("checkpoint-every", 0, 1e9);
+    state_key_ = spec_.text_hash + " " + git_commit() + " threads=" + parser_.get("threads");
     if (parser_.flag_set("cell-costs") && !parser_.flag_set("dry-run")) {
       throw cli::UsageError{"phnn sweep: --cell-costs prints the cost model's estimates and trains "
                             "nothing: add --dry-run"};
@@ -308,6 +309,10 @@ class SweepRun {
   Shard shard_;  // 0/1: the whole sweep
   std::vector<int> ranks_;
   double checkpoint_every_ = 300.0;
+  // What a saved training state must match besides its runs: the sweep text,
+  // the build (a changed trainer would mix two builds in one cell) and the
+  // intra-op thread count.
+  std::string state_key_;
   std::string out_;
   WriterLock lock_;  // rank 0 only; released after the file is closed
   std::optional<ResultsFile> results_;
@@ -343,9 +348,16 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
     }
   } catch (const CellInterrupted& e) {
     *interrupted = true;
-    std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its training state is in %s\n",
-                 prefix.c_str(), item_number, e.step, cell.training.steps,
-                 checkpoints->path().c_str());
+    if (checkpoints->saved_step() == e.step) {
+      std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its training state is in %s\n",
+                   prefix.c_str(), item_number, e.step, cell.training.steps,
+                   checkpoints->path().c_str());
+    } else {
+      std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its state could not be saved "
+                   "(see above): it trains again from %s\n", prefix.c_str(), item_number, e.step,
+                   cell.training.steps,
+                   checkpoints->saved_step() > 0 ? "its last saved state" : "the start");
+    }
     return {};
   } catch (const std::exception& e) {
     std::vector<RunResult> failed(cell.seeds.size());
@@ -436,7 +448,15 @@ SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
                               &p.runs_done_before);
   for (const auto& runs : pending) p.runs_to_do += static_cast<int>(runs.size());
   std::vector<std::vector<int>> resumed;
-  if (root_) resumed = resumed_groups(grid_, &pending, out_, spec_.text_hash);
+  if (root_) {
+    try {
+      resumed = resumed_groups(grid_, &pending, out_, state_key_);
+    } catch (const std::exception& e) {  // never leave the others waiting in the broadcast
+      std::cerr << "phnn sweep: cannot read the saved training states (" << e.what()
+                << "); their items train from the start\n";
+      resumed.clear();
+    }
+  }
   mpi::broadcast(world_, resumed, 0);
   mpi::broadcast(world_, pending, 0);
   p.plan = plan_work(grid_, pending, size_, split_);
@@ -487,7 +507,7 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     std::vector<int> seeds;
     for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
     const CellSpec cell = cell_spec_for(head, seeds);
-    ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, spec_.text_hash),
+    ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, state_key_),
                                 checkpoint_every_, &g_stop_signal, prefix_);
     if (!quiet) announce_item(prefix_, i + 1, work.size(), head, cell, checkpoints.resume_step());
     const auto cell_start = Clock::now();

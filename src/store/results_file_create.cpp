@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -238,9 +239,12 @@ void write_setting_columns(h5::File& file, const std::vector<std::string>& canon
       for (const auto& [name, value] : columns[r]) {
         if (name != key) continue;
         text[r] = value;
-        char* end = nullptr;
-        numbers[r] = std::strtod(value.c_str(), &end);
-        numeric = numeric && !value.empty() && end == value.c_str() + value.size();
+        numbers[r] = std::strtod(value.c_str(), nullptr);
+        // A number only if the text is the canonical key's spelling of that
+        // double (%.17g): a hash of digits or a seed beyond 2^53 stays text.
+        char back[40];
+        std::snprintf(back, sizeof back, "%.17g", numbers[r]);
+        numeric = numeric && !value.empty() && value == back && std::isfinite(numbers[r]);
       }
     }
     std::string name = key;

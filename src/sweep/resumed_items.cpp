@@ -57,6 +57,7 @@ std::vector<std::vector<int>> resumed_groups(const Grid& grid,
   }
   std::vector<std::vector<int>> groups;
   for (const std::string& path : list_cell_checkpoints(out)) {
+    remove_cell_checkpoint(path + ".writing");  // a save a kill cut short
     CellCheckpoint saved;
     std::string problem;
     const bool read = read_cell_checkpoint(path, &saved, &problem);

@@ -12,14 +12,17 @@
 
 namespace phnn {
 
-/// What identifies an item's state: "<sweep text hash>\n<run id> <run id>...".
+/// What identifies an item's state: "<sweep key>\n<run id> <run id>...", the
+/// sweep key being what else a state must match (phnn sweep: the sweep
+/// text's hash, the build's git commit and the thread count).
 std::string item_key(const Grid& grid, const std::vector<int>& runs,
                      const std::string& sweep_hash);
 
 /// Rank 0 before planning: every saved state whose runs are all still in
-/// `pending` (one cell, this sweep's hash) becomes an item of exactly those
-/// runs, and its runs leave `pending`; states of finished or foreign runs
-/// are deleted. Returns the items' runs (Grid::runs indices), in file order.
+/// `pending` (one cell, this sweep key) becomes an item of exactly those
+/// runs, and its runs leave `pending`; states of finished or foreign runs,
+/// of another build, and scratch files of a save cut short are deleted.
+/// Returns the items' runs (Grid::runs indices), in file order.
 std::vector<std::vector<int>> resumed_groups(const Grid& grid,
                                              std::vector<std::vector<int>>* pending,
                                              const std::string& out,
