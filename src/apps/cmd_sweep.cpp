@@ -356,7 +356,9 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
       std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its state could not be saved "
                    "(see above): it trains again from %s\n", prefix.c_str(), item_number, e.step,
                    cell.training.steps,
-                   checkpoints->saved_step() > 0 ? "its last saved state" : "the start");
+                   checkpoints->saved_step() > 0 || checkpoints->resume_step() > 0
+                       ? "its last saved state"
+                       : "the start");
     }
     return {};
   } catch (const std::exception& e) {
