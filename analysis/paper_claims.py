@@ -48,17 +48,42 @@ def reduce_csv(path, *extra):
 
 
 # ------------------------------------------------------------------ the file's cells
+class Probe(namedtuple("Probe", Cell._fields + ("system", "models", "n_train", "size", "reg"))):
+    """A cell without results (--write-comparisons): which cell(s) a comparison reads. `models`
+    lists several when a statement takes the best of them."""
+
+    @staticmethod
+    def of(system, model, config):
+        return Probe(1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0, 0, 0, system, (model,), config["n_train"],
+                     config["size"], config["regularizer"])
+
+    @staticmethod
+    def merge(probes):
+        models = tuple(m for p in probes for m in p.models)
+        return probes[0]._replace(models=tuple(dict.fromkeys(models)))
+
+    def selector(self):
+        """The sweep file's cell selector: "system/models/n_train/size/regularizer"."""
+        models = "+".join(m.lower() for m in self.models)
+        return f"{self.system}/{models}/{self.n_train}/{self.size}/{self.reg}"
+
+
+RECORDED = []  # (selector, selector) of every compare() on probes
+
+
 class Results:
     """Cells by (study, system, model, column) and by configuration (shared columns once)."""
 
-    def __init__(self, stat_rows, run_rows):
+    def __init__(self, stat_rows, run_rows, probes=False):
         self.cells, self.by_config, self.runs = {}, {}, {}
         for r in stat_rows:
             f = lambda k: float(r[k]) if r[k] not in ("", "nan") else math.nan  # noqa: E731
+            config = dict(DEFAULTS, **{r["axis"]: r["column"]})
             cell = Cell(f("median"), f("q25"), f("q75"), f("iqr"), f("ci_low"), f("ci_high"),
                         int(r["done"]), int(r["diverged"]), int(r["expected"]))
+            if probes:
+                cell = Probe.of(r["system"], r["model"], config)
             self.cells[(r["study"], r["system"], r["model"], r["column"])] = cell
-            config = dict(DEFAULTS, **{r["axis"]: r["column"]})
             key = (r["system"], r["model"], config["n_train"], config["size"], config["regularizer"])
             self.by_config[key] = cell
         for r in run_rows:
@@ -91,6 +116,9 @@ def finite(cell):
 
 def compare(label, a, b, paper_says_lower=True):
     """a against b; the paper says a's median is below b's (or above, if not paper_says_lower)."""
+    if isinstance(a, Probe):  # --write-comparisons: record the two cells, decide nothing
+        RECORDED.append((a.selector(), b.selector()))
+        return Comparison(label, True, False)
     lower = a.median < b.median
     resolved = a.hi < b.lo if lower else a.lo > b.hi
     if a.median == b.median:
@@ -114,10 +142,19 @@ def absence(c, happens=None):
     return Comparison(c.label, not occurs, True if occurs else None)
 
 
+def lowest(named_cells):
+    """(model, cell) of the smallest median among (model, cell) pairs of finite cells; for probes
+    (--write-comparisons) one probe that stands for all of them (the sweep picks at run time)."""
+    named_cells = [(m, c) for m, c in named_cells if finite(c)]
+    if not named_cells:
+        return None, None
+    if isinstance(named_cells[0][1], Probe):
+        return named_cells[0][0], Probe.merge([c for _, c in named_cells])
+    return min(named_cells, key=lambda mc: mc[1].median)
+
+
 def best_of(results, study, system, models, column):
-    cells = [(m, results.get(study, system, m, column)) for m in models]
-    cells = [(m, c) for m, c in cells if finite(c)]
-    return min(cells, key=lambda mc: mc[1].median) if cells else (None, None)
+    return lowest([(m, results.get(study, system, m, column)) for m in models])
 
 
 def verdict(comparisons):
@@ -374,10 +411,8 @@ def across_studies(res):
         want, other = ("PHNN-JR", "PHNN-S") if system == "self-sustained" else ("PHNN-S", "PHNN-JR")
         for n_train, size, reg in configs:
             cells = {m: res.by_config.get((system, m, n_train, size, reg)) for m in PHNN_MODELS}
-            a = min((c for m, c in cells.items() if m in FAMILIES[want] and finite(c)),
-                    key=lambda c: c.median, default=None)
-            b = min((c for m, c in cells.items() if m in FAMILIES[other] and finite(c)),
-                    key=lambda c: c.median, default=None)
+            _, a = lowest([(m, c) for m, c in cells.items() if m in FAMILIES[want]])
+            _, b = lowest([(m, c) for m, c in cells.items() if m in FAMILIES[other]])
             if a is not None and b is not None:
                 comps.append(compare(f"{system} N_train {n_train} {size} {reg}: best {want} vs "
                                      f"best {other}", a, b))
@@ -518,6 +553,18 @@ def stability(stat_rows, run_rows, resamples, seed=0, inner=1000):
     return {tag: same[tag] / resamples for tag in base}
 
 
+def comparisons_toml(stat_rows):
+    """Every comparison with an interval that the statements make, as the `comparisons` key of an
+    [adaptive] table (rule = "comparisons"): each distinct pair of cell selectors once, in the
+    order the statements first make it. Built from the file's cells alone (results not read)."""
+    del RECORDED[:]
+    all_claims(Results(stat_rows, [], probes=True))
+    pairs = list(dict.fromkeys(tuple(sorted(p)) for p in RECORDED))
+    lines = ["comparisons = ["]
+    lines += [f'  ["{a}", "{b}"],' for a, b in pairs]
+    return "\n".join(lines + ["]"])
+
+
 def report(results, path, problems=(), stable=None):
     claims = all_claims(results)
     lines = [f"# The paper's statements checked on {os.path.basename(path)}", ""]
@@ -566,9 +613,16 @@ def main(argv=None):
                         "seeds and show the share that agrees (below 90 %%: unstable)")
     parser.add_argument("--strict", action="store_true",
                         help="exit 1 without verdicts if the steps or seeds differ from the paper's")
+    parser.add_argument("--write-comparisons", action="store_true",
+                        help="print the comparisons the statements make, as the `comparisons` "
+                        "key of a sweep file's [adaptive] table (rule = \"comparisons\"); reads "
+                        "only the file's cells (a file with every run pending will do)")
     args = parser.parse_args(argv)
     if not os.path.exists(args.results):
         parser.error(f"{args.results}: no such file")
+    if args.write_comparisons:
+        print(comparisons_toml(reduce_csv(args.results)))
+        return 0
     run_rows = reduce_csv(args.results, "--per-run")
     problems = setting_problems(run_rows)
     for p in problems:

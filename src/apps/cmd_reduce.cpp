@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <iostream>
 #include <limits>
+#include <optional>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "phnn/report/per_run.h"
 #include "phnn/report/tables.h"
 #include "phnn/store/results_file.h"
+#include "phnn/sweep/adaptive.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
 
@@ -154,6 +156,16 @@ void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
                "expected.\n\n";
 }
 
+// Where an adaptive sweep stands, under the preamble.
+void print_adaptive_preamble(const SweepSpec& spec, const AdaptiveState& state) {
+  std::cout << "Adaptive seeds (rule " << to_string(spec.adaptive.rule) << ", "
+            << spec.adaptive.initial_seeds.size() << " seeds per cell, then " << spec.adaptive.batch
+            << " more per round where the rule asks, at most " << spec.adaptive.max_seeds << "): "
+            << (state.complete ? "complete after round " : "round in progress: ") << state.round
+            << "; " << state.active_runs() << " runs asked for; the other pending runs are seeds "
+            << "no round asked for, left out of the tables.\n\n";
+}
+
 }  // namespace
 
 int run_reduce(int argc, char** argv, int first) {
@@ -202,10 +214,19 @@ int run_reduce(int argc, char** argv, int first) {
   }
   auto statuses = file.read_statuses();
   for (int row : damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
-  const auto entries = make_table_entries(grid, statuses, file.read_double_column("mse"));
+  const auto mse = file.read_double_column("mse");
+  // An adaptive sweep: the runs its rounds asked for so far, each cell
+  // expecting its own number of seeds.
+  std::optional<AdaptiveState> adaptive;
+  if (spec.adaptive.enabled) adaptive = replay_adaptive_rounds(spec, grid, statuses, mse);
+  const auto entries = make_table_entries(grid, statuses, mse, adaptive ? &adaptive->active : nullptr);
   std::size_t expected_seeds = 0;
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());
-  if (format == TableFormat::kMarkdown) print_markdown_preamble(file, spec, statuses, seeds_summary);
+  if (adaptive) expected_seeds = 0;
+  if (format == TableFormat::kMarkdown) {
+    print_markdown_preamble(file, spec, statuses, seeds_summary);
+    if (adaptive) print_adaptive_preamble(spec, *adaptive);
+  }
   const int expected = static_cast<int>(expected_seeds);
   std::cout << (seeds_summary ? render_seeds_summary(grid.studies, entries, format, expected)
                               : render_tables(grid.studies, entries, format, expected));

@@ -38,6 +38,7 @@
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "phnn/store/scratch_file.h"
+#include "phnn/sweep/adaptive.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"
 #include "phnn/sweep/output_check.h"
@@ -169,6 +170,8 @@ class SweepRun {
           std::cout << cell_costs_csv(grid_);
         } else if (parser_.flag_set("items")) {
           std::cout << plan_items_csv(grid_, plan_work(grid_, ranks_.front(), split_));
+        } else if (spec_.adaptive.enabled) {
+          std::cout << adaptive_dry_run();
         } else {
           std::cout << dry_run_summary(grid_, ranks_, split_);
         }
@@ -185,11 +188,10 @@ class SweepRun {
     }
     mpi::broadcast(world_, status_codes, 0);
     mpi::broadcast(world_, session_, 0);
-    if (int status = agreed(world_, true, [&] {
-          results_.emplace(ResultsFile::open(out_, MPI_COMM_WORLD, spec_.text_hash));
-        })) {
-      return status;
+    if (spec_.adaptive.enabled) {
+      if (int status = replay_rounds(&status_codes)) return status;
     }
+    if (int status = open_results()) return status;
     if (int status = agreed(world_, true, [&] { journal_.emplace(out_, rank_); })) return status;
     return train_and_close(status_codes);
   }
@@ -219,6 +221,11 @@ class SweepRun {
       } catch (const std::invalid_argument& e) {
         throw cli::UsageError{cli::with_prefix("phnn sweep: ", e.what())};
       }
+    }
+    if (spec_.adaptive.enabled && shard_.count > 1) {
+      throw cli::UsageError{"phnn sweep: --shard: an adaptive sweep ([adaptive]) decides each "
+                            "round from every cell's results, which one shard does not hold; "
+                            "run it as one job (its ranks share the cells)"};
     }
     ranks_ = dry_run_ranks(parser_, size_);
     if (parser_.flag_set("items") && ranks_.size() != 1) {
@@ -292,7 +299,21 @@ class SweepRun {
     std::size_t resumed = 0;
   };
   Planned plan(const std::vector<int>& status_codes);
-  int train_and_close(const std::vector<int>& status_codes);
+  struct RoundOutcome {
+    int my_runs = 0;
+    std::string io_error;
+    bool stopped = false;  // a stop signal on any rank
+  };
+  RoundOutcome train_round(const std::vector<int>& status_codes);
+  int train_and_close(std::vector<int> status_codes);
+  int open_results() {
+    return agreed(world_, true, [&] {
+      results_.emplace(ResultsFile::open(out_, MPI_COMM_WORLD, spec_.text_hash));
+    });
+  }
+  int replay_rounds(std::vector<int>* status_codes);
+  std::string adaptive_dry_run() const;
+  std::string adaptive_line() const;
   int close_and_report(std::string io_error, bool stopped, int total_runs, double seconds);
 
   int argc_;
@@ -319,6 +340,8 @@ class SweepRun {
   std::optional<Journal> journal_;
   int session_ = 0;  // this run's /provenance/session_<k>
   SweepDataSets data_{spec_, grid_};
+  // An adaptive sweep's rounds so far (replay_rounds); unused otherwise.
+  AdaptiveState adaptive_;
   Clock::time_point start_ = Clock::now();
 };
 
@@ -434,7 +457,7 @@ int SweepRun::close_and_report(std::string io_error, bool stopped, int total_run
   try {
     print_summary(out_, total_runs, seconds,
                   failed ? StopReason::kError : stopped ? StopReason::kSignal : StopReason::kNone,
-                  shard_);
+                  shard_, adaptive_line());
   } catch (const std::exception& e) {
     std::cerr << cli::with_prefix("phnn sweep: ", e.what()) << "\n";
   }
@@ -449,6 +472,9 @@ SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
   auto pending = pending_runs(grid_, status_codes, parser_.flag_set("retry-failed"), shard_,
                               &p.runs_done_before);
   for (const auto& runs : pending) p.runs_to_do += static_cast<int>(runs.size());
+  if (spec_.adaptive.enabled) {  // the seeds no round asked for read as finished
+    p.runs_done_before -= static_cast<int>(grid_.runs.size()) - adaptive_.active_runs();
+  }
   std::vector<std::vector<int>> resumed;
   if (root_) {
     try {
@@ -467,7 +493,7 @@ SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
   return p;
 }
 
-int SweepRun::train_and_close(const std::vector<int>& status_codes) {
+SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_codes) {
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
   const Planned planned = plan(status_codes);
   const std::vector<WorkItem>& work = planned.plan.items;
@@ -540,12 +566,114 @@ int SweepRun::train_and_close(const std::vector<int>& status_codes) {
     report_progress(true);
   }
   post_stop();
-  const int stopped = mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>());
+  RoundOutcome outcome;
+  outcome.stopped =
+      mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>()) != 0;
   queue.close();
+  outcome.my_runs = my_runs;
+  outcome.io_error = io_error;
+  return outcome;
+}
+
+// Trains what is left; an adaptive sweep round after round, each decided on
+// the finished file (every rank closes it, rank 0 replays the rounds, every
+// rank opens it again), until its rule names no cell that can grow.
+int SweepRun::train_and_close(std::vector<int> status_codes) {
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
+  int my_runs = 0;
+  RoundOutcome round;
+  for (;;) {
+    round = train_round(status_codes);
+    my_runs += round.my_runs;
+    const bool io_failed =
+        mpi::all_reduce(world_, round.io_error.empty() ? 0 : 1, mpi::maximum<int>()) != 0;
+    if (!spec_.adaptive.enabled || round.stopped || io_failed) break;
+    std::string close_error;
+    try {
+      results_->close();
+    } catch (const std::exception& e) {
+      close_error = prefix_ + e.what();
+    }
+    if (int status = agree(world_, close_error.empty() ? 0 : kExitFailed, close_error)) {
+      return status;
+    }
+    if (int status = replay_rounds(&status_codes)) return status;
+    if (int status = open_results()) return status;
+    if (adaptive_.complete) break;
+  }
   const int total_runs = mpi::all_reduce(world_, my_runs, std::plus<int>());
-  const int failed = close_and_report(io_error, stopped != 0, total_runs, elapsed());
+  const int failed = close_and_report(round.io_error, round.stopped, total_runs, elapsed());
   if (failed) return failed;
-  return stopped ? kExitStopped : 0;
+  return round.stopped ? kExitStopped : 0;
+}
+
+// Rank 0 replays an adaptive sweep's rounds on the file (closed on every
+// rank), every rank gets the state, and the runs no round asked for read as
+// finished in *status_codes, so no rank plans them.
+int SweepRun::replay_rounds(std::vector<int>* status_codes) {
+  std::vector<int> codes, active;
+  int round = 0, complete = 0;
+  std::vector<int> cells_grown;
+  if (int status = agreed(world_, root_, [&] {
+        const ResultsFile file = ResultsFile::open_read_only(out_);
+        const std::vector<RunStatus> statuses = file.read_statuses();
+        const AdaptiveState state =
+            replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
+        for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
+        active.assign(state.active.begin(), state.active.end());
+        round = state.round;
+        complete = state.complete ? 1 : 0;
+        cells_grown = state.cells_grown;
+      })) {
+    return status;
+  }
+  mpi::broadcast(world_, codes, 0);
+  mpi::broadcast(world_, active, 0);
+  mpi::broadcast(world_, cells_grown, 0);
+  mpi::broadcast(world_, round, 0);
+  mpi::broadcast(world_, complete, 0);
+  adaptive_.active.assign(active.begin(), active.end());
+  adaptive_.round = round;
+  adaptive_.complete = complete != 0;
+  adaptive_.cells_grown = cells_grown;
+  for (std::size_t i = 0; i < codes.size(); ++i) {
+    if (!active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
+  }
+  *status_codes = codes;
+  if (root_ && !adaptive_.complete) {
+    std::cout << "phnn sweep: adaptive round " << round << ": " << adaptive_.active_runs()
+              << " runs asked for of at most " << grid_.runs.size() << " ("
+              << (round == 0 ? std::string("every cell's first ") +
+                                   std::to_string(spec_.adaptive.initial_seeds.size()) + " seeds"
+                             : std::to_string(cells_grown.back()) + " cells got " +
+                                   std::to_string(spec_.adaptive.batch) + " more seeds after round " +
+                                   std::to_string(round - 1))
+              << ", rule " << to_string(spec_.adaptive.rule) << ")" << std::endl;
+  }
+  return 0;
+}
+
+// --dry-run of an adaptive sweep: round 0's schedule and the worst case,
+// every cell at max_seeds.
+std::string SweepRun::adaptive_dry_run() const {
+  std::ostringstream out;
+  out << "adaptive sweep (rule " << to_string(spec_.adaptive.rule) << ", batch "
+      << spec_.adaptive.batch << ", max_seeds " << spec_.adaptive.max_seeds << ")\n"
+      << "round 0 (" << spec_.adaptive.initial_seeds.size() << " seeds per cell):\n"
+      << dry_run_summary(expand_grid(round_zero_spec(spec_)), ranks_, split_)
+      << "worst case (every cell at " << spec_.adaptive.max_seeds << " seeds):\n"
+      << dry_run_summary(grid_, ranks_, split_);
+  return out.str();
+}
+
+std::string SweepRun::adaptive_line() const {
+  if (!spec_.adaptive.enabled || !adaptive_.complete) return "";
+  const int asked = adaptive_.active_runs();
+  const int left = static_cast<int>(grid_.runs.size()) - asked;
+  return "adaptive sweep complete after round " + std::to_string(adaptive_.round) + ": " +
+         std::to_string(asked) + " runs of at most " + std::to_string(grid_.runs.size()) +
+         (left > 0 ? "; the " + std::to_string(left) + " pending runs are seeds no round asked for"
+                   : " (every cell at max_seeds)");
 }
 
 }  // namespace

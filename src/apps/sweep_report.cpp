@@ -80,7 +80,7 @@ void print_item(const char* format, const std::string& prefix, int item_number,
 }
 
 void print_summary(const std::string& out, int total_runs, double seconds, StopReason stop,
-                   const Shard& shard) {
+                   const Shard& shard, const std::string& adaptive_line) {
   const ResultsFile summary = ResultsFile::open_read_only(out);
   int counts[4] = {0, 0, 0, 0};
   for (RunStatus s : summary.read_statuses()) ++counts[static_cast<int>(s)];
@@ -98,6 +98,10 @@ void print_summary(const std::string& out, int total_runs, double seconds, StopR
     std::printf("phnn sweep: shard %d/%d done (the pending runs are other shards'); when every "
                 "shard is done: phnn merge OUT SHARD...\n",
                 shard.index, shard.count);
+  } else if (!adaptive_line.empty()) {
+    std::printf("phnn sweep: %s%s\n", adaptive_line.c_str(),
+                counts[3] > 0 ? "; run the same command again with --retry-failed to retry "
+                                "the failed runs" : "");
   } else if (counts[0] > 0 || counts[3] > 0) {
     std::printf("phnn sweep: runs remain; run the same command again%s\n",
                 counts[3] > 0 ? " with --retry-failed to retry the failed ones" : "");

@@ -51,9 +51,11 @@ void print_item(const char* format, const std::string& prefix, int item_number,
 /// Why a sweep ended before its queue was empty.
 enum class StopReason { kNone, kSignal, kError };
 
-/// Rank 0's summary line(s) after the file is closed.
+/// Rank 0's summary line(s) after the file is closed. `adaptive_line`: where
+/// an adaptive sweep that ran to its end stands (its pending runs are the
+/// seeds no round asked for), said instead of "runs remain".
 void print_summary(const std::string& out, int total_runs, double seconds, StopReason stop,
-                   const Shard& shard);
+                   const Shard& shard, const std::string& adaptive_line = "");
 
 }  // namespace apps
 }  // namespace phnn

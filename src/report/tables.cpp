@@ -19,8 +19,10 @@ using namespace table_text;
 using internal::csv_field;
 
 std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<RunStatus>& status,
-                                           const std::vector<double>& mse) {
-  if (status.size() != grid.runs.size() || mse.size() != grid.runs.size()) {
+                                           const std::vector<double>& mse,
+                                           const std::vector<char>* only) {
+  if (status.size() != grid.runs.size() || mse.size() != grid.runs.size() ||
+      (only && only->size() != grid.runs.size())) {
     throw std::invalid_argument("make_table_entries: got " + std::to_string(status.size()) +
                                 " statuses and " + std::to_string(mse.size()) +
                                 " MSEs for a grid of " + std::to_string(grid.runs.size()) +
@@ -30,6 +32,7 @@ std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<R
   for (const StudyTable& study : grid.studies) {
     for (std::size_t i = 0; i < study.runs.size(); ++i) {
       const int r = study.runs[i];
+      if (only && !(*only)[static_cast<std::size_t>(r)]) continue;
       const RunConfig& run = grid.runs[r];
       TableEntry e;
       e.study = study.name;
@@ -266,6 +269,31 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
 }
 
 }  // namespace
+
+std::vector<TableCellName> tied_cells(const std::vector<StudyTable>& studies,
+                                      const std::vector<TableEntry>& entries, int expected_seeds,
+                                      const BootstrapOptions& bootstrap) {
+  bootstrap.validate();
+  const CellIndex by_cell = index_cells(entries);
+  std::vector<TableCellName> tied;
+  for (const StudyTable& study : studies) {
+    for (const std::string& system : study.systems) {
+      const TableEntries t = gather_table(study, system, by_cell);
+      for (std::size_t c = 0; c < study.columns.size(); ++c) {
+        std::vector<CellSummary> column(study.rows.size());
+        for (std::size_t r = 0; r < study.rows.size(); ++r) {
+          column[r] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap);
+        }
+        if (!unmarkable(column, study.rows).empty()) continue;
+        const std::vector<Mark> marks = mark_column(column);
+        for (std::size_t r = 0; r < study.rows.size(); ++r) {
+          if (marks[r] == Mark::kTie) tied.push_back({study.name, system, study.rows[r], study.columns[c]});
+        }
+      }
+    }
+  }
+  return tied;
+}
 
 std::string render_tables(const std::vector<StudyTable>& studies,
                           const std::vector<TableEntry>& entries, TableFormat format,

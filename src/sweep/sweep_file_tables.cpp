@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "phnn/sweep/output_check.h"
+#include "sweep/sweep_file_adaptive.h"
 #include "sweep/sweep_file_systems.h"
 #include "sweep/sweep_file_values.h"
 
@@ -40,7 +41,7 @@ using KeyLines = std::map<std::string, int>;
 
 const char kTableList[] =
     "[data], [training], [grid], [physics.harmonic], [physics.duffing], "
-    "[physics.self-sustained], [study.NAME]";
+    "[physics.self-sustained], [study.NAME], [adaptive]";
 
 class TableWalker {
  public:
@@ -61,6 +62,7 @@ class TableWalker {
     spec_.system_files = systems_.files();
     check_lambdas();
     check_knobs_change_runs();
+    if (spec_.adaptive.enabled) apply_adaptive(&spec_, adaptive_header_, values_);
     return spec_;
   }
 
@@ -89,11 +91,15 @@ class TableWalker {
       physics_tables(values_.table(e, "[physics.SYSTEM]"));
     } else if (e.key == "study") {
       study_tables(e, values_.table(e, "[study.NAME]"));
+    } else if (e.key == "adaptive") {
+      adaptive_header_ = e.line;
+      spec_.adaptive = read_adaptive_table(e, values_);
     } else if (e.value->is_table() || e.value->is_array_of_tables()) {
       fail(e.line,
            "unknown table [" + e.key + "]" +
                did_you_mean(e.key, {"data", "training", "grid", "physics.harmonic",
-                                    "physics.duffing", "physics.self-sustained", "study.NAME"}) +
+                                    "physics.duffing", "physics.self-sustained", "study.NAME",
+                                    "adaptive"}) +
                "; expected one of: " + kTableList);
     } else {
       fail(e.line, "unknown key " + quoted(e.key) + " in the top level (before any [table])" +
@@ -399,7 +405,7 @@ class TableWalker {
   KeyLines data_lines_, training_lines_;
   std::map<SystemKind, KeyLines> physics_lines_;
   std::map<SystemKind, int> physics_header_;
-  int data_header_ = 1, training_header_ = 1;
+  int data_header_ = 1, training_header_ = 1, adaptive_header_ = 1;
   bool has_name_ = false, has_output_ = false;
 };
 

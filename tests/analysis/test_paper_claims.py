@@ -176,5 +176,39 @@ class Stability(unittest.TestCase):
         self.assertIn("| 50 % **unstable** |", text)
 
 
+class WriteComparisons(unittest.TestCase):
+    """--write-comparisons: the cells every interval comparison reads, as sweep-file selectors."""
+
+    def rows(self):
+        rows = []
+        for system in pc.SYSTEMS:
+            for model in ("NODE-RK2",) + pc.PHNN_MODELS:
+                for col in ("25", "100", "400"):  # no results: the cells alone
+                    rows.append(stat_row("I", system, model, "n_train", col, "", "", ""))
+        return rows
+
+    def test_pairs_name_cells_and_families_once(self):
+        text = pc.comparisons_toml(self.rows())
+        lines = text.splitlines()
+        self.assertEqual((lines[0], lines[-1]), ("comparisons = [", "]"))
+        pairs = lines[1:-1]
+        self.assertEqual(len(pairs), len(set(pairs)))  # each pair once
+        # I.4: harmonic PHNN-S DG vs RK2 at N_train 25, one model per side.
+        self.assertIn('  ["harmonic/phnn-s-dg/25/small/none", "harmonic/phnn-s-rk2/25/small/none"],',
+                      pairs)
+        # I.1: the same model at two N_train.
+        self.assertIn('  ["duffing/node-rk2/100/small/none", "duffing/node-rk2/25/small/none"],',
+                      pairs)
+        # I.8: the best of a family against a single model: one '+'-joined side.
+        self.assertTrue(any('"self-sustained/phnn-s-dg+phnn-s-rk2/400/small/none"' in p
+                            and '"self-sustained/node-rk2/400/small/none"' in p for p in pairs))
+        for p in pairs:
+            for selector in p.strip(" [],").split('", "'):
+                fields = selector.strip('"').split("/")
+                self.assertEqual(len(fields), 5, selector)
+                self.assertIn(fields[0], pc.SYSTEMS)
+        self.assertGreaterEqual(len(pc.RECORDED), len(pairs))  # duplicates merged
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -30,9 +30,12 @@ struct TableEntry {
 };
 
 /// Entries for every run of every study of `grid`; status[i] and mse[i]
-/// belong to grid.runs[i]. Throws std::invalid_argument if the sizes differ.
+/// belong to grid.runs[i]. With `only`, just the runs i with only[i] != 0 (an
+/// adaptive sweep's runs asked for so far, phnn/sweep/adaptive.h). Throws
+/// std::invalid_argument if the sizes differ.
 std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<RunStatus>& status,
-                                           const std::vector<double>& mse);
+                                           const std::vector<double>& mse,
+                                           const std::vector<char>* only = nullptr);
 
 /// Output format of render_tables().
 enum class TableFormat { kMarkdown, kLatex, kCsv };
@@ -119,6 +122,21 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
 std::string render_tables(const std::vector<StudyTable>& studies,
                           const std::vector<TableEntry>& entries, TableFormat format,
                           int expected_seeds, const BootstrapOptions& bootstrap = {});
+
+/// A cell of a study table, by name.
+struct TableCellName {
+  std::string study, system, row, column;
+};
+
+/// The cells render_tables() marks " (tie)" (same entries, expected_seeds
+/// and bootstrap), in table order: per column, the smallest median and every
+/// cell whose interval overlaps its interval — the cells whose order more
+/// seeds may settle (an adaptive sweep's "column-best" rule). A column
+/// without a mark (a row with fewer than kMinSeedsForInterval finished runs)
+/// names none.
+std::vector<TableCellName> tied_cells(const std::vector<StudyTable>& studies,
+                                      const std::vector<TableEntry>& entries, int expected_seeds,
+                                      const BootstrapOptions& bootstrap = {});
 
 /// The seeds behind each cell, to make a bimodal cell visible: for each
 /// column of each table, the geometric midpoint of its finite positive MSEs

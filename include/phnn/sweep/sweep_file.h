@@ -80,6 +80,53 @@ struct SweepSystemFile {
   int n_x = 0, n_w = 0, n_u = 0;
 };
 
+/// One side of an [adaptive] comparison: the cell of `system` with these
+/// n_train, size and regularizer, and of `models` the one whose median is
+/// smallest (one model: that cell). Written "system/models/n_train/size/
+/// regularizer", models joined by '+': "duffing/phnn-s-dg+phnn-s-rk2/25/small/none".
+struct CellSelector {
+  std::string text;  // as written
+  std::string system;
+  std::vector<std::pair<ModelKind, IntegratorKind>> models;
+  int n_train = 0;
+  ModelSize size = ModelSize::kSmall;
+  Regularizer regularizer = Regularizer::kNone;
+};
+
+/// Two cells whose medians a question compares (e.g. one of the paper's
+/// statements): unresolved while their bootstrap intervals overlap.
+struct SeedComparison {
+  CellSelector a, b;
+  int line = 0;  // of the comparison in the sweep file
+};
+
+/// Which cells an adaptive sweep gives more seeds after a round
+/// (docs/METHOD.md, "Adaptive seeds").
+enum class AdaptiveRule {
+  /// In every column of every study table, the cells the reducer marks
+  /// (tie): the best median and those whose interval overlaps its interval.
+  kColumnBest,
+  /// Both cells of every comparison of `comparisons` whose intervals overlap.
+  kComparisons,
+};
+std::string to_string(AdaptiveRule rule);
+std::vector<AdaptiveRule> all_adaptive_rules();
+
+/// The [adaptive] table: round 0 trains the studies' `seeds`; after each
+/// finished round `rule` names cells, each of which gets the next `batch`
+/// seed numbers (above its largest), up to `max_seeds` per cell; the sweep
+/// ends when the rule names no cell that can grow.
+struct AdaptiveSpec {
+  bool enabled = false;
+  int max_seeds = 0, batch = 0;
+  AdaptiveRule rule = AdaptiveRule::kColumnBest;
+  std::vector<SeedComparison> comparisons;
+  /// The studies' `seeds` as written (every study has the same): round 0.
+  /// With [adaptive], StudySpec::seeds holds these and then the
+  /// max_seeds - initial_seeds.size() next seed numbers (the runs a cell may get).
+  std::vector<int> initial_seeds;
+};
+
 /// A parsed and validated sweep file: docs/METHOD.md defaults overridden by the file.
 ///
 ///   const SweepSpec spec = parse_sweep_file("sweeps/paper.toml");
@@ -109,6 +156,8 @@ struct SweepSpec {
   /// System files of the `systems` axes, in order of first appearance (each
   /// once; their names differ from each other and from the built-ins').
   std::vector<SweepSystemFile> system_files;
+  /// [adaptive]; enabled = false without it.
+  AdaptiveSpec adaptive;
 
   /// The system file named `name`, or nullptr for a built-in system.
   const SweepSystemFile* system_file(const std::string& name) const;

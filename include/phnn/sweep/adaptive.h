@@ -1,0 +1,69 @@
+// include/phnn/sweep/adaptive.h — adaptive seeds ([adaptive] in a sweep
+// file, docs/METHOD.md "Adaptive seeds"): which runs of the grid the rounds
+// have asked for, decided from finished results alone. Pure functions over a
+// Grid and its runs' statuses and MSEs (the report's statistics); no HDF5,
+// no MPI: the sweep and the reducer call them on what the results file holds.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "phnn/config/run_result.h"
+#include "phnn/report/statistics.h"
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/sweep_file.h"
+
+namespace phnn {
+
+/// Where an adaptive sweep stands.
+struct AdaptiveState {
+  /// Per grid run: asked for by one of rounds 0 .. round.
+  std::vector<char> active;
+  /// Per grid cell: how many of its seeds (its smallest) are asked for.
+  std::vector<int> cell_seeds;
+  /// The round in progress (some run it asked for is pending), or the last
+  /// round when complete.
+  int round = 0;
+  /// Every run asked for has finished and the rule names no cell below
+  /// max_seeds: the sweep is done.
+  bool complete = false;
+  /// Per finished round k: the cells that got more seeds after it.
+  std::vector<int> cells_grown;
+
+  /// Runs asked for.
+  int active_runs() const;
+};
+
+/// Replays the rounds on the results so far (status[i], mse[i] of
+/// grid.runs[i]): round 0 asks for every cell's initial seeds; when every run
+/// asked for has finished (done, diverged or failed), adaptive_rule_cells()
+/// on exactly those runs names cells, and each that is below max_seeds gets
+/// its next `batch` seeds (fewer at the cap). Stops at the first round with a
+/// pending run, or when no cell grows. A run's result depends only on its
+/// configuration and seed, so the state is the same whichever ranks trained
+/// which runs, in whatever groups and order, and after any kill. Throws
+/// std::invalid_argument unless spec.adaptive.enabled and the sizes match.
+AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
+                                     const std::vector<RunStatus>& status,
+                                     const std::vector<double>& mse,
+                                     const BootstrapOptions& bootstrap = {});
+
+/// The cells (indices into grid.cells, ascending) that spec.adaptive.rule
+/// names when the runs with active[i] != 0 are the results:
+///   column-best:  tied_cells() of the study tables (phnn/report/tables.h);
+///   comparisons:  for each comparison, the smallest-median cell of each side
+///                 (among cells with a finished run; a side without one skips
+///                 the comparison); both are named unless the two bootstrap
+///                 intervals of the medians are disjoint (a side with fewer
+///                 than kMinSeedsForInterval finished runs has none: named).
+std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
+                                     const std::vector<char>& active,
+                                     const std::vector<RunStatus>& status,
+                                     const std::vector<double>& mse,
+                                     const BootstrapOptions& bootstrap = {});
+
+/// The sweep of round 0 alone: `spec` without [adaptive], every study's
+/// seeds its initial ones (for --dry-run's round-0 cost).
+SweepSpec round_zero_spec(const SweepSpec& spec);
+
+}  // namespace phnn

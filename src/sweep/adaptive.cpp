@@ -1,0 +1,198 @@
+// src/sweep/adaptive.cpp — adaptive seeds: the rounds replayed from finished
+// results, and the two rules that name the cells of the next round
+// (column-best: the reducer's (tie) cells; comparisons: both sides of every
+// comparison whose intervals overlap). Reads the report's statistics
+// (phnn/report/tables.h); writes nothing.
+#include "phnn/sweep/adaptive.h"
+
+#include <algorithm>
+#include <map>
+#include <stdexcept>
+#include <tuple>
+
+#include "phnn/report/tables.h"
+
+namespace phnn {
+namespace {
+
+std::vector<int> cell_of_runs(const Grid& grid) {
+  std::vector<int> cell_of(grid.runs.size(), -1);
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    for (int r : grid.cells[c].runs) cell_of[static_cast<std::size_t>(r)] = static_cast<int>(c);
+  }
+  return cell_of;
+}
+
+std::vector<int> column_best_cells(const Grid& grid, const std::vector<char>& active,
+                                   const std::vector<RunStatus>& status,
+                                   const std::vector<double>& mse,
+                                   const BootstrapOptions& bootstrap) {
+  const auto entries = make_table_entries(grid, status, mse, &active);
+  std::map<std::tuple<std::string, std::string, std::string, std::string>, int> cell_by_name;
+  const std::vector<int> cell_of = cell_of_runs(grid);
+  for (const StudyTable& study : grid.studies) {
+    for (std::size_t i = 0; i < study.runs.size(); ++i) {
+      const RunConfig& run = grid.runs[static_cast<std::size_t>(study.runs[i])];
+      cell_by_name[{study.name, run.system_name(), model_label(run.model, run.integrator),
+                    study.run_columns[i]}] = cell_of[static_cast<std::size_t>(study.runs[i])];
+    }
+  }
+  std::vector<int> cells;
+  for (const TableCellName& t : tied_cells(grid.studies, entries, 0, bootstrap)) {
+    cells.push_back(cell_by_name.at({t.study, t.system, t.row, t.column}));
+  }
+  return cells;
+}
+
+// "system|model|n_train|size|regularizer" of a run or of one model of a selector.
+std::string selector_key(const std::string& system, ModelKind model, IntegratorKind integrator,
+                         int n_train, ModelSize size, Regularizer regularizer) {
+  return system + "|" + model_key(model, integrator) + "|" + std::to_string(n_train) + "|" +
+         to_string(size) + "|" + to_string(regularizer);
+}
+
+class ComparisonRule {
+ public:
+  ComparisonRule(const Grid& grid, const std::vector<char>& active,
+                 const std::vector<RunStatus>& status, const std::vector<double>& mse,
+                 const BootstrapOptions& bootstrap)
+      : grid_(grid), active_(active), status_(status), mse_(mse), bootstrap_(bootstrap) {
+    for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+      const RunConfig& run = grid.runs[static_cast<std::size_t>(grid.cells[c].runs.front())];
+      cell_by_key_[selector_key(run.system_name(), run.model, run.integrator, run.n_train,
+                                run.size, run.regularizer)] = static_cast<int>(c);
+    }
+  }
+
+  // Named cells of one comparison (none, or both sides' picks).
+  void name_cells(const SeedComparison& c, std::vector<int>* cells) {
+    const int a = pick(c.a), b = pick(c.b);
+    if (a < 0 || b < 0) return;
+    const CellSummary& sa = summary(a);
+    const CellSummary& sb = summary(b);
+    bool resolved = false;
+    if (sa.has_interval() && sb.has_interval() && sa.median != sb.median) {
+      resolved = sa.median < sb.median ? sa.median_interval.high < sb.median_interval.low
+                                       : sa.median_interval.low > sb.median_interval.high;
+    }
+    if (resolved) return;
+    cells->push_back(a);
+    cells->push_back(b);
+  }
+
+ private:
+  // The smallest-median cell of a selector with a finished run, or -1.
+  int pick(const CellSelector& s) {
+    int best = -1;
+    for (const auto& [model, integrator] : s.models) {
+      const auto it = cell_by_key_.find(
+          selector_key(s.system, model, integrator, s.n_train, s.size, s.regularizer));
+      if (it == cell_by_key_.end()) continue;  // the parser checked; a shard may lack it
+      const CellSummary& cs = summary(it->second);
+      if (cs.finished() == 0) continue;
+      if (best < 0 || cs.median < summary(best).median) best = it->second;
+    }
+    return best;
+  }
+
+  const CellSummary& summary(int cell) {
+    const auto it = summaries_.find(cell);
+    if (it != summaries_.end()) return it->second;
+    std::vector<TableEntry> entries;
+    for (int r : grid_.cells[static_cast<std::size_t>(cell)].runs) {
+      const auto i = static_cast<std::size_t>(r);
+      if (!active_[i]) continue;
+      TableEntry e;
+      e.status = status_[i];
+      e.mse = mse_[i];
+      entries.push_back(e);
+    }
+    return summaries_.emplace(cell, summarize_cell(entries, 0, bootstrap_)).first->second;
+  }
+
+  const Grid& grid_;
+  const std::vector<char>& active_;
+  const std::vector<RunStatus>& status_;
+  const std::vector<double>& mse_;
+  const BootstrapOptions& bootstrap_;
+  std::map<std::string, int> cell_by_key_;
+  std::map<int, CellSummary> summaries_;
+};
+
+void mark_active(const Grid& grid, AdaptiveState* state) {
+  state->active.assign(grid.runs.size(), 0);
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    const auto& runs = grid.cells[c].runs;
+    const auto n = std::min<std::size_t>(runs.size(), static_cast<std::size_t>(state->cell_seeds[c]));
+    for (std::size_t k = 0; k < n; ++k) state->active[static_cast<std::size_t>(runs[k])] = 1;
+  }
+}
+
+}  // namespace
+
+int AdaptiveState::active_runs() const {
+  return static_cast<int>(std::count(active.begin(), active.end(), 1));
+}
+
+std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
+                                     const std::vector<char>& active,
+                                     const std::vector<RunStatus>& status,
+                                     const std::vector<double>& mse,
+                                     const BootstrapOptions& bootstrap) {
+  std::vector<int> cells;
+  if (spec.adaptive.rule == AdaptiveRule::kColumnBest) {
+    cells = column_best_cells(grid, active, status, mse, bootstrap);
+  } else {
+    ComparisonRule rule(grid, active, status, mse, bootstrap);
+    for (const SeedComparison& c : spec.adaptive.comparisons) rule.name_cells(c, &cells);
+  }
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  return cells;
+}
+
+AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
+                                     const std::vector<RunStatus>& status,
+                                     const std::vector<double>& mse,
+                                     const BootstrapOptions& bootstrap) {
+  if (!spec.adaptive.enabled) {
+    throw std::invalid_argument("replay_adaptive_rounds: the sweep has no [adaptive] table");
+  }
+  if (status.size() != grid.runs.size() || mse.size() != grid.runs.size()) {
+    throw std::invalid_argument("replay_adaptive_rounds: got " + std::to_string(status.size()) +
+                                " statuses and " + std::to_string(mse.size()) +
+                                " MSEs for a grid of " + std::to_string(grid.runs.size()) + " runs");
+  }
+  const AdaptiveSpec& a = spec.adaptive;
+  AdaptiveState state;
+  state.cell_seeds.assign(grid.cells.size(), static_cast<int>(a.initial_seeds.size()));
+  for (;;) {
+    mark_active(grid, &state);
+    for (std::size_t i = 0; i < status.size(); ++i) {
+      if (state.active[i] && status[i] == RunStatus::kPending) return state;  // round in progress
+    }
+    int grown = 0;
+    for (int c : adaptive_rule_cells(spec, grid, state.active, status, mse, bootstrap)) {
+      int& seeds = state.cell_seeds[static_cast<std::size_t>(c)];
+      if (seeds >= a.max_seeds) continue;
+      seeds = std::min(a.max_seeds, seeds + a.batch);
+      ++grown;
+    }
+    if (grown == 0) {
+      state.complete = true;
+      return state;
+    }
+    state.cells_grown.push_back(grown);
+    ++state.round;
+  }
+}
+
+SweepSpec round_zero_spec(const SweepSpec& spec) {
+  SweepSpec zero = spec;
+  if (!spec.adaptive.enabled) return zero;
+  for (StudySpec& s : zero.studies) s.seeds = spec.adaptive.initial_seeds;
+  zero.adaptive = AdaptiveSpec();
+  return zero;
+}
+
+}  // namespace phnn
