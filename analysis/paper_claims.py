@@ -617,13 +617,19 @@ def main(argv=None):
                         help="print the comparisons the statements make, as the `comparisons` "
                         "key of a sweep file's [adaptive] table (rule = \"comparisons\"); reads "
                         "only the file's cells (a file with every run pending will do)")
+    parser.add_argument("--round", type=int, default=None, metavar="K",
+                        help="adaptive sweeps: the verdicts as they stood after round K (0: "
+                        "every cell at its first seeds, e.g. the 10-seed verdicts)")
     args = parser.parse_args(argv)
     if not os.path.exists(args.results):
         parser.error(f"{args.results}: no such file")
     if args.write_comparisons:
         print(comparisons_toml(reduce_csv(args.results)))
         return 0
-    run_rows = reduce_csv(args.results, "--per-run")
+    if args.round is not None and args.round < 0:
+        parser.error("--round K needs K >= 0")
+    extra = ("--round", str(args.round)) if args.round is not None else ()
+    run_rows = reduce_csv(args.results, "--per-run", *extra)
     problems = setting_problems(run_rows)
     for p in problems:
         print(f"paper_claims.py: warning: {args.results}: {p}", file=sys.stderr)
@@ -632,10 +638,11 @@ def main(argv=None):
         return 1
     if args.stability < 0:
         parser.error("--stability N needs N >= 0")
-    stat_rows = reduce_csv(args.results)
+    stat_rows = reduce_csv(args.results, *extra)
     results = Results(stat_rows, run_rows)
     stable = stability(stat_rows, run_rows, args.stability) if args.stability else None
-    print(report(results, args.results, problems, stable))
+    title = args.results + (f" after round {args.round}" if args.round is not None else "")
+    print(report(results, title, problems, stable))
     return 0
 
 

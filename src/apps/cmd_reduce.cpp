@@ -156,12 +156,29 @@ void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
                "expected.\n\n";
 }
 
+// An adaptive sweep's rounds (up to --round K): the runs they asked for,
+// each cell expecting its own number of seeds. Nothing for other sweeps.
+std::optional<AdaptiveState> adaptive_rounds(const SweepSpec& spec, const Grid& grid,
+                                             const std::vector<RunStatus>& statuses,
+                                             const std::vector<double>& mse,
+                                             const cli::Parser& parser, const std::string& path) {
+  if (!spec.adaptive.enabled) {
+    if (parser.has("round")) {
+      throw cli::UsageError{"phnn reduce: --round: " + path + " is not an adaptive sweep (its "
+                            "sweep file has no [adaptive] table); drop --round"};
+    }
+    return std::nullopt;
+  }
+  const int last = parser.has("round") ? parser.get_int_in("round", 0, 1 << 20) : -1;
+  return replay_adaptive_rounds(spec, grid, statuses, mse, {}, last);
+}
+
 // Where an adaptive sweep stands, under the preamble.
 void print_adaptive_preamble(const SweepSpec& spec, const AdaptiveState& state) {
   std::cout << "Adaptive seeds (rule " << to_string(spec.adaptive.rule) << ", "
             << spec.adaptive.initial_seeds.size() << " seeds per cell, then " << spec.adaptive.batch
             << " more per round where the rule asks, at most " << spec.adaptive.max_seeds << "): "
-            << (state.complete ? "complete after round " : "round in progress: ") << state.round
+            << (state.complete ? "complete after round " : "up to round ") << state.round
             << "; " << state.active_runs() << " runs asked for; the other pending runs are seeds "
             << "no round asked for, left out of the tables.\n\n";
 }
@@ -186,6 +203,9 @@ int run_reduce(int argc, char** argv, int first) {
   parser.flag("per-run",
               "one row per run as CSV (every configuration key, status, MSE, best step, wall "
               "time, ...) instead of the tables");
+  parser.option("round",
+                 "adaptive sweeps: the tables as they stood after round K (0: every cell at its "
+                 "first seeds)");
   if (!parser.parse(argc, argv, first)) return 0;
   const bool per_run = parser.flag_set("per-run"), seeds_summary = parser.flag_set("seeds-summary");
   // --per-run writes CSV: it needs no --format csv, only refuses another one.
@@ -206,19 +226,24 @@ int run_reduce(int argc, char** argv, int first) {
       parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
   const Grid grid = checked_grid(file, spec);
   const std::vector<int> damaged = damaged_rows_named(file);
-  if (per_run) {
-    std::vector<RunRecord> records = read_run_records(file, grid);
-    for (int row : damaged) records[static_cast<std::size_t>(row)].status = RunStatus::kPending;
-    std::cout << render_per_run_csv(records);
-    return 0;
-  }
   auto statuses = file.read_statuses();
   for (int row : damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
   const auto mse = file.read_double_column("mse");
-  // An adaptive sweep: the runs its rounds asked for so far, each cell
-  // expecting its own number of seeds.
-  std::optional<AdaptiveState> adaptive;
-  if (spec.adaptive.enabled) adaptive = replay_adaptive_rounds(spec, grid, statuses, mse);
+  const std::optional<AdaptiveState> adaptive =
+      adaptive_rounds(spec, grid, statuses, mse, parser, path);
+  if (per_run) {
+    std::vector<RunRecord> records = read_run_records(file, grid);
+    for (int row : damaged) records[static_cast<std::size_t>(row)].status = RunStatus::kPending;
+    if (adaptive) {  // only the runs the rounds asked for
+      std::vector<RunRecord> asked;
+      for (std::size_t i = 0; i < records.size(); ++i) {
+        if (adaptive->active[i]) asked.push_back(std::move(records[i]));
+      }
+      records = std::move(asked);
+    }
+    std::cout << render_per_run_csv(records);
+    return 0;
+  }
   const auto entries = make_table_entries(grid, statuses, mse, adaptive ? &adaptive->active : nullptr);
   std::size_t expected_seeds = 0;
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());

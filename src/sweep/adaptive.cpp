@@ -154,7 +154,7 @@ std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
 AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
                                      const std::vector<RunStatus>& status,
                                      const std::vector<double>& mse,
-                                     const BootstrapOptions& bootstrap) {
+                                     const BootstrapOptions& bootstrap, int last_round) {
   if (!spec.adaptive.enabled) {
     throw std::invalid_argument("replay_adaptive_rounds: the sweep has no [adaptive] table");
   }
@@ -171,18 +171,20 @@ AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
     for (std::size_t i = 0; i < status.size(); ++i) {
       if (state.active[i] && status[i] == RunStatus::kPending) return state;  // round in progress
     }
-    int grown = 0;
+    std::vector<int> grow;
     for (int c : adaptive_rule_cells(spec, grid, state.active, status, mse, bootstrap)) {
-      int& seeds = state.cell_seeds[static_cast<std::size_t>(c)];
-      if (seeds >= a.max_seeds) continue;
-      seeds = std::min(a.max_seeds, seeds + a.batch);
-      ++grown;
+      if (state.cell_seeds[static_cast<std::size_t>(c)] < a.max_seeds) grow.push_back(c);
     }
-    if (grown == 0) {
+    if (grow.empty()) {
       state.complete = true;
       return state;
     }
-    state.cells_grown.push_back(grown);
+    if (last_round >= 0 && state.round >= last_round) return state;
+    for (int c : grow) {
+      int& seeds = state.cell_seeds[static_cast<std::size_t>(c)];
+      seeds = std::min(a.max_seeds, seeds + a.batch);
+    }
+    state.cells_grown.push_back(static_cast<int>(grow.size()));
     ++state.round;
   }
 }

@@ -46,6 +46,11 @@ grep -q "adaptive sweep complete after round 3: 24 runs of at most 24" "$dir/log
 per_run "$dir/np1.h5" "$dir/np1.csv"
 "$phnn" reduce "$dir/np1.h5" > "$dir/table.md" || fail "reduce of the adaptive file"
 grep -q "complete after round 3" "$dir/table.md" || fail "reduce does not say where the sweep stands"
+# --round K: the sweep as it stood after round K (round 0: 2 cells x 5 seeds).
+rows() { "$phnn" reduce "$dir/np1.h5" --per-run --round "$1" | tail -n +2 | wc -l; }
+[[ $(rows 0) -eq 10 && $(rows 1) -eq 16 && $(rows 3) -eq 24 ]] ||
+  fail "reduce --per-run --round 0/1/3 gave $(rows 0)/$(rows 1)/$(rows 3) runs, expected 10/16/24"
+"$phnn" reduce "$dir/np1.h5" --round 0 | grep -q "up to round 0" || fail "reduce --round 0"
 for np in 2 3; do
   sweep "$np" "$dir/np$np.h5" || fail "the $np-rank sweep failed"
   per_run "$dir/np$np.h5" "$dir/np$np.csv"

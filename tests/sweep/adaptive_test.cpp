@@ -163,6 +163,11 @@ TEST(AdaptiveRoundsTest, TiedCellsGrowByBatchUpToMaxSeeds) {
   EXPECT_EQ(s.round, 3);
   EXPECT_THAT(s.cells_grown, ElementsAre(2, 2, 2));
   EXPECT_EQ(s.active_runs(), 24);
+  // The same file as it stood after round 1: 5 + 3 seeds per cell.
+  const AdaptiveState after1 = replay_adaptive_rounds(spec, grid, r.status, r.mse, {}, 1);
+  EXPECT_FALSE(after1.complete);
+  EXPECT_EQ(after1.round, 1);
+  EXPECT_EQ(after1.active_runs(), 16);
 }
 
 TEST(AdaptiveRoundsTest, ARoundWithAPendingRunIsInProgress) {

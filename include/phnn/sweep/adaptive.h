@@ -41,12 +41,16 @@ struct AdaptiveState {
 /// its next `batch` seeds (fewer at the cap). Stops at the first round with a
 /// pending run, or when no cell grows. A run's result depends only on its
 /// configuration and seed, so the state is the same whichever ranks trained
-/// which runs, in whatever groups and order, and after any kill. Throws
+/// which runs, in whatever groups and order, and after any kill. With
+/// last_round >= 0 the replay also stops after that round (the runs of rounds
+/// 0 .. last_round; complete only if the sweep ended there): the sweep as it
+/// stood then, e.g. round 0 = every cell at its initial seeds. Throws
 /// std::invalid_argument unless spec.adaptive.enabled and the sizes match.
 AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
                                      const std::vector<RunStatus>& status,
                                      const std::vector<double>& mse,
-                                     const BootstrapOptions& bootstrap = {});
+                                     const BootstrapOptions& bootstrap = {},
+                                     int last_round = -1);
 
 /// The cells (indices into grid.cells, ascending) that spec.adaptive.rule
 /// names when the runs with active[i] != 0 are the results:
