@@ -342,6 +342,7 @@ class SweepRun {
   SweepDataSets data_{spec_, grid_};
   // An adaptive sweep's rounds so far (replay_rounds); unused otherwise.
   AdaptiveState adaptive_;
+  bool planned_once_ = false;
   Clock::time_point start_ = Clock::now();
 };
 
@@ -469,8 +470,11 @@ int SweepRun::close_and_report(std::string io_error, bool stopped, int total_run
 // broadcast lists give the same items on every rank.
 SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
   Planned p;
-  auto pending = pending_runs(grid_, status_codes, parser_.flag_set("retry-failed"), shard_,
-                              &p.runs_done_before);
+  // --retry-failed retries in the session's first round only (an adaptive
+  // sweep plans again after each round; a run that fails again stays failed).
+  auto pending = pending_runs(grid_, status_codes, parser_.flag_set("retry-failed") && !planned_once_,
+                              shard_, &p.runs_done_before);
+  planned_once_ = true;
   for (const auto& runs : pending) p.runs_to_do += static_cast<int>(runs.size());
   if (spec_.adaptive.enabled) {  // the seeds no round asked for read as finished
     p.runs_done_before -= static_cast<int>(grid_.runs.size()) - adaptive_.active_runs();
@@ -508,7 +512,7 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
     }
   }
   const bool quiet = parser_.flag_set("quiet");
-  int my_runs = 0;
+  RoundOutcome outcome;
   double last_progress = -1e9;
   const ProgressLine progress_line(work, size_, queue.mode() == ScheduleMode::kStatic);
   auto report_progress = [&](bool force) {
@@ -518,8 +522,7 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
   };
   // An I/O error on this rank: it takes no more items, nor do the others
   // after the one in hand; then every rank learns of it (agree below) and
-  // exits 1.
-  std::string io_error;
+  // exits 1 (outcome.io_error).
   // A stop signal on any rank stops every rank at its next item boundary:
   // this rank posts it at once, from the training's progress ticks too.
   auto post_stop = [&] {
@@ -551,9 +554,10 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
       post_stop();
       break;
     }
+    std::string& io_error = outcome.io_error;
     io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
     if (io_error.empty()) checkpoints.remove();
-    my_runs += static_cast<int>(item.runs.size());
+    outcome.my_runs += static_cast<int>(item.runs.size());
     if (!io_error.empty()) {
       queue.request_stop();  // the others stop at their next item too
       break;
@@ -566,12 +570,9 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
     report_progress(true);
   }
   post_stop();
-  RoundOutcome outcome;
   outcome.stopped =
       mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>()) != 0;
   queue.close();
-  outcome.my_runs = my_runs;
-  outcome.io_error = io_error;
   return outcome;
 }
 

@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Where an adaptive sweep spent its seeds, and what it cost against every cell at max_seeds.
+
+    /usr/bin/python3 analysis/adaptive_cost.py results/paper-adaptive.h5 sweeps/paper-adaptive.toml
+
+Seeds per cell come from `phnn reduce --per-run` (exactly the runs the rounds asked for), measured
+core-seconds from the runs' `wall_time_s` (an item's wall time shared by its members; one thread
+per rank, so core-seconds). The 40-seed (max_seeds) cost is not measured: per cell it is the
+measured cost scaled by the cost model's ratio, cost(max_seeds) / cost(trained), with the model's
+per-cell fixed and per-member seconds from `phnn sweep SWEEP --dry-run --cell-costs` and a fixed
+part paid once per round the cell trained in (one work item per round). The same figures from the
+cost model alone are printed beside it.
+"""
+import argparse
+import math
+import sys
+from collections import Counter
+
+from phnn_tool import run_csv
+
+def cell_key(row, model_field):
+    return (row["system"], row[model_field], row["size"], row["n_train"], row["regularizer"])
+
+
+def summarize(run_rows, cost_rows, initial, batch, max_seeds):
+    """Per-cell seeds and costs; returns a dict of totals (core-seconds) and the seed histogram."""
+    seeds, measured = Counter(), Counter()
+    for r in run_rows:
+        k = cell_key(r, "model_label")
+        seeds[k] += 1
+        if r["wall_time_s"] not in ("", "nan"):
+            measured[k] += float(r["wall_time_s"])
+    model_trained = model_full = scaled_full = 0.0
+    for c in cost_rows:
+        k = cell_key(c, "model")
+        fixed, member = float(c["fixed_s"]), float(c["member_s"])
+        n = seeds.get(k, 0)
+        rounds = 1 + math.ceil(max(0, n - initial) / batch) if n else 0
+        trained = rounds * fixed + n * member
+        full = fixed + max_seeds * member
+        model_trained += trained
+        model_full += full
+        scaled_full += measured[k] * full / trained if trained > 0 else full
+    return {"seeds": seeds, "runs": sum(seeds.values()), "cells": len(cost_rows),
+            "measured": sum(measured.values()), "scaled_full": scaled_full,
+            "model_trained": model_trained, "model_full": model_full}
+
+
+def report(s, max_seeds):
+    hist = Counter(s["seeds"].values())
+    lines = ["- cells by seeds: " + ", ".join(f"{hist[k]} at {k}" for k in sorted(hist)),
+             f"- runs trained: {s['runs']} of {s['cells'] * max_seeds} "
+             f"({100 * s['runs'] / (s['cells'] * max_seeds):.0f} %)",
+             f"- measured: {s['measured'] / 3600:.2f} core-hours; every cell at {max_seeds} seeds, "
+             f"scaled by the cost model: {s['scaled_full'] / 3600:.2f} core-hours "
+             f"({100 * s['measured'] / s['scaled_full']:.0f} %)",
+             f"- cost model alone: {s['model_trained'] / 3600:.2f} against "
+             f"{s['model_full'] / 3600:.2f} core-hours "
+             f"({100 * s['model_trained'] / s['model_full']:.0f} %)"]
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("results", help="results file of an adaptive sweep")
+    parser.add_argument("sweep", help="its sweep file (for the cost model's per-cell seconds)")
+    args = parser.parse_args(argv)
+    import tomllib
+    with open(args.sweep, "rb") as f:
+        adaptive = tomllib.load(f).get("adaptive")
+    if not adaptive:
+        parser.error(f"{args.sweep}: no [adaptive] table")
+    runs = run_csv("reduce", args.results, "--per-run")
+    costs = run_csv("sweep", args.sweep, "--dry-run", "--cell-costs")
+    # Round 0's seeds: the fewest any cell has (every cell trains them).
+    seeds_by_cell = Counter(cell_key(r, "model_label") for r in runs)
+    initial = min(seeds_by_cell.values()) if seeds_by_cell else 0
+    s = summarize(runs, costs, initial, adaptive["batch"], adaptive["max_seeds"])
+    print(report(s, adaptive["max_seeds"]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
