@@ -210,5 +210,16 @@ class WriteComparisons(unittest.TestCase):
         self.assertGreaterEqual(len(pc.RECORDED), len(pairs))  # duplicates merged
 
 
+class VerdictTable(unittest.TestCase):
+    def test_rows_marked_where_columns_differ(self):
+        import verdict_table as vt
+        a = {"I.1": ("holds", None), "I.4": ("same direction", 0.95)}
+        b = {"I.1": ("holds", None), "I.4": ("partly", 0.5)}
+        lines = vt.table([a, b], ["x.h5@0", "x.h5"]).splitlines()
+        self.assertEqual(lines[0], "| # | x.h5@0 | x.h5 | differ |")
+        self.assertEqual(lines[2], "| I.1 | holds | holds |  |")
+        self.assertEqual(lines[3], "| I.4 | same direction (95 %) | partly (50 %!) | **yes** |")
+
+
 if __name__ == "__main__":
     unittest.main()
