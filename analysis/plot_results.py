@@ -144,6 +144,14 @@ def load(path):
         sweep = parse_sweep(text([f.attrs.get("sweep_text", b"")])[0])
     runs["mse"] = np.where(runs["status"] == DIVERGED, np.inf, runs["mse"])
     runs["rows"] = np.arange(len(runs["status"]))
+    if "adaptive" in sweep:  # only the runs its rounds asked for (phnn reduce --per-run)
+        from phnn_tool import run_csv
+        asked = {r["run_id"] for r in run_csv("reduce", path, "--per-run")}
+        keep = np.array([i in asked for i in runs["id"]], dtype=bool)
+        runs = {k: (v if k in ("states", "has_weights") else
+                    v[keep] if isinstance(v, np.ndarray) else [x for x, k2 in zip(v, keep) if k2])
+                for k, v in runs.items()}
+        runs["rows"] = np.arange(len(runs["status"]))  # positions in the kept arrays
     return runs, name, sweep
 
 

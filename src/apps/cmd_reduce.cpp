@@ -136,13 +136,16 @@ std::vector<int> damaged_rows_named(const ResultsFile& file) {
   return damaged;
 }
 
+// `statuses`: of the runs the tables cover (an adaptive sweep's: those its
+// rounds asked for).
 void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
                              const std::vector<RunStatus>& statuses, bool seeds_summary) {
   int counts[4] = {0, 0, 0, 0};
   for (RunStatus s : statuses) ++counts[static_cast<int>(s)];
   std::cout << "# " << spec.name << " — " << file.path() << "\n\n"
             << counts[1] << " done, " << counts[2] << " diverged, " << counts[3] << " failed, "
-            << counts[0] << " pending of " << file.num_runs() << " runs. ";
+            << counts[0] << " pending of " << statuses.size() << " runs"
+            << (spec.adaptive.enabled ? " asked for" : "") << ". ";
   if (seeds_summary) {
     std::cout << "Cells: seeds whose inference MSE (Eq. 31) lies below / above the column's "
                  "geometric midpoint m; (d=k) diverged runs (counted above), (n=k/N) finished "
@@ -170,7 +173,15 @@ std::optional<AdaptiveState> adaptive_rounds(const SweepSpec& spec, const Grid& 
     return std::nullopt;
   }
   const int last = parser.has("round") ? parser.get_int_in("round", 0, 1 << 20) : -1;
-  return replay_adaptive_rounds(spec, grid, statuses, mse, {}, last);
+  AdaptiveState state = replay_adaptive_rounds(spec, grid, statuses, mse, {}, last);
+  if (last > state.round || (last == state.round && state.pending > 0)) {
+    std::cerr << "phnn reduce: warning: --round " << last << ": " << path
+              << (state.complete ? " ended after round " + std::to_string(state.round)
+                                 : " is in round " + std::to_string(state.round) + ", " +
+                                       std::to_string(state.pending) + " of its runs pending")
+              << "; the tables show that\n";
+  }
+  return state;
 }
 
 // Where an adaptive sweep stands, under the preamble.
@@ -249,7 +260,11 @@ int run_reduce(int argc, char** argv, int first) {
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());
   if (adaptive) expected_seeds = 0;
   if (format == TableFormat::kMarkdown) {
-    print_markdown_preamble(file, spec, statuses, seeds_summary);
+    std::vector<RunStatus> covered;
+    for (std::size_t i = 0; i < statuses.size(); ++i) {
+      if (!adaptive || adaptive->active[i]) covered.push_back(statuses[i]);
+    }
+    print_markdown_preamble(file, spec, covered, seeds_summary);
     if (adaptive) print_adaptive_preamble(spec, *adaptive);
   }
   const int expected = static_cast<int>(expected_seeds);

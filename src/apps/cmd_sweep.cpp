@@ -613,7 +613,7 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
 // finished in *status_codes, so no rank plans them.
 int SweepRun::replay_rounds(std::vector<int>* status_codes) {
   std::vector<int> codes, active;
-  int round = 0, complete = 0;
+  int round = 0, complete = 0, failed = 0;
   std::vector<int> cells_grown;
   if (int status = agreed(world_, root_, [&] {
         const ResultsFile file = ResultsFile::open_read_only(out_);
@@ -625,6 +625,7 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
         round = state.round;
         complete = state.complete ? 1 : 0;
         cells_grown = state.cells_grown;
+        failed = state.failed;
       })) {
     return status;
   }
@@ -641,6 +642,12 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
     if (!active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
   }
   *status_codes = codes;
+  if (root_ && failed > 0) {
+    std::cout << "phnn sweep: warning: " << failed << " failed run" << (failed > 1 ? "s" : "")
+              << " asked for by the rounds so far (their messages: phnn reduce --per-run); the "
+                 "rounds were decided without them; --retry-failed retries them and the rounds "
+                 "after are decided again" << std::endl;
+  }
   if (root_ && !adaptive_.complete) {
     std::cout << "phnn sweep: adaptive round " << round << ": " << adaptive_.active_runs()
               << " runs asked for of at most " << grid_.runs.size() << " ("

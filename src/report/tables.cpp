@@ -270,9 +270,9 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
 
 }  // namespace
 
-std::vector<TableCellName> tied_cells(const std::vector<StudyTable>& studies,
-                                      const std::vector<TableEntry>& entries, int expected_seeds,
-                                      const BootstrapOptions& bootstrap) {
+std::vector<TableCellName> undecided_cells(const std::vector<StudyTable>& studies,
+                                           const std::vector<TableEntry>& entries,
+                                           int expected_seeds, const BootstrapOptions& bootstrap) {
   bootstrap.validate();
   const CellIndex by_cell = index_cells(entries);
   std::vector<TableCellName> tied;
@@ -284,7 +284,13 @@ std::vector<TableCellName> tied_cells(const std::vector<StudyTable>& studies,
         for (std::size_t r = 0; r < study.rows.size(); ++r) {
           column[r] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap);
         }
-        if (!unmarkable(column, study.rows).empty()) continue;
+        if (!unmarkable(column, study.rows).empty()) {
+          // No intervals to compare: the cells that lack one are undecided.
+          for (std::size_t r = 0; r < study.rows.size(); ++r) {
+            if (!column[r].has_interval()) tied.push_back({study.name, system, study.rows[r], study.columns[c]});
+          }
+          continue;
+        }
         const std::vector<Mark> marks = mark_column(column);
         for (std::size_t r = 0; r < study.rows.size(); ++r) {
           if (marks[r] == Mark::kTie) tied.push_back({study.name, system, study.rows[r], study.columns[c]});

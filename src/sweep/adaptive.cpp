@@ -38,7 +38,7 @@ std::vector<int> column_best_cells(const Grid& grid, const std::vector<char>& ac
     }
   }
   std::vector<int> cells;
-  for (const TableCellName& t : tied_cells(grid.studies, entries, 0, bootstrap)) {
+  for (const TableCellName& t : undecided_cells(grid.studies, entries, 0, bootstrap)) {
     cells.push_back(cell_by_name.at({t.study, t.system, t.row, t.column}));
   }
   return cells;
@@ -168,9 +168,13 @@ AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
   state.cell_seeds.assign(grid.cells.size(), static_cast<int>(a.initial_seeds.size()));
   for (;;) {
     mark_active(grid, &state);
+    state.pending = state.failed = 0;
     for (std::size_t i = 0; i < status.size(); ++i) {
-      if (state.active[i] && status[i] == RunStatus::kPending) return state;  // round in progress
+      if (!state.active[i]) continue;
+      state.pending += status[i] == RunStatus::kPending ? 1 : 0;
+      state.failed += status[i] == RunStatus::kFailed ? 1 : 0;
     }
+    if (state.pending > 0) return state;  // round in progress
     std::vector<int> grow;
     for (int c : adaptive_rule_cells(spec, grid, state.active, status, mse, bootstrap)) {
       if (state.cell_seeds[static_cast<std::size_t>(c)] < a.max_seeds) grow.push_back(c);

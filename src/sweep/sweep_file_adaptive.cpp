@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <sstream>
 
+#include "phnn/report/tables.h"
+
 namespace phnn {
 
 std::string to_string(AdaptiveRule rule) {
@@ -61,8 +63,16 @@ CellSelector parse_selector(const std::string& text, int line, const ValueReader
   for (const auto& [kind, integrator] : known_model_pairs()) {
     model_names.push_back(model_key(kind, integrator));
   }
+  if (parts[1].empty()) {
+    reader.fail(line, "comparison cell " + quoted(text) + " names no model; write " +
+                          kSelectorForm);
+  }
   for (const std::string& m : split(parts[1], '+')) {
     s.models.push_back(named(m, known_model_pairs(), model_names, "model", text, line, reader));
+    if (std::count(s.models.begin(), s.models.end(), s.models.back()) > 1) {
+      reader.fail(line, "comparison cell " + quoted(text) + " names model " + quoted(m) +
+                            " twice; list each model once");
+    }
   }
   const std::string& n = parts[2];
   if (n.empty() || n.size() > 9 || !std::all_of(n.begin(), n.end(), [](char c) { return c >= '0' && c <= '9'; })) {
@@ -77,6 +87,18 @@ CellSelector parse_selector(const std::string& text, int line, const ValueReader
   s.regularizer = named(parts[4], regularizers, {"none", "cn", "sn", "sr"}, "regularizer", text,
                         line, reader);
   return s;
+}
+
+// Whether two selectors can pick the same cell.
+bool shares_a_cell(const CellSelector& a, const CellSelector& b) {
+  if (a.system != b.system || a.n_train != b.n_train || a.size != b.size ||
+      a.regularizer != b.regularizer) {
+    return false;
+  }
+  for (const auto& m : a.models) {
+    if (std::find(b.models.begin(), b.models.end(), m) != b.models.end()) return true;
+  }
+  return false;
 }
 
 // comparisons = [["A", "B"], ...]: pairs of cell selectors.
@@ -98,6 +120,11 @@ std::vector<SeedComparison> comparisons(const Entry& e, const ValueReader& reade
     c.line = line;
     c.a = parse_selector(*(*two)[0].value<std::string>(), line, reader);
     c.b = parse_selector(*(*two)[1].value<std::string>(), line, reader);
+    if (shares_a_cell(c.a, c.b)) {
+      reader.fail(line, "comparison of " + quoted(c.a.text) + " with " + quoted(c.b.text) +
+                            ": both sides can pick the same cell, so it could never be "
+                            "resolved; compare two different cells");
+    }
     out.push_back(std::move(c));
   }
   return out;
@@ -192,6 +219,11 @@ void apply_adaptive(SweepSpec* spec, int line, const ValueReader& values) {
     }
   }
   const int initial = static_cast<int>(a.initial_seeds.size());
+  if (a.rule == AdaptiveRule::kColumnBest && initial < kMinSeedsForInterval) {
+    values.fail(line, "rule = \"column-best\" reads the tables' intervals, which need at least " +
+                      std::to_string(kMinSeedsForInterval) + " seeds per cell; give `seeds` at "
+                      "least that many (e.g. \"0-9\")");
+  }
   if (a.max_seeds < initial) {
     values.fail(line, "[adaptive] max_seeds = " + std::to_string(a.max_seeds) + " is below the " +
                       std::to_string(initial) + " seeds every cell starts with; raise max_seeds "

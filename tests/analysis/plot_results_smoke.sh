@@ -63,5 +63,19 @@ if [ $# -ge 2 ]; then
         && grep -q '^| 1 | 2 | 100.0 % | 100.0 % | 100.0 % |$' "$out/replay.md" \
         && grep -q '^| 2 | ' "$out/replay.md" \
         || { echo "schedule_replay.py: unexpected output" >&2; cat "$out/replay.md" >&2; exit 1; }
+    # The comparisons of the shipped adaptive sweeps are what paper_claims.py writes for their
+    # grids (a sweep stopped at once: every run pending, every cell listed).
+    for f in paper-adaptive paper-adaptive-study1; do
+        timeout -s TERM 2 "$2" sweep "$root/sweeps/$f.toml" --out "$out/$f.h5" > /dev/null 2>&1 || true
+        PHNN="$2" "$py" "$root/analysis/paper_claims.py" "$out/$f.h5" --write-comparisons > "$out/$f.cmp"
+        grep -q '^  \["' "$out/$f.cmp" || { echo "$f: no comparison written" >&2; exit 1; }
+        sed -n '/^comparisons = \[/,/^\]/p' "$root/sweeps/$f.toml" | diff - "$out/$f.cmp" > /dev/null \
+            || { echo "sweeps/$f.toml: comparisons differ from paper_claims.py's" >&2; exit 1; }
+    done
+    # plot_results.py on an adaptive file draws only the runs its rounds asked for.
+    PHNN="$2" "$py" "$root/analysis/plot_results.py" "$out/paper-adaptive-study1.h5" "$out/fig4" \
+        > "$out/fig4.log" 2>&1 || { cat "$out/fig4.log" >&2; exit 1; }
+    grep -q "pending of 450 runs" "$out/fig4.log" \
+        || { echo "plot_results.py: not the 450 runs of round 0" >&2; cat "$out/fig4.log" >&2; exit 1; }
 fi
 echo "plot_results smoke test passed"

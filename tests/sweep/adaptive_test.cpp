@@ -60,9 +60,10 @@ TEST(AdaptiveSweepFileTest, SeedsGrowToMaxSeedsAndRoundZeroKeepsTheFileSeeds) {
 
 TEST(AdaptiveSweepFileTest, ComparisonsParseIntoSelectors) {
   const SweepSpec spec = parse_sweep_text(
-      sweep_text(kTwoModels, "max_seeds = 12\nbatch = 3\nrule = \"comparisons\"\n"
-                             "comparisons = [[\"harmonic/phnn-jr-rk2+phnn-jr-rk4/25/small/none\",\n"
-                             "                \"harmonic/phnn-jr-rk4/25/small/none\"]]\n"),
+      sweep_text(kTwoModels + ", \"node-rk2\"",
+                 "max_seeds = 12\nbatch = 3\nrule = \"comparisons\"\n"
+                 "comparisons = [[\"harmonic/phnn-jr-rk2+phnn-jr-rk4/25/small/none\",\n"
+                 "                \"harmonic/node-rk2/25/small/none\"]]\n"),
       "x.toml");
   ASSERT_EQ(spec.adaptive.comparisons.size(), 1u);
   const SeedComparison& c = spec.adaptive.comparisons[0];
@@ -103,6 +104,18 @@ TEST(AdaptiveSweepFileTest, SelectorsMustNameCellsOfTheStudies) {
               HasSubstr("at n_train 100"));
   EXPECT_THAT(error_of(with("harmonic/phnn-jr-rk2/x/small/none")),
               HasSubstr("n_train \"x\" is not a positive integer"));
+  EXPECT_THAT(error_of(with("harmonic//25/small/none")), HasSubstr("names no model"));
+  EXPECT_THAT(error_of(with("harmonic/phnn-jr-rk4+phnn-jr-rk4/25/small/none")),
+              HasSubstr("names model \"phnn-jr-rk4\" twice"));
+  // The other side is phnn-jr-rk2 at the same settings: never resolvable.
+  EXPECT_THAT(error_of(with("harmonic/phnn-jr-rk4+phnn-jr-rk2/25/small/none")),
+              AllOf(HasSubstr("x.toml:10:"), HasSubstr("both sides can pick the same cell")));
+}
+
+TEST(AdaptiveSweepFileTest, ColumnBestNeedsFiveSeeds) {
+  std::string text = sweep_text(kTwoModels, kColumnBest);
+  text.replace(text.find("0-4"), 3, "0-3");
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("x.toml:6:"), HasSubstr("at least 5 seeds")));
 }
 
 TEST(AdaptiveSweepFileTest, StudiesMustShareTheirSeeds) {
@@ -170,6 +183,28 @@ TEST(AdaptiveRoundsTest, TiedCellsGrowByBatchUpToMaxSeeds) {
   EXPECT_EQ(after1.active_runs(), 16);
 }
 
+TEST(AdaptiveRoundsTest, ColumnBestNamesCellsWithoutAnIntervalAndFailedRunsStayOut) {
+  const SweepSpec spec = parse_sweep_text(sweep_text(kTwoModels, kColumnBest), "x.toml");
+  const Grid grid = expand_grid(spec);
+  // Separated cells, but one RK4 seed of round 0 failed: RK4 has 4 finished
+  // seeds, no interval, the column marks nothing, and RK4 alone gets seeds.
+  Results r = results_of(grid, [](const RunConfig& run) {
+    return run.integrator == IntegratorKind::kRk2 ? 1e-3 * (1.0 + run.seed) : 1.0 + run.seed;
+  });
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+    if (grid.runs[i].seed == 2 && grid.runs[i].integrator == IntegratorKind::kRk4) {
+      r.status[i] = RunStatus::kFailed;
+      r.mse[i] = 1e-9;  // never read: a failed run's MSE is not a result
+    }
+  }
+  const AdaptiveState s = replay_adaptive_rounds(spec, grid, r.status, r.mse);
+  EXPECT_TRUE(s.complete);
+  EXPECT_EQ(s.failed, 1);
+  EXPECT_EQ(seeds_of(s, grid, IntegratorKind::kRk2), 5);
+  EXPECT_EQ(seeds_of(s, grid, IntegratorKind::kRk4), 8);  // 7 finished: separated again
+  EXPECT_THAT(s.cells_grown, ElementsAre(1));
+}
+
 TEST(AdaptiveRoundsTest, ARoundWithAPendingRunIsInProgress) {
   const SweepSpec spec = parse_sweep_text(sweep_text(kTwoModels, kColumnBest), "x.toml");
   const Grid grid = expand_grid(spec);
@@ -184,7 +219,10 @@ TEST(AdaptiveRoundsTest, ARoundWithAPendingRunIsInProgress) {
   EXPECT_FALSE(s.complete);
   EXPECT_EQ(s.round, 1);
   EXPECT_EQ(s.active_runs(), 16);
+  EXPECT_EQ(s.pending, 1);
   EXPECT_EQ(seeds_of(s, grid, IntegratorKind::kRk4), 8);
+  // Asked for the state after round 3 while round 1 is in progress: round 1.
+  EXPECT_EQ(replay_adaptive_rounds(spec, grid, r.status, r.mse, {}, 3).round, 1);
 }
 
 TEST(AdaptiveRoundsTest, ComparisonsGrowOnlyTheCellsOfUnresolvedComparisons) {
@@ -219,8 +257,9 @@ TEST(AdaptiveRoundsTest, TheRuleSeesOnlyTheRunsAskedFor) {
   const Results r = results_of(grid, [](const RunConfig& run) {
     return run.integrator == IntegratorKind::kRk2 ? 1e-3 * (1.0 + run.seed) : 1.0 + run.seed;
   });
+  // No run asked for: no cell has an interval, so both are undecided.
   std::vector<char> active(grid.runs.size(), 0);
-  EXPECT_TRUE(adaptive_rule_cells(spec, grid, active, r.status, r.mse).empty());
+  EXPECT_EQ(adaptive_rule_cells(spec, grid, active, r.status, r.mse).size(), 2u);
   for (std::size_t i = 0; i < grid.runs.size(); ++i) active[i] = grid.runs[i].seed < 5;
   EXPECT_TRUE(adaptive_rule_cells(spec, grid, active, r.status, r.mse).empty());
   Results tied = r;

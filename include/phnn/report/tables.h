@@ -128,15 +128,16 @@ struct TableCellName {
   std::string study, system, row, column;
 };
 
-/// The cells render_tables() marks " (tie)" (same entries, expected_seeds
-/// and bootstrap), in table order: per column, the smallest median and every
-/// cell whose interval overlaps its interval — the cells whose order more
-/// seeds may settle (an adaptive sweep's "column-best" rule). A column
-/// without a mark (a row with fewer than kMinSeedsForInterval finished runs)
-/// names none.
-std::vector<TableCellName> tied_cells(const std::vector<StudyTable>& studies,
-                                      const std::vector<TableEntry>& entries, int expected_seeds,
-                                      const BootstrapOptions& bootstrap = {});
+/// The cells whose order in their column more seeds may settle (an adaptive
+/// sweep's "column-best" rule), in table order: per column, the cells
+/// render_tables() marks " (tie)" (same entries, expected_seeds and
+/// bootstrap): the smallest median and every cell whose interval overlaps its
+/// interval; in a column that marks nothing because a row has fewer than
+/// kMinSeedsForInterval finished runs, the cells with fewer (no interval).
+std::vector<TableCellName> undecided_cells(const std::vector<StudyTable>& studies,
+                                           const std::vector<TableEntry>& entries,
+                                           int expected_seeds,
+                                           const BootstrapOptions& bootstrap = {});
 
 /// The seeds behind each cell, to make a bimodal cell visible: for each
 /// column of each table, the geometric midpoint of its finite positive MSEs

@@ -29,6 +29,10 @@ struct AdaptiveState {
   bool complete = false;
   /// Per finished round k: the cells that got more seeds after it.
   std::vector<int> cells_grown;
+  /// Runs asked for that are pending (the round in progress) or failed (a
+  /// failed run counts as finished and its MSE is left out of the decisions,
+  /// as out of the tables).
+  int pending = 0, failed = 0;
 
   /// Runs asked for.
   int active_runs() const;
@@ -54,7 +58,8 @@ AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
 
 /// The cells (indices into grid.cells, ascending) that spec.adaptive.rule
 /// names when the runs with active[i] != 0 are the results:
-///   column-best:  tied_cells() of the study tables (phnn/report/tables.h);
+///   column-best:  undecided_cells() of the study tables (phnn/report/tables.h):
+///                 the (tie) cells, and cells without an interval;
 ///   comparisons:  for each comparison, the smallest-median cell of each side
 ///                 (among cells with a finished run; a side without one skips
 ///                 the comparison); both are named unless the two bootstrap
