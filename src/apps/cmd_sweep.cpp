@@ -598,9 +598,16 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
     if (int status = agree(world_, close_error.empty() ? 0 : kExitFailed, close_error)) {
       return status;
     }
+    const int round_before = adaptive_.round;
+    const int round_runs = mpi::all_reduce(world_, round.my_runs, std::plus<int>());
     if (int status = replay_rounds(&status_codes)) return status;
     if (int status = open_results()) return status;
     if (adaptive_.complete) break;
+    if (round_runs == 0 && adaptive_.round == round_before) {  // never loop without progress
+      round.io_error = prefix_ + "adaptive round " + std::to_string(round_before) +
+                       " has pending runs that this sweep did not train; stopping";
+      break;
+    }
   }
   const int total_runs = mpi::all_reduce(world_, my_runs, std::plus<int>());
   const int failed = close_and_report(round.io_error, round.stopped, total_runs, elapsed());
