@@ -6,6 +6,7 @@
 #include "phnn/sweep/adaptive.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 #include <tuple>
@@ -53,10 +54,11 @@ std::string selector_key(const std::string& system, ModelKind model, IntegratorK
 
 class ComparisonRule {
  public:
-  ComparisonRule(const Grid& grid, const std::vector<char>& active,
+  ComparisonRule(const AdaptiveSpec& adaptive, const Grid& grid, const std::vector<char>& active,
                  const std::vector<RunStatus>& status, const std::vector<double>& mse,
                  const BootstrapOptions& bootstrap)
-      : grid_(grid), active_(active), status_(status), mse_(mse), bootstrap_(bootstrap) {
+      : adaptive_(adaptive), grid_(grid), active_(active), status_(status), mse_(mse),
+        bootstrap_(bootstrap) {
     for (std::size_t c = 0; c < grid.cells.size(); ++c) {
       const RunConfig& run = grid.runs[static_cast<std::size_t>(grid.cells[c].runs.front())];
       cell_by_key_[selector_key(run.system_name(), run.model, run.integrator, run.n_train,
@@ -76,6 +78,10 @@ class ComparisonRule {
                                        : sa.median_interval.low > sb.median_interval.high;
     }
     if (resolved) return;
+    if (adaptive_.futility && sa.has_interval() && sb.has_interval() &&
+        projected(sa).overlaps(projected(sb))) {
+      return;  // max_seeds is not expected to resolve it
+    }
     cells->push_back(a);
     cells->push_back(b);
   }
@@ -95,6 +101,19 @@ class ComparisonRule {
     return best;
   }
 
+  // The interval at max_seeds if the median stays and both distances to
+  // it shrink as 1 / sqrt(seeds): [m - (m - lo) r, m + (hi - m) r] with
+  // r = sqrt(finished / max_seeds) (1 once at the cap). Infinite ends stay.
+  Interval projected(const CellSummary& s) const {
+    const double r = std::sqrt(std::min(1.0, static_cast<double>(s.finished()) /
+                                                 static_cast<double>(adaptive_.max_seeds)));
+    const Interval& i = s.median_interval;
+    const auto toward = [&](double end) {
+      return std::isfinite(end) && std::isfinite(s.median) ? s.median + (end - s.median) * r : end;
+    };
+    return Interval{toward(i.low), toward(i.high)};
+  }
+
   const CellSummary& summary(int cell) {
     const auto it = summaries_.find(cell);
     if (it != summaries_.end()) return it->second;
@@ -110,6 +129,7 @@ class ComparisonRule {
     return summaries_.emplace(cell, summarize_cell(entries, 0, bootstrap_)).first->second;
   }
 
+  const AdaptiveSpec& adaptive_;
   const Grid& grid_;
   const std::vector<char>& active_;
   const std::vector<RunStatus>& status_;
@@ -143,7 +163,7 @@ std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
   if (spec.adaptive.rule == AdaptiveRule::kColumnBest) {
     cells = column_best_cells(grid, active, status, mse, bootstrap);
   } else {
-    ComparisonRule rule(grid, active, status, mse, bootstrap);
+    ComparisonRule rule(spec.adaptive, grid, active, status, mse, bootstrap);
     for (const SeedComparison& c : spec.adaptive.comparisons) rule.name_cells(c, &cells);
   }
   std::sort(cells.begin(), cells.end());

@@ -182,8 +182,14 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
       a.rule = values.choice(k, all_adaptive_rules());
     } else if (k.key == "comparisons") {
       a.comparisons = comparisons(k, values);
+    } else if (k.key == "futility") {
+      if (!k.value->is_boolean()) {
+        values.fail(k.line, "futility expects true or false; got " + values.describe(*k.value));
+      }
+      a.futility = *k.value->value<bool>();
     } else {
-      const std::vector<std::string> keys = {"max_seeds", "batch", "rule", "comparisons"};
+      const std::vector<std::string> keys = {"max_seeds", "batch", "rule", "comparisons",
+                                             "futility"};
       values.fail(k.line, "unknown key " + quoted(k.key) + " in [adaptive]" +
                               did_you_mean(k.key, keys) + "; expected one of: " + join(keys));
     }
@@ -196,6 +202,10 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
   if (a.rule == AdaptiveRule::kComparisons && a.comparisons.empty()) {
     values.fail(e.line, "rule = \"comparisons\" needs `comparisons = [[\"A\", \"B\"], ...]` in "
                         "[adaptive]: the pairs of cells whose medians a question compares");
+  }
+  if (a.rule != AdaptiveRule::kComparisons && a.futility) {
+    values.fail(e.line, "futility applies to rule = \"comparisons\" only; set that rule or "
+                        "remove futility");
   }
   if (a.rule != AdaptiveRule::kComparisons && !a.comparisons.empty()) {
     values.fail(e.line, "comparisons are read by rule = \"comparisons\" only; set that rule or "

@@ -251,6 +251,35 @@ TEST(AdaptiveRoundsTest, ComparisonsGrowOnlyTheCellsOfUnresolvedComparisons) {
   EXPECT_THAT(s.cells_grown, ElementsAre(2));  // then both are at max_seeds
 }
 
+TEST(AdaptiveRoundsTest, FutilitySkipsComparisonsMaxSeedsCannotResolve) {
+  const std::string comparisons =
+      "max_seeds = 40\nbatch = 10\nrule = \"comparisons\"\n"
+      "comparisons = [[\"harmonic/phnn-jr-rk2/25/small/none\", \"harmonic/phnn-jr-rk4/25/small/none\"],\n"
+      "               [\"harmonic/phnn-jr-rk2/25/small/none\", \"harmonic/node-rk2/25/small/none\"]]\n";
+  const SweepSpec plain =
+      parse_sweep_text(sweep_text(kTwoModels + ", \"node-rk2\"", comparisons), "x.toml");
+  const SweepSpec futile = parse_sweep_text(
+      sweep_text(kTwoModels + ", \"node-rk2\"", comparisons + "futility = true\n"), "x.toml");
+  ASSERT_TRUE(futile.adaptive.futility);
+  const Grid grid = expand_grid(plain);
+  // RK2 and RK4 equal (a tie no seed count resolves); NODE 0.3 higher: its
+  // 5-seed interval overlaps RK2's, its interval at 40 seeds would not.
+  const Results r = results_of(grid, [](const RunConfig& run) {
+    return (run.model == ModelKind::kNode ? 1.3 : 1.0) + 0.1 * (run.seed % 5);
+  });
+  std::vector<char> active(grid.runs.size(), 0);
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) active[i] = grid.runs[i].seed < 5;
+  EXPECT_EQ(adaptive_rule_cells(plain, grid, active, r.status, r.mse).size(), 3u);
+  const std::vector<int> named = adaptive_rule_cells(futile, grid, active, r.status, r.mse);
+  ASSERT_EQ(named.size(), 2u);
+  for (int c : named) {
+    EXPECT_NE(grid.runs[static_cast<std::size_t>(grid.cells[c].runs[0])].integrator,
+              IntegratorKind::kRk4);
+  }
+  EXPECT_THAT(error_of(sweep_text(kTwoModels, kColumnBest + "futility = true\n")),
+              HasSubstr("futility applies to rule = \"comparisons\" only"));
+}
+
 TEST(AdaptiveRoundsTest, TheRuleSeesOnlyTheRunsAskedFor) {
   const SweepSpec spec = parse_sweep_text(sweep_text(kTwoModels, kColumnBest), "x.toml");
   const Grid grid = expand_grid(spec);

@@ -121,6 +121,11 @@ struct AdaptiveSpec {
   int max_seeds = 0, batch = 0;
   AdaptiveRule rule = AdaptiveRule::kColumnBest;
   std::vector<SeedComparison> comparisons;
+  /// rule comparisons only: skip an unresolved comparison that max_seeds is
+  /// not expected to resolve — its two intervals, narrowed about their
+  /// medians by sqrt(finished / max_seeds), still overlap (docs/METHOD.md,
+  /// "Adaptive seeds").
+  bool futility = false;
   /// The studies' `seeds` as written (every study has the same): round 0.
   /// With [adaptive], StudySpec::seeds holds these and then the
   /// max_seeds - initial_seeds.size() next seed numbers (the runs a cell may get).
