@@ -314,6 +314,10 @@ class SweepRun {
   int replay_rounds(std::vector<int>* status_codes);
   std::string adaptive_dry_run() const;
   std::string adaptive_line() const;
+  // Seconds since this sweep started.
+  double elapsed() const {
+    return std::chrono::duration<double>(Clock::now() - start_).count();
+  }
   int close_and_report(std::string io_error, bool stopped, int total_runs, double seconds);
 
   int argc_;
@@ -498,7 +502,6 @@ SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
 }
 
 SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_codes) {
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
   const Planned planned = plan(status_codes);
   const std::vector<WorkItem>& work = planned.plan.items;
   const ScheduleMode mode = parser_.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
@@ -580,7 +583,6 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
 // the finished file (every rank closes it, rank 0 replays the rounds, every
 // rank opens it again), until its rule names no cell that can grow.
 int SweepRun::train_and_close(std::vector<int> status_codes) {
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start_).count(); };
   int my_runs = 0;
   RoundOutcome round;
   for (;;) {
@@ -619,36 +621,28 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
 // rank), every rank gets the state, and the runs no round asked for read as
 // finished in *status_codes, so no rank plans them.
 int SweepRun::replay_rounds(std::vector<int>* status_codes) {
-  std::vector<int> codes, active;
-  int round = 0, complete = 0, failed = 0;
-  std::vector<int> cells_grown;
+  std::vector<int> codes;
   if (int status = agreed(world_, root_, [&] {
         const ResultsFile file = ResultsFile::open_read_only(out_);
         const std::vector<RunStatus> statuses = file.read_statuses();
-        const AdaptiveState state =
-            replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
+        adaptive_ = replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
         for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
-        active.assign(state.active.begin(), state.active.end());
-        round = state.round;
-        complete = state.complete ? 1 : 0;
-        cells_grown = state.cells_grown;
-        failed = state.failed;
       })) {
     return status;
   }
+  // What the other ranks use of the state (cell_seeds, pending and failed
+  // stay rank 0's).
   mpi::broadcast(world_, codes, 0);
-  mpi::broadcast(world_, active, 0);
-  mpi::broadcast(world_, cells_grown, 0);
-  mpi::broadcast(world_, round, 0);
-  mpi::broadcast(world_, complete, 0);
-  adaptive_.active.assign(active.begin(), active.end());
-  adaptive_.round = round;
-  adaptive_.complete = complete != 0;
-  adaptive_.cells_grown = cells_grown;
+  mpi::broadcast(world_, adaptive_.active, 0);
+  mpi::broadcast(world_, adaptive_.cells_grown, 0);
+  mpi::broadcast(world_, adaptive_.round, 0);
+  mpi::broadcast(world_, adaptive_.complete, 0);
   for (std::size_t i = 0; i < codes.size(); ++i) {
-    if (!active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
+    if (!adaptive_.active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
   }
   *status_codes = codes;
+  const int round = adaptive_.round, failed = adaptive_.failed;
+  const std::vector<int>& cells_grown = adaptive_.cells_grown;
   if (root_ && failed > 0) {
     std::cout << "phnn sweep: warning: " << failed << " failed run" << (failed > 1 ? "s" : "")
               << " asked for by the rounds so far (their messages: phnn reduce --per-run); the "

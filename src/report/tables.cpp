@@ -163,6 +163,27 @@ std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   return marks;
 }
 
+// One column of a table judged as render_tables() marks it: each row's
+// summary, then either why nothing is marked or the marks.
+struct ColumnJudgement {
+  std::vector<CellSummary> cells;  // per row
+  std::string unmarkable;          // "" if the column may mark a best
+  std::vector<Mark> marks;         // per row; kNone throughout when unmarkable
+};
+
+ColumnJudgement judge_column(const TableEntries& t, std::size_t c, int expected_seeds,
+                             const BootstrapOptions& bootstrap) {
+  const std::size_t rows = t.study->rows.size();
+  ColumnJudgement j;
+  j.cells.resize(rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    j.cells[r] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap);
+  }
+  j.unmarkable = unmarkable(j.cells, t.study->rows);
+  j.marks = j.unmarkable.empty() ? mark_column(j.cells) : std::vector<Mark>(rows, Mark::kNone);
+  return j;
+}
+
 // " (n=k)" when `counts` and the cell is complete (an incomplete one says
 // " (n=k/N)" in its annotations).
 std::string own_count(const CellSummary& s, bool counts) {
@@ -218,17 +239,14 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
   std::vector<std::vector<Mark>> marks(rows, std::vector<Mark>(cols, Mark::kNone));
   std::vector<std::string> unmarked;  // "column: why", for the note under the table
   for (std::size_t c = 0; c < cols; ++c) {
-    std::vector<CellSummary> column(rows);
+    const ColumnJudgement j = judge_column(t, c, expected_seeds, bootstrap);
     for (std::size_t r = 0; r < rows; ++r) {
-      column[r] = cells[r][c] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap);
+      cells[r][c] = j.cells[r];
+      marks[r][c] = j.marks[r];
     }
-    const std::string why = unmarkable(column, t.study->rows);
-    if (!why.empty()) {
-      unmarked.push_back((cols > 1 ? t.study->columns[c] + ": " : std::string()) + why);
-      continue;
+    if (!j.unmarkable.empty()) {
+      unmarked.push_back((cols > 1 ? t.study->columns[c] + ": " : std::string()) + j.unmarkable);
     }
-    const std::vector<Mark> column_marks = mark_column(column);
-    for (std::size_t r = 0; r < rows; ++r) marks[r][c] = column_marks[r];
   }
   if (format == TableFormat::kCsv) return render_summary_csv(t, cells, marks, out);
   TextTable text{t.study, t.system, t.study->columns, {}, {}, {}};
@@ -280,20 +298,12 @@ std::vector<TableCellName> undecided_cells(const std::vector<StudyTable>& studie
     for (const std::string& system : study.systems) {
       const TableEntries t = gather_table(study, system, by_cell);
       for (std::size_t c = 0; c < study.columns.size(); ++c) {
-        std::vector<CellSummary> column(study.rows.size());
+        const ColumnJudgement j = judge_column(t, c, expected_seeds, bootstrap);
         for (std::size_t r = 0; r < study.rows.size(); ++r) {
-          column[r] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap);
-        }
-        if (!unmarkable(column, study.rows).empty()) {
-          // No intervals to compare: the cells that lack one are undecided.
-          for (std::size_t r = 0; r < study.rows.size(); ++r) {
-            if (!column[r].has_interval()) tied.push_back({study.name, system, study.rows[r], study.columns[c]});
-          }
-          continue;
-        }
-        const std::vector<Mark> marks = mark_column(column);
-        for (std::size_t r = 0; r < study.rows.size(); ++r) {
-          if (marks[r] == Mark::kTie) tied.push_back({study.name, system, study.rows[r], study.columns[c]});
+          // Unmarkable: no intervals to compare, the cells without one are undecided.
+          const bool undecided = j.unmarkable.empty() ? j.marks[r] == Mark::kTie
+                                                      : !j.cells[r].has_interval();
+          if (undecided) tied.push_back({study.name, system, study.rows[r], study.columns[c]});
         }
       }
     }
