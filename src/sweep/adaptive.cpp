@@ -56,9 +56,9 @@ class ComparisonRule {
  public:
   ComparisonRule(const AdaptiveSpec& adaptive, const Grid& grid, const std::vector<char>& active,
                  const std::vector<RunStatus>& status, const std::vector<double>& mse,
-                 const BootstrapOptions& bootstrap)
+                 const BootstrapOptions& bootstrap, const BootstrapOptions& stop)
       : adaptive_(adaptive), grid_(grid), active_(active), status_(status), mse_(mse),
-        bootstrap_(bootstrap) {
+        bootstrap_(bootstrap), stop_(stop) {
     for (std::size_t c = 0; c < grid.cells.size(); ++c) {
       const RunConfig& run = grid.runs[static_cast<std::size_t>(grid.cells[c].runs.front())];
       cell_by_key_[selector_key(run.system_name(), run.model, run.integrator, run.n_train,
@@ -66,18 +66,14 @@ class ComparisonRule {
     }
   }
 
-  // Named cells of one comparison (none, or both sides' picks).
+  // Named cells of one comparison (none, or both sides' picks): resolved
+  // at the stop confidence, or futile at the tables' confidence, stops it.
   void name_cells(const SeedComparison& c, std::vector<int>* cells) {
     const int a = pick(c.a), b = pick(c.b);
     if (a < 0 || b < 0) return;
+    if (resolved(summary(a, stop_, &stop_summaries_), summary(b, stop_, &stop_summaries_))) return;
     const CellSummary& sa = summary(a);
     const CellSummary& sb = summary(b);
-    bool resolved = false;
-    if (sa.has_interval() && sb.has_interval() && sa.median != sb.median) {
-      resolved = sa.median < sb.median ? sa.median_interval.high < sb.median_interval.low
-                                       : sa.median_interval.low > sb.median_interval.high;
-    }
-    if (resolved) return;
     if (adaptive_.futility && sa.has_interval() && sb.has_interval() &&
         projected(sa).overlaps(projected(sb))) {
       return;  // max_seeds is not expected to resolve it
@@ -114,9 +110,20 @@ class ComparisonRule {
     return Interval{toward(i.low), toward(i.high)};
   }
 
-  const CellSummary& summary(int cell) {
-    const auto it = summaries_.find(cell);
-    if (it != summaries_.end()) return it->second;
+  // The medians differ and their intervals are disjoint.
+  static bool resolved(const CellSummary& sa, const CellSummary& sb) {
+    if (!sa.has_interval() || !sb.has_interval() || sa.median == sb.median) return false;
+    return sa.median < sb.median ? sa.median_interval.high < sb.median_interval.low
+                                 : sa.median_interval.low > sb.median_interval.high;
+  }
+
+  const CellSummary& summary(int cell) { return summary(cell, bootstrap_, &summaries_); }
+
+  // The cell's statistics with `options`, cached in `cache`.
+  const CellSummary& summary(int cell, const BootstrapOptions& options,
+                             std::map<int, CellSummary>* cache) {
+    const auto it = cache->find(cell);
+    if (it != cache->end()) return it->second;
     std::vector<TableEntry> entries;
     for (int r : grid_.cells[static_cast<std::size_t>(cell)].runs) {
       const auto i = static_cast<std::size_t>(r);
@@ -126,7 +133,7 @@ class ComparisonRule {
       e.mse = mse_[i];
       entries.push_back(e);
     }
-    return summaries_.emplace(cell, summarize_cell(entries, 0, bootstrap_)).first->second;
+    return cache->emplace(cell, summarize_cell(entries, 0, options)).first->second;
   }
 
   const AdaptiveSpec& adaptive_;
@@ -135,8 +142,9 @@ class ComparisonRule {
   const std::vector<RunStatus>& status_;
   const std::vector<double>& mse_;
   const BootstrapOptions& bootstrap_;
+  const BootstrapOptions& stop_;
   std::map<std::string, int> cell_by_key_;
-  std::map<int, CellSummary> summaries_;
+  std::map<int, CellSummary> summaries_, stop_summaries_;
 };
 
 void mark_active(const Grid& grid, AdaptiveState* state) {
@@ -159,11 +167,14 @@ std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
                                      const std::vector<RunStatus>& status,
                                      const std::vector<double>& mse,
                                      const BootstrapOptions& bootstrap) {
+  // The stop test's intervals: at stop_confidence when set.
+  BootstrapOptions stop = bootstrap;
+  if (spec.adaptive.stop_confidence > 0) stop.confidence = spec.adaptive.stop_confidence;
   std::vector<int> cells;
   if (spec.adaptive.rule == AdaptiveRule::kColumnBest) {
-    cells = column_best_cells(grid, active, status, mse, bootstrap);
+    cells = column_best_cells(grid, active, status, mse, stop);
   } else {
-    ComparisonRule rule(spec.adaptive, grid, active, status, mse, bootstrap);
+    ComparisonRule rule(spec.adaptive, grid, active, status, mse, bootstrap, stop);
     for (const SeedComparison& c : spec.adaptive.comparisons) rule.name_cells(c, &cells);
   }
   std::sort(cells.begin(), cells.end());

@@ -187,9 +187,15 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
         values.fail(k.line, "futility expects true or false; got " + values.describe(*k.value));
       }
       a.futility = *k.value->value<bool>();
+    } else if (k.key == "stop_confidence") {
+      a.stop_confidence = values.number(k, *k.value);
+      if (!(a.stop_confidence >= 0.5 && a.stop_confidence <= 0.999)) {
+        values.fail(k.line, "stop_confidence expects a number in [0.5, 0.999] (e.g. 0.99: an "
+                            "early resolution must hold at 99 %); got " + values.describe(*k.value));
+      }
     } else {
       const std::vector<std::string> keys = {"max_seeds", "batch", "rule", "comparisons",
-                                             "futility"};
+                                             "futility", "stop_confidence"};
       values.fail(k.line, "unknown key " + quoted(k.key) + " in [adaptive]" +
                               did_you_mean(k.key, keys) + "; expected one of: " + join(keys));
     }

@@ -280,6 +280,52 @@ TEST(AdaptiveRoundsTest, FutilitySkipsComparisonsMaxSeedsCannotResolve) {
               HasSubstr("futility applies to rule = \"comparisons\" only"));
 }
 
+// Two cells of 10 seeds each, 1..10 and 1..10 + shift: at the shift below
+// their 95 % intervals are disjoint and their 99 % intervals overlap
+// (checked first, on the statistics alone).
+TEST(AdaptiveRoundsTest, StopConfidenceKeepsMarginalResolutionsGrowing) {
+  const double shift = 5.5;
+  std::vector<double> low, high;
+  for (int k = 1; k <= 10; ++k) {
+    low.push_back(k);
+    high.push_back(k + shift);
+  }
+  BootstrapOptions at99;
+  at99.confidence = 0.99;
+  ASSERT_FALSE(bootstrap_median_interval(low).overlaps(bootstrap_median_interval(high)));
+  ASSERT_TRUE(bootstrap_median_interval(low, at99).overlaps(bootstrap_median_interval(high, at99)));
+
+  for (const std::string rule : {"comparisons", "column-best"}) {
+    SCOPED_TRACE(rule);
+    std::string adaptive = "max_seeds = 20\nbatch = 10\nrule = \"" + rule + "\"\n";
+    if (rule == "comparisons") {
+      adaptive += "comparisons = [[\"harmonic/phnn-jr-rk2/25/small/none\", "
+                  "\"harmonic/phnn-jr-rk4/25/small/none\"]]\n";
+    }
+    std::string text = sweep_text(kTwoModels, adaptive);
+    text.replace(text.find("\"0-4\""), 5, "\"0-9\"");
+    const SweepSpec plain = parse_sweep_text(text, "x.toml");
+    const SweepSpec strict = parse_sweep_text(text + "stop_confidence = 0.99\n", "x.toml");
+    ASSERT_EQ(strict.adaptive.stop_confidence, 0.99);
+    const Grid grid = expand_grid(plain);
+    const Results r = results_of(grid, [&](const RunConfig& run) {
+      const double v = 1.0 + run.seed % 10;
+      return run.integrator == IntegratorKind::kRk4 ? v + shift : v;
+    });
+    std::vector<char> active(grid.runs.size(), 0);
+    for (std::size_t i = 0; i < grid.runs.size(); ++i) active[i] = grid.runs[i].seed < 10;
+    EXPECT_TRUE(adaptive_rule_cells(plain, grid, active, r.status, r.mse).empty());
+    EXPECT_EQ(adaptive_rule_cells(strict, grid, active, r.status, r.mse).size(), 2u);
+    // Replayed: the strict sweep takes both cells to 20 seeds; the plain one stops at 10.
+    EXPECT_EQ(replay_adaptive_rounds(plain, grid, r.status, r.mse).active_runs(), 20);
+    EXPECT_EQ(replay_adaptive_rounds(strict, grid, r.status, r.mse).active_runs(), 40);
+  }
+  for (const char* bad : {"0.3", "1", "\"high\""}) {
+    EXPECT_THAT(error_of(sweep_text(kTwoModels, kColumnBest + "stop_confidence = " + bad + "\n")),
+                AllOf(HasSubstr("x.toml:10:"), HasSubstr("stop_confidence expects a number")));
+  }
+}
+
 TEST(AdaptiveRoundsTest, TheRuleSeesOnlyTheRunsAskedFor) {
   const SweepSpec spec = parse_sweep_text(sweep_text(kTwoModels, kColumnBest), "x.toml");
   const Grid grid = expand_grid(spec);

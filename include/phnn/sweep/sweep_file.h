@@ -126,6 +126,14 @@ struct AdaptiveSpec {
   /// medians by sqrt(finished / max_seeds), still overlap (docs/METHOD.md,
   /// "Adaptive seeds").
   bool futility = false;
+  /// `stop_confidence`: a comparison (column-best: a cell against its
+  /// column's best) stops getting seeds before max_seeds only when its
+  /// intervals at this confidence are disjoint; the tables, the verdicts and
+  /// the futility projection keep the reducer's confidence (0.95). Above it,
+  /// an early resolution must be clear, not marginal (an interim boundary
+  /// stricter than the final one, docs/METHOD.md "Adaptive seeds"). 0: the
+  /// reducer's confidence.
+  double stop_confidence = 0;
   /// The studies' `seeds` as written (every study has the same): round 0.
   /// With [adaptive], StudySpec::seeds holds these and then the
   /// max_seeds - initial_seeds.size() next seed numbers (the runs a cell may get).
