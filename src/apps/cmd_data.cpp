@@ -6,10 +6,12 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "phnn/data/measured.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/output_path.h"
 #include "phnn/store/scratch_file.h"
 #include "phnn/store/ph_dataset_file.h"
+#include "phnn/store/trajectory_files.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {
@@ -18,9 +20,24 @@ namespace apps {
 namespace {
 
 int write_file_system_data(const std::string& path, const DatasetOptions& options, int n_train,
-                           const std::string& out, std::chrono::steady_clock::time_point start) {
+                           const std::string& out, const std::string& csv,
+                           std::chrono::steady_clock::time_point start) {
   const std::unique_ptr<PhSystem> system = load_system_file(path);
   const PhSystemData data = make_ph_system_data(*system, options, n_train);
+  if (!csv.empty()) {
+    // Written first: a failure leaves no data set that lacks its CSV.
+    const TrajectoryColumns columns{system->state_names(), system->input_names()};
+    const std::vector<MeasuredTrajectory> trajectories = generated_trajectories(*system, data);
+    write_atomically(csv, "writing", [&](const std::string& scratch) {
+      write_trajectory_csv(scratch, columns, trajectories,
+                           "`phnn data --system " + path + " --data-seed " +
+                               std::to_string(options.data_seed) + "`; import with `phnn import " +
+                               csv + " --system " + path + " --num-validation " +
+                               std::to_string(options.num_validation) + " --num-inference " +
+                               std::to_string(options.num_inference) + " --data-seed " +
+                               std::to_string(options.data_seed) + "`");
+    });
+  }
   write_atomically(out, "writing", [&](const std::string& scratch) { write_ph_dataset_file(scratch, data); });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -46,6 +63,8 @@ int run_data(int argc, char** argv, int first) {
   parser.option("data-seed", "seed of the counter-based RNG", "0");
   parser.option("damping", "c of z(w) = c w [N s/m] (harmonic, duffing)", "0.14737");
   parser.option("mass", "m [kg]", "0.16");
+  parser.option("csv", "also write the trajectories behind the splits to this CSV "
+                       "(`phnn import`'s format; system files only)");
   if (!parser.parse(argc, argv, first)) return 0;
 
   const std::string system_arg = parser.get("system");
@@ -73,8 +92,19 @@ int run_data(int argc, char** argv, int first) {
   const std::string out = parser.get("out");
   const std::string problem = output_problem("data", out, OutputKind::kDataSet, {system_arg});
   if (!problem.empty()) throw cli::UsageError{"phnn data: --out " + problem};
+  const std::string csv = parser.get("csv");
+  if (parser.has("csv")) {
+    if (!from_file) {
+      throw cli::UsageError{"phnn data: --csv needs a system file: use --system "
+                            "sweeps/systems/" + system_arg + ".toml (the same system)"};
+    }
+    const std::string bad = output_problem("data", csv, OutputKind::kTrajectoryCsv, {system_arg, out});
+    if (!bad.empty()) throw cli::UsageError{"phnn data: --csv " + bad};
+  }
   const auto start = std::chrono::steady_clock::now();
-  if (from_file) return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, start);
+  if (from_file) {
+    return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, csv, start);
+  }
   const SystemData data = make_system_data(system, options, static_cast<int>(n_train));
   write_atomically(out, "writing", [&](const std::string& path) { write_dataset_file(path, data); });
   const double seconds =

@@ -22,6 +22,7 @@ struct Command {
 // Each parses its own options (apps/cli.h) from argv[2] on.
 const Command kCommands[] = {
     {"data", phnn::apps::run_data},
+    {"import", phnn::apps::run_import},
 #ifdef PHNN_HAVE_TRAIN
     {"train", phnn::apps::run_train},
 #endif
@@ -52,6 +53,7 @@ const char* kUsage =
     "port-Hamiltonian neural networks\").\n\n"
     "commands:\n"
     "  data     generate a system's data splits into an HDF5 file\n"
+    "  import   read recorded trajectories (CSV, HDF5) into a data-set file\n"
     "  train    train one cell (all seeds of one configuration)\n"
     "  sweep    run a sweep file over MPI ranks into one HDF5 results file\n"
     "  reduce   print the paper's median [IQR] tables from a results file\n"

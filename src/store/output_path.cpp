@@ -8,6 +8,7 @@
 
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/scratch_file.h"
+#include "phnn/store/trajectory_files.h"
 
 namespace phnn {
 namespace {
@@ -29,6 +30,8 @@ bool ours(const std::string& out, OutputKind kind) {
       std::string line;
       return std::getline(in, line) && is_eval_csv_header(line);
     }
+    case OutputKind::kTrajectoryCsv:
+      return is_phnn_trajectory_csv(out);
   }
   return false;
 }
@@ -37,7 +40,8 @@ std::string what_we_write(OutputKind kind) {
   switch (kind) {
     case OutputKind::kResults: return "writes a new results file";
     case OutputKind::kDataSet: return "only replaces data-set files it wrote";
-    case OutputKind::kEvalCsv: return "only replaces CSV files it wrote";
+    case OutputKind::kEvalCsv:
+    case OutputKind::kTrajectoryCsv: return "only replaces CSV files it wrote";
   }
   return "";
 }

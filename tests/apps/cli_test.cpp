@@ -255,7 +255,7 @@ TEST(PhnnCommandLineTest, AMisspelledOptionExitsTwoBeforeAnyWork) {
 }
 
 TEST(PhnnCommandLineTest, EveryCommandHasItsHelp) {
-  for (const char* command : {"data", "train", "sweep", "reduce", "merge", "eval"}) {
+  for (const char* command : {"data", "import", "train", "sweep", "reduce", "merge", "eval"}) {
     std::string log;
     EXPECT_EQ(phnn(std::string(command) + " --help", &log), 0) << command;
     EXPECT_THAT(log, HasSubstr(std::string("Usage: phnn ") + command)) << log;

@@ -15,6 +15,7 @@ enum class OutputKind {
   kResults,  // a results file: never replaced (train, merge write new ones)
   kDataSet,  // a data-set file of `phnn data`: replaced by a new one
   kEvalCsv,  // the CSV of `phnn eval`: replaced by a new one
+  kTrajectoryCsv,  // the CSV of `phnn data --csv`: replaced by a new one
 };
 
 /// Why `command` must not write `out` ("" if it may): `out` is one of

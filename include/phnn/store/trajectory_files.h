@@ -1,0 +1,53 @@
+// include/phnn/store/trajectory_files.h — recorded trajectories in CSV and
+// HDF5 files (docs/DATASET_FORMAT.md, "Trajectory files"): the readers of
+// `phnn import` and the CSV writer of `phnn data --csv`. Reads the files it
+// is given; writes only the file it is given.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "phnn/data/measured.h"
+
+namespace phnn {
+
+/// The column names a trajectory file must hold: the system's state and
+/// input names.
+struct TrajectoryColumns {
+  std::vector<std::string> states, inputs;
+};
+
+/// CSV, one row per sample: a header naming the columns `trajectory`, `t`,
+/// every state and every input (in any order, each once, nothing else),
+/// then numbers (`trajectory` a non-negative integer; rows of one
+/// trajectory contiguous, in increasing t). Blank lines and lines starting
+/// with '#' are skipped; CRLF line ends are accepted. Throws
+/// MeasuredDataError "FILE:LINE: what; the fix" (missing, extra or repeated
+/// column, a ragged row, a field that is not a number, NaN or infinity, a
+/// trajectory whose rows are split, an empty file).
+std::vector<MeasuredTrajectory> read_trajectory_csv(const std::string& path,
+                                                    const TrajectoryColumns& columns);
+
+/// The first line of every trajectory CSV phnn writes starts with this (the
+/// readers skip it as a comment): only such files are ever replaced.
+constexpr const char* kTrajectoryCsvMarker = "# phnn trajectories";
+/// True when `path`'s first line starts with kTrajectoryCsvMarker.
+bool is_phnn_trajectory_csv(const std::string& path);
+
+/// Writes `trajectories` as CSV: the marker line (with `note` after it),
+/// the header `trajectory,t,<states>,<inputs>`, then one row per sample,
+/// values as the shortest text that reads back to the same double.
+void write_trajectory_csv(const std::string& path, const TrajectoryColumns& columns,
+                          const std::vector<MeasuredTrajectory>& trajectories,
+                          const std::string& note = "");
+
+/// HDF5: a group `/trajectories` with one group per trajectory, named by its
+/// id (a non-negative integer), holding `t` (N), `x` (N x n_x, columns in
+/// the order of the system's states) and `u` (N x n_u; absent when n_u = 0).
+/// Optional string attributes `state_names` and `input_names` on
+/// `/trajectories` (comma-separated) are checked against the system's.
+/// Throws MeasuredDataError naming "FILE:/trajectories/ID" and the fix.
+std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
+                                                   const TrajectoryColumns& columns);
+
+}  // namespace phnn

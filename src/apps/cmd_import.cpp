@@ -1,0 +1,98 @@
+// src/apps/cmd_import.cpp — `phnn import`: recorded trajectories (CSV or
+// HDF5) into a data-set file, split as docs/METHOD.md "Measured data" says.
+#include <chrono>
+#include <iostream>
+
+#include "apps/cli.h"
+#include "apps/commands.h"
+#include "h5/h5file.h"
+#include "phnn/data/measured.h"
+#include "phnn/store/output_path.h"
+#include "phnn/store/ph_dataset_file.h"
+#include "phnn/store/scratch_file.h"
+#include "phnn/store/trajectory_files.h"
+#include "phnn/systems/ph_system.h"
+
+namespace phnn {
+namespace apps {
+
+namespace {
+
+std::vector<MeasuredTrajectory> read_inputs(const std::vector<std::string>& files,
+                                            const TrajectoryColumns& columns) {
+  std::vector<MeasuredTrajectory> all;
+  for (const std::string& f : files) {
+    std::vector<MeasuredTrajectory> part =
+        h5::File::is_hdf5(f) ? read_trajectory_h5(f, columns) : read_trajectory_csv(f, columns);
+    for (auto& m : part) all.push_back(std::move(m));
+  }
+  return all;
+}
+
+ImportOptions import_options(const cli::Parser& parser) {
+  ImportOptions o;
+  o.data_seed = static_cast<std::uint64_t>(parser.get_int_in("data-seed", 0, 2147483647));
+  o.num_validation = parser.get_int_in("num-validation", 1, 100000000);
+  o.num_inference = parser.get_int_in("num-inference", 1, 100000000);
+  o.pair_window = parser.get_double_in("pair-window", 0.0, 1e12);
+  o.sample_rate = parser.get_double_in("sample-rate", 0.0, 1e12);
+  o.split_seed = parser.has("split-seed") ? parser.get_int_in("split-seed", 0, 2147483647) : -1;
+  return o;
+}
+
+}  // namespace
+
+int run_import(int argc, char** argv, int first) {
+  cli::Parser parser("import",
+                     "Reads recorded trajectories (CSV: trajectory,t,<states>,<inputs>; or HDF5:\n"
+                     "/trajectories/<id>/{t,x,u}) and writes a data-set file that `phnn train\n"
+                     "--data` and sweeps read: training and validation pairs, one per trajectory,\n"
+                     "and inference trajectories, each from different trajectories\n"
+                     "(docs/METHOD.md, \"Measured data\").");
+  parser.positional_rest("FILE", "CSV or HDF5 trajectory files (their trajectories are joined)");
+  parser.option("system", "a system file (.toml) or built-in name: the state and input names", "",
+                true);
+  parser.option("out", "output data-set file (HDF5)", "", true);
+  parser.option("num-validation", "trajectories for validation pairs", "2500");
+  parser.option("num-inference", "trajectories for inference (the last ones after the split)", "100");
+  parser.option("pair-window", "draw pairs with t_n+1 - t_0 <= this [s]; 0: anywhere", "0");
+  parser.option("sample-rate", "sampling rate [Hz] (checked against t); 0: from t", "0");
+  parser.option("data-seed", "seed of the pair draws (as `phnn data --data-seed`)", "0");
+  parser.option("split-seed", "shuffle the trajectories by this seed before the split "
+                              "(default: in the order of their ids)");
+  if (!parser.parse(argc, argv, first)) return 0;
+
+  const auto start = std::chrono::steady_clock::now();
+  if (!is_system_file_argument(parser.get("system"))) {
+    throw cli::UsageError{"phnn import: --system " + parser.get("system") + ": give a system file "
+                          "(the built-in systems are sweeps/systems/harmonic.toml, duffing.toml "
+                          "and self-sustained.toml)"};
+  }
+  const std::unique_ptr<PhSystem> system = make_system(parser.get("system"));
+  const ImportOptions options = import_options(parser);
+  const std::string out = parser.get("out");
+  std::vector<std::string> inputs = parser.rest();
+  inputs.push_back(parser.get("system"));
+  const std::string problem = output_problem("import", out, OutputKind::kDataSet, inputs);
+  if (!problem.empty()) throw cli::UsageError{"phnn import: --out " + problem};
+
+  const TrajectoryColumns columns{system->state_names(), system->input_names()};
+  std::string summary;
+  PhSystemData data;
+  try {
+    data = split_measured_data(*system, read_inputs(parser.rest(), columns), options, &summary);
+  } catch (const MeasuredDataError& e) {
+    throw cli::UsageError{std::string("phnn import: ") + e.what()};  // bad input: exit 2
+  }
+  write_atomically(out, "writing", [&](const std::string& path) { write_ph_dataset_file(path, data); });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << summary << "phnn import: " << system->name() << ": " << data.train.size()
+            << " train pairs, " << data.validation.size() << " validation pairs, "
+            << data.inference.size() << " inference trajectories -> " << out << " (" << seconds
+            << " s)\n";
+  return 0;
+}
+
+}  // namespace apps
+}  // namespace phnn

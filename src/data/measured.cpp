@@ -1,0 +1,273 @@
+// src/data/measured.cpp — recorded trajectories into a data set (checks,
+// sample rate, split, pair draws) and a generated set's trajectories back
+// (include/phnn/data/measured.h). In memory only.
+#include "phnn/data/measured.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include "phnn/common/check.h"
+#include "phnn/data/counter_rng.h"
+
+namespace phnn {
+namespace {
+
+[[noreturn]] void fail(const std::string& message) { throw MeasuredDataError(message); }
+
+std::string where(const MeasuredTrajectory& m) { return m.where(0); }
+
+std::string g(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// Shapes, finite values, >= 2 samples, increasing time, constant inputs.
+void check_trajectory(const MeasuredTrajectory& m, int nx, int nu) {
+  const std::size_t n = m.t.size();
+  PHNN_CHECK(m.x.size() == n && m.u.size() == n, "ragged trajectory from the reader");
+  if (n < 2) {
+    fail(where(m) + " has " + std::to_string(n) + " sample; a training pair (x_n, x_n+1) needs "
+         "at least 2: drop it or record longer");
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    PHNN_CHECK(m.x[k].size() == nx && m.u[k].size() == nu, "wrong width from the reader");
+    if (!std::isfinite(m.t[k]) || !m.x[k].allFinite() || !m.u[k].allFinite()) {
+      fail(m.where(k) + ": a value is NaN or infinite; remove "
+           "or repair the sample (phnn needs every state and input finite)");
+    }
+    if (k > 0 && !(m.t[k] > m.t[k - 1])) {
+      fail(m.where(k) + ": t = " + g(m.t[k]) +
+           " does not increase (previous " + g(m.t[k - 1]) + "); sort the samples by time");
+    }
+    if (k > 0 && m.u[k] != m.u[0]) {
+      fail(m.where(k) + ": the input changes within the "
+           "trajectory; phnn trains with one constant input per trajectory: split the "
+           "recording where the input changes");
+    }
+  }
+}
+
+// h of one trajectory, checked uniform: every step within tol h of the
+// median step (a gap or one bad stamp cannot shift the reference), then h =
+// (t_N-1 - t_0) / (N - 1), the most accurate estimate once uniform.
+double uniform_step(const MeasuredTrajectory& m, double tolerance) {
+  std::vector<double> steps;
+  for (std::size_t k = 1; k < m.t.size(); ++k) steps.push_back(m.t[k] - m.t[k - 1]);
+  std::vector<double> sorted = steps;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  for (std::size_t k = 1; k < m.t.size(); ++k) {
+    const double dt = steps[k - 1];
+    if (std::abs(dt - median) > tolerance * median) {
+      fail(m.where(k) + ": t jumps by " + g(dt) + " s where the trajectory's step is " + g(median) +
+           " s (" + (dt > 1.5 * median ? "a gap" : "jitter") +
+           "); phnn needs uniform sampling: resample the recording or split it at the gap");
+    }
+  }
+  return (m.t.back() - m.t.front()) / static_cast<double>(m.t.size() - 1);
+}
+
+// The common step h = 1 / rate: given, or from the time columns (snapped
+// to an integer rate within 1e-9).
+double common_step(const std::vector<MeasuredTrajectory>& all, const ImportOptions& o,
+                   std::string* summary) {
+  double h0 = 0.0;
+  const MeasuredTrajectory* first = nullptr;
+  for (const MeasuredTrajectory& m : all) {
+    const double h = uniform_step(m, o.time_tolerance);
+    if (!first) {
+      first = &m, h0 = h;
+    } else if (std::abs(h - h0) > o.time_tolerance * h0) {
+      fail(where(m) + " is sampled every " + g(h) + " s, " + where(*first) + " every " + g(h0) +
+           " s; phnn needs one sampling rate: resample one of them");
+    }
+  }
+  if (o.sample_rate > 0) {
+    if (std::abs(h0 * o.sample_rate - 1.0) > o.time_tolerance) {
+      fail("--sample-rate " + g(o.sample_rate) + " Hz disagrees with the time column (" +
+           where(*first) + " is sampled at " + g(1.0 / h0) + " Hz); drop --sample-rate or fix t");
+    }
+    if (summary) *summary += "sample rate " + g(o.sample_rate) + " Hz (given)\n";
+    return 1.0 / o.sample_rate;
+  }
+  const double rate = 1.0 / h0, whole = std::round(rate);
+  if (whole >= 1 && std::abs(rate - whole) <= 1e-9 * rate) {
+    if (summary) *summary += "sample rate " + g(whole) + " Hz (from t)\n";
+    return 1.0 / whole;
+  }
+  if (summary) *summary += "sample rate " + g(rate) + " Hz (from t, not an integer)\n";
+  return h0;
+}
+
+// The pair (x_n, x_n+1) of a trajectory: n uniform among the positions
+// with t_n+1 - t_0 <= window (all when window = 0), keyed by its id.
+void draw_pair(const PhSystem& system, const MeasuredTrajectory& m, const ImportOptions& o,
+               PhPairSet* pairs) {
+  int positions = static_cast<int>(m.t.size()) - 1;
+  if (o.pair_window > 0) {
+    positions = 0;
+    while (positions + 1 < static_cast<int>(m.t.size()) &&
+           m.t[static_cast<std::size_t>(positions) + 1] - m.t[0] <= o.pair_window * (1 + 1e-9)) {
+      ++positions;
+    }
+    if (positions == 0) {
+      fail(where(m) + ": no pair ends within --pair-window " + g(o.pair_window) + " s of its "
+           "start (the second sample is at " + g(m.t[1] - m.t[0]) + " s); widen the window");
+    }
+  }
+  CounterRng pick = CounterRng::for_trajectory(o.data_seed, system.rng_id(), m.id,
+                                               CounterRng::kTrainingPair);
+  const auto n = static_cast<std::size_t>(pick.below(static_cast<std::uint64_t>(positions)));
+  pairs->x.push_back(m.x[n]);
+  pairs->x_next.push_back(m.x[n + 1]);
+  pairs->u.push_back(m.u[n]);
+  pairs->trajectory.push_back(m.id);
+  pairs->position.push_back(static_cast<int>(n));
+}
+
+// Sorted by id; unique ids; shuffled by split_seed (Fisher-Yates on one
+// counter stream) when it is >= 0.
+void order_for_split(std::vector<MeasuredTrajectory>* all, const ImportOptions& o) {
+  std::stable_sort(all->begin(), all->end(),
+                   [](const MeasuredTrajectory& a, const MeasuredTrajectory& b) { return a.id < b.id; });
+  for (std::size_t i = 1; i < all->size(); ++i) {
+    if ((*all)[i].id == (*all)[i - 1].id) {
+      fail((*all)[i].where(0) + " was already read at " + (*all)[i - 1].where(0) +
+           " (a trajectory's rows must be contiguous and its id unique); give each trajectory "
+           "its own id");
+    }
+  }
+  if (o.split_seed < 0) return;
+  CounterRng rng(mix64(static_cast<std::uint64_t>(o.split_seed) ^ 0x73706c6974ULL));  // "split"
+  for (std::size_t i = all->size(); i > 1; --i) {
+    std::swap((*all)[i - 1], (*all)[static_cast<std::size_t>(rng.below(i))]);
+  }
+}
+
+}  // namespace
+
+std::string MeasuredTrajectory::where(std::size_t k) const {
+  if (k < line.size()) return source + ":" + std::to_string(line[k]) + ": trajectory " + std::to_string(id);
+  return source + ": trajectory " + std::to_string(id) + (k > 0 ? ", sample " + std::to_string(k) : "");
+}
+
+void ImportOptions::validate() const {
+  PHNN_REQUIRE(num_validation >= 1, "num_validation = " << num_validation << " must be >= 1");
+  PHNN_REQUIRE(num_inference >= 1, "num_inference = " << num_inference << " must be >= 1");
+  PHNN_REQUIRE(std::isfinite(pair_window) && pair_window >= 0,
+               "pair_window = " << pair_window << " must be >= 0 (0: the whole trajectory)");
+  PHNN_REQUIRE(std::isfinite(sample_rate) && sample_rate >= 0,
+               "sample_rate = " << sample_rate << " must be >= 0 (0: from the time column)");
+  PHNN_REQUIRE(time_tolerance > 0 && time_tolerance < 0.5,
+               "time_tolerance = " << time_tolerance << " must be in (0, 0.5)");
+}
+
+PhSystemData split_measured_data(const PhSystem& system,
+                                 std::vector<MeasuredTrajectory> trajectories,
+                                 const ImportOptions& options, std::string* summary) {
+  options.validate();
+  const long total = static_cast<long>(trajectories.size());
+  const long held = static_cast<long>(options.num_validation) + options.num_inference;
+  if (total < held + 1) {
+    fail("the data hold " + std::to_string(total) + " trajectories; " +
+         std::to_string(options.num_validation) + " for validation, " +
+         std::to_string(options.num_inference) + " for inference and at least 1 for training "
+         "need " + std::to_string(held + 1) + ": lower --num-validation / --num-inference or "
+         "record more trajectories");
+  }
+  for (const MeasuredTrajectory& m : trajectories) check_trajectory(m, system.n_x(), system.n_u());
+  order_for_split(&trajectories, options);
+  const double h = common_step(trajectories, options, summary);
+  const std::size_t num_train = static_cast<std::size_t>(total - held);
+  const std::size_t infer_begin = num_train + static_cast<std::size_t>(options.num_validation);
+
+  PhSystemData data;
+  data.system_name = system.name();
+  data.system_text = system.source_text();
+  data.state_names = system.state_names();
+  data.state_units = system.state_units();
+  data.input_names = system.input_names();
+  data.n_w = system.n_w();
+  data.train.step = data.validation.step = data.inference.step = h;
+  for (std::size_t i = 0; i < infer_begin; ++i) {
+    draw_pair(system, trajectories[i], options, i < num_train ? &data.train : &data.validation);
+  }
+  std::size_t samples = trajectories[infer_begin].t.size();
+  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
+    samples = std::min(samples, trajectories[i].t.size());
+  }
+  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
+    const MeasuredTrajectory& m = trajectories[i];
+    data.inference.trajectory.push_back(m.id);
+    data.inference.u.push_back(m.u[0]);
+    data.inference.states.emplace_back(m.x.begin(), m.x.begin() + static_cast<long>(samples));
+  }
+
+  // What the options record: the rate, the split sizes, the window and the
+  // inference duration; no generation.
+  DatasetOptions& o = data.options;
+  o.data_seed = options.data_seed;
+  o.sample_rate = 1.0 / h;
+  o.generation_step = h;
+  o.period = 1.0;
+  o.beta = h * static_cast<double>(samples - 1);
+  double longest = 0.0;
+  for (std::size_t i = 0; i < infer_begin; ++i) {
+    longest = std::max(longest, trajectories[i].t.back() - trajectories[i].t.front());
+  }
+  o.alpha = std::min(options.pair_window > 0 ? options.pair_window : longest, o.beta);
+  o.num_trajectories = static_cast<int>(total);
+  o.num_train_max = static_cast<int>(num_train);
+  o.num_validation = options.num_validation;
+  o.num_inference = options.num_inference;
+  if (summary) {
+    *summary += std::to_string(num_train) + " training, " + std::to_string(options.num_validation) +
+                " validation, " + std::to_string(options.num_inference) + " inference trajectories" +
+                (options.split_seed >= 0 ? " (shuffled by split seed " +
+                                               std::to_string(options.split_seed) + ")"
+                                         : " (in the order of their ids)") + "\n";
+    *summary += "inference trajectories cut to " + std::to_string(samples) + " samples (" +
+                g(o.beta) + " s), the shortest of them\n";
+  }
+  return data;
+}
+
+std::vector<MeasuredTrajectory> generated_trajectories(const PhSystem& system,
+                                                       const PhSystemData& data) {
+  const DatasetOptions& o = data.options;
+  const int stride = o.stride(), positions = o.num_pair_positions();
+  const double h = data.train.step;
+  std::vector<MeasuredTrajectory> out;
+  const auto add = [&](std::int64_t id, const VecX& u, std::vector<VecX> states) {
+    MeasuredTrajectory m;
+    m.id = id;
+    m.source = "generated";
+    for (std::size_t n = 0; n < states.size(); ++n) m.t.push_back(static_cast<double>(n) * h);
+    m.u.assign(states.size(), u);
+    m.x = std::move(states);
+    out.push_back(std::move(m));
+  };
+  for (const PhPairSet* pairs : {&data.train, &data.validation}) {
+    for (std::size_t i = 0; i < pairs->size(); ++i) {
+      const PhTrajectory traj =
+          ph_generate_trajectory(system, o, pairs->trajectory[i], positions * stride);
+      std::vector<VecX> sub;
+      for (int n = 0; n <= positions; ++n) sub.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
+      const auto n = static_cast<std::size_t>(pairs->position[i]);
+      PHNN_CHECK(sub[n] == pairs->x[i] && sub[n + 1] == pairs->x_next[i] && traj.u == pairs->u[i],
+                 "trajectory " << pairs->trajectory[i] << " regenerated differs from its pair");
+      add(pairs->trajectory[i], traj.u, std::move(sub));
+    }
+  }
+  for (std::size_t i = 0; i < data.inference.size(); ++i) {
+    add(data.inference.trajectory[i], data.inference.u[i], data.inference.states[i]);
+  }
+  return out;
+}
+
+}  // namespace phnn

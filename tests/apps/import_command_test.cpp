@@ -1,0 +1,93 @@
+// tests/apps/import_command_test.cpp — `phnn data --csv` and `phnn import`:
+// the acceptance's round trip (a generated set through CSV trains to the
+// same MSEs bit for bit), bad input refused with exit 2 and no output file,
+// and files that are not phnn's never overwritten.
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "h5/h5file.h"
+#include "test_util.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+int phnn(const std::string& args, std::string* output) {
+  return testing_util::run_shell(std::string(PHNN_BINARY) + " " + args, output);
+}
+
+const std::string kPendulum = std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum.toml";
+
+bool exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+std::vector<double> mses(const std::string& results) {
+  return h5::File::open(results, h5::Access::kReadOnly).read_doubles("/runs/mse");
+}
+
+TEST(ImportCommandTest, AGeneratedSetThroughCsvTrainsToTheSameMsesBitForBit) {
+  const std::string dir = ::testing::TempDir() + "phnn_import_rt/";
+  ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
+  std::string log;
+  ASSERT_EQ(phnn("data --system " + kPendulum + " --n-train 25 --out " + dir + "a.h5 --csv " + dir +
+                     "a.csv",
+                 &log),
+            0)
+      << log;
+  ASSERT_EQ(phnn("import " + dir + "a.csv --system " + kPendulum + " --out " + dir + "b.h5", &log), 0)
+      << log;
+  EXPECT_THAT(log, AllOf(HasSubstr("sample rate 100 Hz"), HasSubstr("25 train pairs")));
+  for (const char* d : {"a", "b"}) {
+    ASSERT_EQ(phnn("train --system " + kPendulum + " --model phnn-s-dg --n-train 25 --seeds 0-1 "
+                   "--steps 200 --eval-every 100 --quiet --data " + dir + d + ".h5 --out " + dir +
+                   "r" + d + ".h5",
+                   &log),
+              0)
+        << log;
+  }
+  const std::vector<double> a = mses(dir + "ra.h5"), b = mses(dir + "rb.h5");
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_TRUE(std::isfinite(a[0]) && std::isfinite(a[1]));
+  EXPECT_EQ(a, b);  // bitwise
+  std::system(("rm -rf " + dir).c_str());
+}
+
+TEST(ImportCommandTest, BadInputExitsTwoAndWritesNoDataSet) {
+  const std::string dir = ::testing::TempDir() + "phnn_import_bad/";
+  ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
+  std::ofstream(dir + "bad.csv") << "trajectory,t,q,p,u\n0,0,1,0,0\n0,0.1,1,0\n";
+  std::string log;
+  EXPECT_EQ(phnn("import " + dir + "bad.csv --system " + kPendulum + " --out " + dir + "o.h5", &log), 2);
+  EXPECT_THAT(log, AllOf(HasSubstr("phnn import: " + dir + "bad.csv:3: 4 fields"), HasSubstr("one value per column")));
+  EXPECT_FALSE(exists(dir + "o.h5"));
+  // A built-in name: the system file is named.
+  EXPECT_EQ(phnn("import " + dir + "bad.csv --system harmonic --out " + dir + "o.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("sweeps/systems/harmonic.toml"));
+  // --out over a file phnn did not write (the input itself, or a user's file) is refused.
+  EXPECT_EQ(phnn("import " + dir + "bad.csv --system " + kPendulum + " --out " + dir + "bad.csv", &log), 2);
+  EXPECT_THAT(log, HasSubstr("is the input"));
+  std::ofstream(dir + "mine.csv") << "trajectory,t,q,p,u\n";
+  EXPECT_EQ(phnn("data --system " + kPendulum + " --n-train 5 --out " + dir + "d.h5 --csv " + dir + "mine.csv",
+                 &log),
+            2);
+  EXPECT_THAT(log, AllOf(HasSubstr("mine.csv: exists"), HasSubstr("never overwrites")));
+  EXPECT_FALSE(exists(dir + "d.h5"));
+  std::ifstream in(dir + "mine.csv");
+  std::string first;
+  std::getline(in, first);
+  EXPECT_EQ(first, "trajectory,t,q,p,u");
+  std::system(("rm -rf " + dir).c_str());
+}
+
+}  // namespace
+}  // namespace phnn
