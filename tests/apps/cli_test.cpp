@@ -235,7 +235,7 @@ TEST(PhnnCommandLineTest, AnUnknownCommandExitsTwoWithTheClosestName) {
   std::string log;
   EXPECT_EQ(phnn("trian --steps 1", &log), kUsageError);
   EXPECT_EQ(log,
-            "phnn: unknown command \"trian\" (did you mean train?); expected one of: data, "
+            "phnn: unknown command \"trian\" (did you mean train?); expected one of: data, import, "
             "train, sweep, reduce, merge, eval, verify\n");
   EXPECT_EQ(phnn("--verison", &log), kUsageError);
   EXPECT_THAT(log, HasSubstr("(did you mean --version?)"));
