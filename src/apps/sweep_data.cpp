@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "phnn/store/ph_dataset_file.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {
@@ -17,7 +18,16 @@ void SweepDataSets::make(const std::string& system_name) {
     if (run.system_name() == system_name) max_train = std::max(max_train, run.n_train);
   }
   DataSet d;
-  if (const SweepSystemFile* file = spec_.system_file(system_name)) {
+  const SweepSystemFile* file = spec_.system_file(system_name);
+  if (file && file->is_data()) {
+    // A `data` file: its splits as they are (the [data] table does not apply).
+    d.system = compile_system(file->text, file->path);
+    d.file = read_ph_dataset_file(file->path);
+    if (data_set_checksum(*d.file) != file->data_checksum) {
+      throw std::runtime_error("data-set file " + file->path + " changed while the sweep was "
+                               "starting (its checksum differs); start the sweep again");
+    }
+  } else if (file) {
     d.system = compile_system(file->text, file->entry);
     d.file = make_ph_system_data(*d.system, spec_.data, max_train);
   } else {

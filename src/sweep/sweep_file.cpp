@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "phnn/config/run_config.h"
+#include "phnn/store/ph_dataset_file.h"
 #include "phnn/systems/system_file.h"
 #include "sweep/sweep_file_source.h"
 #include "sweep/sweep_file_tables.h"
@@ -60,6 +61,7 @@ std::string sweep_hash(const std::string& text, const std::vector<SweepSystemFil
   std::string all = text;
   for (const SweepSystemFile& f : files) {
     all += '\0' + f.entry + '\0' + f.text;
+    if (f.is_data()) all += "\0data " + f.data_checksum;  // a data-set file's contents
   }
   return hex64(fnv1a64(all));
 }
@@ -79,6 +81,25 @@ SweepSpec parse_sweep_text(const std::string& text, const std::string& display_n
   spec.text_hash = sweep_hash(text, spec.system_files);
   return spec;
 }
+
+namespace {
+
+// A `data` entry read from disk: the system text it stores, the checksum of
+// its contents and its training pairs.
+SystemFileText read_data_file_entry(const std::string& file) {
+  const PhSystemData data = read_ph_dataset_file(file);
+  if (data.system_text.empty()) {
+    throw std::runtime_error(file + " holds data of the built-in system " + data.system_name +
+                             " (a version-1 data set); make it from the system file, e.g. "
+                             "`phnn data --system sweeps/systems/" + data.system_name + ".toml`");
+  }
+  SystemFileText t{file, data.system_text};
+  t.data_checksum = data_set_checksum(data);
+  t.data_train_pairs = static_cast<int>(data.train.size());
+  return t;
+}
+
+}  // namespace
 
 SweepSpec parse_sweep_file(const std::string& path) {
   // O_NONBLOCK: opening a FIFO must not wait for a writer; it is refused below.
@@ -119,6 +140,7 @@ SweepSpec parse_sweep_file(const std::string& path) {
   const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
   return parse_sweep_text(text, path, [&dir](const std::string& entry) {
     const std::string file = !entry.empty() && entry[0] == '/' ? entry : dir + entry;
+    if (is_data_file_entry(entry)) return read_data_file_entry(file);
     return SystemFileText{file, read_system_file_text(file)};
   });
 }

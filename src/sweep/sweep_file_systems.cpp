@@ -6,6 +6,7 @@
 
 #include "phnn/config/run_config.h"
 #include "phnn/systems/system_file.h"
+#include "sweep/sweep_file_values.h"
 
 namespace phnn {
 namespace {
@@ -20,8 +21,15 @@ std::string message_of(const SystemFileError& e) {
 
 }  // namespace
 
+const SweepSystemFile* SweepSystems::file(const std::string& name) const {
+  for (const SweepSystemFile& f : files_) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
 std::string SweepSystems::resolve(const std::string& value, int line) {
-  if (is_system_file_argument(value)) return load(value, line);
+  if (is_system_file_argument(value) || is_data_file_entry(value)) return load(value, line);
   builtin_lines_.emplace(value, line);
   return value;
 }
@@ -44,6 +52,10 @@ std::string SweepSystems::load(const std::string& entry, int line) {
     source_.fail(line, "systems value " + quoted(entry) + ": " + e.what());
   }
   file.text = source.text;
+  if (is_data_file_entry(entry) && source.data_checksum.empty()) {
+    source_.fail(line, "data value " + quoted(entry) + " was read as a system file; it must be a "
+                           "data-set file written by `phnn data` or `phnn import`");
+  }
   std::unique_ptr<PhSystem> system;
   try {
     system = compile_system(file.text, source.shown_as);
@@ -55,11 +67,28 @@ std::string SweepSystems::load(const std::string& entry, int line) {
   file.n_w = system->n_w();
   file.n_u = system->n_u();
   file.text_hash = hex64(fnv1a64(file.text));
+  if (is_data_file_entry(entry)) {
+    // Named by the file's stem ("noisy" of "data/noisy.h5"); its runs'
+    // identity covers the contents.
+    const std::size_t slash = entry.rfind('/');
+    file.name = entry.substr(slash == std::string::npos ? 0 : slash + 1);
+    file.name.resize(file.name.size() - 3);
+    file.data_checksum = source.data_checksum;
+    file.data_train_pairs = source.data_train_pairs;
+    file.path = source.shown_as;
+    file.text_hash = hex64(fnv1a64(file.text + "\n# data " + file.data_checksum));
+    if (file.name.empty() || find_system(file.name)) {
+      source_.fail(line, "data-set file " + quoted(entry) + " is named " + quoted(file.name) +
+                             " by its stem, which " + (file.name.empty() ? "is empty" : "is a built-in system's name") +
+                             "; rename the file");
+    }
+  }
   for (const SweepSystemFile& other : files_) {
     if (other.name == file.name) {
       source_.fail(line, "system files " + quoted(other.entry) + " and " + quoted(entry) +
                              " are both named " + quoted(file.name) +
-                             "; give each system file its own `name`");
+                             "; give each system file its own `name` (a data-set file is named "
+                             "by its file name without .h5)");
     }
   }
   files_.push_back(file);

@@ -29,6 +29,8 @@ class SweepSystems {
   void check_names() const;
 
   const std::vector<SweepSystemFile>& files() const { return files_; }
+  /// The file (system or data-set file) of system `name`, or nullptr.
+  const SweepSystemFile* file(const std::string& name) const;
 
  private:
   std::string load(const std::string& entry, int line);

@@ -23,6 +23,8 @@ namespace {
 struct AxisSet {
   std::string title;
   std::optional<std::vector<std::string>> systems;
+  /// `data`: the names of its data-set files' systems (their stems).
+  std::optional<std::vector<std::string>> data;
   std::optional<std::vector<std::pair<ModelKind, IntegratorKind>>> models;
   std::optional<std::vector<ModelSize>> sizes;
   std::optional<std::vector<int>> n_train;
@@ -214,7 +216,14 @@ class TableWalker {
     StudySpec study;
     study.name = name;
     study.title = axes.title;
-    study.systems = axes.systems ? *axes.systems : grid_.systems ? *grid_.systems : system_names();
+    // `data` adds its files' systems; with `data` and no `systems` (here or
+    // in [grid]) the files are the only systems.
+    const std::optional<std::vector<std::string>>& data = axes.data ? axes.data : grid_.data;
+    study.systems = axes.systems    ? *axes.systems
+                    : grid_.systems ? *grid_.systems
+                    : data          ? std::vector<std::string>()
+                                    : system_names();
+    if (data) study.systems.insert(study.systems.end(), data->begin(), data->end());
     study.models = axes.models ? *axes.models : grid_.models ? *grid_.models : all_model_pairs();
     study.sizes = axes.sizes    ? *axes.sizes
                   : grid_.sizes ? *grid_.sizes
@@ -250,6 +259,18 @@ class TableWalker {
       fail(line, "n_train value " + std::to_string(n) + (lines.empty() ? " (the default)" : "") +
                      " of study " + quoted(study.name) + " is outside [1, num_train_max = " +
                      std::to_string(max) + "]; lower it or raise num_train_max in [data]");
+    }
+    for (const std::string& system : study.systems) {
+      const SweepSystemFile* f = systems_.file(system);
+      if (!f || !f->is_data()) continue;
+      for (std::size_t i = 0; i < study.n_train.size(); ++i) {
+        if (study.n_train[i] <= f->data_train_pairs) continue;
+        fail(i < lines.size() ? lines[i] : 1,
+             "n_train value " + std::to_string(study.n_train[i]) + " of study " +
+                 quoted(study.name) + " is more than the " + std::to_string(f->data_train_pairs) +
+                 " training pairs of the data-set file " + quoted(f->entry) +
+                 "; lower n_train or import more training trajectories");
+      }
     }
   }
 
@@ -295,6 +316,34 @@ class TableWalker {
     }
   }
 
+  // data = "a.h5" or ["a.h5", "b.h5"]: data-set files, each a system of
+  // its own (named by its stem) whose runs use the file's splits.
+  std::vector<std::string> data_axis(const Entry& e) const {
+    std::vector<const toml::node*> items;
+    if (const toml::array* a = e.value->as_array()) {
+      for (const toml::node& n : *a) items.push_back(&n);
+    } else {
+      items.push_back(e.value);
+    }
+    if (items.empty()) fail(e.line, "data expects a data-set file or a non-empty list of them");
+    std::vector<std::string> names;
+    for (const toml::node* n : items) {
+      const int line = line_of(*n) > 0 ? line_of(*n) : e.line;
+      const auto* s = n->as_string();
+      if (!s || !is_data_file_entry(s->get())) {
+        fail(line, "data expects data-set files (paths ending in .h5, written by `phnn data` or "
+                   "`phnn import`, relative to this file); got " + values_.describe(*n));
+      }
+      const std::string name = systems_.resolve(s->get(), line);
+      if (std::find(names.begin(), names.end(), name) != names.end()) {
+        fail(line, "data lists " + quoted(s->get()) + " twice, or two files with the stem " +
+                       quoted(name) + "; list each data-set file once, with distinct file names");
+      }
+      names.push_back(name);
+    }
+    return names;
+  }
+
   Handlers axis_handlers(AxisSet& axes, bool allow_title) const {
     Handlers h;
     if (allow_title) {
@@ -304,6 +353,7 @@ class TableWalker {
       axes.systems = values_.systems(
           e, [this](const std::string& value, int line) { return systems_.resolve(value, line); });
     });
+    h.emplace_back("data", [this, &axes](const Entry& e) { axes.data = data_axis(e); });
     h.emplace_back("models", [this, &axes](const Entry& e) { axes.models = values_.models(e); });
     h.emplace_back("sizes", [this, &axes](const Entry& e) { axes.sizes = values_.sizes(e); });
     h.emplace_back("n_train", [this, &axes](const Entry& e) {

@@ -151,8 +151,8 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
     for (const std::string& change : cmp.changes) {
       text += "\n    " + change;
       if (change.rfind("system_file:", 0) == 0) {
-        text += "\n      (the text of a system file the sweep names changed: any byte of it is "
-                "part of the runs' identity)";
+        text += "\n      (the text of a system file the sweep names, or the contents of a "
+                "data-set file of `data`, changed: any byte of them is part of the runs' identity)";
       }
     }
   }

@@ -12,7 +12,17 @@ namespace phnn {
 /// or where in a results file it was stored).
 struct SystemFileText {
   std::string shown_as, text;
+  /// A data-set file named in `data` (sweeps/FORMAT.md): the checksum of its
+  /// contents (data_set_checksum) and its number of training pairs; empty
+  /// and 0 for a system file.
+  std::string data_checksum;
+  int data_train_pairs = 0;
 };
+
+/// True for a `data` entry of a sweep file: a path ending in ".h5".
+inline bool is_data_file_entry(const std::string& entry) {
+  return entry.size() > 3 && entry.compare(entry.size() - 3, 3, ".h5") == 0;
+}
 
 /// Returns the system file a sweep file names (`entry` as written in
 /// `systems`); throws SystemFileError (or any std::exception) when it

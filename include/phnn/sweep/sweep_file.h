@@ -78,6 +78,14 @@ struct SweepSystemFile {
   std::string text, text_hash;
   /// States, dissipation ports and inputs of the system.
   int n_x = 0, n_w = 0, n_u = 0;
+  /// A data-set file of `data` (entry ends in ".h5"): its system file is the
+  /// text stored in it, `name` the file's stem, text_hash also covers the
+  /// checksum of its contents (a changed data file makes different runs),
+  /// and its runs train and infer on the file's splits. `path` is where it
+  /// was read (relative entries resolved against the sweep file).
+  std::string data_checksum, path;
+  int data_train_pairs = 0;
+  bool is_data() const { return !data_checksum.empty(); }
 };
 
 /// One side of an [adaptive] comparison: the cell of `system` with these
@@ -197,7 +205,8 @@ SweepSpec parse_sweep_text(const std::string& text, const std::string& display_n
                            const SystemFileReader& read_system_file = {});
 
 /// hex64 of the sweep text alone when it names no system file, else of the
-/// text followed by each system file's entry and text (SweepSpec::text_hash).
+/// text followed by each system file's entry and text (and a data-set file's
+/// checksum) (SweepSpec::text_hash).
 std::string sweep_hash(const std::string& text, const std::vector<SweepSystemFile>& files);
 
 /// "node-rk2", "phnn-jr-dg", ...: the sweep-file spelling of a model.
