@@ -74,8 +74,7 @@ class ComparisonRule {
     if (resolved(summary(a, stop_, &stop_summaries_), summary(b, stop_, &stop_summaries_))) return;
     const CellSummary& sa = summary(a);
     const CellSummary& sb = summary(b);
-    if (adaptive_.futility && sa.has_interval() && sb.has_interval() &&
-        projected(sa).overlaps(projected(sb))) {
+    if (adaptive_.futility && sa.has_interval() && sb.has_interval() && futile(sa, sb)) {
       return;  // max_seeds is not expected to resolve it
     }
     cells->push_back(a);
@@ -95,6 +94,16 @@ class ComparisonRule {
       if (best < 0 || cs.median < summary(best).median) best = it->second;
     }
     return best;
+  }
+
+  // A tie more seeds are not expected to break: one median lies inside the
+  // other's interval projected to max_seeds (the medians would have to move
+  // apart by more than a projected half-width). A mere overlap of the two
+  // projections is not enough: such a pair sits at the margin, where a few
+  // more seeds often resolve it.
+  bool futile(const CellSummary& a, const CellSummary& b) const {
+    const auto inside = [](double m, const Interval& i) { return i.low <= m && m <= i.high; };
+    return inside(a.median, projected(b)) || inside(b.median, projected(a));
   }
 
   // The interval at max_seeds if the median stays and both distances to

@@ -280,6 +280,39 @@ TEST(AdaptiveRoundsTest, FutilitySkipsComparisonsMaxSeedsCannotResolve) {
               HasSubstr("futility applies to rule = \"comparisons\" only"));
 }
 
+// At the margin: RK4 = RK2 + 0.1, 5 seeds 1.0 ... 1.4 apart by 0.1. The
+// intervals narrowed to 40 seeds still overlap, but neither median lies
+// inside the other's narrowed interval: not futile, both cells grow.
+TEST(AdaptiveRoundsTest, FutilityLeavesMarginalOverlapsGrowing) {
+  const std::string comparisons =
+      "max_seeds = 40\nbatch = 10\nrule = \"comparisons\"\nfutility = true\n"
+      "comparisons = [[\"harmonic/phnn-jr-rk2/25/small/none\", \"harmonic/phnn-jr-rk4/25/small/none\"]]\n";
+  const SweepSpec spec = parse_sweep_text(sweep_text(kTwoModels, comparisons), "x.toml");
+  const Grid grid = expand_grid(spec);
+  const double shift = 0.1;
+  const Results r = results_of(grid, [&](const RunConfig& run) {
+    return (run.integrator == IntegratorKind::kRk4 ? shift : 0.0) + 1.0 + 0.1 * (run.seed % 5);
+  });
+  std::vector<double> lo, hi;
+  for (int k = 0; k < 5; ++k) {
+    lo.push_back(1.0 + 0.1 * k);
+    hi.push_back(shift + 1.0 + 0.1 * k);
+  }
+  // Preconditions on the statistics alone: 5-seed intervals overlap, their
+  // projections (x sqrt(5/40) about the medians 1.2 and 1.3) too, and
+  // neither projection holds the other median.
+  const Interval a = bootstrap_median_interval(lo), b = bootstrap_median_interval(hi);
+  const double r8 = std::sqrt(5.0 / 40.0);
+  const Interval pa{1.2 - (1.2 - a.low) * r8, 1.2 + (a.high - 1.2) * r8};
+  const Interval pb{1.3 - (1.3 - b.low) * r8, 1.3 + (b.high - 1.3) * r8};
+  ASSERT_TRUE(a.overlaps(b));
+  ASSERT_TRUE(pa.overlaps(pb)) << pa.low << " " << pa.high << " / " << pb.low << " " << pb.high;
+  ASSERT_TRUE(pa.high < 1.3 && pb.low > 1.2);
+  std::vector<char> active(grid.runs.size(), 0);
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) active[i] = grid.runs[i].seed < 5;
+  EXPECT_EQ(adaptive_rule_cells(spec, grid, active, r.status, r.mse).size(), 2u);
+}
+
 // Two cells of 10 seeds each, 1..10 and 1..10 + shift: at the shift below
 // their 95 % intervals are disjoint and their 99 % intervals overlap
 // (checked first, on the statistics alone).

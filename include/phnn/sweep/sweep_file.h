@@ -130,9 +130,9 @@ struct AdaptiveSpec {
   AdaptiveRule rule = AdaptiveRule::kColumnBest;
   std::vector<SeedComparison> comparisons;
   /// rule comparisons only: skip an unresolved comparison that max_seeds is
-  /// not expected to resolve — its two intervals, narrowed about their
-  /// medians by sqrt(finished / max_seeds), still overlap (docs/METHOD.md,
-  /// "Adaptive seeds").
+  /// not expected to resolve — one cell's median lies inside the other's
+  /// interval narrowed about its median by sqrt(finished / max_seeds)
+  /// (docs/METHOD.md, "Adaptive seeds").
   bool futility = false;
   /// `stop_confidence`: a comparison (column-best: a cell against its
   /// column's best) stops getting seeds before max_seeds only when its
