@@ -2,6 +2,8 @@
 #include <sys/stat.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 #include "apps/cli.h"
@@ -19,11 +21,41 @@ namespace apps {
 
 namespace {
 
+// --noise "0.01" (every state) or "0.01,0.02" (one per state).
+NoiseOptions noise_options(const cli::Parser& parser, int n_x) {
+  NoiseOptions o;
+  o.relative = !parser.flag_set("noise-absolute");
+  if (!parser.has("noise")) return o;
+  const std::string text = parser.get("noise");
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(v) || v < 0) {
+      throw cli::UsageError{"phnn data: --noise " + text + ": \"" + item + "\" is not a number "
+                            ">= 0; write one level for all states (0.01) or one per state "
+                            "(0.01,0.02)"};
+    }
+    o.levels.push_back(v);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (o.levels.size() == 1) o.levels.assign(static_cast<std::size_t>(n_x), o.levels[0]);
+  if (static_cast<int>(o.levels.size()) != n_x) {
+    throw cli::UsageError{"phnn data: --noise " + text + " gives " + std::to_string(o.levels.size()) +
+                          " levels for " + std::to_string(n_x) + " states; give one, or one per state"};
+  }
+  return o;
+}
+
 int write_file_system_data(const std::string& path, const DatasetOptions& options, int n_train,
                            const std::string& out, const std::string& csv,
-                           std::chrono::steady_clock::time_point start) {
+                           const cli::Parser& parser, std::chrono::steady_clock::time_point start) {
   const std::unique_ptr<PhSystem> system = load_system_file(path);
-  const PhSystemData data = make_ph_system_data(*system, options, n_train);
+  PhSystemData data = make_ph_system_data(*system, options, n_train);
+  add_measurement_noise(&data, system->rng_id(), noise_options(parser, system->n_x()));
   if (!csv.empty()) {
     // Written first: a failure leaves no data set that lacks its CSV.
     const TrajectoryColumns columns{system->state_names(), system->input_names()};
@@ -47,6 +79,7 @@ int write_file_system_data(const std::string& path, const DatasetOptions& option
             << " validation pairs, " << data.inference.size() << " inference trajectories x "
             << (data.inference.size() ? data.inference.states[0].size() : 0) << " samples -> "
             << out << " (" << seconds << " s)\n";
+  if (!data.noise.empty()) std::cout << "phnn data: noise: " << data.noise << "\n";
   return 0;
 }
 
@@ -65,6 +98,10 @@ int run_data(int argc, char** argv, int first) {
   parser.option("mass", "m [kg]", "0.16");
   parser.option("csv", "also write the trajectories behind the splits to this CSV "
                        "(`phnn import`'s format; system files only)");
+  parser.option("noise", "measurement noise on the training and validation pairs: one level for "
+                         "all states (0.01) or one per state (0.01,0.02), relative to each "
+                         "state's spread (system files only)");
+  parser.flag("noise-absolute", "--noise levels are absolute standard deviations");
   if (!parser.parse(argc, argv, first)) return 0;
 
   const std::string system_arg = parser.get("system");
@@ -93,6 +130,17 @@ int run_data(int argc, char** argv, int first) {
   const std::string problem = output_problem("data", out, OutputKind::kDataSet, {system_arg});
   if (!problem.empty()) throw cli::UsageError{"phnn data: --out " + problem};
   const std::string csv = parser.get("csv");
+  if ((parser.has("noise") || parser.flag_set("noise-absolute")) && !from_file) {
+    throw cli::UsageError{"phnn data: --noise needs a system file: use --system sweeps/systems/" +
+                          system_arg + ".toml (the same system)"};
+  }
+  if (parser.flag_set("noise-absolute") && !parser.has("noise")) {
+    throw cli::UsageError{"phnn data: --noise-absolute without --noise; give the levels"};
+  }
+  if (parser.has("noise") && parser.has("csv")) {
+    throw cli::UsageError{"phnn data: --csv writes the clean trajectories, --noise perturbs only "
+                          "the pairs: use one of them (add noise to a recording before importing it)"};
+  }
   if (parser.has("csv")) {
     if (!from_file) {
       throw cli::UsageError{"phnn data: --csv needs a system file: use --system "
@@ -103,7 +151,8 @@ int run_data(int argc, char** argv, int first) {
   }
   const auto start = std::chrono::steady_clock::now();
   if (from_file) {
-    return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, csv, start);
+    return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, csv, parser,
+                                  start);
   }
   const SystemData data = make_system_data(system, options, static_cast<int>(n_train));
   write_atomically(out, "writing", [&](const std::string& path) { write_dataset_file(path, data); });

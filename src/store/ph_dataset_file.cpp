@@ -154,6 +154,7 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
   file.set_attribute(g, "state_units", join(data.state_units));
   file.set_attribute(g, "input_names", join(data.input_names));
   file.set_attribute(g, "time_units", std::string("s"));
+  if (!data.noise.empty()) file.set_attribute(g, "noise", data.noise);
   write_options(file, g, data.options);
   write_pairs(file, p + "/train", data.train, nx, nu);
   write_pairs(file, p + "/validation", data.validation, nx, nu);
@@ -183,6 +184,7 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
   d.state_units = split(file.string_attribute(g, "state_units"));
   d.input_names = split(file.string_attribute(g, "input_names"));
   d.n_w = static_cast<int>(file.int_attribute(g, "n_w"));
+  if (file.has_attribute(g, "noise")) d.noise = file.string_attribute(g, "noise");
   const int nx = static_cast<int>(d.state_names.size());
   const int nu = static_cast<int>(d.input_names.size());
   d.options = read_options(file, g);

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
+#include "phnn/store/ph_dataset_file.h"
 #include "test_util.h"
 
 namespace phnn {
@@ -86,6 +87,27 @@ TEST(ImportCommandTest, BadInputExitsTwoAndWritesNoDataSet) {
   std::string first;
   std::getline(in, first);
   EXPECT_EQ(first, "trajectory,t,q,p,u");
+  std::system(("rm -rf " + dir).c_str());
+}
+
+TEST(ImportCommandTest, DataNoiseIsRecordedAndItsMisusesRefused) {
+  const std::string dir = ::testing::TempDir() + "phnn_noise_cli/";
+  ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
+  std::string log;
+  ASSERT_EQ(phnn("data --system " + kPendulum + " --n-train 5 --noise 0.01 --out " + dir + "n.h5", &log), 0)
+      << log;
+  EXPECT_THAT(read_ph_dataset_file(dir + "n.h5").noise, HasSubstr("relative levels 0.01 0.01"));
+  EXPECT_EQ(phnn("data --system harmonic --noise 0.01 --out " + dir + "h.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("sweeps/systems/harmonic.toml"));
+  EXPECT_EQ(phnn("data --system " + kPendulum + " --noise 0.01,0.02,0.03 --out " + dir + "x.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("3 levels for 2 states"));
+  EXPECT_EQ(phnn("data --system " + kPendulum + " --noise -1 --out " + dir + "x.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("is not a number >= 0"));
+  EXPECT_EQ(phnn("data --system " + kPendulum + " --noise 0.01 --csv " + dir + "x.csv --out " + dir + "x.h5",
+                 &log),
+            2);
+  EXPECT_THAT(log, HasSubstr("use one of them"));
+  EXPECT_FALSE(exists(dir + "x.h5"));
   std::system(("rm -rf " + dir).c_str());
 }
 

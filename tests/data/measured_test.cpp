@@ -159,6 +159,56 @@ TEST(MeasuredDataTest, PairWindowLimitsWherePairsAreDrawn) {
       MeasuredDataError);
 }
 
+// Measurement noise: N(0, sigma_j^2) on the pairs only, sigma_j = level x
+// the clean pairs' spread of state j, each trajectory's draws its own.
+TEST(MeasuredDataTest, NoiseIsGaussianWithTheAskedSigmaOnThePairsOnly) {
+  const auto system = pendulum();
+  DatasetOptions o = small_options();
+  o.num_validation = 500;
+  const PhSystemData clean = make_ph_system_data(*system, o, 6);
+  PhSystemData noisy = clean;
+  NoiseOptions noise;
+  noise.levels = {0.01, 0.05};
+  const std::vector<double> sigma = add_measurement_noise(&noisy, system->rng_id(), noise);
+  ASSERT_EQ(sigma.size(), 2u);
+  EXPECT_THAT(noisy.noise, AllOf(HasSubstr("relative levels 0.01 0.05"), HasSubstr("inference clean")));
+  for (int j = 0; j < 2; ++j) {
+    // The spread, independently: standard deviation of x_j over the validation pairs.
+    std::vector<double> v;
+    for (const VecX& x : clean.validation.x) v.push_back(x(j));
+    double mean = 0, var = 0;
+    for (double x : v) mean += x / static_cast<double>(v.size());
+    for (double x : v) var += (x - mean) * (x - mean) / static_cast<double>(v.size() - 1);
+    EXPECT_NEAR(sigma[static_cast<std::size_t>(j)], noise.levels[static_cast<std::size_t>(j)] * std::sqrt(var), 1e-12);
+    // Standardized errors: mean ~ 0 (SE 0.03 for ~1000), std ~ 1 (SE 0.022).
+    std::vector<double> z;
+    for (int split = 0; split < 2; ++split) {
+      const PhPairSet& c = split ? clean.validation : clean.train;
+      const PhPairSet& n = split ? noisy.validation : noisy.train;
+      for (std::size_t i = 0; i < c.size(); ++i) {
+        z.push_back((n.x[i](j) - c.x[i](j)) / sigma[static_cast<std::size_t>(j)]);
+        z.push_back((n.x_next[i](j) - c.x_next[i](j)) / sigma[static_cast<std::size_t>(j)]);
+      }
+    }
+    double zm = 0, zv = 0;
+    for (double x : z) zm += x / static_cast<double>(z.size());
+    for (double x : z) zv += (x - zm) * (x - zm) / static_cast<double>(z.size() - 1);
+    EXPECT_LT(std::abs(zm), 0.15) << "state " << j;
+    EXPECT_NEAR(std::sqrt(zv), 1.0, 0.1) << "state " << j;
+  }
+  EXPECT_EQ(noisy.inference.states, clean.inference.states);
+  // A trajectory's noise depends on its index only: fewer training pairs
+  // keep the same noisy pairs.
+  PhSystemData fewer = make_ph_system_data(*system, o, 3);
+  add_measurement_noise(&fewer, system->rng_id(), noise);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(fewer.train.x[i], noisy.train.x[i]);
+  EXPECT_EQ(fewer.validation.x_next, noisy.validation.x_next);
+  EXPECT_NE(data_set_checksum(noisy), data_set_checksum(clean));
+  NoiseOptions wrong;
+  wrong.levels = {0.1};
+  EXPECT_THROW(add_measurement_noise(&fewer, system->rng_id(), wrong), std::invalid_argument);
+}
+
 // ------------------------------------------------------------ bad input
 
 std::string error_of(const std::function<void()>& f) {

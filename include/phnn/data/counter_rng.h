@@ -23,6 +23,7 @@ class CounterRng {
     kInitialCondition = 1,
     kControl = 2,
     kTrainingPair = 3,
+    kMeasurementNoise = 4,
   };
 
   static CounterRng for_trajectory(std::uint64_t data_seed, int system_id,

@@ -68,6 +68,9 @@ struct PhSystemData {
   DatasetOptions options;
   PhPairSet train, validation;
   PhInferenceSet inference;
+  /// Measurement noise added to the pairs ("" = none), e.g. "relative 0.01:
+  /// sigma q=0.0021 p=0.0034" (add_measurement_noise, data/measured.h).
+  std::string noise;
 };
 
 /// hex64 of FNV-1a 64 over what training and inference read: the system
