@@ -186,13 +186,7 @@ PhSystemData split_measured_data(const PhSystem& system,
   const std::size_t num_train = static_cast<std::size_t>(total - held);
   const std::size_t infer_begin = num_train + static_cast<std::size_t>(options.num_validation);
 
-  PhSystemData data;
-  data.system_name = system.name();
-  data.system_text = system.source_text();
-  data.state_names = system.state_names();
-  data.state_units = system.state_units();
-  data.input_names = system.input_names();
-  data.n_w = system.n_w();
+  PhSystemData data = labelled_ph_system_data(system);
   data.train.step = data.validation.step = data.inference.step = h;
   for (std::size_t i = 0; i < infer_begin; ++i) {
     draw_pair(system, trajectories[i], options, i < num_train ? &data.train : &data.validation);

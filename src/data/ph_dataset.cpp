@@ -220,6 +220,17 @@ PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& op
   return set;
 }
 
+PhSystemData labelled_ph_system_data(const PhSystem& system) {
+  PhSystemData data;
+  data.system_name = system.name();
+  data.system_text = system.source_text();
+  data.state_names = system.state_names();
+  data.state_units = system.state_units();
+  data.input_names = system.input_names();
+  data.n_w = system.n_w();
+  return data;
+}
+
 std::string data_set_checksum(const PhSystemData& data) {
   // FNV-1a 64 (the run ids' hash), fed field by field.
   std::uint64_t h = 0xcbf29ce484222325ULL;
@@ -264,13 +275,7 @@ PhSystemData make_ph_system_data(const PhSystem& system, const DatasetOptions& o
   options.validate();
   PHNN_REQUIRE(num_train >= 1 && num_train <= options.num_train_max,
                "n_train = " << num_train << " outside [1, " << options.num_train_max << "]");
-  PhSystemData data;
-  data.system_name = system.name();
-  data.system_text = system.source_text();
-  data.state_names = system.state_names();
-  data.state_units = system.state_units();
-  data.input_names = system.input_names();
-  data.n_w = system.n_w();
+  PhSystemData data = labelled_ph_system_data(system);
   data.options = options;
   data.train = ph_make_pairs(system, options, 0, num_train);
   data.validation = ph_make_pairs(system, options, options.validation_begin(), options.num_validation);

@@ -73,6 +73,10 @@ struct PhSystemData {
   std::string noise;
 };
 
+/// A data set of `system` with no splits yet: its name, text, state and
+/// input names and units, n_w (what every data set of it carries).
+PhSystemData labelled_ph_system_data(const PhSystem& system);
+
 /// hex64 of FNV-1a 64 over what training and inference read: the system
 /// text, the state and input names, every pair's x, x_next, u and every
 /// inference state and input (doubles by their bytes), and the steps. Two
