@@ -15,6 +15,7 @@
 #include "phnn/integrators/discrete_gradient.h"
 #include "phnn/integrators/explicit_midpoint.h"
 #include "phnn/systems/oscillators.h"
+#include "phnn/systems/system_file.h"
 
 namespace phnn {
 namespace testing_util {
@@ -80,6 +81,13 @@ inline int run_shell(const std::string& command, std::string* output = nullptr) 
 inline std::string mpiexec_phnn(int ranks) {
   return std::string(PHNN_MPIEXEC) + " -n " + std::to_string(ranks) + " " + PHNN_MPIEXEC_PREFLAGS +
          " " + PHNN_BINARY;
+}
+#endif
+
+#ifdef PHNN_SOURCE_DIR
+/// A shipped system file, sweeps/systems/<name>.toml, compiled.
+inline std::unique_ptr<PhSystem> shipped_system(const std::string& name) {
+  return load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/" + name + ".toml");
 }
 #endif
 

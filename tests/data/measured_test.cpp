@@ -15,6 +15,7 @@
 
 #include "phnn/store/trajectory_files.h"
 #include "phnn/systems/system_file.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -22,9 +23,7 @@ namespace {
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 
-std::unique_ptr<PhSystem> pendulum() {
-  return load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum.toml");
-}
+std::unique_ptr<PhSystem> pendulum() { return testing_util::shipped_system("pendulum"); }
 
 DatasetOptions small_options() {
   DatasetOptions o;

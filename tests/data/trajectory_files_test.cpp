@@ -15,6 +15,7 @@
 #include "h5/h5file.h"
 #include "phnn/data/measured.h"
 #include "phnn/systems/system_file.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -22,9 +23,7 @@ namespace {
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 
-std::unique_ptr<PhSystem> pendulum() {
-  return load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum.toml");
-}
+std::unique_ptr<PhSystem> pendulum() { return testing_util::shipped_system("pendulum"); }
 
 std::string error_of(const std::function<void()>& f) {
   try {
