@@ -313,7 +313,9 @@ PhSystemData file_system_data(const cli::Parser& parser, const PhSystem& system,
                             (data.system_text.empty() ? "the built-in system " + data.system_name
                                                       : "another text of system " + data.system_name) +
                             ", not from " + parser.get("system") +
-                            "; regenerate it with `phnn data --system " + parser.get("system") + "`"};
+                            "; regenerate it with `phnn data --system " + parser.get("system") +
+                            "` (or, for recordings, `phnn import ... --system " + parser.get("system") +
+                            "`)"};
     }
     return data;
   }
