@@ -5,8 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <numeric>
 #include <sstream>
 
 #include "phnn/common/check.h"
@@ -16,8 +14,6 @@ namespace phnn {
 namespace {
 
 [[noreturn]] void fail(const std::string& message) { throw MeasuredDataError(message); }
-
-std::string where(const MeasuredTrajectory& m) { return m.where(0); }
 
 std::string g(double v) {
   std::ostringstream s;
@@ -31,7 +27,7 @@ void check_trajectory(const MeasuredTrajectory& m, int nx, int nu) {
   const std::size_t n = m.t.size();
   PHNN_CHECK(m.x.size() == n && m.u.size() == n, "ragged trajectory from the reader");
   if (n < 2) {
-    fail(where(m) + " has " + std::to_string(n) + " sample; a training pair (x_n, x_n+1) needs "
+    fail(m.where(0) + " has " + std::to_string(n) + " sample; a training pair (x_n, x_n+1) needs "
          "at least 2: drop it or record longer");
   }
   for (std::size_t k = 0; k < n; ++k) {
@@ -83,14 +79,14 @@ double common_step(const std::vector<MeasuredTrajectory>& all, const ImportOptio
     if (!first) {
       first = &m, h0 = h;
     } else if (std::abs(h - h0) > o.time_tolerance * h0) {
-      fail(where(m) + " is sampled every " + g(h) + " s, " + where(*first) + " every " + g(h0) +
+      fail(m.where(0) + " is sampled every " + g(h) + " s, " + first->where(0) + " every " + g(h0) +
            " s; phnn needs one sampling rate: resample one of them");
     }
   }
   if (o.sample_rate > 0) {
     if (std::abs(h0 * o.sample_rate - 1.0) > o.time_tolerance) {
       fail("--sample-rate " + g(o.sample_rate) + " Hz disagrees with the time column (" +
-           where(*first) + " is sampled at " + g(1.0 / h0) + " Hz); drop --sample-rate or fix t");
+           first->where(0) + " is sampled at " + g(1.0 / h0) + " Hz); drop --sample-rate or fix t");
     }
     if (summary) *summary += "sample rate " + g(o.sample_rate) + " Hz (given)\n";
     return 1.0 / o.sample_rate;
@@ -116,7 +112,7 @@ void draw_pair(const PhSystem& system, const MeasuredTrajectory& m, const Import
       ++positions;
     }
     if (positions == 0) {
-      fail(where(m) + ": no pair ends within --pair-window " + g(o.pair_window) + " s of its "
+      fail(m.where(0) + ": no pair ends within --pair-window " + g(o.pair_window) + " s of its "
            "start (the second sample is at " + g(m.t[1] - m.t[0]) + " s); widen the window");
     }
   }

@@ -231,45 +231,6 @@ PhSystemData labelled_ph_system_data(const PhSystem& system) {
   return data;
 }
 
-std::string data_set_checksum(const PhSystemData& data) {
-  // FNV-1a 64 (the run ids' hash), fed field by field.
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  const auto bytes = [&h](const void* p, std::size_t n) {
-    const auto* c = static_cast<const unsigned char*>(p);
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 0x100000001b3ULL;
-  };
-  const auto text = [&](const std::string& s) {
-    const std::uint64_t n = s.size();
-    bytes(&n, sizeof n);
-    bytes(s.data(), s.size());
-  };
-  const auto vec = [&](const VecX& v) {
-    const std::uint64_t n = static_cast<std::uint64_t>(v.size());
-    bytes(&n, sizeof n);
-    bytes(v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
-  };
-  text(data.system_text);
-  for (const auto& s : data.state_names) text(s);
-  for (const auto& s : data.input_names) text(s);
-  for (const PhPairSet* p : {&data.train, &data.validation}) {
-    bytes(&p->step, sizeof p->step);
-    for (std::size_t i = 0; i < p->size(); ++i) {
-      vec(p->x[i]);
-      vec(p->x_next[i]);
-      vec(p->u[i]);
-    }
-  }
-  bytes(&data.inference.step, sizeof data.inference.step);
-  for (std::size_t i = 0; i < data.inference.size(); ++i) {
-    vec(data.inference.u[i]);
-    for (const VecX& x : data.inference.states[i]) vec(x);
-  }
-  static const char* digits = "0123456789abcdef";
-  std::string out(16, '0');
-  for (int k = 15; k >= 0; --k, h >>= 4) out[static_cast<std::size_t>(k)] = digits[h & 15];
-  return out;
-}
-
 PhSystemData make_ph_system_data(const PhSystem& system, const DatasetOptions& options,
                                  int num_train) {
   options.validate();

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "h5/h5file.h"
+#include "phnn/config/run_config.h"
 #include "store/dataset_file_io.h"
 
 namespace phnn {
@@ -134,6 +135,41 @@ PhSystemData from_version1(const SystemData& v1) {
 }
 
 }  // namespace
+
+std::string data_set_checksum(const PhSystemData& data) {
+  // The bytes hashed, field by field: sizes as uint64, doubles as stored.
+  std::string bytes;
+  const auto raw = [&bytes](const void* p, std::size_t n) {
+    bytes.append(static_cast<const char*>(p), n);
+  };
+  const auto text = [&](const std::string& s) {
+    const std::uint64_t n = s.size();
+    raw(&n, sizeof n);
+    bytes += s;
+  };
+  const auto vec = [&](const VecX& v) {
+    const std::uint64_t n = static_cast<std::uint64_t>(v.size());
+    raw(&n, sizeof n);
+    raw(v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
+  };
+  text(data.system_text);
+  for (const auto& s : data.state_names) text(s);
+  for (const auto& s : data.input_names) text(s);
+  for (const PhPairSet* p : {&data.train, &data.validation}) {
+    raw(&p->step, sizeof p->step);
+    for (std::size_t i = 0; i < p->size(); ++i) {
+      vec(p->x[i]);
+      vec(p->x_next[i]);
+      vec(p->u[i]);
+    }
+  }
+  raw(&data.inference.step, sizeof data.inference.step);
+  for (std::size_t i = 0; i < data.inference.size(); ++i) {
+    vec(data.inference.u[i]);
+    for (const VecX& x : data.inference.states[i]) vec(x);
+  }
+  return hex64(fnv1a64(bytes));
+}
 
 namespace internal {
 

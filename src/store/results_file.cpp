@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "phnn/store/ph_dataset_file.h"
 #include "store/dataset_file_io.h"
 #include "store/results_file_internal.h"
 

@@ -13,6 +13,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "phnn/store/ph_dataset_file.h"
 #include "phnn/store/trajectory_files.h"
 #include "phnn/systems/system_file.h"
 #include "test_util.h"

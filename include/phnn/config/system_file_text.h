@@ -15,7 +15,7 @@ struct SystemFileText {
   /// A data-set file named in `data` (sweeps/FORMAT.md): the checksum of its
   /// contents (data_set_checksum) and its number of training pairs; empty
   /// and 0 for a system file.
-  std::string data_checksum;
+  std::string data_checksum = "";
   int data_train_pairs = 0;
 };
 

@@ -77,13 +77,6 @@ struct PhSystemData {
 /// input names and units, n_w (what every data set of it carries).
 PhSystemData labelled_ph_system_data(const PhSystem& system);
 
-/// hex64 of FNV-1a 64 over what training and inference read: the system
-/// text, the state and input names, every pair's x, x_next, u and every
-/// inference state and input (doubles by their bytes), and the steps. Two
-/// files with the same contents have the same checksum, whatever their
-/// other attributes.
-std::string data_set_checksum(const PhSystemData& data);
-
 /// Generates the splits; `num_train` <= options.num_train_max training pairs.
 PhSystemData make_ph_system_data(const PhSystem& system, const DatasetOptions& options,
                                  int num_train);

@@ -14,6 +14,13 @@ namespace phnn {
 /// Writes `data` to a new HDF5 file (replaces `path`).
 void write_ph_dataset_file(const std::string& path, const PhSystemData& data);
 
+/// hex64(fnv1a64(...)) (the run ids' hash) over what training and inference
+/// read: the system text, the state and input names, every pair's x,
+/// x_next, u and every inference state and input (doubles by their bytes),
+/// and the steps. Two files with the same contents have the same checksum,
+/// whatever their other attributes: a data-set file's identity in sweeps.
+std::string data_set_checksum(const PhSystemData& data);
+
 /// Reads a data-set file of either version (a built-in system's version-1
 /// file comes back with state names q, p and input u). Throws
 /// std::runtime_error naming the file when it is not a phnn data set.
