@@ -336,6 +336,7 @@ int general(int repeats) {
     phnn::DatasetOptions options;
     options.num_validation = 64;
     options.num_inference = 1;
+    options.beta = 0.4;  // 40-step rollouts: T(700) - T(100) is the training steps alone
     const phnn::PhSystemData data = phnn::make_ph_system_data(*system, options, 100);
     const phnn::SystemData builtin = phnn::make_system_data(
         phnn::OscillatorOptions::defaults(phnn::SystemKind::kHarmonic), options, 100);

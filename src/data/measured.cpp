@@ -22,7 +22,7 @@ std::string g(double v) {
   return s.str();
 }
 
-// Shapes, finite values, >= 2 samples, increasing time, constant inputs.
+// Shapes, finite values, >= 2 samples, increasing time.
 void check_trajectory(const MeasuredTrajectory& m, int nx, int nu) {
   const std::size_t n = m.t.size();
   PHNN_CHECK(m.x.size() == n && m.u.size() == n, "ragged trajectory from the reader");
@@ -39,11 +39,6 @@ void check_trajectory(const MeasuredTrajectory& m, int nx, int nu) {
     if (k > 0 && !(m.t[k] > m.t[k - 1])) {
       fail(m.where(k) + ": t = " + g(m.t[k]) +
            " does not increase (previous " + g(m.t[k - 1]) + "); sort the samples by time");
-    }
-    if (k > 0 && m.u[k] != m.u[0]) {
-      fail(m.where(k) + ": the input changes within the "
-           "trajectory; phnn trains with one constant input per trajectory: split the "
-           "recording where the input changes");
     }
   }
 }
@@ -191,11 +186,20 @@ PhSystemData split_measured_data(const PhSystem& system,
   for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
     samples = std::min(samples, trajectories[i].t.size());
   }
+  // Inputs that change within an inference trajectory are replayed sample
+  // by sample at inference (zero-order hold); constant ones stay one per
+  // trajectory.
+  bool varying = false;
+  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
+    const MeasuredTrajectory& m = trajectories[i];
+    for (std::size_t k = 1; k < samples && !varying; ++k) varying = m.u[k] != m.u[0];
+  }
   for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
     const MeasuredTrajectory& m = trajectories[i];
     data.inference.trajectory.push_back(m.id);
     data.inference.u.push_back(m.u[0]);
     data.inference.states.emplace_back(m.x.begin(), m.x.begin() + static_cast<long>(samples));
+    if (varying) data.inference.inputs.emplace_back(m.u.begin(), m.u.begin() + static_cast<long>(samples));
   }
 
   // What the options record: the rate, the split sizes, the window and the
@@ -285,12 +289,18 @@ std::vector<MeasuredTrajectory> generated_trajectories(const PhSystem& system,
   const int stride = o.stride(), positions = o.num_pair_positions();
   const double h = data.train.step;
   std::vector<MeasuredTrajectory> out;
-  const auto add = [&](std::int64_t id, const VecX& u, std::vector<VecX> states) {
+  // inputs: per sample (time-varying designs), else empty and u throughout.
+  const auto add = [&](std::int64_t id, const VecX& u, const std::vector<VecX>& inputs,
+                       std::vector<VecX> states) {
     MeasuredTrajectory m;
     m.id = id;
     m.source = "generated";
     for (std::size_t n = 0; n < states.size(); ++n) m.t.push_back(static_cast<double>(n) * h);
-    m.u.assign(states.size(), u);
+    if (inputs.empty()) {
+      m.u.assign(states.size(), u);
+    } else {
+      m.u.assign(inputs.begin(), inputs.begin() + static_cast<long>(states.size()));
+    }
     m.x = std::move(states);
     out.push_back(std::move(m));
   };
@@ -301,13 +311,16 @@ std::vector<MeasuredTrajectory> generated_trajectories(const PhSystem& system,
       std::vector<VecX> sub;
       for (int n = 0; n <= positions; ++n) sub.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
       const auto n = static_cast<std::size_t>(pairs->position[i]);
-      PHNN_CHECK(sub[n] == pairs->x[i] && sub[n + 1] == pairs->x_next[i] && traj.u == pairs->u[i],
+      const VecX& u_n = traj.inputs.empty() ? traj.u : traj.inputs[n];
+      PHNN_CHECK(sub[n] == pairs->x[i] && sub[n + 1] == pairs->x_next[i] && u_n == pairs->u[i],
                  "trajectory " << pairs->trajectory[i] << " regenerated differs from its pair");
-      add(pairs->trajectory[i], traj.u, std::move(sub));
+      add(pairs->trajectory[i], traj.u, traj.inputs, std::move(sub));
     }
   }
   for (std::size_t i = 0; i < data.inference.size(); ++i) {
-    add(data.inference.trajectory[i], data.inference.u[i], data.inference.states[i]);
+    add(data.inference.trajectory[i], data.inference.u[i],
+        data.inference.inputs.empty() ? std::vector<VecX>{} : data.inference.inputs[i],
+        data.inference.states[i]);
   }
   return out;
 }

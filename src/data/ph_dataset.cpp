@@ -135,8 +135,68 @@ VecX control_input(const PhSystem& system, CounterRng* rng) {
       u(0) = -rng->uniform(interval[0], interval[1]);
       break;
     }
+    case ControlDesign::Design::kSines:
+    case ControlDesign::Design::kChirp:
+    case ControlDesign::Design::kSteps:
+      break;  // input_samples()
   }
   return u;
+}
+
+// Steps: a new level per input ~ U(range[i]) every `hold` seconds, drawn in
+// order as the samples reach it.
+std::vector<VecX> step_samples(const ControlDesign& c, int nu, int count, double hs,
+                               CounterRng* rng) {
+  std::vector<VecX> out;
+  VecX level = VecX::Zero(nu);
+  long drawn = -1;
+  for (int k = 0; k < count; ++k) {
+    const long j = static_cast<long>(std::floor(k * hs / c.hold + 1e-9));
+    for (; drawn < j; ++drawn) {
+      for (int i = 0; i < nu; ++i) {
+        level(i) = rng->uniform(c.range[static_cast<std::size_t>(i)][0], c.range[static_cast<std::size_t>(i)][1]);
+      }
+    }
+    out.push_back(level);
+  }
+  return out;
+}
+
+// Time-varying designs (ControlDesign::time_varying): the inputs at the
+// samples k = 0..count-1, t_k = k h_s, each held over [t_k, t_{k+1}). Drawn
+// from the control stream input by input: the offset c_i (if a range is
+// given), then (a, phi) per sine, or (a, phi) of the chirp.
+std::vector<VecX> input_samples(const PhSystem& system, const DatasetOptions& options,
+                                CounterRng* rng) {
+  const ControlDesign& c = system.control_design();
+  const int nu = system.n_u();
+  const int count = options.num_inference_steps() + 1;
+  const double hs = options.stride() * options.generation_step;
+  if (c.design == ControlDesign::Design::kSteps) return step_samples(c, nu, count, hs, rng);
+  const double two_pi = 2.0 * M_PI, duration = options.beta * options.period;
+  std::vector<VecX> out(static_cast<std::size_t>(count), VecX::Zero(nu));
+  for (int i = 0; i < nu; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const double offset = c.range.empty() ? 0.0 : rng->uniform(c.range[iu][0], c.range[iu][1]);
+    const std::size_t m = c.design == ControlDesign::Design::kSines ? c.frequencies.size() : 1;
+    std::vector<double> a(m), phi(m);
+    for (std::size_t j = 0; j < m; ++j) {
+      a[j] = rng->uniform(c.amplitude[0], c.amplitude[1]);
+      phi[j] = rng->uniform(0.0, two_pi);
+    }
+    for (int k = 0; k < count; ++k) {
+      const double t = k * hs;
+      double v = offset;
+      if (c.design == ControlDesign::Design::kSines) {
+        for (std::size_t j = 0; j < m; ++j) v += a[j] * std::sin(two_pi * c.frequencies[j] * t + phi[j]);
+      } else {
+        const double f0 = c.frequencies[0], f1 = c.frequencies[1];
+        v += a[0] * std::sin(two_pi * (f0 * t + (f1 - f0) * t * t / (2.0 * duration)) + phi[0]);
+      }
+      out[static_cast<std::size_t>(k)](i) = v;
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -151,7 +211,12 @@ PhTrajectorySpec ph_trajectory_spec(const PhSystem& system, const DatasetOptions
       CounterRng::for_trajectory(options.data_seed, system.rng_id(), index, CounterRng::kControl);
   PhTrajectorySpec spec;
   spec.x0 = initial_state(system, options, &ic);
-  spec.u = control_input(system, &ctrl);
+  if (system.control_design().time_varying()) {
+    spec.inputs = input_samples(system, options, &ctrl);
+    spec.u = spec.inputs.front();
+  } else {
+    spec.u = control_input(system, &ctrl);
+  }
   return spec;
 }
 
@@ -162,10 +227,21 @@ PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions
   PhTrajectory traj;
   traj.index = index;
   traj.u = spec.u;
+  const int stride = options.stride();
+  if (!spec.inputs.empty()) {
+    // The samples this trajectory spans (its last state's included).
+    const std::size_t samples = static_cast<std::size_t>(num_steps / stride) + 1;
+    PHNN_REQUIRE(samples <= spec.inputs.size(),
+                 "ph_generate_trajectory: " << num_steps << " steps outrun the input signal ("
+                                            << spec.inputs.size() << " samples)");
+    traj.inputs.assign(spec.inputs.begin(), spec.inputs.begin() + static_cast<long>(samples));
+  }
   traj.states.reserve(static_cast<std::size_t>(num_steps) + 1);
   traj.states.push_back(spec.x0);
   for (int n = 0; n < num_steps; ++n) {
-    const PhImplicitStep step = ph_discrete_gradient_step(system, traj.states.back(), spec.u,
+    // Zero-order hold: u of sample floor(n / stride) over the whole step.
+    const VecX& u = spec.inputs.empty() ? spec.u : spec.inputs[static_cast<std::size_t>(n / stride)];
+    const PhImplicitStep step = ph_discrete_gradient_step(system, traj.states.back(), u,
                                                           options.generation_step, options.newton);
     if (step.status != StepStatus::kConverged) {
       std::ostringstream msg;
@@ -194,7 +270,7 @@ PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options, s
     const PhTrajectory traj = ph_generate_trajectory(system, options, i, (n + 1) * stride);
     pairs.x.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
     pairs.x_next.push_back(traj.states.back());
-    pairs.u.push_back(traj.u);
+    pairs.u.push_back(traj.inputs.empty() ? traj.u : traj.inputs[static_cast<std::size_t>(n)]);
     pairs.trajectory.push_back(i);
     pairs.position.push_back(n);
   }
@@ -216,6 +292,7 @@ PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& op
     set.trajectory.push_back(i);
     set.u.push_back(traj.u);
     set.states.push_back(std::move(sub));
+    if (!traj.inputs.empty()) set.inputs.push_back(traj.inputs);
   }
   return set;
 }

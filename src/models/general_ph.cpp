@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "models/general_heads.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -155,12 +156,23 @@ torch::Tensor GeneralPortHamiltonianModel::block_t(const std::vector<double>& ma
   return from_values(t, cols, rows, options().dtype);
 }
 
+// With fused networks, H and gradH come from one fused head on the network's
+// order-1 jet (general_heads.h); otherwise from the op-by-op jet (the
+// reference the tests compare the heads with).
 torch::Tensor GeneralPortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
+  if (l_h().options().fused) {
+    return internal::general_hamiltonian_head(l_h().forward(x), {}, x).h.squeeze(-1);
+  }
   return general_hamiltonian_jet(l_h(), x, 0).v.squeeze(-1);
 }
 
 HamiltonianAndGradient GeneralPortHamiltonianModel::energy_and_gradient(
     const torch::Tensor& x) const {
+  if (l_h().options().fused) {
+    const Jet o = l_h().forward_input(x, static_cast<int>(x.size(-1)), /*order=*/1);
+    const auto head = internal::general_hamiltonian_head(o.v, o.g, x);
+    return {head.h, head.grad};
+  }
   const Jet H = general_hamiltonian_jet(l_h(), x, 1);
   return {H.v, H.g.squeeze(-1)};
 }
@@ -175,6 +187,14 @@ torch::Tensor GeneralPortHamiltonianModel::discrete_gradient(const torch::Tensor
                                                              const torch::Tensor& dx,
                                                              double min_dx_norm) const {
   const int64_t B = x.size(1);
+  if (l_h().options().fused) {
+    // H at the ends needs no derivative: one order-0 call for both.
+    const auto ends = torch::cat({x, x + dx}, /*dim=*/1);
+    const auto h_ends = internal::general_hamiltonian_head(l_h().forward(ends), {}, ends).h;
+    const auto grad_mid = energy_and_gradient(x + 0.5 * dx).grad;
+    return internal::general_gonzalez_head(h_ends.narrow(1, 0, B), h_ends.narrow(1, B, B),
+                                           grad_mid, dx, min_dx_norm);
+  }
   const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
   const HamiltonianAndGradient h = energy_and_gradient(points);
   const auto grad_mid = h.grad.narrow(1, 2 * B, B);
@@ -211,6 +231,7 @@ GeneralPhnnS::GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t
     }
   }
   s_w_ = block_t(w_rows, nx + nu, 0, nw, 0, nx + nu);
+  s_w_rows_ = w_rows;
   s_x_ = block_t(s.S, width, 0, nx, 0, width);
   const int64_t total = tri + skew;
   if (nw > 0) {
@@ -235,6 +256,14 @@ Jet GeneralPhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_
                                     const torch::Tensor& u, int order,
                                     bool /*dissipation_fixed*/) const {
   const ModelStructure& s = structure();
+  if (order == 0 && l_h().options().fused) {
+    // Fused heads: w = [S_wx S_wu] [e; u], then f = S_x [e; z(w); u]
+    // (with no ports S_x is [S_xx S_xu]).
+    if (s.n_w == 0) return Jet{internal::general_linear_head(effort.v, u, s.S, s.n_x), {}, {}};
+    const auto w = internal::general_linear_head(effort.v, u, s_w_rows_, s.n_w);
+    return Jet{internal::general_s_field_head(effort.v, u, nets_[1]->forward(w), w, s.S, s.n_w),
+               {}, {}};
+  }
   const int d = directions_of(effort);
   const Jet U = Jet::constant(u, d, order);
   const int64_t E = effort.v.size(0);
@@ -281,6 +310,10 @@ Jet GeneralPhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_d
                                      bool dissipation_fixed) const {
   const ModelStructure& s = structure();
   const int64_t m = s.n_x + s.n_u;
+  if (order == 0 && l_h().options().fused) {
+    const auto o = nets_[1]->forward(torch::cat({x_dissipation, u}, -1));
+    return Jet{internal::general_jr_field_head(effort.v, u, o, s.J), {}, {}};
+  }
   const int d = directions_of(effort);
   const Jet U = Jet::constant(u, d, order);
   const Jet eu = Jet::cat({effort, U});

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "h5/h5file.h"
+#include "phnn/common/check.h"
 #include "phnn/config/run_config.h"
 #include "store/dataset_file_io.h"
 
@@ -168,6 +169,11 @@ std::string data_set_checksum(const PhSystemData& data) {
     vec(data.inference.u[i]);
     for (const VecX& x : data.inference.states[i]) vec(x);
   }
+  // Time-varying inputs (absent from the data sets before them: their
+  // checksums are unchanged).
+  for (const auto& traj : data.inference.inputs) {
+    for (const VecX& u : traj) vec(u);
+  }
   return hex64(fnv1a64(bytes));
 }
 
@@ -206,6 +212,19 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
   if (nu > 0) {
     file.write(p + "/inference/u", {m, static_cast<std::uint64_t>(nu)}, flatten(data.inference.u));
   }
+  if (!data.inference.inputs.empty()) {
+    PHNN_REQUIRE(data.inference.inputs.size() == m, "write_ph_system_data: inputs of "
+                                                        << data.inference.inputs.size() << " of " << m
+                                                        << " inference trajectories");
+    std::vector<double> inputs;
+    for (const auto& traj : data.inference.inputs) {
+      PHNN_REQUIRE(traj.size() == steps, "write_ph_system_data: " << traj.size()
+                                                                  << " inputs for " << steps << " samples");
+      const auto flat = flatten(traj);
+      inputs.insert(inputs.end(), flat.begin(), flat.end());
+    }
+    file.write(p + "/inference/inputs", {m, steps, static_cast<std::uint64_t>(nu)}, inputs);
+  }
   file.write(p + "/inference/trajectory", {m}, data.inference.trajectory);
   file.set_attribute(p + "/inference", "step_s", data.inference.step);
 }
@@ -239,6 +258,21 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
   }
   d.inference.u = nu > 0 ? unflatten(file.read_doubles(p + "/inference/u"), nu, m)
                          : std::vector<VecX>(m, VecX(0));
+  if (nu > 0 && file.exists(p + "/inference/inputs")) {
+    const auto in_dims = file.dims(p + "/inference/inputs");
+    if (in_dims.size() != 3 || in_dims[0] != m || in_dims[1] != steps ||
+        in_dims[2] != static_cast<std::uint64_t>(nu)) {
+      throw std::runtime_error(p + "/inference/inputs: expected [" + std::to_string(m) + ", " +
+                               std::to_string(steps) + ", " + std::to_string(nu) +
+                               "] (trajectories, samples, inputs); rewrite the file with phnn data or phnn import");
+    }
+    const auto inputs = file.read_doubles(p + "/inference/inputs");
+    for (std::size_t i = 0; i < m; ++i) {
+      const std::vector<double> part(inputs.begin() + static_cast<long>(i * steps * nu),
+                                     inputs.begin() + static_cast<long>((i + 1) * steps * nu));
+      d.inference.inputs.push_back(unflatten(part, nu, steps));
+    }
+  }
   return d;
 }
 

@@ -39,6 +39,23 @@ const std::map<std::string, Fn1>& functions() {
   return table;
 }
 
+// Powers that need no std::pow (whose glibc version differs with the CPU's
+// FMA support, and which is ~10x a product): b^2, b^3, b^4 as products,
+// b^(1/2) by the correctly rounded sqrt, negative exponents as 1 / b^|n|
+// (GiNaC writes every quotient as a power -1).
+const std::map<std::string, Fn1>& power_functions() {
+  static const std::map<std::string, Fn1> table = {
+      {"sq", [](double a) { return a * a; }},
+      {"cube", [](double a) { return (a * a) * a; }},
+      {"pow4", [](double a) { const double s = a * a; return s * s; }},
+      {"sqrt", [](double a) { return std::sqrt(a); }},
+      {"inv", [](double a) { return 1.0 / a; }},
+  };
+  return table;
+}
+
+std::string power_source(const GiNaC::ex& base, const GiNaC::ex& exponent);
+
 std::string number(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", v);
@@ -55,6 +72,22 @@ std::string sorted_operands(const GiNaC::ex& e, const char* op) {
   return out + ")";
 }
 
+std::string power_source(const GiNaC::ex& base, const GiNaC::ex& exponent) {
+  const std::string b = muparser_source(base);
+  if (GiNaC::is_a<GiNaC::numeric>(exponent)) {
+    const GiNaC::numeric n = GiNaC::ex_to<GiNaC::numeric>(exponent);
+    const GiNaC::numeric a = GiNaC::abs(n);
+    std::string positive;
+    if (a == 2) positive = "phnn_sq(" + b + ")";
+    if (a == 3) positive = "phnn_cube(" + b + ")";
+    if (a == 4) positive = "phnn_pow4(" + b + ")";
+    if (a == GiNaC::numeric(1, 2)) positive = "phnn_sqrt(" + b + ")";
+    if (a == 1) positive = b;
+    if (!positive.empty()) return n.is_negative() ? "phnn_inv(" + positive + ")" : positive;
+  }
+  return "(" + b + "^" + muparser_source(exponent) + ")";
+}
+
 }  // namespace
 
 std::string muparser_source(const GiNaC::ex& e) {
@@ -68,10 +101,7 @@ std::string muparser_source(const GiNaC::ex& e) {
   if (is_a<GiNaC::constant>(e)) return number(GiNaC::ex_to<GiNaC::numeric>(e.evalf()).to_double());
   if (is_a<GiNaC::add>(e)) return sorted_operands(e, "+");
   if (is_a<GiNaC::mul>(e)) return sorted_operands(e, "*");
-  if (is_a<GiNaC::power>(e)) {
-    // muParser's ^ (std::pow; integer exponents up to 4 as products).
-    return "(" + muparser_source(e.op(0)) + "^" + muparser_source(e.op(1)) + ")";
-  }
+  if (is_a<GiNaC::power>(e)) return power_source(e.op(0), e.op(1));
   if (is_a<GiNaC::function>(e)) {
     const std::string name = GiNaC::ex_to<GiNaC::function>(e).get_name();
     if (functions().count(name) == 0 || e.nops() != 1) {
@@ -90,6 +120,7 @@ CompiledExpressions::CompiledExpressions(const std::vector<std::string>& sources
   if (count_ == 0) return;
   for (std::size_t i = 0; i < names.size(); ++i) parser_.DefineVar(names[i], vars + i);
   for (const auto& [name, f] : functions()) parser_.DefineFun("phnn_" + name, f);
+  for (const auto& [name, f] : power_functions()) parser_.DefineFun("phnn_" + name, f);
   std::string joined;
   for (const std::string& s : sources) joined += (joined.empty() ? "" : ",") + s;
   parser_.SetExpr(joined);

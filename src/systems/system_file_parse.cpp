@@ -220,6 +220,13 @@ void read_structure(const Reader& r, const toml::table& t, SystemDefinition* def
   const toml::node* s = r.get(t, "S", true, " (the structure matrix, rows and columns ordered "
                                             "states, ports, inputs)", 1);
   def->lines["S"] = Reader::line(*s);
+  if (nx + nw + nu > kMaxDimension) {
+    r.fail(Reader::line(*s), std::to_string(nx) + " states, " + std::to_string(nw) + " ports and " +
+                                 std::to_string(nu) + " inputs make S " + std::to_string(nx + nw + nu) +
+                                 " square; at most " + std::to_string(kMaxDimension) +
+                                 " is supported: reduce the model or raise kMaxDimension "
+                                 "(include/phnn/systems/ph_system.h) and rebuild");
+  }
   def->S = r.matrix(*s, "S", nx + nw + nu);
   check_skew(r, Reader::line(*s), def->S, "S");
   if (nw > 0 && def->S.block(nx, nx, nw, nw).cwiseAbs().maxCoeff() != 0.0) {
@@ -302,6 +309,56 @@ void read_initial(const Reader& r, const toml::table& t, SystemDefinition* def) 
   }
 }
 
+// [control] design = "sines" | "chirp" | "steps" (ControlDesign): inputs
+// held over each sample. Every key of the table is checked.
+void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
+                               const std::string& design, int nu, ControlDesign* c) {
+  if (nu == 0) r.fail(line, "control.design = \"" + design + "\" needs at least one input");
+  const std::vector<std::string> keys =
+      design == "steps" ? std::vector<std::string>{"design", "range", "hold"}
+      : design == "sines" ? std::vector<std::string>{"design", "range", "frequencies", "amplitude"}
+                          : std::vector<std::string>{"design", "range", "frequency", "amplitude"};
+  for (const auto& [key, value] : ct) {
+    const std::string k(key.str());
+    if (std::find(keys.begin(), keys.end(), k) != keys.end()) continue;
+    std::string known;
+    for (const auto& name : keys) known += (known.empty() ? "" : ", ") + name;
+    r.fail(Reader::line(value), "unknown key \"" + k + "\" in [control] for design \"" + design +
+                                    "\"; it knows: " + known);
+  }
+  const bool need_range = design == "steps";
+  if (const toml::node* range = r.get(ct, "range", need_range, " in [control] (one [lo, hi] per input)", line)) {
+    c->range = r.intervals(*range, "control.range", static_cast<std::size_t>(nu), "input");
+  }
+  if (design == "steps") {
+    c->design = ControlDesign::Design::kSteps;
+    if (const toml::node* h = r.get(ct, "hold", false, "", 0)) {
+      c->hold = r.number(*h, "control.hold");
+      if (!(c->hold > 0.0)) r.fail(Reader::line(*h), "\"control.hold\" must be > 0 (seconds per level)");
+    }
+    return;
+  }
+  c->design = design == "sines" ? ControlDesign::Design::kSines : ControlDesign::Design::kChirp;
+  const toml::node* a = r.get(ct, "amplitude", true, " in [control] (an interval [lo, hi])", line);
+  c->amplitude = r.interval(*a, "control.amplitude");
+  const std::string fkey = design == "sines" ? "frequencies" : "frequency";
+  const toml::node* f = r.get(ct, fkey, true,
+                              design == "sines" ? " in [control] (a list of frequencies in Hz)"
+                                                : " in [control] (an interval [f0, f1] in Hz)",
+                              line);
+  const toml::array* fa = f->as_array();
+  if (fa == nullptr || fa->empty() || (design == "chirp" && fa->size() != 2)) {
+    r.fail(Reader::line(*f), "\"control." + fkey + "\" must be " +
+                                 (design == "sines" ? "a non-empty list of frequencies in Hz"
+                                                    : "[f0, f1] in Hz"));
+  }
+  for (const toml::node& v : *fa) {
+    const double hz = r.number(v, "control." + fkey);
+    if (hz < 0.0) r.fail(Reader::line(v), "\"control." + fkey + "\" must be >= 0 Hz");
+    c->frequencies.push_back(hz);
+  }
+}
+
 void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) {
   ControlDesign& c = def->control;
   const toml::node* n = r.get(t, "control", false, "", 0);
@@ -340,11 +397,14 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
       r.fail(line, "control.design = \"limit-cycle\" is the paper's Algorithm 4 for 1 port and 1 "
                    "input; use \"constant\"");
     }
+  } else if (design == "sines" || design == "chirp" || design == "steps") {
+    read_time_varying_control(r, *ct, line, design, nu, &c);
   } else {
-    const std::string near = closest_name(design, {"constant", "energy-shaping", "limit-cycle"});
+    const std::string near = closest_name(
+        design, {"constant", "energy-shaping", "limit-cycle", "sines", "chirp", "steps"});
     r.fail(Reader::line(*design_node), "unknown control.design \"" + design + "\"" +
                      (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
-                     "; expected one of: constant, energy-shaping, limit-cycle");
+                     "; expected one of: constant, energy-shaping, limit-cycle, sines, chirp, steps");
   }
 }
 

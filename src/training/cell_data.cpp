@@ -1,6 +1,7 @@
 // src/training/cell_data.cpp — CellData from the two kinds of data sets.
 #include "training/cell_data.h"
 
+#include "phnn/common/check.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {
@@ -92,6 +93,13 @@ CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
   CellData d = common_cell_data(data);
   d.n_x = system.n_x();
   d.n_u = system.n_u();
+  // Time-varying inputs: u_n of steps 0..steps-1 (the last sample's input
+  // moves no step).
+  for (const auto& traj : data.inference.inputs) {
+    PHNN_REQUIRE(traj.size() >= static_cast<std::size_t>(d.inference_steps),
+                 "make_cell_data: " << traj.size() << " inputs for " << d.inference_steps << " steps");
+    for (int n = 0; n < d.inference_steps; ++n) append(traj[static_cast<std::size_t>(n)], &d.inference_inputs);
+  }
   d.general = std::make_shared<ModelStructure>(model_structure(system));
   if (d.inference_count == 0) return d;
   d.has_figures = true;
@@ -104,6 +112,11 @@ CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
     d.figure_x0[k].assign(states, states + static_cast<long>(nx));
     const auto u = d.inference_u.begin() + static_cast<long>(i * nu);
     d.figure_u[k].assign(u, u + static_cast<long>(nu));
+    if (!d.inference_inputs.empty()) {
+      const std::size_t per = static_cast<std::size_t>(d.inference_steps) * nu;
+      const auto in = d.inference_inputs.begin() + static_cast<long>(i * per);
+      d.figure_inputs[k].assign(in, in + static_cast<long>(per));
+    }
   }
   return d;
 }

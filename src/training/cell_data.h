@@ -31,6 +31,9 @@ struct CellData {
   FlatPairs train, validation;
   // Inference: states [count][steps + 1][n_x], inputs [count][n_u].
   std::vector<double> inference_states, inference_u;
+  // Time-varying inputs: u_n of every step, [count][steps][n_u] (u_n held
+  // over step n -> n + 1); empty when the inputs are constant.
+  std::vector<double> inference_inputs;
   std::size_t inference_count = 0;
   int inference_steps = 0;
   double inference_step = 0.01;
@@ -41,6 +44,7 @@ struct CellData {
   // H(x0) = 0.5 J and 0.75 J; system files: inference trajectories 0 and 1.
   bool has_figures = false;
   std::array<std::vector<double>, 2> figure_x0, figure_u;
+  std::array<std::vector<double>, 2> figure_inputs;  // [steps][n_u] as inference_inputs
   std::array<std::vector<double>, 2> figure_references;
   // File-defined systems: the structure of the n-dimensional models.
   std::shared_ptr<const ModelStructure> general;

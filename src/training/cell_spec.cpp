@@ -51,6 +51,11 @@ void require_finite_data(const CellData& data, int n_train) {
   const std::size_t points = static_cast<std::size_t>(data.inference_steps) + 1;
   for (std::size_t i = 0; i < data.inference_count; ++i) {
     bool finite = finite_row(data.inference_u, i, data.n_u);
+    for (std::size_t n = 0; finite && !data.inference_inputs.empty() &&
+                            n < static_cast<std::size_t>(data.inference_steps);
+         ++n) {
+      finite = finite_row(data.inference_inputs, i * (points - 1) + n, data.n_u);
+    }
     std::size_t bad_step = 0;
     for (std::size_t n = 0; finite && n < points; ++n) {
       finite = finite_row(data.inference_states, i * points + n, data.n_x);

@@ -53,6 +53,26 @@ ModelOptions inference_model_options(const CellSpec& cell, const CellData& data)
                       cell.training.dg_structure_point, torch::kFloat64, data.general};
 }
 
+namespace {
+// [steps, B, n_u]: u_n of the inference rows, then the figure rows; undefined
+// when the inputs are constant.
+torch::Tensor step_inputs(const CellData& data, int64_t B_inf, int64_t F, int steps) {
+  if (data.inference_inputs.empty()) return {};
+  const int64_t nu = data.n_u;
+  auto out = torch::empty({steps, B_inf + F, nu}, torch::kFloat64);
+  out.narrow(1, 0, B_inf)
+      .copy_(torch::from_blob(const_cast<double*>(data.inference_inputs.data()), {B_inf, steps, nu},
+                              torch::kFloat64)
+                 .transpose(0, 1));
+  for (int64_t k = 0; k < F; ++k) {
+    out.select(1, B_inf + k)
+        .copy_(torch::from_blob(const_cast<double*>(data.figure_inputs[k].data()), {steps, nu},
+                                torch::kFloat64));
+  }
+  return out;
+}
+}  // namespace
+
 Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const CellData& data) {
   PHNN_CHECK(model_ref.options().dtype == torch::kFloat64,
              "roll_out: inference is float64; got a " << model_ref.options().dtype << " model");
@@ -84,7 +104,9 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
   }
   const double h_inf = data.inference_step;
   auto x = x0.unsqueeze(0).expand({E, B, nx}).contiguous();
-  const auto u = u0.unsqueeze(0).expand({E, B, nu}).contiguous();
+  const auto u_constant = u0.unsqueeze(0).expand({E, B, nu}).contiguous();
+  // Time-varying inputs: the recorded u_n of every row, replayed step by step.
+  const torch::Tensor u_steps = step_inputs(data, B_inf, F, steps);  // [steps, B, n_u] or undefined
   auto diverged = torch::zeros({E, B}, torch::kBool);
   auto sq_err = torch::zeros({E, B_inf}, torch::kFloat64);
   auto newton_failures = torch::zeros({E}, torch::kLong);
@@ -96,6 +118,8 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
   dg_options.min_dx_norm = opt.dg_min_dx_norm;
   DgNewtonJacobian newton_jacobian;  // carried along the rollout
   for (int n = 1; n <= steps; ++n) {
+    const torch::Tensor u =
+        u_steps.defined() ? u_steps[n - 1].unsqueeze(0).expand({E, B, nu}).contiguous() : u_constant;
     torch::Tensor next;
     if (use_dg) {
       const auto s = cell.integrator == IntegratorKind::kDg4

@@ -86,6 +86,46 @@ TEST(GeneralModelTest, JetsMatchAutogradInFourStates) {
   }
 }
 
+// The fused heads (general_heads.h) against the op-by-op jets, same weights:
+// H, the RK field and the DG field, and the gradients of a loss on each
+// with respect to every parameter, on 4 states (n_w = 2) and 6 states
+// (n_w = 3, so the skew part K of z is used), and on a 2-state system.
+TEST(GeneralModelTest, FusedHeadsMatchTheReferenceJetsWithGradients) {
+  for (const std::string name : {"harmonic", "coupled-duffing", "mass-chain"}) {
+    const auto system = load_system_file(shipped(name));
+    const int n = system->n_x();
+    for (ModelKind m : {ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
+      ModelOptions options{m, ModelSize::kSmall, SystemKind::kHarmonic};
+      options.general = std::make_shared<ModelStructure>(model_structure(*system));
+      const auto fused = DynamicsModel::create(options, kSeeds);
+      options.fused_networks = false;
+      const auto reference = DynamicsModel::create(options, kSeeds);
+      const auto x = uniform({3, 30, n}, 0.5, 11), u = uniform({3, 30, 1}, 1.0, 12);
+      const auto dx = uniform({3, 30, n}, 0.02, 13), w = uniform({3, 30, n}, 1.0, 14);
+      const auto loss = [&](const DynamicsModel& model, int which) {
+        if (which == 0) return (model.hamiltonian(x) * w.select(-1, 0)).sum();
+        if (which == 1) return (model.field(x, u, false).f * w).sum();
+        return (model.discrete_gradient_field(x, dx, u, 6e-6) * w).sum();
+      };
+      for (int which = 0; which < 3; ++which) {
+        const auto la = loss(*fused, which), lb = loss(*reference, which);
+        EXPECT_LT(std::abs((la - lb).item<double>()), 1e-12 * (1.0 + std::abs(lb.item<double>())))
+            << name << " " << to_string(m) << " " << which;
+        // H does not use the dissipation network: its gradients are unused.
+        const auto ga = torch::autograd::grad({la}, fused->parameters(), {}, false, false, true);
+        const auto gb = torch::autograd::grad({lb}, reference->parameters(), {}, false, false, true);
+        ASSERT_EQ(ga.size(), gb.size());
+        for (std::size_t k = 0; k < ga.size(); ++k) {
+          ASSERT_EQ(ga[k].defined(), gb[k].defined()) << name << " " << which << " " << k;
+          if (!ga[k].defined()) continue;
+          EXPECT_LT(max_rel(ga[k], gb[k]), 1e-10) << name << " " << to_string(m) << " " << which
+                                                  << " parameter " << k;
+        }
+      }
+    }
+  }
+}
+
 // PHNN-JR with u = 0: gradH^T f = -gradH^T R_xx gradH <= 0; PHNN-S with
 // u = 0: gradH^T f = -w^T z(w) = -|L_z w|^2 <= 0 (J, S skew).
 TEST(GeneralModelTest, FieldsDissipateEnergyWithoutInput) {

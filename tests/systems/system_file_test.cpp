@@ -222,6 +222,16 @@ TEST(SystemFileErrorTest, StructureMatrixOfTheWrongSize) {
               AllOf(HasSubstr("toy.toml:7:"), HasSubstr("4 x 4 matrix"), HasSubstr("got 3 rows")));
 }
 
+// Vectors and matrices have a fixed capacity (kMaxDimension): a larger S is
+// refused where it is read, before anything of that size is built.
+TEST(SystemFileErrorTest, StructureLargerThanTheSupportedSize) {
+  std::string ports = "\"w\"";
+  for (int i = 2; i <= kMaxDimension; ++i) ports += ", \"w" + std::to_string(i) + "\"";
+  EXPECT_THAT(error_of(replaced("ports = [\"w\"]", "ports = [" + ports + "]")),
+              AllOf(HasSubstr("toy.toml:7:"), HasSubstr("make S 35 square"),
+                    HasSubstr("at most 32")));
+}
+
 TEST(SystemFileErrorTest, EnergyNegativeAtASampledInitialState) {
   EXPECT_THAT(error_of(replaced("k*q^2/2\"", "k*q^2/2 - 0.5\"")),
               AllOf(HasSubstr("toy.toml:5:"), HasSubstr("is negative"), HasSubstr("fix H")));

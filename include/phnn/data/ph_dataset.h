@@ -14,9 +14,12 @@
 
 namespace phnn {
 
-/// Initial state and constant input of trajectory `index`.
+/// Initial state and input of trajectory `index`: u is constant, or, for a
+/// time-varying control design, `inputs` holds u at every sample k = 0..K
+/// (K the inference steps; held over [t_k, t_{k+1})) and u = inputs[0].
 struct PhTrajectorySpec {
   VecX x0, u;
+  std::vector<VecX> inputs;
 };
 
 /// Draws x0 by the system's InitialConditionDesign (stream
@@ -33,6 +36,7 @@ struct PhTrajectory {
   std::int64_t index = 0;
   VecX u;
   std::vector<VecX> states;  // at the generation rate, n = 0..steps
+  std::vector<VecX> inputs;  // time-varying inputs: u per sample (steps / stride + 1); else empty
 };
 
 /// `num_steps` DG steps at h_gen. Throws std::runtime_error naming system,
@@ -53,7 +57,11 @@ PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options,
 
 struct PhInferenceSet {
   std::vector<std::int64_t> trajectory;
-  std::vector<VecX> u;
+  std::vector<VecX> u;  // the input at the first sample
+  /// Time-varying inputs: [trajectory][n], u_n held over step n -> n + 1
+  /// (n = 0..steps, the last for the final sample); empty when every
+  /// trajectory's input is constant.
+  std::vector<std::vector<VecX>> inputs;
   std::vector<std::vector<VecX>> states;  // [trajectory][n], n = 0..steps at sr_infer
   double step = 0.01;
   std::size_t size() const { return u.size(); }

@@ -4,7 +4,9 @@
 // file-defined system. Built from the same stacked MLPs and forward-mode
 // jets as the 2-state models, with the matrix algebra written for any size;
 // on the paper's 2-state structures they compute the 2-state models' fields
-// (tested to round-off). No fused closed-form heads.
+// (tested to round-off). With fused networks, the order-0 and order-1 parts
+// (H, gradH, the DG, the fields) run through fused heads with hand-written
+// backwards (src/models/general_heads.h); jets of order 2 run op by op.
 #pragma once
 
 #include "phnn/models/port_hamiltonian.h"
@@ -63,6 +65,7 @@ class GeneralPhnnS : public GeneralPortHamiltonianModel {
 
  private:
   torch::Tensor s_w_, s_x_, s_y_;  // jet_linear factors, see the constructor
+  std::vector<double> s_w_rows_;   // [S_wx S_wu] row-major (the fused head's)
   torch::Tensor place_l_, place_lt_, place_skew_;  // L_z outputs -> L, L^T, K - K^T
 };
 

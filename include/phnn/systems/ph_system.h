@@ -14,8 +14,14 @@
 
 namespace phnn {
 
-using VecX = Eigen::VectorXd;
-using MatX = Eigen::MatrixXd;
+/// The largest n_x + n_w + n_u (the size of S) a system may have. Vectors and
+/// matrices of a system live on the stack up to this size (Eigen's
+/// fixed-capacity dynamic types): the integrators' steps allocate nothing
+/// (a heap allocation per temporary was half of a system file's DG step,
+/// docs/BENCHMARKS.md). System files above it are refused where S is read.
+constexpr int kMaxDimension = 32;
+using VecX = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDimension, 1>;
+using MatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDimension, kMaxDimension>;
 
 /// How the initial states x0 of a system's trajectories are drawn
 /// (docs/METHOD.md "System files").
@@ -53,11 +59,27 @@ struct ControlDesign {
     /// The paper's Algorithm 4 (n_w = n_u = 1, z polynomial with z'
     /// quadratic): w ~ U(I_w), I_w = {w : z'(w) < 0}, u = -w.
     kLimitCycle,
+    /// Inputs that vary in time, held over each sample of the data (zero-
+    /// order hold at the sample rate; docs/METHOD.md "Time-varying inputs"):
+    /// u_i(t) = c_i + sum_k a_ik sin(2 pi f_k t + phi_ik), c_i ~ U(range[i])
+    /// (0 without a range), a_ik ~ U(amplitude), phi_ik ~ U(0, 2 pi).
+    kSines,
+    /// u_i(t) = c_i + a_i sin(2 pi (f0 t + (f1 - f0) t^2 / (2 D)) + phi_i):
+    /// a linear sweep from f0 to f1 over the trajectory's duration D.
+    kChirp,
+    /// u_i piecewise constant: a new level ~ U(range[i]) every `hold` seconds.
+    kSteps,
   };
   Design design = Design::kConstant;
-  std::vector<std::array<double, 2>> range;  // kConstant: one per input
+  std::vector<std::array<double, 2>> range;  // kConstant, kSteps: one per input; kSines/kChirp offsets
   double equilibrium_energy_min = 0.1;       // kEnergyShaping
   double equilibrium_energy_max = 1.0;
+  std::vector<double> frequencies;           // kSines: f_k [Hz]; kChirp: {f0, f1}
+  std::array<double, 2> amplitude = {0.0, 0.0};  // kSines, kChirp
+  double hold = 0.1;                         // kSteps [s]
+  bool time_varying() const {
+    return design == Design::kSines || design == Design::kChirp || design == Design::kSteps;
+  }
 };
 
 /// The port variables of eq:phs_S at one effort e (in place of gradH):

@@ -1,0 +1,307 @@
+// src/models/general_heads.cpp — the n-dimensional fused heads of
+// src/models/general_heads.h: the Cholesky-form Hamiltonian with its
+// gradient, the Gonzalez DG, the PHNN-S port map and field, the PHNN-JR
+// field. Plain loops per row over small n; the backward formulas are written
+// above each class.
+#include "models/general_heads.h"
+
+#include "models/fused_heads_common.h"
+#include "phnn/common/check.h"
+
+namespace phnn {
+namespace internal {
+namespace {
+
+using namespace heads;
+
+// Row-major lower triangle: entry (r, c), c <= r, is output r (r + 1) / 2 + c.
+inline int tri(int r, int c) { return r * (r + 1) / 2 + c; }
+
+int64_t rows_of(const Tensor& t) { return t.size(0) * t.size(1); }
+
+// u broadcast to the rows of `like` and made contiguous.
+Tensor rows_like(const Tensor& u, const Tensor& like) {
+  return u.expand({like.size(0), like.size(1), u.size(-1)}).contiguous();
+}
+
+// ------------------------------------------------------------ Hamiltonian
+// Per row, with L_rc = o_k (k = tri(r, c)), softplus(o_k) on the diagonal,
+// s_k = sigmoid(o_k) on the diagonal and 1 off it:
+//   v = L x,  H = |v|^2 / 2,  c_k = v_r s_k x_c,
+//   gradH_i = (L^T v)_i + sum_k o_g[i][k] c_k.
+// Backward with adjoints H~, g~ (c~_k = sum_i g~_i o_g[i][k]):
+//   o_g~[i][k] = g~_i c_k
+//   v~_r = H~ v_r + sum_{c<=r} (g~_c L_rc + c~_k s_k x_c)
+//   L~_rc = g~_c v_r + v~_r x_c
+//   x~_c = sum_{r>=c} (c~_k v_r s_k + v~_r L_rc)
+//   o~_k = L~_rc off the diagonal; L~_rr softplus'(o_k) + c~_k v_r x_r s_k (1 - s_k) on it.
+// The forward keeps (softplus, sigmoid, softplus') of every diagonal output.
+struct LowerFactor {
+  const double* o;
+  const double* aux;  // 3 per diagonal entry
+  double entry(int r, int c) const { return r == c ? aux[3 * r] : o[tri(r, c)]; }
+  double sig(int r, int c) const { return r == c ? aux[3 * r + 1] : 1.0; }
+};
+
+void lower_times(const LowerFactor& L, const double* x, int n, double* v) {
+  for (int r = 0; r < n; ++r) {
+    double s = 0.0;
+    for (int c = 0; c <= r; ++c) s += L.entry(r, c) * x[c];
+    v[r] = s;
+  }
+}
+
+class GeneralHamiltonianFunction
+    : public torch::autograd::Function<GeneralHamiltonianFunction> {
+ public:
+  static variable_list forward(AutogradContext* ctx, const Tensor& o_in,
+                               const c10::optional<Tensor>& o_g_in, const Tensor& x_in) {
+    const Tensor o = dense(o_in), x = dense(x_in);
+    const bool with_grad = o_g_in.has_value();
+    const Tensor o_g = with_grad ? dense(*o_g_in) : Tensor();
+    const int n = static_cast<int>(x.size(-1)), K = static_cast<int>(o.size(-1));
+    PHNN_CHECK(K == n * (n + 1) / 2, "general_hamiltonian_head: " << K << " outputs for " << n << " states");
+    const int64_t rows = rows_of(o);
+    Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
+    Tensor grad = with_grad ? torch::empty_like(x) : Tensor();
+    Tensor aux = torch::empty({rows, 3 * n}, o.options());
+    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+    const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
+    double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
+    double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
+    std::vector<double> v(n), c(K);
+    for (int64_t r = 0; r < rows; ++r) {
+      double* a = pa + 3 * n * r;
+      for (int i = 0; i < n; ++i) {
+        const SoftplusSigmoid f(po[K * r + tri(i, i)]);
+        a[3 * i] = f.softplus, a[3 * i + 1] = f.sigmoid, a[3 * i + 2] = f.slope;
+      }
+      const LowerFactor L{po + K * r, a};
+      const double* xr = px + n * r;
+      lower_times(L, xr, n, v.data());
+      double s = 0.0;
+      for (int i = 0; i < n; ++i) s += v[i] * v[i];
+      ph[r] = 0.5 * s;
+      if (!with_grad) continue;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j <= i; ++j) c[tri(i, j)] = v[i] * L.sig(i, j) * xr[j];
+      const double* og = pog + static_cast<int64_t>(n) * K * r;
+      for (int i = 0; i < n; ++i) {
+        double g = 0.0;
+        for (int k = i; k < n; ++k) g += L.entry(k, i) * v[k];
+        for (int k = 0; k < K; ++k) g += og[i * K + k] * c[k];
+        pg[n * r + i] = g;
+      }
+    }
+    ctx->save_for_backward({o, with_grad ? o_g : o, x, aux});
+    ctx->saved_data["with_grad"] = with_grad;
+    return with_grad ? variable_list{h, grad} : variable_list{h};
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const Tensor &o = saved[0], &x = saved[2], &aux = saved[3];
+    const bool with_grad = ctx->saved_data["with_grad"].toBool();
+    const int n = static_cast<int>(x.size(-1)), K = static_cast<int>(o.size(-1));
+    const int64_t rows = rows_of(o);
+    const Tensor h_bar = grads[0].defined() ? dense(grads[0]) : torch::zeros({o.size(0), o.size(1), 1}, o.options());
+    const Tensor g_bar = with_grad && grads[1].defined() ? dense(grads[1]) : Tensor();
+    Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
+    Tensor o_g_bar = with_grad ? torch::zeros_like(saved[1]) : Tensor();
+    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+    const double *phb = h_bar.data_ptr<double>(), *pa = aux.data_ptr<double>();
+    const double* pog = g_bar.defined() ? saved[1].data_ptr<double>() : nullptr;
+    const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
+    double* pogb = g_bar.defined() ? o_g_bar.data_ptr<double>() : nullptr;
+    double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
+    std::vector<double> v(n), gb(n), cb(K), vb(n);
+    for (int64_t r = 0; r < rows; ++r) {
+      const LowerFactor L{po + K * r, pa + 3 * n * r};
+      const double* xr = px + n * r;
+      lower_times(L, xr, n, v.data());
+      std::fill(gb.begin(), gb.end(), 0.0);
+      std::fill(cb.begin(), cb.end(), 0.0);
+      if (pgb) {
+        const double* og = pog + static_cast<int64_t>(n) * K * r;
+        double* ogb = pogb + static_cast<int64_t>(n) * K * r;
+        for (int i = 0; i < n; ++i) gb[i] = pgb[n * r + i];
+        for (int i = 0; i < n; ++i) {
+          for (int j = 0; j <= i; ++j) {
+            const int k = tri(i, j);
+            const double ck = v[i] * L.sig(i, j) * xr[j];
+            double s = 0.0;
+            for (int d = 0; d < n; ++d) {
+              s += gb[d] * og[d * K + k];
+              ogb[d * K + k] = gb[d] * ck;
+            }
+            cb[k] = s;
+          }
+        }
+      }
+      for (int i = 0; i < n; ++i) {
+        double s = phb[r] * v[i];
+        for (int c = 0; c <= i; ++c) s += gb[c] * L.entry(i, c) + cb[tri(i, c)] * L.sig(i, c) * xr[c];
+        vb[i] = s;
+      }
+      double* ob = pob + K * r;
+      double* xb = pxb + n * r;
+      for (int c = 0; c < n; ++c) {
+        double s = 0.0;
+        for (int i = c; i < n; ++i) s += cb[tri(i, c)] * v[i] * L.sig(i, c) + vb[i] * L.entry(i, c);
+        xb[c] = s;
+      }
+      const double* a = pa + 3 * n * r;
+      for (int i = 0; i < n; ++i) {
+        for (int c = 0; c <= i; ++c) {
+          const int k = tri(i, c);
+          const double l_bar = gb[c] * v[i] + vb[i] * xr[c];
+          if (c < i) {
+            ob[k] = l_bar;
+          } else {
+            const double s = a[3 * i + 1];
+            ob[k] = l_bar * a[3 * i + 2] + cb[k] * v[i] * xr[i] * s * (1.0 - s);
+          }
+        }
+      }
+    }
+    return {o_bar, o_g_bar, x_bar};
+  }
+};
+
+// --------------------------------------------------------------- Gonzalez
+// Per row: n2 = |dx|^2, D = H1 - H0 - g.dx, k = D / n2 (0 if n2 < tau^2),
+// dg = g + k dx. Backward with dg~, s = dg~.dx (small rows: g~ = dg~ only):
+//   H1~ = s / n2,  H0~ = -s / n2,  g~ = dg~ - (s / n2) dx,
+//   dx~ = k dg~ - (s / n2) (g + 2 k dx).
+double dot(const double* a, const double* b, int n) {
+  double s = 0.0;
+  for (int i = 0; i < n; ++i) s += a[i] * b[i];
+  return s;
+}
+
+class GeneralGonzalezFunction : public torch::autograd::Function<GeneralGonzalezFunction> {
+ public:
+  static Tensor forward(AutogradContext* ctx, const Tensor& h0_in, const Tensor& h1_in,
+                        const Tensor& g_in, const Tensor& dx_in, double min_dx_norm) {
+    const Tensor h0 = dense(h0_in), h1 = dense(h1_in), g = dense(g_in), dx = dense(dx_in);
+    const int n = static_cast<int>(g.size(-1));
+    const int64_t rows = rows_of(g);
+    Tensor dg = torch::empty_like(g);
+    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
+    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
+    double* out = dg.data_ptr<double>();
+    const double tau2 = min_dx_norm * min_dx_norm;
+    for (int64_t r = 0; r < rows; ++r) {
+      const double *gr = pg + n * r, *d = pd + n * r;
+      const double n2 = dot(d, d, n);
+      const double k = n2 < tau2 ? 0.0 : (p1[r] - p0[r] - dot(gr, d, n)) / n2;
+      for (int i = 0; i < n; ++i) out[n * r + i] = gr[i] + k * d[i];
+    }
+    ctx->save_for_backward({h0, h1, g, dx});
+    ctx->saved_data["tau2"] = tau2;
+    return dg;
+  }
+
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const Tensor &h0 = saved[0], &h1 = saved[1], &g = saved[2], &dx = saved[3];
+    const double tau2 = ctx->saved_data["tau2"].toDouble();
+    const Tensor db = dense(grads[0]);
+    const int n = static_cast<int>(g.size(-1));
+    const int64_t rows = rows_of(g);
+    Tensor h0_bar = torch::empty_like(h0), h1_bar = torch::empty_like(h1);
+    Tensor g_bar = torch::empty_like(g), dx_bar = torch::empty_like(dx);
+    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
+    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>(), *pb = db.data_ptr<double>();
+    double *ph0b = h0_bar.data_ptr<double>(), *ph1b = h1_bar.data_ptr<double>();
+    double *pgb = g_bar.data_ptr<double>(), *pxb = dx_bar.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      const double *gr = pg + n * r, *d = pd + n * r, *b = pb + n * r;
+      double *gb = pgb + n * r, *xb = pxb + n * r;
+      const double n2 = dot(d, d, n);
+      if (n2 < tau2) {
+        ph0b[r] = ph1b[r] = 0.0;
+        for (int i = 0; i < n; ++i) gb[i] = b[i], xb[i] = 0.0;
+        continue;
+      }
+      const double k = (p1[r] - p0[r] - dot(gr, d, n)) / n2;
+      const double s = dot(b, d, n) / n2;
+      ph1b[r] = s, ph0b[r] = -s;
+      for (int i = 0; i < n; ++i) {
+        gb[i] = b[i] - s * d[i];
+        xb[i] = k * b[i] - s * (gr[i] + 2.0 * k * d[i]);
+      }
+    }
+    return {h0_bar, h1_bar, g_bar, dx_bar, Tensor()};
+  }
+};
+
+// ----------------------------------------------------------------- linear
+// y_i = sum_j M_ij a_j + sum_j M_i(n_a + j) b_j;  a~_j = sum_i y~_i M_ij, b~ likewise.
+class LinearFunction : public torch::autograd::Function<LinearFunction> {
+ public:
+  static Tensor forward(AutogradContext* ctx, const Tensor& a_in, const Tensor& b_in,
+                        std::vector<double> M, int64_t out) {
+    const Tensor a = dense(a_in), b = rows_like(b_in, a_in);
+    const int na = static_cast<int>(a.size(-1)), nb = static_cast<int>(b.size(-1)), w = na + nb;
+    PHNN_CHECK(static_cast<int64_t>(M.size()) == out * w, "general_linear_head: matrix size");
+    const int64_t rows = rows_of(a);
+    Tensor y = torch::empty({a.size(0), a.size(1), out}, a.options());
+    const double *pa = a.data_ptr<double>(), *pb = b.data_ptr<double>();
+    double* py = y.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      for (int64_t i = 0; i < out; ++i) {
+        const double* m = M.data() + i * w;
+        double s = 0.0;
+        for (int j = 0; j < na; ++j) s += m[j] * pa[na * r + j];
+        for (int j = 0; j < nb; ++j) s += m[na + j] * pb[nb * r + j];
+        py[out * r + i] = s;
+      }
+    }
+    ctx->saved_data["M"] = M;
+    ctx->saved_data["na"] = static_cast<int64_t>(na);
+    ctx->saved_data["nb"] = static_cast<int64_t>(nb);
+    return y;
+  }
+  static variable_list backward(AutogradContext* ctx, variable_list grads) {
+    const std::vector<double> M = ctx->saved_data["M"].toDoubleVector();
+    const int na = static_cast<int>(ctx->saved_data["na"].toInt());
+    const int nb = static_cast<int>(ctx->saved_data["nb"].toInt()), w = na + nb;
+    const Tensor yb = dense(grads[0]);
+    const int out = static_cast<int>(yb.size(-1));
+    const int64_t rows = rows_of(yb);
+    Tensor a_bar = torch::empty({yb.size(0), yb.size(1), na}, yb.options());
+    Tensor b_bar = torch::empty({yb.size(0), yb.size(1), nb}, yb.options());
+    const double* pyb = yb.data_ptr<double>();
+    double *pab = a_bar.data_ptr<double>(), *pbb = b_bar.data_ptr<double>();
+    for (int64_t r = 0; r < rows; ++r) {
+      for (int j = 0; j < w; ++j) {
+        double s = 0.0;
+        for (int i = 0; i < out; ++i) s += pyb[out * r + i] * M[static_cast<std::size_t>(i * w + j)];
+        if (j < na) pab[na * r + j] = s; else pbb[nb * r + j - na] = s;
+      }
+    }
+    return {a_bar, b_bar, Tensor(), Tensor()};
+  }
+};
+
+}  // namespace
+
+GeneralHamiltonian general_hamiltonian_head(const Tensor& o, const Tensor& o_g, const Tensor& x) {
+  const auto out = GeneralHamiltonianFunction::apply(
+      o, o_g.defined() ? c10::optional<Tensor>(o_g) : c10::nullopt, x);
+  return {out[0], o_g.defined() ? out[1] : Tensor()};
+}
+
+Tensor general_gonzalez_head(const Tensor& h0, const Tensor& h1, const Tensor& grad_mid,
+                             const Tensor& dx, double min_dx_norm) {
+  return GeneralGonzalezFunction::apply(h0, h1, grad_mid, dx.expand_as(grad_mid), min_dx_norm);
+}
+
+Tensor general_linear_head(const Tensor& a, const Tensor& b, const std::vector<double>& M,
+                           int rows) {
+  return LinearFunction::apply(a, b, M, static_cast<int64_t>(rows));
+}
+
+}  // namespace internal
+}  // namespace phnn

@@ -1,0 +1,56 @@
+// src/models/general_heads.h — the fused heads of the n-dimensional PHNN-S and
+// PHNN-JR (include/phnn/models/general_ph.h): the parts that sit on top of the
+// networks, each one autograd node with a hand-written backward, computed row
+// by row (a row = one member and one batch element, so a member's bits never
+// depend on its stackmates). Order 0 and 1 in the state (training, RK and DG
+// fields); the jets of order 2 (regularizers, DG4, Newton Jacobians) stay on
+// the op-by-op path of general_ph.cpp, which is also the reference the tests
+// compare these heads with. Private to src/models.
+#pragma once
+
+#include <vector>
+
+#include <torch/torch.h>
+
+namespace phnn {
+namespace internal {
+
+/// H = |L(x) x|^2 / 2 with L lower triangular n x n from the n (n + 1) / 2
+/// outputs o [E, B, K] of L_H (row-major lower triangle, softplus on the
+/// diagonal), and, when o_g [E, B, n (direction), K] is defined, gradH:
+///   v = L x,  gradH_i = (L^T v)_i + sum_k o_g[i][k] c_k,
+///   c_k = v_r x_c (sigmoid(o_k) on the diagonal) for entry k = (r, c).
+struct GeneralHamiltonian {
+  torch::Tensor h, grad;  // [E, B, 1], [E, B, n] or undefined
+};
+GeneralHamiltonian general_hamiltonian_head(const torch::Tensor& o, const torch::Tensor& o_g,
+                                            const torch::Tensor& x);
+
+/// Gonzalez discrete gradient for n states (eq: gonzalez-discrete-gradient):
+///   dg = g + (H1 - H0 - g.dx) / |dx|^2 dx,  = g where |dx| < min_dx_norm.
+torch::Tensor general_gonzalez_head(const torch::Tensor& h0, const torch::Tensor& h1,
+                                    const torch::Tensor& grad_mid, const torch::Tensor& dx,
+                                    double min_dx_norm);
+
+/// A linear map y = M [a; b] per row, M row-major rows x (n_a + n_b)
+/// (a structure block): the PHNN-S port variables w = [S_wx S_wu] [e; u].
+torch::Tensor general_linear_head(const torch::Tensor& a, const torch::Tensor& b,
+                                  const std::vector<double>& M, int rows);
+
+/// PHNN-S field for n_w ports from the effort e [E, B, n_x], u [E, B, n_u],
+/// the L_z outputs o [E, B, n_w (n_w + 1) / 2 + n_w (n_w - 1) / 2] (L_z lower
+/// triangle, then K strictly lower) and w [E, B, n_w]:
+///   z = L_z^T L_z w + (K - K^T) w,  f = S_x [e; z; u],
+/// S_x the first n_x rows of S (row-major, n_x + n_w + n_u columns).
+torch::Tensor general_s_field_head(const torch::Tensor& e, const torch::Tensor& u,
+                                   const torch::Tensor& o, const torch::Tensor& w,
+                                   const std::vector<double>& S, int n_w);
+
+/// PHNN-JR field: f = [(J - L^T L) [e; u]]_{1:n_x} with L lower triangular
+/// m x m (m = n_x + n_u) from the L_R outputs o [E, B, m (m + 1) / 2] and J
+/// row-major m x m.
+torch::Tensor general_jr_field_head(const torch::Tensor& e, const torch::Tensor& u,
+                                    const torch::Tensor& o, const std::vector<double>& J);
+
+}  // namespace internal
+}  // namespace phnn
