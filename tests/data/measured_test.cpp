@@ -48,7 +48,8 @@ void expect_same_pairs(const PhPairSet& a, const PhPairSet& b) {
 // as CSV, read them, split them: the same pairs and inference trajectories,
 // bit for bit (the pair draws share their key; t = n / 100 gives h = 0.01).
 TEST(MeasuredDataTest, AGeneratedSetWrittenAsCsvAndImportedIsTheSameSet) {
-  const auto system = pendulum();
+  for (const char* name : {"pendulum", "pendulum-forced"}) {
+  const auto system = testing_util::shipped_system(name);
   const PhSystemData data = make_ph_system_data(*system, small_options(), 4);
   const std::string csv = ::testing::TempDir() + "phnn_measured_roundtrip.csv";
   const TrajectoryColumns columns{system->state_names(), system->input_names()};
@@ -64,10 +65,14 @@ TEST(MeasuredDataTest, AGeneratedSetWrittenAsCsvAndImportedIsTheSameSet) {
   expect_same_pairs(back.validation, data.validation);
   EXPECT_EQ(back.inference.states, data.inference.states);
   EXPECT_EQ(back.inference.u, data.inference.u);
+  EXPECT_EQ(back.inference.inputs, data.inference.inputs);  // the forced pendulum's per sample
+  EXPECT_EQ(back.inference.inputs.empty(), std::string(name) == "pendulum");
   EXPECT_EQ(back.inference.trajectory, data.inference.trajectory);
   EXPECT_EQ(back.inference.step, data.inference.step);
   EXPECT_EQ(back.system_text, system->source_text());
+  EXPECT_EQ(data_set_checksum(back), data_set_checksum(data)) << name;
   std::remove(csv.c_str());
+  }
 }
 
 // Synthetic recordings: trajectory id k has `samples` samples at 50 Hz,

@@ -137,9 +137,19 @@ TEST(MeasuredDataTest, BadRecordingsFailAtTheirSampleWithTheFix) {
   o.num_inference = 1;
   EXPECT_THAT(split_error(kHeader + kGood, o),
               AllOf(HasSubstr("the data hold 3 trajectories"), HasSubstr("need 4")));
-  // 19. an input that changes within a trajectory
-  EXPECT_THAT(split_error(kHeader + kGood + "3,0,1,0,0\n3,0.1,1,0,0.5\n"),
-              AllOf(HasSubstr(".csv:12: trajectory 3: the input changes"), HasSubstr("split the recording")));
+  // 19. (no longer an error) an input that changes within a trajectory: the
+  // inference trajectory (the last id) keeps it per sample.
+  {
+    ImportOptions one;
+    one.num_validation = one.num_inference = 1;
+    const std::string path = csv_file(kHeader + kGood + "3,0,1,0,0\n3,0.1,1,0,0.5\n3,0.2,1,0,-0.5\n");
+    const PhSystemData d = split_measured_data(*pendulum(), read_trajectory_csv(path, kPendulum), one);
+    std::remove(path.c_str());
+    ASSERT_EQ(d.inference.inputs.size(), 1u);
+    ASSERT_EQ(d.inference.inputs[0].size(), 3u);
+    EXPECT_EQ(d.inference.inputs[0][1](0), 0.5);
+    EXPECT_EQ(d.inference.inputs[0][2](0), -0.5);
+  }
   // 20. a sample rate that disagrees with t
   ImportOptions rate;
   rate.num_validation = rate.num_inference = 1;

@@ -39,6 +39,7 @@ TEST(SystemFileTest, ShippedSystemsHaveTheirDeclaredDimensions) {
     int nx, nw, nu;
   };
   for (const Dims& d : {Dims{"harmonic", 2, 1, 1}, Dims{"pendulum", 2, 1, 1},
+                        Dims{"pendulum-forced", 2, 1, 1},
                         Dims{"coupled-duffing", 4, 2, 1}, Dims{"mass-chain", 6, 3, 1}}) {
     const auto sys = load_system_file(shipped(d.name));
     EXPECT_EQ(sys->n_x(), d.nx) << d.name;
