@@ -339,15 +339,19 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int a
             << model_label(cell.model, cell.integrator) << " size=" << to_string(cell.size)
             << " n_train=" << cell.n_train << " reg=" << to_string(cell.regularizer)
             << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << std::endl;
-  print_estimate(cell_sweep_text(cell, data, path),
-                 [&](const std::string&) { return SystemFileText{path, system->source_text()}; });
+  // The data set is at hand (read or generated above): supplied, not to generate.
+  const SystemFileReader read = [&](const std::string&) {
+    SystemFileText t{path, system->source_text()};
+    t.data_supplied = true;
+    return t;
+  };
+  print_estimate(cell_sweep_text(cell, data, path), read);
   const auto results = train_cell(cell, data, *system, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
   if (parser.has("out")) {
     const std::string out = parser.get("out");
     write_cell_file(
-        out, cell, cell_sweep_text(cell, data, path),
-        [&](const std::string&) { return SystemFileText{path, system->source_text()}; },
+        out, cell, cell_sweep_text(cell, data, path), read,
         [&](ResultsFile* file) { file->store_file_system_data(data.system_name, data, path); },
         results, provenance, provenance_value(provenance, "started"));
     std::printf("runs written to %s\n", out.c_str());

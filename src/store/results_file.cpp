@@ -298,6 +298,7 @@ SystemFileReader ResultsFile::stored_system_files() const {
       }
       entries.push_back(impl_->file.string_attribute(group, "sweep_entry"));
       texts.push_back({path() + "@" + group, impl_->file.string_attribute(group, "system_file")});
+      texts.back().data_supplied = true;  // the data set is stored beside it
       if (is_data_file_entry(entries.back())) {  // a `data` file: its stored copy
         const PhSystemData data = internal::read_ph_system_data(impl_->file, group);
         texts.back().data_checksum = data_set_checksum(data);

@@ -62,6 +62,12 @@ std::string SweepSystems::load(const std::string& entry, int line) {
   } catch (const SystemFileError& e) {
     throw SweepFileError(e.file(), e.line(), message_of(e));
   }
+  if (!is_data_file_entry(entry) && !source.data_supplied && !system->has_energy()) {
+    source_.fail(line, "system file " + quoted(entry) + " defines no energy H (structure only), so "
+                           "the sweep cannot generate its data; import recordings with `phnn import "
+                           "... --system " + entry + " --out DATA.h5` and list DATA.h5 under data = "
+                           "[...], or add H, z, [initial] and [control] to the system file");
+  }
   file.name = system->name();
   file.n_x = system->n_x();
   file.n_w = system->n_w();

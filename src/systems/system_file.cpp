@@ -108,21 +108,26 @@ class FileSystem : public PhSystem {
   const std::vector<std::string>& state_names() const override { return def_.states; }
   const std::vector<std::string>& state_units() const override { return def_.state_units; }
   const std::vector<std::string>& input_names() const override { return def_.inputs; }
+  bool has_energy() const override { return def_.has_energy(); }
   double hamiltonian(const VecX& x) const override {
+    need_energy();
     set_states(x);
     return *energy_->eval();
   }
   VecX grad_hamiltonian(const VecX& x) const override {
+    need_energy();
     set_states(x);
     return Eigen::Map<const VecX>(gradient_->eval(), n_x());
   }
   MatX hessian(const VecX& x) const override;
   VecX dissipation(const VecX& w) const override {
+    need_energy();
     if (n_w() == 0) return VecX(0);
     set_ports(w);
     return Eigen::Map<const VecX>(dissipation_->eval(), n_w());
   }
   MatX dissipation_jacobian(const VecX& w) const override {
+    need_energy();
     if (n_w() == 0) return MatX(0, 0);
     set_ports(w);
     return Eigen::Map<const Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(
@@ -151,6 +156,16 @@ class FileSystem : public PhSystem {
   void check_energy_at(const std::vector<VecX>& points) const;
 
  private:
+  // A structure-only file generates nothing: its energy and dissipation
+  // law are not defined.
+  void need_energy() const {
+    if (def_.has_energy()) return;
+    throw SystemFileError(def_.file, def_.line_of("name"),
+                          "system \"" + def_.name + "\" defines no energy H (a structure-only "
+                          "file): it can describe measured data (phnn import, then --data or "
+                          "data = [...]) but cannot generate any; add H, z, [initial] and "
+                          "[control] to generate data");
+  }
   std::string location(const std::string& key) const {
     return def_.file + ":" + std::to_string(def_.line_of(key));
   }
@@ -216,6 +231,7 @@ void FileSystem::compile() {
   for (std::size_t i = 0; i < np; ++i) vars_[nx + i] = def_.parameters[i].second;
   w_offset_ = nx + np;
   d_offset_ = w_offset_ + nw + nx;  // after the ports and the midpoint symbols a
+  if (!def_.has_energy()) return;  // structure only: nothing to evaluate
   const GiNaC::ex H = parse_expression(def_, "H", def_.energy, s.energy_table,
                                        "the states and parameters");
   std::vector<GiNaC::ex> grad, hess;
@@ -311,6 +327,7 @@ std::array<double, 2> FileSystem::self_oscillation_interval() const {
 }
 
 MatX FileSystem::hessian(const VecX& x) const {
+  need_energy();
   set_states(x);
   const double* v = hessian_->eval();
   MatX h(n_x(), n_x());
@@ -321,6 +338,7 @@ MatX FileSystem::hessian(const VecX& x) const {
 }
 
 VecX FileSystem::dissipation_second(const VecX& w, const VecX& s) const {
+  need_energy();
   const int nw = n_w();
   VecX out = VecX::Zero(nw);
   if (nw == 0) return out;
@@ -335,6 +353,7 @@ VecX FileSystem::dissipation_second(const VecX& w, const VecX& s) const {
 }
 
 VecX FileSystem::discrete_gradient(const VecX& x, const VecX& dx) const {
+  need_energy();
   if (!defect_is_zero_ && !gradient_and_defect_) return PhSystem::discrete_gradient(x, dx);
   const int n = n_x();
   const double n2 = dx.squaredNorm();
@@ -347,6 +366,7 @@ VecX FileSystem::discrete_gradient(const VecX& x, const VecX& dx) const {
 }
 
 MatX FileSystem::discrete_gradient_jacobian(const VecX& x, const VecX& dx) const {
+  need_energy();
   if (!defect_is_zero_ && !hessian_and_defect_) return PhSystem::discrete_gradient_jacobian(x, dx);
   const double n2 = dx.squaredNorm();
   if (defect_is_zero_ || n2 == 0.0) return 0.5 * hessian(x + 0.5 * dx);
@@ -461,7 +481,7 @@ std::string read_system_file_text(const std::string& path) {
 
 std::unique_ptr<PhSystem> compile_system(const std::string& text, const std::string& file) {
   auto sys = std::make_unique<FileSystem>(parse_system_definition(text, file));
-  sys->check_energy_and_box();
+  if (sys->has_energy()) sys->check_energy_and_box();
   return sys;
 }
 

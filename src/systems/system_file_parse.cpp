@@ -250,10 +250,26 @@ void read_structure(const Reader& r, const toml::table& t, SystemDefinition* def
   }
 }
 
+// Without H the file is structure only (measured data): z, [initial] and
+// [control] describe how data are generated and are refused.
 void read_expressions(const Reader& r, const toml::table& t, SystemDefinition* def) {
-  const toml::node* h = r.get(t, "H", true, " (the energy, an expression of the states and parameters)", 1);
+  const toml::node* h = r.get(t, "H", false, "", 1);
+  if (h == nullptr) {
+    for (const char* key : {"z", "initial", "control"}) {
+      if (const toml::node* n = t.get(key)) {
+        r.fail(Reader::line(*n), std::string("\"") + key + "\" generates data from the energy H, "
+                                 "which this file does not define; add H (the file then generates "
+                                 "data) or remove " + key + " (a structure-only file for phnn import)");
+      }
+    }
+    return;
+  }
   def->lines["H"] = Reader::line(*h);
   def->energy = r.string(*h, "H");
+  if (def->energy.find_first_not_of(" \t") == std::string::npos) {
+    r.fail(Reader::line(*h), "\"H\" is empty; write the energy, or remove the key for a "
+                             "structure-only file (measured data)");
+  }
   const toml::node* z = r.get(t, "z", !def->ports.empty(),
                               " (the dissipation law, one expression per port)", 1);
   if (z != nullptr) {
@@ -473,8 +489,10 @@ SystemDefinition parse_system_definition(const std::string& text, const std::str
   read_names(r, t, &def);
   read_structure(r, t, &def);
   read_expressions(r, t, &def);
-  read_initial(r, t, &def);
-  read_control(r, t, &def);
+  if (def.has_energy()) {
+    read_initial(r, t, &def);
+    read_control(r, t, &def);
+  }
   read_plots(r, t, &def);
   return def;
 }

@@ -137,7 +137,10 @@ Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
   std::unique_ptr<DynamicsModel> model;
   Evaluation out = evaluate_on(cell, make_cell_data(data, system), weights, &model);
   const RunResult& r = out.result;
-  const auto energy = [&system](const VecX& x) { return system.hamiltonian(x); };
+  // A structure-only system (measured data) has no true energy to compare.
+  const auto energy = [&system](const VecX& x) {
+    return system.has_energy() ? system.hamiltonian(x) : std::numeric_limits<double>::quiet_NaN();
+  };
   out.energy_05 = energy_trace(*model, energy, data.inference.step, data.state_names,
                                r.figure_prediction_05, r.figure_reference_05);
   out.energy_075 = energy_trace(*model, energy, data.inference.step, data.state_names,

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -66,6 +67,40 @@ TEST(ImportCommandTest, AGeneratedSetThroughCsvTrainsToTheSameMsesBitForBit) {
     EXPECT_EQ(a, b) << name;  // bitwise
     std::system(("rm -rf " + dir).c_str());
   }
+}
+
+// A structure-only system file (no H) is enough for measured data: the
+// same recordings imported with it train to the MSEs of the full file
+// (same name, so the same pair draws; same S, so the same models). It
+// generates nothing: `phnn data` refuses it at its name, exit 2.
+TEST(ImportCommandTest, AStructureOnlySystemFileIsEnoughForMeasuredData) {
+  const std::string dir = ::testing::TempDir() + "phnn_import_structure/";
+  ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
+  std::ifstream in(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum-structure.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string own_name = "name = \"pendulum-structure\"";
+  text.replace(text.find(own_name), own_name.size(), "name = \"pendulum\"");
+  std::ofstream(dir + "structure.toml") << text;
+  std::string log;
+  ASSERT_EQ(phnn("data --system " + kPendulum + " --n-train 25 --out " + dir + "a.h5 --csv " + dir +
+                     "a.csv", &log), 0) << log;
+  std::vector<double> mse[2];
+  int k = 0;
+  for (const std::string& system : {kPendulum, dir + "structure.toml"}) {
+    ASSERT_EQ(phnn("import " + dir + "a.csv --system " + system + " --out " + dir + "b.h5", &log), 0) << log;
+    ASSERT_EQ(phnn("train --system " + system + " --model phnn-jr-rk2 --n-train 25 --seeds 0-1 "
+                   "--steps 100 --eval-every 50 --quiet --data " + dir + "b.h5 --out " + dir + "r.h5", &log),
+              0) << log;
+    mse[k++] = mses(dir + "r.h5");
+    std::remove((dir + "b.h5").c_str());
+    std::remove((dir + "r.h5").c_str());
+  }
+  EXPECT_TRUE(std::isfinite(mse[1][0]));
+  EXPECT_EQ(mse[0], mse[1]);  // bitwise
+  EXPECT_EQ(phnn("data --system " + dir + "structure.toml --out " + dir + "c.h5", &log), 2);
+  EXPECT_THAT(log, AllOf(HasSubstr("structure.toml:7:"), HasSubstr("defines no energy H")));
+  EXPECT_FALSE(exists(dir + "c.h5"));
+  std::system(("rm -rf " + dir).c_str());
 }
 
 TEST(ImportCommandTest, BadInputExitsTwoAndWritesNoDataSet) {

@@ -131,6 +131,12 @@ TEST(SweepDataFilesTest, BadDataValuesFailAtTheirLineWithTheFix) {
   EXPECT_THAT(error_in(dir, sweep("data = \"d/v1.h5\"")),
               AllOf(HasSubstr("s.toml:6:"), HasSubstr("built-in system harmonic"),
                     HasSubstr("sweeps/systems/harmonic.toml")));
+  // A structure-only system file (no H) as a system to generate: refused
+  // at its line with the import route.
+  EXPECT_THAT(error_in(dir, sweep("systems = [\"" + std::string(PHNN_SOURCE_DIR) +
+                                  "/sweeps/systems/pendulum-structure.toml\"]")),
+              AllOf(HasSubstr("s.toml:6:"), HasSubstr("defines no energy H"),
+                    HasSubstr("phnn import"), HasSubstr("data = [...]")));
   std::system(("rm -rf " + dir).c_str());
 }
 

@@ -233,6 +233,30 @@ TEST(SystemFileErrorTest, StructureLargerThanTheSupportedSize) {
                     HasSubstr("at most 32")));
 }
 
+// Structure only (measured data): no H, z, [initial], [control]. It
+// compiles; whatever needs the energy says so at its name; the generating
+// keys without H are refused at their line.
+TEST(SystemFileErrorTest, StructureOnlyFilesDescribeButDoNotGenerate) {
+  const auto sys = load_system_file(shipped("pendulum-structure"));
+  EXPECT_FALSE(sys->has_energy());
+  EXPECT_EQ(sys->n_x(), 2);
+  EXPECT_EQ(sys->n_w(), 1);
+  EXPECT_EQ(sys->n_u(), 1);
+  try {
+    sys->hamiltonian(VecX::Zero(2));
+    ADD_FAILURE() << "no energy, yet hamiltonian() returned";
+  } catch (const SystemFileError& e) {
+    EXPECT_THAT(e.what(), AllOf(HasSubstr("pendulum-structure.toml:7:"), HasSubstr("defines no energy H"),
+                                HasSubstr("phnn import")));
+  }
+  std::string text = kGood;
+  text.erase(text.find("H = "), text.find('\n', text.find("H = ")) - text.find("H = ") + 1);
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("toy.toml:5:"), HasSubstr("\"z\" generates data"),
+                                    HasSubstr("add H")));
+  EXPECT_THAT(error_of(replaced("H = \"p^2/(2*m) + k*q^2/2\"", "H = \" \"")),
+              HasSubstr("\"H\" is empty"));
+}
+
 TEST(SystemFileErrorTest, EnergyNegativeAtASampledInitialState) {
   EXPECT_THAT(error_of(replaced("k*q^2/2\"", "k*q^2/2 - 0.5\"")),
               AllOf(HasSubstr("toy.toml:5:"), HasSubstr("is negative"), HasSubstr("fix H")));

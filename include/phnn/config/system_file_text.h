@@ -17,6 +17,10 @@ struct SystemFileText {
   /// and 0 for a system file.
   std::string data_checksum = "";
   int data_train_pairs = 0;
+  /// The data set comes with the text (a results file's /data, `phnn train
+  /// --data`), so nothing is generated: a structure-only system file (no
+  /// energy H) is accepted. False for files a sweep reads from disk.
+  bool data_supplied = false;
 };
 
 /// True for a `data` entry of a sweep file: a path ending in ".h5".

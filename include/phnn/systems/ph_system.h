@@ -110,6 +110,10 @@ class PhSystem {
   int n_u() const { return static_cast<int>(input_names().size()); }
   int n_w() const { return static_cast<int>(S().rows()) - n_x() - n_u(); }
 
+  /// False for a structure-only system file (no energy H): it describes
+  /// measured data; hamiltonian(), the dissipation law and everything that
+  /// generates data throw a SystemFileError saying so.
+  virtual bool has_energy() const { return true; }
   virtual double hamiltonian(const VecX& x) const = 0;
   virtual VecX grad_hamiltonian(const VecX& x) const = 0;
   virtual MatX hessian(const VecX& x) const = 0;

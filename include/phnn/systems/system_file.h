@@ -42,7 +42,7 @@ struct SystemDefinition {
   std::string name, description;
   std::vector<std::string> states, state_units, inputs, input_units, ports;
   std::vector<std::pair<std::string, double>> parameters;  // file order
-  std::string energy;                                      // H
+  std::string energy;                                      // H ("" = none: structure only)
   std::vector<std::string> dissipation;                    // z, one per port
   MatX S, J;
   InitialConditionDesign initial;
@@ -52,6 +52,9 @@ struct SystemDefinition {
   std::vector<std::array<int, 2>> phase_pairs;
   std::map<std::string, int> lines;  // key ("H", "S", "initial", ...) -> line
   int line_of(const std::string& key) const;
+  /// False for a structure-only file (no H, z, [initial], [control]): it
+  /// describes measured data (phnn import) and generates nothing.
+  bool has_energy() const { return !energy.empty(); }
 };
 
 /// Parses and validates system-file text (no compilation of the
