@@ -265,6 +265,16 @@ int main(int argc, char** argv) {
   }
   for (const std::string& path : o.systems) {
     const auto sys = phnn::load_system_file(path);
+    if (!sys->has_energy()) {
+      std::fprintf(stderr, "work_precision: %s defines no energy H (structure only); give a system "
+                           "file that generates data\n", path.c_str());
+      return 2;
+    }
+    if (sys->control_design().time_varying()) {
+      std::fprintf(stderr, "work_precision: note: %s has a time-varying input; each trajectory "
+                           "holds its first sample's input here (orders of the schemes at fixed u)\n",
+                   path.c_str());
+    }
     std::vector<phnn::PhTrajectorySpec> specs;
     for (int i = 0; i < o.trajectories; ++i) {
       specs.push_back(phnn::ph_trajectory_spec(*sys, data, data.inference_begin() + i));

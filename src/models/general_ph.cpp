@@ -232,6 +232,7 @@ GeneralPhnnS::GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t
   }
   s_w_ = block_t(w_rows, nx + nu, 0, nw, 0, nx + nu);
   s_w_rows_ = w_rows;
+  s_x_rows_.assign(s.S.begin(), s.S.begin() + nx * width);  // [S_xx S_xw S_xu]
   s_x_ = block_t(s.S, width, 0, nx, 0, width);
   const int64_t total = tri + skew;
   if (nw > 0) {
@@ -259,7 +260,7 @@ Jet GeneralPhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_
   if (order == 0 && l_h().options().fused) {
     // Fused heads: w = [S_wx S_wu] [e; u], then f = S_x [e; z(w); u]
     // (with no ports S_x is [S_xx S_xu]).
-    if (s.n_w == 0) return Jet{internal::general_linear_head(effort.v, u, s.S, s.n_x), {}, {}};
+    if (s.n_w == 0) return Jet{internal::general_linear_head(effort.v, u, s_x_rows_, s.n_x), {}, {}};
     const auto w = internal::general_linear_head(effort.v, u, s_w_rows_, s.n_w);
     return Jet{internal::general_s_field_head(effort.v, u, nets_[1]->forward(w), w, s.S, s.n_w),
                {}, {}};

@@ -36,7 +36,16 @@ std::vector<double> flatten(const std::vector<VecX>& rows) {
   return out;
 }
 
-std::vector<VecX> unflatten(const std::vector<double>& flat, int width, std::size_t count) {
+// `count` rows of `width` from a dataset's values; a dataset of another size
+// (a damaged or hand-made file) is refused before anything is indexed.
+std::vector<VecX> unflatten(const std::vector<double>& flat, int width, std::size_t count,
+                            const std::string& what = "a data-set file's dataset") {
+  if (width < 0 || width > kMaxDimension || flat.size() != count * static_cast<std::size_t>(width)) {
+    throw std::runtime_error(what + ": " + std::to_string(flat.size()) + " values where " +
+                             std::to_string(count) + " rows of " + std::to_string(width) +
+                             " are expected; the file is damaged or was not written by phnn: "
+                             "write it again with phnn data or phnn import");
+  }
   std::vector<VecX> out(count, VecX(width));
   for (std::size_t i = 0; i < count; ++i) {
     for (int j = 0; j < width; ++j) out[i](j) = flat[i * static_cast<std::size_t>(width) + static_cast<std::size_t>(j)];
@@ -59,9 +68,10 @@ PhPairSet read_pairs(const h5::File& file, const std::string& group, int nx, int
   PhPairSet p;
   p.trajectory = file.read_ints(group + "/trajectory");
   const std::size_t n = p.trajectory.size();
-  p.x = unflatten(file.read_doubles(group + "/x"), nx, n);
-  p.x_next = unflatten(file.read_doubles(group + "/x_next"), nx, n);
-  p.u = nu > 0 ? unflatten(file.read_doubles(group + "/u"), nu, n) : std::vector<VecX>(n, VecX(0));
+  p.x = unflatten(file.read_doubles(group + "/x"), nx, n, group + "/x");
+  p.x_next = unflatten(file.read_doubles(group + "/x_next"), nx, n, group + "/x_next");
+  p.u = nu > 0 ? unflatten(file.read_doubles(group + "/u"), nu, n, group + "/u")
+               : std::vector<VecX>(n, VecX(0));
   for (auto v : file.read_ints(group + "/position")) p.position.push_back(static_cast<int>(v));
   p.step = file.double_attribute(group, "step_s");
   return p;
@@ -242,6 +252,12 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
   if (file.has_attribute(g, "noise")) d.noise = file.string_attribute(g, "noise");
   const int nx = static_cast<int>(d.state_names.size());
   const int nu = static_cast<int>(d.input_names.size());
+  if (nx < 1 || d.n_w < 0 || nx + d.n_w + nu > kMaxDimension) {
+    throw std::runtime_error(g + ": " + std::to_string(nx) + " states, " + std::to_string(d.n_w) +
+                             " ports and " + std::to_string(nu) + " inputs: not a data set phnn "
+                             "can read (at least 1 state, at most " + std::to_string(kMaxDimension) +
+                             " in all); the file is damaged or was not written by phnn");
+  }
   d.options = read_options(file, g);
   d.train = read_pairs(file, p + "/train", nx, nu);
   d.validation = read_pairs(file, p + "/validation", nx, nu);
@@ -251,12 +267,18 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
   const auto dims = file.dims(p + "/inference/states");
   const auto flat = file.read_doubles(p + "/inference/states");
   const std::size_t steps = dims.size() == 3 ? dims[1] : 0;
+  if (flat.size() != m * steps * static_cast<std::size_t>(nx)) {
+    throw std::runtime_error(p + "/inference/states: " + std::to_string(flat.size()) +
+                             " values for " + std::to_string(m) + " trajectories of " +
+                             std::to_string(steps) + " samples of " + std::to_string(nx) +
+                             " states; the file is damaged or was not written by phnn");
+  }
   for (std::size_t i = 0; i < m; ++i) {
     const std::vector<double> part(flat.begin() + static_cast<long>(i * steps * nx),
                                    flat.begin() + static_cast<long>((i + 1) * steps * nx));
     d.inference.states.push_back(unflatten(part, nx, steps));
   }
-  d.inference.u = nu > 0 ? unflatten(file.read_doubles(p + "/inference/u"), nu, m)
+  d.inference.u = nu > 0 ? unflatten(file.read_doubles(p + "/inference/u"), nu, m, p + "/inference/u")
                          : std::vector<VecX>(m, VecX(0));
   if (nu > 0 && file.exists(p + "/inference/inputs")) {
     const auto in_dims = file.dims(p + "/inference/inputs");

@@ -12,6 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "h5/h5file.h"
 #include "phnn/integrators/ph_steps.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/ph_dataset_file.h"
@@ -20,6 +21,7 @@
 namespace phnn {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 std::string shipped(const std::string& name) {
@@ -165,6 +167,30 @@ TEST(PhDatasetTest, VersionTwoFileRoundTripsWithNamesAndTheSystemText) {
   // The built-in reader names the version instead of failing on a missing attribute.
   EXPECT_THAT([&] { read_dataset_file(path); },
               ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("format_version 2")));
+  std::remove(path.c_str());
+}
+
+// Damaged or hand-made files: more states than the vectors hold (40 names),
+// and a dataset shorter than its names say, are refused before anything
+// is indexed (no write past a fixed-capacity vector).
+TEST(PhDatasetTest, DamagedFilesAreRefusedBeforeAnythingIsIndexed) {
+  DatasetOptions options;
+  options.num_validation = 5;
+  options.num_inference = 2;
+  const auto system = load_system_file(shipped("pendulum"));
+  const std::string path = ::testing::TempDir() + "ph_dataset_damaged.h5";
+  std::string names = "q0";
+  for (int i = 1; i < 40; ++i) names += ",q" + std::to_string(i);
+  write_ph_dataset_file(path, make_ph_system_data(*system, options, 3));
+  h5::File::open(path, h5::Access::kReadWrite).set_attribute("/", "state_names", names);
+  EXPECT_THAT([&] { read_ph_dataset_file(path); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  AllOf(HasSubstr("40 states"), HasSubstr("not a data set phnn can read"))));
+  write_ph_dataset_file(path, make_ph_system_data(*system, options, 3));
+  h5::File::open(path, h5::Access::kReadWrite).set_attribute("/", "state_names", std::string("q,p,r"));
+  EXPECT_THAT([&] { read_ph_dataset_file(path); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  AllOf(HasSubstr("/train/x: 6 values where 3 rows of 3"), HasSubstr("damaged"))));
   std::remove(path.c_str());
 }
 

@@ -91,8 +91,22 @@ TEST(GeneralModelTest, JetsMatchAutogradInFourStates) {
 // with respect to every parameter, on 4 states (n_w = 2) and 6 states
 // (n_w = 3, so the skew part K of z is used), and on a 2-state system.
 TEST(GeneralModelTest, FusedHeadsMatchTheReferenceJetsWithGradients) {
-  for (const std::string name : {"harmonic", "coupled-duffing", "mass-chain"}) {
-    const auto system = load_system_file(shipped(name));
+  // A lossless forced oscillator: no ports (PHNN-S is S_x [gradH; u]).
+  const std::string lossless = R"(name = "lossless"
+states = ["q", "p"]
+inputs = ["u"]
+H = "p^2/2 + q^2/2"
+S = [[0, 1, 0], [-1, 0, 1], [0, -1, 0]]
+[initial]
+method = "energy"
+energy = [0.1, 1.0]
+[control]
+design = "constant"
+range = [[-1, 1]]
+)";
+  for (const std::string name : {"harmonic", "coupled-duffing", "mass-chain", "lossless"}) {
+    const auto system = name == "lossless" ? compile_system(lossless, "lossless.toml")
+                                           : load_system_file(shipped(name));
     const int n = system->n_x();
     for (ModelKind m : {ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
       ModelOptions options{m, ModelSize::kSmall, SystemKind::kHarmonic};

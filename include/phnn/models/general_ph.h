@@ -66,6 +66,7 @@ class GeneralPhnnS : public GeneralPortHamiltonianModel {
  private:
   torch::Tensor s_w_, s_x_, s_y_;  // jet_linear factors, see the constructor
   std::vector<double> s_w_rows_;   // [S_wx S_wu] row-major (the fused head's)
+  std::vector<double> s_x_rows_;   // the first n_x rows of S (no ports: [S_xx S_xu])
   torch::Tensor place_l_, place_lt_, place_skew_;  // L_z outputs -> L, L^T, K - K^T
 };
 
