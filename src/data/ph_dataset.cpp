@@ -172,7 +172,15 @@ std::vector<VecX> input_samples(const PhSystem& system, const DatasetOptions& op
   const int nu = system.n_u();
   const int count = options.num_inference_steps() + 1;
   const double hs = options.stride() * options.generation_step;
-  if (c.design == ControlDesign::Design::kSteps) return step_samples(c, nu, count, hs, rng);
+  if (c.design == ControlDesign::Design::kSteps) {
+    // A level per sample at most: a shorter hold would draw levels nobody
+    // samples (and, for a tiny hold, without end).
+    PHNN_REQUIRE(c.hold >= hs * (1.0 - 1e-9),
+                 system.control_location() << ": control.hold = " << c.hold
+                                           << " s is shorter than one sample (" << hs << " s at "
+                                           << options.sample_rate << " Hz); use hold >= " << hs);
+    return step_samples(c, nu, count, hs, rng);
+  }
   const double two_pi = 2.0 * M_PI, duration = options.beta * options.period;
   std::vector<VecX> out(static_cast<std::size_t>(count), VecX::Zero(nu));
   for (int i = 0; i < nu; ++i) {

@@ -144,6 +144,7 @@ class FileSystem : public PhSystem {
   const std::string& source_text() const override { return def_.text; }
   std::string energy_location() const override { return location("H"); }
   std::string initial_location() const override { return location("initial"); }
+  std::string control_location() const override { return location("control"); }
   std::array<double, 2> self_oscillation_interval() const override;
   std::vector<std::array<int, 2>> phase_pairs() const override {
     return def_.phase_pairs.empty() ? PhSystem::phase_pairs() : def_.phase_pairs;

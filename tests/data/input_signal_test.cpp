@@ -156,6 +156,13 @@ TEST(InputSignalTest, ControlTableErrorsNameTheLineAndTheFix) {
   EXPECT_THAT(control_error("[control]\ndesign = \"steps\"\nrange = [[-1, 1]]\nperiod = 1"),
               AllOf(HasSubstr("unknown key \"period\""), HasSubstr("it knows: design, range, hold")));
   EXPECT_THAT(control_error("[control]\ndesign = \"sine\""), HasSubstr("did you mean \"sines\"?"));
+  // A hold shorter than a sample (here 1e-300 s: without the check, ~1e298
+  // levels would be drawn per sample) is refused where the data are made.
+  const auto tiny = compile_system(coupled_with("[control]\ndesign = \"steps\"\nrange = [[-1, 1]]\nhold = 1e-300"),
+                                   "forced.toml");
+  EXPECT_THAT([&] { ph_trajectory_spec(*tiny, small_options(), 0); },
+              ::testing::ThrowsMessage<std::invalid_argument>(
+                  AllOf(HasSubstr("forced.toml:"), HasSubstr("shorter than one sample"), HasSubstr("hold >= 0.01"))));
 }
 
 }  // namespace
