@@ -1,7 +1,7 @@
 // src/models/fused_heads.cpp — forward and backward of the closed-form field
-// heads (PHNN-JR and its jet, PHNN-S) and the Gonzalez discrete gradient,
-// row by row (a row = one member and one batch element). The Hamiltonian
-// heads: fused_heads_hamiltonian.cpp.
+// heads (PHNN-JR and its jet, PHNN-S), row by row (a row = one member and one
+// batch element). The Hamiltonian heads: fused_heads_hamiltonian.cpp; the
+// Gonzalez quotient: the n-state head of general_heads.cpp.
 #include "models/fused_heads.h"
 
 #include "models/fused_heads_common.h"
@@ -275,74 +275,6 @@ class PhnnSFieldFunction : public torch::autograd::Function<PhnnSFieldFunction> 
   }
 };
 
-// --------------------------------------------------------------- Gonzalez
-// Per row: n2 = |dx|^2, D = H1 - H0 - g.dx, k = D / n2 (0 if n2 < tau^2),
-// dg = g + k dx. Backward with dg~, s = dg~.dx (small rows: g~ = dg~ only):
-//   H1~ = s / n2,  H0~ = -s / n2,  g~ = dg~ - (s / n2) dx,
-//   dx~ = k dg~ - (s / n2) (g + 2 k dx).
-class GonzalezFunction : public torch::autograd::Function<GonzalezFunction> {
- public:
-  static Tensor forward(AutogradContext* ctx, const Tensor& h0_in, const Tensor& h1_in,
-                        const Tensor& g_in, const Tensor& dx_in, double min_dx_norm) {
-    const Tensor h0 = dense(h0_in), h1 = dense(h1_in), g = dense(g_in), dx = dense(dx_in);
-    const int64_t rows = g.size(0) * g.size(1);
-    Tensor dg = torch::empty_like(g);
-    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
-    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
-    double* out = dg.data_ptr<double>();
-    const double tau2 = min_dx_norm * min_dx_norm;
-    for (int64_t r = 0; r < rows; ++r) {
-      const double* gr = pg + 2 * r;
-      const double* d = pd + 2 * r;
-      const double n2 = d[0] * d[0] + d[1] * d[1];
-      const double defect = p1[r] - p0[r] - (gr[0] * d[0] + gr[1] * d[1]);
-      const double k = n2 < tau2 ? 0.0 : defect / n2;
-      out[2 * r] = gr[0] + k * d[0];
-      out[2 * r + 1] = gr[1] + k * d[1];
-    }
-    ctx->save_for_backward({h0, h1, g, dx});
-    ctx->saved_data["tau2"] = tau2;
-    return dg;
-  }
-
-  static variable_list backward(AutogradContext* ctx, variable_list grads) {
-    const auto saved = ctx->get_saved_variables();
-    const Tensor &h0 = saved[0], &h1 = saved[1], &g = saved[2], &dx = saved[3];
-    const double tau2 = ctx->saved_data["tau2"].toDouble();
-    const Tensor db = dense(grads[0]);
-    const int64_t rows = g.size(0) * g.size(1);
-    Tensor h0_bar = torch::empty_like(h0), h1_bar = torch::empty_like(h1);
-    Tensor g_bar = torch::empty_like(g), dx_bar = torch::empty_like(dx);
-    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
-    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
-    const double* pb = db.data_ptr<double>();
-    double *ph0b = h0_bar.data_ptr<double>(), *ph1b = h1_bar.data_ptr<double>();
-    double *pgb = g_bar.data_ptr<double>(), *pxb = dx_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double* gr = pg + 2 * r;
-      const double* d = pd + 2 * r;
-      const double* b = pb + 2 * r;
-      const double n2 = d[0] * d[0] + d[1] * d[1];
-      double* gb = pgb + 2 * r;
-      double* xb = pxb + 2 * r;
-      if (n2 < tau2) {
-        ph0b[r] = ph1b[r] = 0.0;
-        gb[0] = b[0], gb[1] = b[1], xb[0] = xb[1] = 0.0;
-        continue;
-      }
-      const double k = (p1[r] - p0[r] - (gr[0] * d[0] + gr[1] * d[1])) / n2;
-      const double s_n2 = (b[0] * d[0] + b[1] * d[1]) / n2;
-      ph1b[r] = s_n2;
-      ph0b[r] = -s_n2;
-      for (int i = 0; i < 2; ++i) {
-        gb[i] = b[i] - s_n2 * d[i];
-        xb[i] = k * b[i] - s_n2 * (gr[i] + 2.0 * k * d[i]);
-      }
-    }
-    return {h0_bar, h1_bar, g_bar, dx_bar, Tensor()};
-  }
-};
-
 }  // namespace
 
 torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
@@ -372,12 +304,6 @@ torch::Tensor phnn_s_field_head(const torch::Tensor& effort, const torch::Tensor
                                 const torch::Tensor& l, const torch::Tensor& w,
                                 const std::array<std::array<double, 4>, 4>& S) {
   return PhnnSFieldFunction::apply(effort, u.expand({effort.size(0), effort.size(1), 1}), l, w, S);
-}
-
-torch::Tensor gonzalez_head(const torch::Tensor& h_x, const torch::Tensor& h_x_dx,
-                            const torch::Tensor& grad_mid, const torch::Tensor& dx,
-                            double min_dx_norm) {
-  return GonzalezFunction::apply(h_x, h_x_dx, grad_mid, dx.expand_as(grad_mid), min_dx_norm);
 }
 
 }  // namespace internal

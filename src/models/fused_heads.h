@@ -59,12 +59,5 @@ torch::Tensor phnn_s_field_head(const torch::Tensor& effort, const torch::Tensor
                                 const torch::Tensor& l, const torch::Tensor& w,
                                 const std::array<std::array<double, 4>, 4>& S);
 
-/// Gonzalez discrete gradient (eq: gonzalez-discrete-gradient) from H(x)
-/// [E, B, 1], H(x + dx) [E, B, 1], gradH(x + dx/2) [E, B, 2] and dx:
-///   dg = g + (H(x+dx) - H(x) - g.dx) / |dx|^2 dx,  = g where |dx| < min_dx_norm.
-torch::Tensor gonzalez_head(const torch::Tensor& h_x, const torch::Tensor& h_x_dx,
-                            const torch::Tensor& grad_mid, const torch::Tensor& dx,
-                            double min_dx_norm);
-
 }  // namespace internal
 }  // namespace phnn

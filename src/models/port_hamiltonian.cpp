@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "models/fused_heads.h"
+#include "models/general_heads.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -122,8 +123,10 @@ torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
     const auto ends = torch::cat({x, x + dx}, /*dim=*/1);
     const auto h_ends = internal::hamiltonian_head(l_h().forward(ends), {}, ends).h;
     const auto grad_mid = hamiltonian_and_gradient(l_h(), x + 0.5 * dx).grad;
-    return internal::gonzalez_head(h_ends.narrow(1, 0, B), h_ends.narrow(1, B, B), grad_mid, dx,
-                                   min_dx_norm);
+    // The n-state Gonzalez head: for n = 2 the same operations in the same
+    // order as the former 2-state one (bitwise; PaperPathTest).
+    return internal::general_gonzalez_head(h_ends.narrow(1, 0, B), h_ends.narrow(1, B, B), grad_mid,
+                                           dx, min_dx_norm);
   }
   // One network call for H(x), H(x + dx) and gradH(x + dx/2).
   const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
