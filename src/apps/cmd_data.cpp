@@ -2,6 +2,7 @@
 #include <sys/stat.h>
 
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -148,6 +149,11 @@ int run_data(int argc, char** argv, int first) {
     }
     const std::string bad = output_problem("data", csv, OutputKind::kTrajectoryCsv, {system_arg, out});
     if (!bad.empty()) throw cli::UsageError{"phnn data: --csv " + bad};
+    // Neither exists yet, so compare the paths themselves.
+    if (std::filesystem::weakly_canonical(csv) == std::filesystem::weakly_canonical(out)) {
+      throw cli::UsageError{"phnn data: --csv and --out are the same file (" + csv +
+                            "); give the trajectories' CSV its own name, e.g. " + out + ".csv"};
+    }
   }
   const auto start = std::chrono::steady_clock::now();
   if (from_file) {

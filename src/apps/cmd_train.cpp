@@ -317,6 +317,12 @@ PhSystemData file_system_data(const cli::Parser& parser, const PhSystem& system,
                             "` (or, for recordings, `phnn import ... --system " + parser.get("system") +
                             "`)"};
     }
+    if (static_cast<std::size_t>(n_train) > data.train.size()) {
+      throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " exceeds the " +
+                            std::to_string(data.train.size()) + " training pairs of --data " +
+                            parser.get("data") + "; lower --n-train, or make the data set with more "
+                            "(phnn data --n-train, or import more training trajectories)"};
+    }
     return data;
   }
   const DatasetOptions options = generation_options(parser, n_train);

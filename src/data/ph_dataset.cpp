@@ -3,6 +3,7 @@
 // and energy-interval draws) and the DG trajectories behind the splits.
 #include "phnn/data/ph_dataset.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -176,10 +177,21 @@ std::vector<VecX> input_samples(const PhSystem& system, const DatasetOptions& op
     // A level per sample at most: a shorter hold would draw levels nobody
     // samples (and, for a tiny hold, without end).
     PHNN_REQUIRE(c.hold >= hs * (1.0 - 1e-9),
-                 system.control_location() << ": control.hold = " << c.hold
+                 system.control_location("hold") << ": control.hold = " << c.hold
                                            << " s is shorter than one sample (" << hs << " s at "
                                            << options.sample_rate << " Hz); use hold >= " << hs);
     return step_samples(c, nu, count, hs, rng);
+  }
+  // Above half the sample rate the held samples cannot represent a sine
+  // (it aliases to a slower one): refused rather than silently folded.
+  const double nyquist = 0.5 / hs;
+  for (double f : c.frequencies) {
+    PHNN_REQUIRE(f <= nyquist, system.control_location(c.design == ControlDesign::Design::kSines
+                                                           ? "frequencies" : "frequency")
+                                   << ": " << f << " Hz is above half the sample rate (" << nyquist
+                                   << " Hz at " << options.sample_rate
+                                   << " Hz): the held samples cannot represent it; use frequencies <= "
+                                   << nyquist << " Hz");
   }
   const double two_pi = 2.0 * M_PI, duration = options.beta * options.period;
   std::vector<VecX> out(static_cast<std::size_t>(count), VecX::Zero(nu));
@@ -224,6 +236,16 @@ PhTrajectorySpec ph_trajectory_spec(const PhSystem& system, const DatasetOptions
     spec.u = spec.inputs.front();
   } else {
     spec.u = control_input(system, &ctrl);
+  }
+  // Finite numbers can still overflow (a range of +-1e308, amplitudes of
+  // 1e308): refused at the control table, not as a Newton failure later.
+  for (std::size_t k = 0; k < std::max<std::size_t>(spec.inputs.size(), 1); ++k) {
+    const VecX& u = spec.inputs.empty() ? spec.u : spec.inputs[k];
+    PHNN_REQUIRE(u.allFinite(), system.control_location()
+                                    << ": the input of trajectory " << index << " is not finite at sample "
+                                    << k << " (u = " << u.transpose()
+                                    << "): the control's numbers overflow; give ranges and "
+                                       "amplitudes of physical size");
   }
   return spec;
 }

@@ -144,7 +144,10 @@ class FileSystem : public PhSystem {
   const std::string& source_text() const override { return def_.text; }
   std::string energy_location() const override { return location("H"); }
   std::string initial_location() const override { return location("initial"); }
-  std::string control_location() const override { return location("control"); }
+  std::string control_location(const std::string& key = "") const override {
+    const std::string full = "control." + key;
+    return location(!key.empty() && def_.lines.count(full) ? full : "control");
+  }
   std::array<double, 2> self_oscillation_interval() const override;
   std::vector<std::array<int, 2>> phase_pairs() const override {
     return def_.phase_pairs.empty() ? PhSystem::phase_pairs() : def_.phase_pairs;

@@ -328,7 +328,8 @@ void read_initial(const Reader& r, const toml::table& t, SystemDefinition* def) 
 // [control] design = "sines" | "chirp" | "steps" (ControlDesign): inputs
 // held over each sample. Every key of the table is checked.
 void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
-                               const std::string& design, int nu, ControlDesign* c) {
+                               const std::string& design, int nu, SystemDefinition* def) {
+  ControlDesign* c = &def->control;
   if (nu == 0) r.fail(line, "control.design = \"" + design + "\" needs at least one input");
   const std::vector<std::string> keys =
       design == "steps" ? std::vector<std::string>{"design", "range", "hold"}
@@ -349,6 +350,7 @@ void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
   if (design == "steps") {
     c->design = ControlDesign::Design::kSteps;
     if (const toml::node* h = r.get(ct, "hold", false, "", 0)) {
+      def->lines["control.hold"] = Reader::line(*h);
       c->hold = r.number(*h, "control.hold");
       if (!(c->hold > 0.0)) r.fail(Reader::line(*h), "\"control.hold\" must be > 0 (seconds per level)");
     }
@@ -362,7 +364,14 @@ void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
                               design == "sines" ? " in [control] (a list of frequencies in Hz)"
                                                 : " in [control] (an interval [f0, f1] in Hz)",
                               line);
+  def->lines["control." + fkey] = Reader::line(*f);
   const toml::array* fa = f->as_array();
+  constexpr std::size_t kMaxSines = 64;
+  if (fa != nullptr && fa->size() > kMaxSines) {
+    r.fail(Reader::line(*f), "\"control." + fkey + "\" lists " + std::to_string(fa->size()) +
+                                 " frequencies; at most " + std::to_string(kMaxSines) +
+                                 " sines per input are supported");
+  }
   if (fa == nullptr || fa->empty() || (design == "chirp" && fa->size() != 2)) {
     r.fail(Reader::line(*f), "\"control." + fkey + "\" must be " +
                                  (design == "sines" ? "a non-empty list of frequencies in Hz"
@@ -414,7 +423,7 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
                    "input; use \"constant\"");
     }
   } else if (design == "sines" || design == "chirp" || design == "steps") {
-    read_time_varying_control(r, *ct, line, design, nu, &c);
+    read_time_varying_control(r, *ct, line, design, nu, def);
   } else {
     const std::string near = closest_name(
         design, {"constant", "energy-shaping", "limit-cycle", "sines", "chirp", "steps"});

@@ -163,6 +163,21 @@ TEST(InputSignalTest, ControlTableErrorsNameTheLineAndTheFix) {
   EXPECT_THAT([&] { ph_trajectory_spec(*tiny, small_options(), 0); },
               ::testing::ThrowsMessage<std::invalid_argument>(
                   AllOf(HasSubstr("forced.toml:"), HasSubstr("shorter than one sample"), HasSubstr("hold >= 0.01"))));
+  // Found by a hostile campaign: frequencies above half the sample rate
+  // (aliasing), numbers that overflow to a non-finite input, 65 sines.
+  const auto fast = compile_system(coupled_with("[control]\ndesign = \"sines\"\nfrequencies = [1e6]\n"
+                                                "amplitude = [0.1, 0.2]"), "forced.toml");
+  EXPECT_THAT([&] { ph_trajectory_spec(*fast, small_options(), 0); },
+              ::testing::ThrowsMessage<std::invalid_argument>(
+                  AllOf(HasSubstr("above half the sample rate (50 Hz"), HasSubstr("<= 50 Hz"))));
+  const auto huge = compile_system(coupled_with("[control]\ndesign = \"sines\"\nfrequencies = [1, 2]\n"
+                                                "amplitude = [1e308, 1e308]"), "forced.toml");
+  EXPECT_THAT([&] { ph_trajectory_spec(*huge, small_options(), 0); },
+              ::testing::ThrowsMessage<std::invalid_argument>(AllOf(HasSubstr("not finite"), HasSubstr("overflow"))));
+  std::string many = "1";
+  for (int i = 0; i < 64; ++i) many += ", 1";
+  EXPECT_THAT(control_error("[control]\ndesign = \"sines\"\nfrequencies = [" + many + "]\namplitude = [0, 1]"),
+              HasSubstr("at most 64 sines"));
 }
 
 }  // namespace

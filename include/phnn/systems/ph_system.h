@@ -151,7 +151,11 @@ class PhSystem {
   /// key, or the built-in's name).
   virtual std::string energy_location() const { return name(); }
   virtual std::string initial_location() const { return name(); }
-  virtual std::string control_location() const { return name(); }
+  /// "FILE:LINE" of [control] or, given a key ("hold"), of that key.
+  virtual std::string control_location(const std::string& key = "") const {
+    (void)key;
+    return name();
+  }
   /// I_w = {w : z'(w) < 0} of Algorithm 4 (ControlDesign::kLimitCycle);
   /// throws std::invalid_argument where the system has none.
   virtual std::array<double, 2> self_oscillation_interval() const;
