@@ -84,6 +84,29 @@ int write_file_system_data(const std::string& path, const DatasetOptions& option
   return 0;
 }
 
+// --csv: with a system file only, not with --noise, never over --out or the
+// system file.
+void check_csv_option(const cli::Parser& parser, const std::string& csv, const std::string& out,
+                      const std::string& system_arg, bool from_file) {
+  if (parser.has("noise") && parser.has("csv")) {
+    throw cli::UsageError{"phnn data: --csv writes the clean trajectories, --noise perturbs only "
+                          "the pairs: use one of them (add noise to a recording before importing it)"};
+  }
+  if (parser.has("csv")) {
+    if (!from_file) {
+      throw cli::UsageError{"phnn data: --csv needs a system file: use --system "
+                            "sweeps/systems/" + system_arg + ".toml (the same system)"};
+    }
+    const std::string bad = output_problem("data", csv, OutputKind::kTrajectoryCsv, {system_arg, out});
+    if (!bad.empty()) throw cli::UsageError{"phnn data: --csv " + bad};
+    // Neither exists yet, so compare the paths themselves.
+    if (std::filesystem::weakly_canonical(csv) == std::filesystem::weakly_canonical(out)) {
+      throw cli::UsageError{"phnn data: --csv and --out are the same file (" + csv +
+                            "); give the trajectories' CSV its own name, e.g. " + out + ".csv"};
+    }
+  }
+}
+
 }  // namespace
 
 int run_data(int argc, char** argv, int first) {
@@ -138,23 +161,7 @@ int run_data(int argc, char** argv, int first) {
   if (parser.flag_set("noise-absolute") && !parser.has("noise")) {
     throw cli::UsageError{"phnn data: --noise-absolute without --noise; give the levels"};
   }
-  if (parser.has("noise") && parser.has("csv")) {
-    throw cli::UsageError{"phnn data: --csv writes the clean trajectories, --noise perturbs only "
-                          "the pairs: use one of them (add noise to a recording before importing it)"};
-  }
-  if (parser.has("csv")) {
-    if (!from_file) {
-      throw cli::UsageError{"phnn data: --csv needs a system file: use --system "
-                            "sweeps/systems/" + system_arg + ".toml (the same system)"};
-    }
-    const std::string bad = output_problem("data", csv, OutputKind::kTrajectoryCsv, {system_arg, out});
-    if (!bad.empty()) throw cli::UsageError{"phnn data: --csv " + bad};
-    // Neither exists yet, so compare the paths themselves.
-    if (std::filesystem::weakly_canonical(csv) == std::filesystem::weakly_canonical(out)) {
-      throw cli::UsageError{"phnn data: --csv and --out are the same file (" + csv +
-                            "); give the trajectories' CSV its own name, e.g. " + out + ".csv"};
-    }
-  }
+  check_csv_option(parser, csv, out, system_arg, from_file);
   const auto start = std::chrono::steady_clock::now();
   if (from_file) {
     return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, csv, parser,

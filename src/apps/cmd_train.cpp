@@ -317,12 +317,10 @@ PhSystemData file_system_data(const cli::Parser& parser, const PhSystem& system,
                             "` (or, for recordings, `phnn import ... --system " + parser.get("system") +
                             "`)"};
     }
-    if (static_cast<std::size_t>(n_train) > data.train.size()) {
+    if (static_cast<std::size_t>(n_train) > data.train.size())
       throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " exceeds the " +
                             std::to_string(data.train.size()) + " training pairs of --data " +
-                            parser.get("data") + "; lower --n-train, or make the data set with more "
-                            "(phnn data --n-train, or import more training trajectories)"};
-    }
+                            parser.get("data") + "; lower --n-train, or make a larger data set"};
     return data;
   }
   const DatasetOptions options = generation_options(parser, n_train);
@@ -347,9 +345,7 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int a
             << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << std::endl;
   // The data set is at hand (read or generated above): supplied, not to generate.
   const SystemFileReader read = [&](const std::string&) {
-    SystemFileText t{path, system->source_text()};
-    t.data_supplied = true;
-    return t;
+    return SystemFileText{path, system->source_text(), "", 0, /*data_supplied=*/true};
   };
   print_estimate(cell_sweep_text(cell, data, path), read);
   const auto results = train_cell(cell, data, *system, progress_printer(parser.flag_set("quiet")));
