@@ -311,8 +311,7 @@ std::vector<MeasuredTrajectory> generated_trajectories(const PhSystem& system,
       std::vector<VecX> sub;
       for (int n = 0; n <= positions; ++n) sub.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
       const auto n = static_cast<std::size_t>(pairs->position[i]);
-      const VecX& u_n = traj.inputs.empty() ? traj.u : traj.inputs[n];
-      PHNN_CHECK(sub[n] == pairs->x[i] && sub[n + 1] == pairs->x_next[i] && u_n == pairs->u[i],
+      PHNN_CHECK(sub[n] == pairs->x[i] && sub[n + 1] == pairs->x_next[i] && traj.input(n) == pairs->u[i],
                  "trajectory " << pairs->trajectory[i] << " regenerated differs from its pair");
       add(pairs->trajectory[i], traj.u, traj.inputs, std::move(sub));
     }

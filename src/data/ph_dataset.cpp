@@ -112,14 +112,21 @@ double equilibrium_offset(const PhSystem& system, double e) {
   return energy(hi) - e <= e - energy(lo) ? hi : lo;
 }
 
+// u_i ~ U(range[i]) for each input, in order.
+VecX uniform_in_ranges(const std::vector<std::array<double, 2>>& range, int nu, CounterRng* rng) {
+  VecX u(nu);
+  for (int i = 0; i < nu; ++i) {
+    u(i) = rng->uniform(range[static_cast<std::size_t>(i)][0], range[static_cast<std::size_t>(i)][1]);
+  }
+  return u;
+}
+
 VecX control_input(const PhSystem& system, CounterRng* rng) {
   const ControlDesign& c = system.control_design();
   VecX u = VecX::Zero(system.n_u());
   switch (c.design) {
     case ControlDesign::Design::kConstant:
-      for (int i = 0; i < u.size(); ++i) {
-        u(i) = rng->uniform(c.range[static_cast<std::size_t>(i)][0], c.range[static_cast<std::size_t>(i)][1]);
-      }
+      u = uniform_in_ranges(c.range, system.n_u(), rng);
       break;
     case ControlDesign::Design::kEnergyShaping: {
       // Algorithm 3: E_eq ~ U(I_Eeq), sign +-1, u = -dH/dq(q*, 0).
@@ -153,11 +160,7 @@ std::vector<VecX> step_samples(const ControlDesign& c, int nu, int count, double
   long drawn = -1;
   for (int k = 0; k < count; ++k) {
     const long j = static_cast<long>(std::floor(k * hs / c.hold + 1e-9));
-    for (; drawn < j; ++drawn) {
-      for (int i = 0; i < nu; ++i) {
-        level(i) = rng->uniform(c.range[static_cast<std::size_t>(i)][0], c.range[static_cast<std::size_t>(i)][1]);
-      }
-    }
+    for (; drawn < j; ++drawn) level = uniform_in_ranges(c.range, nu, rng);
     out.push_back(level);
   }
   return out;
@@ -240,7 +243,7 @@ PhTrajectorySpec ph_trajectory_spec(const PhSystem& system, const DatasetOptions
   // Finite numbers can still overflow (a range of +-1e308, amplitudes of
   // 1e308): refused at the control table, not as a Newton failure later.
   for (std::size_t k = 0; k < std::max<std::size_t>(spec.inputs.size(), 1); ++k) {
-    const VecX& u = spec.inputs.empty() ? spec.u : spec.inputs[k];
+    const VecX& u = spec.input(k);
     PHNN_REQUIRE(u.allFinite(), system.control_location()
                                     << ": the input of trajectory " << index << " is not finite at sample "
                                     << k << " (u = " << u.transpose()
@@ -270,7 +273,7 @@ PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions
   traj.states.push_back(spec.x0);
   for (int n = 0; n < num_steps; ++n) {
     // Zero-order hold: u of sample floor(n / stride) over the whole step.
-    const VecX& u = spec.inputs.empty() ? spec.u : spec.inputs[static_cast<std::size_t>(n / stride)];
+    const VecX& u = spec.input(static_cast<std::size_t>(n / stride));
     const PhImplicitStep step = ph_discrete_gradient_step(system, traj.states.back(), u,
                                                           options.generation_step, options.newton);
     if (step.status != StepStatus::kConverged) {
@@ -300,7 +303,7 @@ PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options, s
     const PhTrajectory traj = ph_generate_trajectory(system, options, i, (n + 1) * stride);
     pairs.x.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
     pairs.x_next.push_back(traj.states.back());
-    pairs.u.push_back(traj.inputs.empty() ? traj.u : traj.inputs[static_cast<std::size_t>(n)]);
+    pairs.u.push_back(traj.input(static_cast<std::size_t>(n)));
     pairs.trajectory.push_back(i);
     pairs.position.push_back(n);
   }

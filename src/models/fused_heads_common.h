@@ -1,6 +1,7 @@
-// src/models/fused_heads_common.h — shared by fused_heads.cpp and
-// fused_heads_hamiltonian.cpp only: softplus/sigmoid from one exp, and the
-// structure matrices a head saves for its backward.
+// src/models/fused_heads_common.h — shared by the fused heads of src/models
+// only (fused_heads*.cpp, general*_heads.cpp): softplus/sigmoid from one exp,
+// the structure matrices a head saves for its backward, and the row and
+// lower-triangle indexing of the n-state heads.
 #pragma once
 
 #include <array>
@@ -30,6 +31,17 @@ struct SoftplusSigmoid {
 };
 
 inline Tensor dense(const Tensor& t) { return t.contiguous(); }
+
+// Rows of an [E, B, ...] tensor: one member and one batch element each.
+inline int64_t rows_of(const Tensor& t) { return t.size(0) * t.size(1); }
+
+// u [.., .., n_u] broadcast to the rows of `like` and made contiguous.
+inline Tensor rows_like(const Tensor& u, const Tensor& like) {
+  return u.expand({like.size(0), like.size(1), u.size(-1)}).contiguous();
+}
+
+// Row-major lower triangle: entry (r, c), c <= r, is output r (r + 1) / 2 + c.
+inline int tri(int r, int c) { return r * (r + 1) / 2 + c; }
 
 // A head's constant structure matrix (J or S), kept for its backward as one
 // list entry of the context.

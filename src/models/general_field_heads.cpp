@@ -12,12 +12,6 @@ namespace {
 
 using namespace heads;
 
-inline int tri(int r, int c) { return r * (r + 1) / 2 + c; }
-
-Tensor rows_like(const Tensor& u, const Tensor& like) {
-  return u.expand({like.size(0), like.size(1), u.size(-1)}).contiguous();
-}
-
 // y = L x and x~ = L^T y~ for a lower-triangular L stored as its row-major triangle.
 void lower_times(const double* L, const double* x, int n, double* y) {
   for (int r = 0; r < n; ++r) {
@@ -61,7 +55,7 @@ class SFieldFunction : public torch::autograd::Function<SFieldFunction> {
     const int n = static_cast<int>(nw), T = static_cast<int>(o.size(-1)), W = nx + n + nu;
     PHNN_CHECK(static_cast<int>(S.size()) >= nx * W && T == n * n,
                "general_s_field_head: structure or output sizes");
-    const int64_t rows = e.size(0) * e.size(1);
+    const int64_t rows = rows_of(e);
     Tensor f = torch::empty_like(e);
     const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
     const double *po = o.data_ptr<double>(), *pw = w.data_ptr<double>();
@@ -97,7 +91,7 @@ class SFieldFunction : public torch::autograd::Function<SFieldFunction> {
     const int nx = static_cast<int>(dims[0]), n = static_cast<int>(dims[1]);
     const int nu = static_cast<int>(dims[2]), T = static_cast<int>(o.size(-1)), W = nx + n + nu;
     const Tensor fb = dense(grads[0]);
-    const int64_t E = o.size(0), B = o.size(1), rows = E * B;
+    const int64_t E = o.size(0), B = o.size(1), rows = rows_of(o);
     Tensor e_bar = torch::empty({E, B, nx}, o.options()), u_bar = torch::empty({E, B, nu}, o.options());
     Tensor o_bar = torch::empty_like(o), w_bar = torch::empty_like(w);
     const double *po = o.data_ptr<double>(), *pw = w.data_ptr<double>(), *pfb = fb.data_ptr<double>();
@@ -146,7 +140,7 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
     PHNN_CHECK(static_cast<int>(J.size()) == m * m && o.size(-1) == m * (m + 1) / 2,
                "general_jr_field_head: structure or output sizes");
     const int K = m * (m + 1) / 2;
-    const int64_t rows = e.size(0) * e.size(1);
+    const int64_t rows = rows_of(e);
     Tensor f = torch::empty_like(e);
     const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>(), *po = o.data_ptr<double>();
     double* pf = f.data_ptr<double>();
@@ -174,7 +168,7 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
     const int nx = static_cast<int>(e.size(-1)), nu = static_cast<int>(u.size(-1)), m = nx + nu;
     const int K = m * (m + 1) / 2;
     const Tensor fb = dense(grads[0]);
-    const int64_t rows = e.size(0) * e.size(1);
+    const int64_t rows = rows_of(e);
     Tensor e_bar = torch::empty_like(e), u_bar = torch::empty_like(u), o_bar = torch::empty_like(o);
     const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>(), *po = o.data_ptr<double>();
     const double* pfb = fb.data_ptr<double>();

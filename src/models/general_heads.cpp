@@ -14,16 +14,6 @@ namespace {
 
 using namespace heads;
 
-// Row-major lower triangle: entry (r, c), c <= r, is output r (r + 1) / 2 + c.
-inline int tri(int r, int c) { return r * (r + 1) / 2 + c; }
-
-int64_t rows_of(const Tensor& t) { return t.size(0) * t.size(1); }
-
-// u broadcast to the rows of `like` and made contiguous.
-Tensor rows_like(const Tensor& u, const Tensor& like) {
-  return u.expand({like.size(0), like.size(1), u.size(-1)}).contiguous();
-}
-
 // ------------------------------------------------------------ Hamiltonian
 // Per row, with L_rc = o_k (k = tri(r, c)), softplus(o_k) on the diagonal,
 // s_k = sigmoid(o_k) on the diagonal and 1 off it:

@@ -53,6 +53,28 @@ std::vector<VecX> unflatten(const std::vector<double>& flat, int width, std::siz
   return out;
 }
 
+// [trajectory][sample] vectors as one [m, samples, width] array, and back
+// (inference states and time-varying inputs); every trajectory the same length.
+std::vector<double> flatten_trajectories(const std::vector<std::vector<VecX>>& trajectories) {
+  std::vector<double> out;
+  for (const auto& traj : trajectories) {
+    const auto flat = flatten(traj);
+    out.insert(out.end(), flat.begin(), flat.end());
+  }
+  return out;
+}
+std::vector<std::vector<VecX>> unflatten_trajectories(const std::vector<double>& flat, std::size_t m,
+                                                      std::size_t samples, int width) {
+  std::vector<std::vector<VecX>> out;
+  const std::size_t per = samples * static_cast<std::size_t>(width);
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::vector<double> part(flat.begin() + static_cast<long>(i * per),
+                                   flat.begin() + static_cast<long>((i + 1) * per));
+    out.push_back(unflatten(part, width, samples));
+  }
+  return out;
+}
+
 void write_pairs(h5::File& file, const std::string& group, const PhPairSet& p, int nx, int nu) {
   file.create_group(group);
   const std::uint64_t n = p.size();
@@ -213,12 +235,8 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
   file.create_group(p + "/inference");
   const std::uint64_t m = data.inference.size();
   const std::uint64_t steps = m ? data.inference.states[0].size() : 0;
-  std::vector<double> states;
-  for (const auto& traj : data.inference.states) {
-    const auto flat = flatten(traj);
-    states.insert(states.end(), flat.begin(), flat.end());
-  }
-  file.write(p + "/inference/states", {m, steps, static_cast<std::uint64_t>(nx)}, states);
+  file.write(p + "/inference/states", {m, steps, static_cast<std::uint64_t>(nx)},
+             flatten_trajectories(data.inference.states));
   if (nu > 0) {
     file.write(p + "/inference/u", {m, static_cast<std::uint64_t>(nu)}, flatten(data.inference.u));
   }
@@ -226,14 +244,12 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
     PHNN_REQUIRE(data.inference.inputs.size() == m, "write_ph_system_data: inputs of "
                                                         << data.inference.inputs.size() << " of " << m
                                                         << " inference trajectories");
-    std::vector<double> inputs;
     for (const auto& traj : data.inference.inputs) {
       PHNN_REQUIRE(traj.size() == steps, "write_ph_system_data: " << traj.size()
                                                                   << " inputs for " << steps << " samples");
-      const auto flat = flatten(traj);
-      inputs.insert(inputs.end(), flat.begin(), flat.end());
     }
-    file.write(p + "/inference/inputs", {m, steps, static_cast<std::uint64_t>(nu)}, inputs);
+    file.write(p + "/inference/inputs", {m, steps, static_cast<std::uint64_t>(nu)},
+               flatten_trajectories(data.inference.inputs));
   }
   file.write(p + "/inference/trajectory", {m}, data.inference.trajectory);
   file.set_attribute(p + "/inference", "step_s", data.inference.step);
@@ -273,11 +289,7 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
                              std::to_string(steps) + " samples of " + std::to_string(nx) +
                              " states; the file is damaged or was not written by phnn");
   }
-  for (std::size_t i = 0; i < m; ++i) {
-    const std::vector<double> part(flat.begin() + static_cast<long>(i * steps * nx),
-                                   flat.begin() + static_cast<long>((i + 1) * steps * nx));
-    d.inference.states.push_back(unflatten(part, nx, steps));
-  }
+  d.inference.states = unflatten_trajectories(flat, m, steps, nx);
   d.inference.u = nu > 0 ? unflatten(file.read_doubles(p + "/inference/u"), nu, m, p + "/inference/u")
                          : std::vector<VecX>(m, VecX(0));
   if (nu > 0 && file.exists(p + "/inference/inputs")) {
@@ -288,12 +300,7 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
                                std::to_string(steps) + ", " + std::to_string(nu) +
                                "] (trajectories, samples, inputs); rewrite the file with phnn data or phnn import");
     }
-    const auto inputs = file.read_doubles(p + "/inference/inputs");
-    for (std::size_t i = 0; i < m; ++i) {
-      const std::vector<double> part(inputs.begin() + static_cast<long>(i * steps * nu),
-                                     inputs.begin() + static_cast<long>((i + 1) * steps * nu));
-      d.inference.inputs.push_back(unflatten(part, nu, steps));
-    }
+    d.inference.inputs = unflatten_trajectories(file.read_doubles(p + "/inference/inputs"), m, steps, nu);
   }
   return d;
 }

@@ -20,6 +20,8 @@ namespace phnn {
 struct PhTrajectorySpec {
   VecX x0, u;
   std::vector<VecX> inputs;
+  /// The input held over sample k.
+  const VecX& input(std::size_t k) const { return inputs.empty() ? u : inputs[k]; }
 };
 
 /// Draws x0 by the system's InitialConditionDesign (stream
@@ -37,6 +39,8 @@ struct PhTrajectory {
   VecX u;
   std::vector<VecX> states;  // at the generation rate, n = 0..steps
   std::vector<VecX> inputs;  // time-varying inputs: u per sample (steps / stride + 1); else empty
+  /// The input held over sample k.
+  const VecX& input(std::size_t k) const { return inputs.empty() ? u : inputs[k]; }
 };
 
 /// `num_steps` DG steps at h_gen. Throws std::runtime_error naming system,
