@@ -4,6 +4,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/provenance.h"
 #include "phnn/sweep/merge.h"
 #include "phnn/sweep/version.h"
 
@@ -20,7 +21,19 @@ int run_merge(int argc, char** argv, int first) {
       "their runs pending; `phnn sweep FILE --out OUT` then trains just those.");
   parser.positional("OUT", "new results file (must not exist)");
   parser.positional_rest("SHARD", "shard results files of one sweep file");
+  parser.flag("mix-kernels", "merge shards computed with different kernel sets (their results "
+                             "differ by round-off; refused without it)");
   if (!parser.parse(argc, argv, first)) return 0;
+  if (!parser.flag_set("mix-kernels")) {
+    std::string reference;
+    for (const std::string& shard : parser.rest()) {
+      const auto sessions = ResultsFile::open_read_only(shard).read_sessions();
+      if (sessions.empty()) continue;
+      if (reference.empty()) reference = kernel_set_of(sessions.front());
+      const std::string problem = kernel_mix_problem(sessions, reference, shard);
+      if (!problem.empty()) throw cli::UsageError{"phnn merge: " + problem};
+    }
+  }
   // The summary first: a merge that throws must not leave "phnn merge: " on
   // stdout before the error (it read as a doubled prefix in a job log).
   const std::string summary = merge_shards(parser.rest(), parser.get("OUT"), program_version());

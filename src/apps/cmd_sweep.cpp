@@ -119,6 +119,8 @@ void declare_options(cli::Parser* parser) {
                  "0");
   parser->flag("static", "static round-robin scheduling instead of the MPI-3 shared counter");
   parser->flag("retry-failed", "re-run runs whose status is failed (done/diverged are kept)");
+  parser->flag("mix-kernels", "resume a results file whose runs another kernel set computed "
+                              "(results differ by round-off; refused without it)");
   parser->option("shard",
                  "I/N: train only cells c with c % N == I (cells largest first), into "
                  "<output>.shard-I-of-N.h5 unless --out is given; one shard per Slurm array "
@@ -260,6 +262,11 @@ class SweepRun {
       if (resume) {
         copy_file(out_, scratch);
         file.emplace(ResultsFile::open(scratch, MPI_COMM_NULL, spec_.text_hash));
+        const std::string problem =
+            kernel_mix_problem(file->read_sessions(), kernel_set_of(session), out_);
+        if (!problem.empty() && !parser_.flag_set("mix-kernels")) {
+          throw cli::UsageError{"phnn sweep: " + problem};
+        }
       } else {
         std::vector<std::string> studies;
         for (const auto& s : grid_.run_studies) studies.push_back(join(s, ","));

@@ -14,6 +14,7 @@
 #include <torch/version.h>
 
 #include "h5/h5file.h"
+#include "models/kernel_isa.h"
 #include "phnn/sweep/version.h"
 #include "phnn/sweep/writer_lock.h"
 
@@ -90,12 +91,33 @@ std::string all_hosts(MPI_Comm comm) {
 
 }  // namespace
 
+std::string kernel_set_of(const Provenance& session) {
+  for (const auto& [key, value] : session) {
+    if (key == "kernels") return value.substr(0, value.find(';'));
+  }
+  return "no phnn kernels (BLAS and LibTorch chose by CPU)";
+}
+
+std::string kernel_mix_problem(const std::vector<Provenance>& sessions, const std::string& ours,
+                               const std::string& file) {
+  for (std::size_t k = 0; k < sessions.size(); ++k) {
+    const std::string theirs = kernel_set_of(sessions[k]);
+    if (theirs == ours) continue;
+    return file + ": session " + std::to_string(k) + " computed its runs with " + theirs +
+           ", this one uses " + ours +
+           ": their results differ by round-off (docs/METHOD.md \"Deterministic kernels\"). "
+           "Write to another file, or pass --mix-kernels to mix them anyway.";
+  }
+  return "";
+}
+
 Provenance build_provenance() {
   return {{"program_version", program_version()},
           {"git_commit", git_commit()},
           {"compiler", compiler_version()},
           {"libtorch", std::string("LibTorch ") + TORCH_VERSION},
           {"blas", blas_version()},
+          {"kernels", internal::kernel_description()},
           {"hdf5", h5::library_version()},
           {"mpi", mpi_version()}};
 }

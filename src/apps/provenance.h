@@ -5,6 +5,7 @@
 #include <mpi.h>
 
 #include <string>
+#include <vector>
 
 #include "phnn/common/utc_time.h"
 #include "phnn/store/results_file.h"
@@ -19,6 +20,18 @@ Provenance build_provenance();
 /// command_line and started (now). Collective over `comm` (gathers the host
 /// names; MPI_COMM_NULL: this host, 1 rank); every rank gets rank 0's values.
 Provenance session_provenance(MPI_Comm comm, int argc, char** argv);
+
+/// The kernel set a session's runs were computed with: "phnn kernels N"
+/// from its `kernels` entry, or, for files written before that entry
+/// existed, "no phnn kernels (BLAS and LibTorch chose by CPU)".
+std::string kernel_set_of(const Provenance& session);
+
+/// "" when every session in `sessions` used `ours` (kernel_set_of), else a
+/// message naming the first that did not, its set and the way out; for
+/// resume and merge, which refuse to mix kernel sets (their results differ
+/// by round-off) unless told to (--mix-kernels).
+std::string kernel_mix_problem(const std::vector<Provenance>& sessions, const std::string& ours,
+                               const std::string& file);
 
 /// `phnn --version`: one `key: value` line per build_provenance() entry.
 std::string version_text();

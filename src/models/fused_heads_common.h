@@ -10,6 +10,8 @@
 
 #include <torch/torch.h>
 
+#include "models/vector_math.h"
+
 namespace phnn {
 namespace internal {
 namespace heads {
@@ -23,9 +25,9 @@ using torch::autograd::variable_list;
 struct SoftplusSigmoid {
   double softplus, sigmoid, slope;
   explicit SoftplusSigmoid(double x) {
-    const double z = std::exp(-std::fabs(x));
+    const double z = exp_nonpositive(-std::fabs(x));
     sigmoid = x >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z);
-    softplus = x > 20.0 ? x : std::fmax(x, 0.0) + std::log1p(z);
+    softplus = x > 20.0 ? x : std::fmax(x, 0.0) + log1p_unit(z);
     slope = x > 20.0 ? 1.0 : sigmoid;
   }
 };

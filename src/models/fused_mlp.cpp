@@ -9,7 +9,7 @@
 //   channel 1 + i        the tangent  da/dx_i            (order >= 1, i < d)
 //   channel 1 + d + p    the curvature d2a/dx_i dx_j     (order 2, pair p = (i <= j))
 // A linear layer acts on every channel alike (the bias on channel 0 only), so
-// one dgemm per member maps all C*B rows: Z = A W (+ b on channel 0).
+// one GEMM per member maps all C*B rows: Z = A W (+ b on channel 0).
 //
 // tanh layer, elementwise with t = tanh(z_0), s = 1 - t^2 = tanh',
 // s1 = -2 t s = tanh'', s2 = s (6 t^2 - 2) = tanh''' (chain rule of a jet):
@@ -29,8 +29,8 @@
 
 #include <torch/csrc/autograd/functions/utils.h>
 
-#include "models/blas.h"
 #include "models/jet_kernels.h"
+#include "models/member_gemm.h"
 #include "models/vector_math.h"
 #include "phnn/common/check.h"
 
@@ -58,27 +58,21 @@ struct Channels {
 };
 
 // Row-major per member: C[e] = A[e] B[e] with A [rows, k], B [k, cols]
-// (column-major C^T = B^T A^T). trans_b: B[e] is stored as [cols, k].
+// (trans_b: B[e] is stored as [cols, k]); member_gemm.h's kernel.
 void gemm_nn(int64_t E, int rows, int k, int cols, const double* a, const double* b, double* c,
-             bool transpose_b, double beta) {
-  const double one = 1.0;
-  const char tb = transpose_b ? 'T' : 'N', ta = 'N';
-  const int ldb = transpose_b ? k : cols;
-  for (int64_t e = 0; e < E; ++e) {
-    dgemm_(&tb, &ta, &cols, &rows, &k, &one, b + e * k * cols, &ldb, a + e * rows * k, &k, &beta,
-           c + e * rows * cols, &cols);
-  }
+             bool transpose_b) {
+  const MatrixView<double> av{a, int64_t{rows} * k, k, 1};
+  const MatrixView<double> bv = transpose_b ? MatrixView<double>{b, int64_t{k} * cols, 1, k}
+                                            : MatrixView<double>{b, int64_t{k} * cols, cols, 1};
+  member_gemm(E, rows, k, cols, av, bv, c, /*accumulate=*/false);
 }
 
-// Per member: W~[e] = A[e]^T Z~[e], A [rows, n_in], Z~ [rows, n_out].
+// Per member: W~[e] (+)= A[e]^T Z~[e], A [rows, n_in], Z~ [rows, n_out].
 void gemm_tn(int64_t E, int rows, int n_in, int n_out, const double* a, const double* z,
-             double* w, double beta) {
-  const double one = 1.0, zero = beta;
-  const char tz = 'N', ta = 'T';
-  for (int64_t e = 0; e < E; ++e) {
-    dgemm_(&tz, &ta, &n_out, &n_in, &rows, &one, z + e * rows * n_out, &n_out,
-           a + e * rows * n_in, &n_in, &zero, w + e * n_in * n_out, &n_out);
-  }
+             double* w, bool accumulate) {
+  const MatrixView<double> at{a, int64_t{rows} * n_in, 1, n_in};
+  const MatrixView<double> zv{z, int64_t{rows} * n_out, n_out, 1};
+  member_gemm(E, n_in, rows, n_out, at, zv, w, accumulate);
 }
 
 // dst[e][b][k] = src[e][b][k] for a 3-D view with any strides (expanded
@@ -188,7 +182,7 @@ void linear_forward(const Plan& plan, int64_t l, const double* a, const Tensor& 
                     double* z) {
   const int64_t n_in = plan.widths[l], n_out = plan.widths[l + 1];
   gemm_nn(plan.E, static_cast<int>(plan.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
-          a, w.data_ptr<double>(), z, /*transpose_b=*/false, 0.0);
+          a, w.data_ptr<double>(), z, /*transpose_b=*/false);
   const double* pb = b.data_ptr<double>();
   for (int64_t e = 0; e < plan.E; ++e) {
     double* ze = z + e * plan.block(n_out);
@@ -294,7 +288,7 @@ variable_list FusedMlpBackward::apply(variable_list&& grads) {
     if (sink || should_compute_output(static_cast<std::size_t>(3 + l))) {  // W~ = A^T Z~
       Tensor w_bar = sink ? sinks_[ul] : torch::empty({E, n_in, n_out}, torch::kFloat64);
       gemm_tn(E, static_cast<int>(p.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
-              ws + p.act[ul], z_bar, w_bar.data_ptr<double>(), /*beta=*/sink ? 1.0 : 0.0);
+              ws + p.act[ul], z_bar, w_bar.data_ptr<double>(), /*accumulate=*/sink);
       if (!sink) out[3 + ul] = w_bar;
     }
     if (sink || should_compute_output(static_cast<std::size_t>(3 + L + l))) {  // b~ = sum_batch Z~_0
@@ -312,7 +306,7 @@ variable_list FusedMlpBackward::apply(variable_list&& grads) {
     }
     if (l == 0 && !(need_v || need_g || need_h)) break;
     gemm_nn(E, static_cast<int>(p.rows()), static_cast<int>(n_out), static_cast<int>(n_in), z_bar,
-            weights_[ul].data_ptr<double>(), a_bar, /*transpose_b=*/true, 0.0);  // A~ = Z~ W^T
+            weights_[ul].data_ptr<double>(), a_bar, /*transpose_b=*/true);  // A~ = Z~ W^T
     if (l == 0) break;
     tanh_jet_backward(p.ch.d, p.ch.order, E, p.B * n_in, ws + p.pre[ul - 1], ws + p.tanh[ul - 1],
                       a_bar, z_bar);

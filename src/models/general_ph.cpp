@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "models/general_heads.h"
+#include "models/ordered_sum.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -83,9 +84,9 @@ Jet per_member(int64_t members, F&& f) {
 
 Jet jet_linear(const Jet& a, const torch::Tensor& M) {
   Jet out;
-  out.v = torch::matmul(a.v, M);
-  if (a.g.defined()) out.g = torch::matmul(a.g, M);
-  if (a.h.defined()) out.h = torch::matmul(a.h, M);
+  out.v = internal::ordered_matmul(a.v, M);
+  if (a.g.defined()) out.g = internal::ordered_matmul(a.g, M);
+  if (a.h.defined()) out.h = internal::ordered_matmul(a.h, M);
   return out;
 }
 
@@ -105,17 +106,17 @@ Jet jet_matvec(const Jet& A, const Jet& b, int64_t n, int64_t m) {
   const int order = std::min(A.order(), b.order());
   const auto Av = A.v.unflatten(-1, {n, m});                      // [E, B, n, m]
   Jet out;
-  out.v = torch::matmul(Av, b.v.unsqueeze(-1)).squeeze(-1);     // [E, B, n]
+  out.v = internal::ordered_matmul(Av, b.v.unsqueeze(-1)).squeeze(-1);     // [E, B, n]
   if (order < 1) return out;
   const auto Ag = A.g.unflatten(-1, {n, m});                      // [E, B, d, n, m]
   const auto bv = b.v.unsqueeze(2).unsqueeze(-1);                 // [E, B, 1, m, 1]
-  out.g = torch::matmul(Ag, bv).squeeze(-1) +
-          torch::matmul(Av.unsqueeze(2), b.g.unsqueeze(-1)).squeeze(-1);  // [E, B, d, n]
+  out.g = internal::ordered_matmul(Ag, bv).squeeze(-1) +
+          internal::ordered_matmul(Av.unsqueeze(2), b.g.unsqueeze(-1)).squeeze(-1);  // [E, B, d, n]
   if (order < 2) return out;
   const auto Ah = A.h.unflatten(-1, {n, m});                      // [E, B, d, d, n, m]
-  const auto cross = torch::matmul(Ag.unsqueeze(3), b.g.unsqueeze(2).unsqueeze(-1)).squeeze(-1);
-  out.h = torch::matmul(Ah, bv.unsqueeze(2)).squeeze(-1) + cross + cross.transpose(2, 3) +
-          torch::matmul(Av.unsqueeze(2).unsqueeze(2), b.h.unsqueeze(-1)).squeeze(-1);
+  const auto cross = internal::ordered_matmul(Ag.unsqueeze(3), b.g.unsqueeze(2).unsqueeze(-1)).squeeze(-1);
+  out.h = internal::ordered_matmul(Ah, bv.unsqueeze(2)).squeeze(-1) + cross + cross.transpose(2, 3) +
+          internal::ordered_matmul(Av.unsqueeze(2).unsqueeze(2), b.h.unsqueeze(-1)).squeeze(-1);
   return out;
 }
 
@@ -198,9 +199,9 @@ torch::Tensor GeneralPortHamiltonianModel::discrete_gradient(const torch::Tensor
   const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
   const HamiltonianAndGradient h = energy_and_gradient(points);
   const auto grad_mid = h.grad.narrow(1, 2 * B, B);
-  const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);
+  const auto n2 = internal::ordered_sum(dx * dx, 1).unsqueeze(-1);
   const auto defect =
-      h.h.narrow(1, B, B) - h.h.narrow(1, 0, B) - (grad_mid * dx).sum(-1, /*keepdim=*/true);
+      h.h.narrow(1, B, B) - h.h.narrow(1, 0, B) - internal::ordered_sum(grad_mid * dx, 1).unsqueeze(-1);
   const auto small = n2 < min_dx_norm * min_dx_norm;
   const auto coef = torch::where(small, torch::zeros_like(defect),
                                  defect / torch::where(small, torch::ones_like(n2), n2));

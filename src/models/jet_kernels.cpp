@@ -4,6 +4,8 @@
 // FMA contraction so every clone gives the same bits.
 #include "models/jet_kernels.h"
 
+#include "models/kernel_isa.h"
+
 namespace phnn {
 namespace internal {
 namespace {
@@ -11,28 +13,28 @@ namespace {
 using Out = double* __restrict__;
 using In = const double* __restrict__;
 
-inline int64_t pair_count(int64_t d, int64_t order) { return order >= 2 ? d * (d + 1) / 2 : 0; }
-inline int64_t channels(int64_t d, int64_t order) {
+PHNN_KERNEL_INLINE int64_t pair_count(int64_t d, int64_t order) { return order >= 2 ? d * (d + 1) / 2 : 0; }
+PHNN_KERNEL_INLINE int64_t channels(int64_t d, int64_t order) {
   return 1 + (order >= 1 ? d : 0) + pair_count(d, order);
 }
 
 // a_i = s z_i, s = 1 - t^2.
-inline void tangent_forward(In t, In zi, Out ai, int64_t n) {
+PHNN_KERNEL_INLINE void tangent_forward(In t, In zi, Out ai, int64_t n) {
   for (int64_t k = 0; k < n; ++k) ai[k] = (1.0 - t[k] * t[k]) * zi[k];
 }
 // a_ij = s z_ij - 2 t s z_i z_j.
-inline void pair_forward(In t, In zi, In zj, In zp, Out ap, int64_t n) {
+PHNN_KERNEL_INLINE void pair_forward(In t, In zi, In zj, In zp, Out ap, int64_t n) {
   for (int64_t k = 0; k < n; ++k) {
     const double s = 1.0 - t[k] * t[k];
     ap[k] = s * zp[k] - 2.0 * t[k] * s * zi[k] * zj[k];
   }
 }
 // z~_0 = s a~_0.
-inline void value_backward(In t, In ab, Out zb, int64_t n) {
+PHNN_KERNEL_INLINE void value_backward(In t, In ab, Out zb, int64_t n) {
   for (int64_t k = 0; k < n; ++k) zb[k] = (1.0 - t[k] * t[k]) * ab[k];
 }
 // z~_0 += s1 a~_i z_i,  z~_i = s a~_i.
-inline void tangent_backward(In t, In zi, In abi, Out zb0, Out zbi, int64_t n) {
+PHNN_KERNEL_INLINE void tangent_backward(In t, In zi, In abi, Out zb0, Out zbi, int64_t n) {
   for (int64_t k = 0; k < n; ++k) {
     const double s = 1.0 - t[k] * t[k];
     zb0[k] += -2.0 * t[k] * s * abi[k] * zi[k];
@@ -41,7 +43,7 @@ inline void tangent_backward(In t, In zi, In abi, Out zb0, Out zbi, int64_t n) {
 }
 // Pair (i, j), i != j: z~_0 += a~_ij (s1 z_ij + s2 z_i z_j), z~_ij = s a~_ij,
 // z~_i += s1 a~_ij z_j, z~_j += s1 a~_ij z_i.
-inline void pair_backward(In t, In zi, In zj, In zp, In abp, Out zb0, Out zbi, Out zbj, Out zbp,
+PHNN_KERNEL_INLINE void pair_backward(In t, In zi, In zj, In zp, In abp, Out zb0, Out zbi, Out zbj, Out zbp,
                           int64_t n) {
   for (int64_t k = 0; k < n; ++k) {
     const double tt = t[k] * t[k], s = 1.0 - tt, s1 = -2.0 * t[k] * s;
@@ -52,7 +54,7 @@ inline void pair_backward(In t, In zi, In zj, In zp, In abp, Out zb0, Out zbi, O
   }
 }
 // Pair (i, i): as above with z~_i += 2 s1 a~_ii z_i.
-inline void diagonal_pair_backward(In t, In zi, In zp, In abp, Out zb0, Out zbi, Out zbp, int64_t n) {
+PHNN_KERNEL_INLINE void diagonal_pair_backward(In t, In zi, In zp, In abp, Out zb0, Out zbi, Out zbp, int64_t n) {
   for (int64_t k = 0; k < n; ++k) {
     const double tt = t[k] * t[k], s = 1.0 - tt, s1 = -2.0 * t[k] * s;
     zb0[k] += abp[k] * (s1 * zp[k] + s * (6.0 * tt - 2.0) * zi[k] * zi[k]);
@@ -61,10 +63,7 @@ inline void diagonal_pair_backward(In t, In zi, In zp, In abp, Out zb0, Out zbi,
   }
 }
 
-}  // namespace
-
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-void tanh_jet_forward(int64_t d, int64_t order, int64_t E, int64_t n, const double* z,
+PHNN_KERNEL_INLINE void forward_body(int64_t d, int64_t order, int64_t E, int64_t n, const double* z,
                       const double* t, double* a) {
   const int64_t C = channels(d, order);
   for (int64_t e = 0; e < E; ++e) {
@@ -83,8 +82,7 @@ void tanh_jet_forward(int64_t d, int64_t order, int64_t E, int64_t n, const doub
   }
 }
 
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-void tanh_jet_backward(int64_t d, int64_t order, int64_t E, int64_t n, const double* z,
+PHNN_KERNEL_INLINE void backward_body(int64_t d, int64_t order, int64_t E, int64_t n, const double* z,
                        const double* t, const double* a_bar, double* z_bar) {
   const int64_t C = channels(d, order);
   for (int64_t e = 0; e < E; ++e) {
@@ -111,6 +109,17 @@ void tanh_jet_backward(int64_t d, int64_t order, int64_t E, int64_t n, const dou
     }
   }
 }
+
+}  // namespace
+
+PHNN_KERNEL_VARIANTS(void, tanh_jet_forward,
+                     (int64_t d, int64_t order, int64_t E, int64_t n, const double* z,
+                      const double* t, double* a),
+                     (d, order, E, n, z, t, a), forward_body)
+PHNN_KERNEL_VARIANTS(void, tanh_jet_backward,
+                     (int64_t d, int64_t order, int64_t E, int64_t n, const double* z,
+                      const double* t, const double* a_bar, double* z_bar),
+                     (d, order, E, n, z, t, a_bar, z_bar), backward_body)
 
 }  // namespace internal
 }  // namespace phnn

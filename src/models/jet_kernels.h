@@ -1,6 +1,6 @@
 // src/models/jet_kernels.h — the elementwise part of a tanh layer's jet and
 // its adjoint (formulas (F) and (B) in fused_mlp.cpp), compiled for
-// AVX-512, AVX2 and baseline x86-64 and chosen at run time.
+// AVX-512, AVX2 and baseline x86-64 and chosen by kernel_isa.h.
 #pragma once
 
 #include <cstdint>

@@ -8,6 +8,8 @@
 
 #include "models/fused_heads.h"
 #include "models/general_heads.h"
+#include "models/ordered_sum.h"
+#include "models/pinned_activations.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -61,15 +63,15 @@ HamiltonianAndGradient hamiltonian_and_gradient(const StackedMlp& l_h, const tor
   }
   const auto q = x.narrow(-1, 0, 1), p = x.narrow(-1, 1, 1);
   const auto o0 = o.v.narrow(-1, 0, 1), l10 = o.v.narrow(-1, 1, 1), o2 = o.v.narrow(-1, 2, 1);
-  const auto l00 = torch::softplus(o0), l11 = torch::softplus(o2);
+  const auto l00 = internal::pinned_softplus(o0), l11 = internal::pinned_softplus(o2);
   const auto v0 = l00 * q, v1 = l10 * q + l11 * p;
   HamiltonianAndGradient out;
   out.h = 0.5 * (v0 * v0 + v1 * v1);
   // L^T v = (l00 v0 + l10 v1, l11 v1).
   const auto lt_v = torch::cat({l00 * v0 + l10 * v1, l11 * v1}, -1);
-  const auto c = torch::cat({v0 * torch::sigmoid(o0) * q, v1 * q, v1 * torch::sigmoid(o2) * p}, -1);
+  const auto c = torch::cat({v0 * internal::pinned_sigmoid(o0) * q, v1 * q, v1 * internal::pinned_sigmoid(o2) * p}, -1);
   // (do/dx) c: o.g is [E, B, 2 (directions), 3 (outputs)].
-  out.grad = lt_v + (o.g * c.unsqueeze(-2)).sum(-1);
+  out.grad = lt_v + internal::ordered_sum(o.g * c.unsqueeze(-2), 1);
   return out;
 }
 
@@ -134,8 +136,8 @@ torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
   const auto h_x = h.h.narrow(1, 0, B);
   const auto h_xdx = h.h.narrow(1, B, B);
   const auto grad_mid = h.grad.narrow(1, 2 * B, B);  // [E, B, 2]
-  const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);
-  const auto defect = h_xdx - h_x - (grad_mid * dx).sum(-1, /*keepdim=*/true);
+  const auto n2 = internal::ordered_sum(dx * dx, 1).unsqueeze(-1);
+  const auto defect = h_xdx - h_x - internal::ordered_sum(grad_mid * dx, 1).unsqueeze(-1);
   const auto small = n2 < min_dx_norm * min_dx_norm;
   const auto coef = torch::where(small, torch::zeros_like(defect),
                                  defect / torch::where(small, torch::ones_like(n2), n2));
@@ -177,12 +179,12 @@ FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
   const auto hess = grad_m.g;                                                // [E, B, 2, 2]
   const auto h0 = hamiltonian(x).unsqueeze(-1);
   const auto end = energy_and_gradient(x + dx);
-  const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);                       // [E, B, 1]
+  const auto n2 = internal::ordered_sum(dx * dx, 1).unsqueeze(-1);                          // [E, B, 1]
   const auto small = n2 < min_dx_norm * min_dx_norm;
   const auto safe_n2 = torch::where(small, torch::ones_like(n2), n2);
   const auto k = torch::where(small, torch::zeros_like(n2),
-                              (end.h - h0 - (grad_m.v * dx).sum(-1, true)) / safe_n2);
-  const auto hess_dx = torch::matmul(hess, dx.unsqueeze(-1)).squeeze(-1);  // Hm dx
+                              (end.h - h0 - internal::ordered_sum(grad_m.v * dx, 1).unsqueeze(-1)) / safe_n2);
+  const auto hess_dx = internal::ordered_matmul(hess, dx.unsqueeze(-1)).squeeze(-1);  // Hm dx
   const auto dk = torch::where(small, torch::zeros_like(dx),
                                (end.grad - grad_m.v - 0.5 * hess_dx) / safe_n2 - 2.0 * k * dx / safe_n2);
   const auto eye = torch::eye(x.size(-1), x.options());
@@ -276,7 +278,7 @@ torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x, const torch::Te
   int idx = 0;
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j <= k; ++j) L.select(-2, k).select(-1, j).copy_(o.select(-1, idx++));
-  return torch::matmul(L.transpose(-1, -2), L);
+  return internal::ordered_matmul(L.transpose(-1, -2), L);
 }
 
 Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -289,10 +291,10 @@ Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipat
     // Matrix form: L_R from its 6 outputs by one placement matmul, then
     // f = [J e - L^T (L e)]_{1:2} with e = (gradH, u).
     const auto o = nets_[1]->forward(torch::cat({x_dissipation, u}, -1));  // [E, B, 6]
-    const auto L = torch::matmul(o, placement_).unflatten(-1, {3, 3});    // [E, B, 3, 3]
+    const auto L = internal::ordered_matmul(o, placement_).unflatten(-1, {3, 3});    // [E, B, 3, 3]
     const auto e = torch::cat({effort.v, u}, -1).unsqueeze(-1);            // [E, B, 3, 1]
-    const auto re = torch::matmul(L.transpose(-1, -2), torch::matmul(L, e));
-    const auto je = torch::matmul(j_matrix_, e);
+    const auto re = internal::ordered_matmul(L.transpose(-1, -2), internal::ordered_matmul(L, e));
+    const auto je = internal::ordered_matmul(j_matrix_, e);
     return Jet{(je - re).squeeze(-1).narrow(-1, 0, 2), {}, {}};
   }
   // L_R(x, u): lower triangular 3 x 3 from 6 outputs, row by row (constant
@@ -365,8 +367,8 @@ torch::Tensor PortHamiltonianModel::average_vector_field_gradient(const torch::T
   const auto g = (5.0 / 18.0) * hg.grad.narrow(1, 2 * B, B) +
                  (8.0 / 18.0) * hg.grad.narrow(1, 3 * B, B) +
                  (5.0 / 18.0) * hg.grad.narrow(1, 4 * B, B);
-  const auto n2 = (dx * dx).sum(-1, /*keepdim=*/true);
-  const auto defect = hg.h.narrow(1, B, B) - hg.h.narrow(1, 0, B) - (g * dx).sum(-1, true);
+  const auto n2 = internal::ordered_sum(dx * dx, 1).unsqueeze(-1);
+  const auto defect = hg.h.narrow(1, B, B) - hg.h.narrow(1, 0, B) - internal::ordered_sum(g * dx, 1).unsqueeze(-1);
   const auto small = n2 < min_dx_norm * min_dx_norm;
   const auto coef = torch::where(small, torch::zeros_like(defect),
                                  defect / torch::where(small, torch::ones_like(n2), n2));
@@ -396,9 +398,10 @@ FieldEval PortHamiltonianModel::discrete_gradient4_field(const torch::Tensor& x,
   const auto v = phi.v;                               // [E, B, 2]
   const auto A = phi.g.transpose(-1, -2);             // [E, B, component, direction]
   const auto vv = v.unsqueeze(-1) * v.unsqueeze(-2);  // [E, B, i, j]
-  const auto second = (phi.h * vv.unsqueeze(-1)).sum({-3, -2});  // [E, B, 2]
-  const auto Av = torch::matmul(A, v.unsqueeze(-1));
-  const auto AAv = torch::matmul(A, Av).squeeze(-1);
+  // Sums in one fixed order (ordered_sum.h), not matmul's BLAS kernels.
+  const auto second = internal::ordered_sum((phi.h * vv.unsqueeze(-1)).movedim(-1, 2), 2);  // [E, B, n]
+  const auto Av = internal::ordered_sum(A * v.unsqueeze(-2), 1);                             // [E, B, n]
+  const auto AAv = internal::ordered_sum(A * Av.unsqueeze(-2), 1);
   FieldEval out;
   out.f = v + (h * h) * (second / 24.0 - AAv / 12.0);
   out.dfdx = A;

@@ -1,24 +1,12 @@
 // src/models/stacked_matmul.cpp
 #include "models/stacked_matmul.h"
 
-#include "models/blas.h"
+#include "models/member_gemm.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
 namespace internal {
 namespace {
-
-// dgemm_ / sgemm_ by the element type (float: float32 training).
-void gemm(const char* ta, const char* tb, const int* m, const int* n, const int* k,
-          const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
-          const double* beta, double* c, const int* ldc) {
-  dgemm_(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc);
-}
-void gemm(const char* ta, const char* tb, const int* m, const int* n, const int* k,
-          const float* alpha, const float* a, const int* lda, const float* b, const int* ldb,
-          const float* beta, float* c, const int* ldc) {
-  sgemm_(ta, tb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc);
-}
 
 // A row-major [rows x cols] matrix inside a 3-D tensor: plain (row stride
 // ld, unit column stride) or the transpose of a plain [cols x rows] matrix.
@@ -51,21 +39,17 @@ Operand<T> describe(const torch::Tensor& t) {
   return op;
 }
 
-// One gemm per member into c [E, R, N] (T = double or float).
+// One product per member into c [E, R, N] (T = double or float), by
+// member_gemm.h's kernel (the same bits on every CPU).
 template <typename T>
 void member_products(const torch::Tensor& a, const torch::Tensor& b, torch::Tensor* c) {
   const int64_t E = a.size(0), R = a.size(1), K = a.size(2), N = b.size(2);
   const Operand<T> A = describe<T>(a), B = describe<T>(b);
-  // Row-major C = A B is column-major C^T = B^T A^T.
-  const char ta = A.transposed ? 'T' : 'N', tb = B.transposed ? 'T' : 'N';
-  const int m = static_cast<int>(N), n = static_cast<int>(R), k = static_cast<int>(K);
-  const int ldc = static_cast<int>(N);
-  const T one = 1, zero = 0;
-  T* out = c->data_ptr<T>();
-  for (int64_t e = 0; e < E; ++e) {
-    gemm(&tb, &ta, &m, &n, &k, &one, B.data + e * B.member_stride, &B.ld,
-         A.data + e * A.member_stride, &A.ld, &zero, out + e * R * N, &ldc);
-  }
+  const auto view = [](const Operand<T>& op) {
+    return op.transposed ? MatrixView<T>{op.data, op.member_stride, 1, op.ld}
+                         : MatrixView<T>{op.data, op.member_stride, op.ld, 1};
+  };
+  member_gemm(E, R, K, N, view(A), view(B), c->data_ptr<T>(), /*accumulate=*/false);
 }
 
 torch::Tensor forward_product(const torch::Tensor& a, const torch::Tensor& b) {

@@ -5,6 +5,7 @@
 
 #include "models/fused_mlp.h"
 #include "models/stacked_matmul.h"
+#include "models/pinned_activations.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
 
@@ -115,7 +116,7 @@ Jet jet_scale(const Jet& a, double s) {
 }
 
 Jet jet_tanh(const Jet& a) {
-  const auto t = torch::tanh(a.v);
+  const auto t = internal::pinned_tanh(a.v);
   if (!a.g.defined()) return Jet{t, {}, {}};
   const auto d1 = 1.0 - t * t;
   const auto d2 = a.h.defined() ? -2.0 * t * d1 : torch::Tensor();
@@ -123,9 +124,9 @@ Jet jet_tanh(const Jet& a) {
 }
 
 Jet jet_softplus(const Jet& a) {
-  const auto sp = torch::softplus(a.v);
+  const auto sp = internal::pinned_softplus(a.v);
   if (!a.g.defined()) return Jet{sp, {}, {}};
-  const auto s = torch::sigmoid(a.v);
+  const auto s = internal::pinned_sigmoid(a.v);
   const auto d2 = a.h.defined() ? s * (1.0 - s) : torch::Tensor();
   return apply(a, sp, s, d2);
 }
@@ -196,7 +197,7 @@ torch::Tensor StackedMlp::reference_forward(const torch::Tensor& x) const {
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
     a = internal::stacked_matmul(a, weights_[l]) + biases_[l];
-    if (l < last) a = torch::tanh(a);
+    if (l < last) a = internal::pinned_tanh(a);
   }
   return a;
 }
@@ -236,7 +237,7 @@ Jet StackedMlp::reference_forward_input(const torch::Tensor& x, int directions,
   z.g = weights_[0].narrow(1, 0, directions).unsqueeze(1).expand({E, B, directions, weights_[0].size(2)});
   Jet a;
   if (weights_.size() == 1) return z;
-  const auto t = torch::tanh(z.v);
+  const auto t = internal::pinned_tanh(z.v);
   const auto d1 = 1.0 - t * t;
   a.v = t;
   a.g = d1.unsqueeze(-2) * z.g;

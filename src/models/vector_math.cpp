@@ -4,24 +4,33 @@
 #include <cmath>
 #include <cstring>
 
+#include "models/kernel_isa.h"
+
 namespace phnn {
 namespace internal {
 namespace {
 
-// exp(x) for 0 <= x <= 44 (the caller clamps), Cephes' exp.c.
-inline double exp_reduced(double x) {
-  constexpr double kLog2e = 1.4426950408889634073599;
-  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
-  constexpr double kShifter = 6755399441055744.0;  // 1.5 * 2^52: t - kShifter = round(t)
-  const double t = x * kLog2e + kShifter;
-  const double k = t - kShifter;
-  const double r = (x - k * kLn2Hi) - k * kLn2Lo;
+// exp(r) for |r| <= ln2 / 2: Cephes' Pade form
+// exp r = 1 + 2 r P(r^2) / (Q(r^2) - r P(r^2)).
+PHNN_KERNEL_INLINE double exp_pade(double r) {
   const double rr = r * r;
   const double p = r * ((1.26177193074810590878e-4 * rr + 3.02994407707441961300e-2) * rr +
                         9.99999999999999999910e-1);
   const double q = ((3.00198505138664455042e-6 * rr + 2.52448340349684104192e-3) * rr +
                     2.27265548208155028766e-1) * rr + 2.00000000000000000009e0;
   const double e = 1.0 + 2.0 * p / (q - p);
+  return e;
+}
+
+// exp(x) for 0 <= x <= 44 (the caller clamps), Cephes' exp.c.
+PHNN_KERNEL_INLINE double exp_reduced(double x) {
+  constexpr double kLog2e = 1.4426950408889634073599;
+  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
+  constexpr double kShifter = 6755399441055744.0;  // 1.5 * 2^52: t - kShifter = round(t)
+  const double t = x * kLog2e + kShifter;
+  const double k = t - kShifter;
+  const double r = (x - k * kLn2Hi) - k * kLn2Lo;
+  const double e = exp_pade(r);
   // 2^k from its bits: the low mantissa bits of t hold k.
   int64_t t_bits, shifter_bits;
   std::memcpy(&t_bits, &t, sizeof t);
@@ -33,7 +42,7 @@ inline double exp_reduced(double x) {
   return e * scale;
 }
 
-inline double tanh_one(double x) {
+PHNN_KERNEL_INLINE double tanh_one(double x) {
   const double z = x * x;
   const double num = (-9.64399179425052238628e-1 * z - 9.92877231001918586564e1) * z -
                      1.61468768441708447952e3;
@@ -47,12 +56,40 @@ inline double tanh_one(double x) {
   return x == x ? y : x;  // NaN in, NaN out
 }
 
-}  // namespace
-
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-void tanh_array(const double* x, double* y, int64_t n) {
+PHNN_KERNEL_INLINE void tanh_body(const double* x, double* y, int64_t n) {
   for (int64_t i = 0; i < n; ++i) y[i] = tanh_one(x[i]);
 }
+
+}  // namespace
+
+// exp(x), x <= 0: the reduction and Pade form of exp_reduced(), with 2^k
+// applied in two halves so results down to the subnormals (x > -745.2)
+// come out right; 0 below.
+double exp_nonpositive(double x) {
+  if (x != x) return x;
+  if (x < -745.2) return 0.0;
+  constexpr double kLog2e = 1.4426950408889634073599;
+  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
+  const double k = std::nearbyint(x * kLog2e);
+  const double r = (x - k * kLn2Hi) - k * kLn2Lo;
+  const double e = exp_pade(r);
+  const auto ki = static_cast<int>(k);
+  const int k1 = ki / 2, k2 = ki - k1;  // both >= -538: normal powers of two
+  return e * std::ldexp(1.0, k1) * std::ldexp(1.0, k2);
+}
+
+// log(1 + z) = 2 atanh(s), s = z / (2 + z) in [0, 1/3] for z in [0, 1]:
+// atanh s = s (1 + s^2/3 + s^4/5 + ...), 19 terms (s^38/39 < 2^-60).
+double log1p_unit(double z) {
+  if (z != z) return z;
+  const double s = z / (2.0 + z), s2 = s * s;
+  double sum = 1.0 / 39.0;
+  for (int k = 18; k >= 0; --k) sum = sum * s2 + 1.0 / (2 * k + 1);
+  return 2.0 * s * sum;
+}
+
+PHNN_KERNEL_VARIANTS(void, tanh_array, (const double* x, double* y, int64_t n), (x, y, n),
+                     tanh_body)
 
 }  // namespace internal
 }  // namespace phnn

@@ -1,5 +1,5 @@
 // src/models/vector_math.h — tanh over arrays, written so the compiler
-// vectorizes it (AVX-512 / AVX2 clones chosen at run time), for the fused
+// vectorizes it (AVX-512 / AVX2 / baseline copies, kernel_isa.h), for the fused
 // networks. LibTorch's tanh on this build goes through Sleef's 1-ulp AVX2
 // kernel at ~5 ns per element, 20 % of a small training step (perf).
 #pragma once
@@ -20,6 +20,15 @@ namespace internal {
 /// built from its bits. Both branches are computed and blended, so the loop
 /// has no branch and vectorizes.
 void tanh_array(const double* x, double* y, int64_t n);
+
+/// exp(x) for x <= 0 (0 below -745.2, NaN stays NaN), within 2 ulp of
+/// std::exp (tested). Our own, like tanh_array: glibc picks its exp by CPU
+/// (an FMA variant), which could change last bits between machines.
+double exp_nonpositive(double x);
+
+/// log(1 + z) for 0 <= z <= 1, within 3 ulp of std::log1p (tested); by
+/// the series of 2 atanh(z / (2 + z)), for the same reason.
+double log1p_unit(double z);
 
 }  // namespace internal
 }  // namespace phnn

@@ -1,6 +1,11 @@
 // src/training/discrete_step.cpp
 #include "phnn/training/discrete_step.h"
 
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "models/ordered_sum.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -50,9 +55,9 @@ torch::Tensor discrete_loss(const torch::Tensor& x_next, const torch::Tensor& x_
                             LossNorm norm) {
   const auto scaled = (x_next - x_hat) / h;  // [E, B, 2]
   switch (norm) {
-    case LossNorm::kMeanL1: return scaled.abs().mean({1, 2});
-    case LossNorm::kSumL1: return scaled.abs().sum(2).mean(1);
-    case LossNorm::kMse: return (scaled * scaled).mean({1, 2});
+    case LossNorm::kMeanL1: return internal::ordered_mean(scaled.abs(), 2);
+    case LossNorm::kSumL1: return internal::ordered_mean(internal::ordered_sum(scaled.abs(), 1), 1);
+    case LossNorm::kMse: return internal::ordered_mean(scaled * scaled, 2);
   }
   PHNN_CHECK(false, "discrete_loss: unknown LossNorm " << static_cast<int>(norm));
   return {};
@@ -60,15 +65,59 @@ torch::Tensor discrete_loss(const torch::Tensor& x_next, const torch::Tensor& x_
 
 namespace {
 
+// x with M x = r for every row (M [.., n, n], r [.., n], float64, no
+// gradient): Gaussian elimination with partial pivoting (the first largest
+// |pivot|), then back substitution, in one fixed order. LAPACK's solve
+// (torch::linalg_solve) runs OpenBLAS kernels chosen by CPU, so its last
+// bits changed between machines; it also threw on a singular M, where
+// this gives inf/NaN and the rollout marks the row diverged.
+void lu_solve_one(double* A, double* b, double* x, int64_t n) {
+  for (int64_t k = 0; k < n; ++k) {
+    int64_t pivot = k;
+    for (int64_t i = k + 1; i < n; ++i)
+      if (std::fabs(A[i * n + k]) > std::fabs(A[pivot * n + k])) pivot = i;
+    if (pivot != k) {
+      for (int64_t j = 0; j < n; ++j) std::swap(A[k * n + j], A[pivot * n + j]);
+      std::swap(b[k], b[pivot]);
+    }
+    for (int64_t i = k + 1; i < n; ++i) {
+      const double f = A[i * n + k] / A[k * n + k];
+      for (int64_t j = k + 1; j < n; ++j) A[i * n + j] -= f * A[k * n + j];
+      b[i] -= f * b[k];
+    }
+  }
+  for (int64_t i = n - 1; i >= 0; --i) {
+    double s = b[i];
+    for (int64_t j = i + 1; j < n; ++j) s -= A[i * n + j] * x[j];
+    x[i] = s / A[i * n + i];
+  }
+}
+
+torch::Tensor lu_solve_rows(const torch::Tensor& M, const torch::Tensor& r) {
+  PHNN_CHECK(r.scalar_type() == torch::kFloat64 && !(torch::GradMode::is_enabled() && (M.requires_grad() || r.requires_grad())),
+             "lu_solve_rows: float64 inference only");
+  const int64_t n = r.size(-1);
+  std::vector<int64_t> shape = r.sizes().vec();
+  shape.push_back(n);
+  torch::Tensor A = torch::empty(shape, r.options()), b = torch::empty(r.sizes(), r.options());
+  A.copy_(M.expand(shape));
+  b.copy_(r);
+  torch::Tensor x = torch::empty_like(b);
+  double *pa = A.data_ptr<double>(), *pb = b.data_ptr<double>(), *px = x.data_ptr<double>();
+  for (int64_t row = 0; row < b.numel() / n; ++row)
+    lu_solve_one(pa + row * n * n, pb + row * n, px + row * n, n);
+  return x;
+}
+
 // The Newton update delta = -M^{-1} r of every row by Cramer's rule, with
 // M = m (+ I when add_identity) [.., 2, 2] and r [.., 2]. The identity is
 // added as 1 + m_ii, so callers passing -h J get I - h J to the bit.
-// More than two states: an LU solve per row (torch::linalg_solve).
+// More than two states: lu_solve_rows.
 torch::Tensor newton_update(const torch::Tensor& m, bool add_identity, const torch::Tensor& r) {
   const int64_t n = r.size(-1);
   if (n != 2) {
     const auto M = add_identity ? m + torch::eye(n, m.options()) : m;
-    return -torch::linalg_solve(M, r.unsqueeze(-1)).squeeze(-1);
+    return -lu_solve_rows(M, r);
   }
   const double one = add_identity ? 1.0 : 0.0;
   const auto m00 = m.select(-2, 0).select(-1, 0), m11 = m.select(-2, 1).select(-1, 1);

@@ -29,16 +29,61 @@ void FlatAdam::restore(const torch::Tensor& m, const torch::Tensor& v, int64_t s
 
 void FlatAdam::zero_grad() { g_.zero_(); }
 
+namespace {
+
+// b^t by repeated squaring: the same few correctly rounded products on
+// every CPU (std::pow is chosen by glibc per CPU and is not correctly
+// rounded, so it could differ between machines).
+double integer_power(double b, int64_t t) {
+  double result = 1.0;
+  for (; t > 0; t >>= 1, b *= b)
+    if (t & 1) result *= b;
+  return result;
+}
+
+struct AdamScalars {
+  double b1, b2, step, root_correction2, eps;
+};
+
+// One element per iteration, each operation rounded on its own (no
+// contraction, no library function but sqrt, which IEEE 754 rounds
+// correctly): the same bits on every CPU, vectorized or not. LibTorch's
+// add_(g, alpha) fused the multiply-add only in its vectorized AVX2/AVX-512
+// kernels, so the old tensor form changed with ATEN_CPU_CAPABILITY.
+//   m = b1 m + (1 - b1) g
+//   v = b2 v + ((1 - b2) g) g
+//   p = p + (-lr / (1 - b1^t)) m / (sqrt(v) / sqrt(1 - b2^t) + eps)
+// in T (float32 training: the scalars rounded to float first).
+template <typename T>
+void adam_update(const torch::Tensor& p_t, const torch::Tensor& g_t, const torch::Tensor& m_t,
+                 const torch::Tensor& v_t, const AdamScalars& s) {
+  const T b1 = static_cast<T>(s.b1), b2 = static_cast<T>(s.b2), c1 = static_cast<T>(1 - s.b1),
+          c2 = static_cast<T>(1 - s.b2), step = static_cast<T>(s.step),
+          root2 = static_cast<T>(s.root_correction2), eps = static_cast<T>(s.eps);
+  T* p = p_t.data_ptr<T>();
+  T* m = m_t.data_ptr<T>();
+  T* v = v_t.data_ptr<T>();
+  const T* g = g_t.data_ptr<T>();
+  const int64_t n = p_t.numel();
+  for (int64_t k = 0; k < n; ++k) {
+    m[k] = b1 * m[k] + c1 * g[k];
+    v[k] = b2 * v[k] + c2 * g[k] * g[k];
+    p[k] = p[k] + step * m[k] / (std::sqrt(v[k]) / root2 + eps);
+  }
+}
+
+}  // namespace
+
 void FlatAdam::step() {
-  torch::NoGradGuard no_grad;
   ++t_;
-  const auto& g = g_;
-  const double bias_correction1 = 1 - std::pow(b1_, static_cast<double>(t_));
-  const double bias_correction2 = 1 - std::pow(b2_, static_cast<double>(t_));
-  m_.mul_(b1_).add_(g, 1 - b1_);
-  v_.mul_(b2_).addcmul_(g, g, 1 - b2_);
-  const auto denom = (v_.sqrt() / std::sqrt(bias_correction2)).add_(eps_);
-  p_.addcdiv_(m_, denom, -lr_ / bias_correction1);
+  const double bias_correction1 = 1 - integer_power(b1_, t_);
+  const double root_correction2 = std::sqrt(1 - integer_power(b2_, t_));
+  const double step = -lr_ / bias_correction1;
+  if (p_.scalar_type() == torch::kFloat32) {
+    adam_update<float>(p_, g_, m_, v_, {b1_, b2_, step, root_correction2, eps_});
+  } else {
+    adam_update<double>(p_, g_, m_, v_, {b1_, b2_, step, root_correction2, eps_});
+  }
 }
 
 }  // namespace phnn

@@ -3,6 +3,8 @@
 
 #include <limits>
 
+#include "models/ordered_sum.h"
+
 namespace phnn {
 namespace {
 // sqrt with a finite derivative at 0 (the clamped branch has zero slope).
@@ -50,11 +52,11 @@ JacobianStats jacobian_stats(const torch::Tensor& jacobian, double eps) {
 torch::Tensor regularizer_penalty(Regularizer reg, const JacobianStats& stats,
                                   const TrainerOptions& options) {
   switch (reg) {
-    case Regularizer::kCn: return options.lambda_cn * (stats.kappa * stats.kappa).mean(-1);
-    case Regularizer::kSn: return options.lambda_sn * stats.sigma_max.mean(-1);
+    case Regularizer::kCn: return options.lambda_cn * internal::ordered_mean(stats.kappa * stats.kappa, 1);
+    case Regularizer::kSn: return options.lambda_sn * internal::ordered_mean(stats.sigma_max, 1);
     case Regularizer::kSr: {
       const auto r = stats.rho - 1.0;
-      return options.lambda_sr * (r * r).mean(-1);
+      return options.lambda_sr * internal::ordered_mean(r * r, 1);
     }
     case Regularizer::kNone: break;
   }

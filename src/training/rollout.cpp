@@ -3,6 +3,7 @@
 
 #include <limits>
 
+#include "models/ordered_sum.h"
 #include "phnn/common/check.h"
 #include "phnn/integrators/discrete_gradient.h"
 
@@ -131,11 +132,11 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
       next = explicit_step(*model, cell.integrator, x, u, h_inf);
     }
     const auto bad = torch::isfinite(next).all(-1).logical_not() |
-                     (next.norm(2, -1) > opt.divergence_norm);
+                     (internal::ordered_sum(next * next, 1).sqrt() > opt.divergence_norm);
     diverged = diverged | bad;
     x = torch::where(diverged.unsqueeze(-1), torch::zeros_like(next), next);
     const auto diff = x.narrow(1, 0, B_inf) - ref[n].unsqueeze(0);
-    sq_err += (diff * diff).sum(-1);
+    sq_err += internal::ordered_sum(diff * diff, 1);
     if (F > 0) {
       figure_states.push_back(torch::where(diverged.narrow(1, B_inf, F).unsqueeze(-1),
                                            torch::full_like(next.narrow(1, B_inf, F), NAN),

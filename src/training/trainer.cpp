@@ -15,6 +15,7 @@
 
 #include <torch/torch.h>
 
+#include "models/ordered_sum.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
 #include "phnn/integrators/discrete_gradient.h"
@@ -190,8 +191,9 @@ void CellTrainer::validate(int step) {
   const auto val = data_loss(t_.xv, t_.xv_next, t_.uv);
   const auto train = data_loss(t_.x_all, t_.x_next_all, t_.u_all);
   const auto stats = jacobian_stats(model_->field(t_.x_all, t_.u_all, true).dfdx, opt_.jacobian_eps);
-  const auto kappa = stats.kappa.mean(-1), sigma = stats.sigma_max.mean(-1),
-             rho = stats.rho.mean(-1);
+  const auto kappa = internal::ordered_mean(stats.kappa, 1),
+             sigma = internal::ordered_mean(stats.sigma_max, 1),
+             rho = internal::ordered_mean(stats.rho, 1);
   std::vector<int64_t> improved;
   std::vector<double> live_best;
   for (int64_t e = 0; e < E_; ++e) {

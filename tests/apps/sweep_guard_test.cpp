@@ -409,6 +409,33 @@ TEST(SweepGuardTest, ResultsFilesWithoutProvenanceStillResume) {
   for (RunStatus s : file.read_statuses()) EXPECT_EQ(s, RunStatus::kDone);
 }
 
+// Runs of another kernel set differ by round-off: resuming into their file
+// is refused on every rank, naming the set and the way out, and changes
+// nothing; --mix-kernels resumes anyway.
+TEST(SweepGuardTest, ResumeRefusesAnotherKernelSetUnlessTold) {
+  const std::string dir = temp_dir("kernels");
+  const std::string sweep = write_file(dir + "/tiny.toml", kTinySweep);
+  const std::string out = dir + "/out.h5";
+  run_tiny(sweep, out, 1);
+  EXPECT_THAT(as_map(ResultsFile::open_read_only(out).read_sessions()[0]).at("kernels"),
+              HasSubstr("phnn kernels "));
+  {
+    h5::File file = h5::File::open(out, h5::Access::kReadWrite);
+    file.set_attribute("/provenance/session_0", "kernels", std::string("phnn kernels 0; avx2"));
+  }
+  const std::string hash = ResultsFile::open_read_only(out).sweep_hash();
+  {
+    ResultsFile file = ResultsFile::open(out, MPI_COMM_NULL, hash);
+    file.write_run(0, RunResult{});  // pending again: a resume would train it
+  }
+  expect_every_rank_exits(2, "sweep " + sweep + " --quiet --out " + out, 2, "--mix-kernels");
+  EXPECT_EQ(ResultsFile::open_read_only(out).read_sessions().size(), 1u);
+  EXPECT_EQ(ResultsFile::open_read_only(out).read_statuses()[0], RunStatus::kPending);
+  std::string log;
+  EXPECT_EQ(run_ranks(1, "sweep " + sweep + " --quiet --mix-kernels --out " + out, &log), 0) << log;
+  EXPECT_EQ(ResultsFile::open_read_only(out).read_statuses()[0], RunStatus::kDone);
+}
+
 TEST(SweepGuardTest, VersionPrintsTheBuildAndItsLibraries) {
   std::string log;
   ASSERT_EQ(shell(std::string(PHNN_BINARY) + " --version", &log), 0) << log;

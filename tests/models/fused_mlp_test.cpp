@@ -207,5 +207,29 @@ TEST(VectorTanhTest, WithinTwoUlpOfStdTanh) {
   EXPECT_TRUE(std::isnan(out[2]));
 }
 
+// The softplus/sigmoid pieces: exp on (-750, 0] (subnormal results
+// included) within 2 ulp of the C library, log1p on [0, 1] within 3 (the
+// rounding of s = z / (2 + z) carries into 2 atanh s).
+TEST(VectorTanhTest, ExpAndLog1pWithinTwoUlpOfStd) {
+  const auto ulps = [](double got, double ref) {
+    const double ulp = std::nextafter(std::fabs(ref), 2.0 * std::fabs(ref) + 1.0) - std::fabs(ref);
+    return std::fabs(got - ref) / ulp;
+  };
+  double worst_exp = 0.0, worst_log = 0.0;
+  for (double x = -750.0; x <= 0.0; x += 1.37e-3) {
+    worst_exp = std::max(worst_exp, ulps(internal::exp_nonpositive(x), std::exp(x)));
+  }
+  for (double e = -20.0; e <= 0.0; e += 1e-4) {
+    const double z = std::pow(10.0, e);
+    worst_log = std::max(worst_log, ulps(internal::log1p_unit(z), std::log1p(z)));
+  }
+  EXPECT_LE(worst_exp, 2.0);
+  EXPECT_LE(worst_log, 3.0);
+  EXPECT_EQ(internal::exp_nonpositive(0.0), 1.0);
+  EXPECT_EQ(internal::exp_nonpositive(-800.0), 0.0);
+  EXPECT_EQ(internal::log1p_unit(0.0), 0.0);
+  EXPECT_TRUE(std::isnan(internal::exp_nonpositive(std::numeric_limits<double>::quiet_NaN())));
+}
+
 }  // namespace
 }  // namespace phnn

@@ -8,9 +8,11 @@
 namespace phnn {
 
 /// Adam (Kingma & Ba; the update of torch::optim::Adam 1.13, no weight
-/// decay, no AMSGrad) on a single flat leaf tensor: the same arithmetic in
-/// the same order, so it matches torch::optim::Adam on the separate tensors
-/// bit for bit (tested), in ~8 ops per step instead of ~8 per tensor.
+/// decay, no AMSGrad) on a single flat leaf tensor, as one plain loop whose
+/// every operation is rounded on its own: the same bits on every CPU
+/// (docs/METHOD.md "Deterministic kernels"). It agrees with
+/// torch::optim::Adam to round-off (tested; LibTorch fuses some
+/// multiply-adds depending on ATEN_CPU_CAPABILITY).
 ///   m = b1 m + (1 - b1) g;  v = b2 v + (1 - b2) g^2
 ///   p -= lr / (1 - b1^t) * m / (sqrt(v) / sqrt(1 - b2^t) + eps)
 class FlatAdam {

@@ -1,0 +1,80 @@
+// src/models/kernel_isa.cpp — see kernel_isa.h.
+#include "models/kernel_isa.h"
+
+#include <atomic>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+namespace phnn {
+namespace internal {
+namespace {
+
+KernelIsa cpu_isa() {
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("x86-64-v4")) return KernelIsa::kAvx512;
+  if (__builtin_cpu_supports("x86-64-v3")) return KernelIsa::kAvx2;
+  return KernelIsa::kBaseline;
+}
+
+KernelIsa decide() {
+  const KernelIsa best = cpu_isa();
+  const char* env = std::getenv("PHNN_KERNEL_ISA");
+  if (env == nullptr || *env == '\0') return best;
+  const std::string v(env);
+  KernelIsa asked;
+  if (v == "baseline") {
+    asked = KernelIsa::kBaseline;
+  } else if (v == "avx2") {
+    asked = KernelIsa::kAvx2;
+  } else if (v == "avx512") {
+    asked = KernelIsa::kAvx512;
+  } else {
+    throw std::runtime_error("PHNN_KERNEL_ISA=" + v +
+                             ": expected baseline, avx2 or avx512 (or unset: the CPU's best)");
+  }
+  return static_cast<int>(asked) < static_cast<int>(best) ? asked : best;
+}
+
+KernelIsa decided() {
+  static const KernelIsa isa = decide();
+  return isa;
+}
+
+std::atomic<int> forced{-1};  // ScopedKernelIsa's choice, or -1
+
+}  // namespace
+
+KernelIsa kernel_isa() {
+  const int f = forced.load(std::memory_order_relaxed);
+  return f >= 0 ? static_cast<KernelIsa>(f) : decided();
+}
+
+ScopedKernelIsa::ScopedKernelIsa(KernelIsa isa) : previous_(forced.load()) {
+  const KernelIsa best = cpu_isa();
+  forced.store(static_cast<int>(static_cast<int>(isa) < static_cast<int>(best) ? isa : best));
+}
+
+ScopedKernelIsa::~ScopedKernelIsa() { forced.store(previous_); }
+
+std::string kernel_description() {
+  std::string cpu;  // __builtin_cpu_supports takes literals only
+  if (__builtin_cpu_supports("avx512f")) cpu += " avx512f";
+  if (__builtin_cpu_supports("avx2")) cpu += " avx2";
+  if (__builtin_cpu_supports("fma")) cpu += " fma";
+  cpu = cpu.empty() ? "baseline" : cpu.substr(1);
+  return "phnn kernels " + std::to_string(kKernelSet) + "; " + kernel_isa_name(kernel_isa()) +
+         " of " + kernel_isa_name(cpu_isa()) + " (CPU: " + cpu + ")";
+}
+
+const char* kernel_isa_name(KernelIsa isa) {
+  switch (isa) {
+    case KernelIsa::kAvx512: return "avx512";
+    case KernelIsa::kAvx2: return "avx2";
+    case KernelIsa::kBaseline: break;
+  }
+  return "baseline";
+}
+
+}  // namespace internal
+}  // namespace phnn

@@ -1,0 +1,31 @@
+// src/models/ordered_sum.h — sums over trailing dimensions in one fixed
+// order, differentiable: the reductions of the loss, the regularizers and
+// the rollout errors. LibTorch's sum and mean add in an order set by the
+// vector width of the kernel it dispatches to (ATEN_CPU_CAPABILITY: 4
+// doubles under AVX2, 8 under AVX-512), so their bits changed with the CPU
+// (docs/METHOD.md "Deterministic kernels").
+#pragma once
+
+#include <torch/torch.h>
+
+namespace phnn {
+namespace internal {
+
+/// s[o] = (((t[o, 0] + t[o, 1]) + t[o, 2]) + ...) over the last `dims`
+/// dimensions of t (row-major), one rounding per addition, left to right.
+/// float64 or float32; dims = 0 returns t. Differentiable to any order (the
+/// adjoint of a sum is a broadcast). Example: ordered_sum(x, 2) of [E, B, n]
+/// is [E].
+torch::Tensor ordered_sum(const torch::Tensor& t, int64_t dims);
+
+/// ordered_sum(t, dims) / (number of summed elements).
+torch::Tensor ordered_mean(const torch::Tensor& t, int64_t dims);
+
+/// torch::matmul(a, b) for a [..., n, m] and b [..., m, k] (batch
+/// dimensions broadcast; at least 2-D each), each element summed over m in
+/// order by ordered_sum: for the small products of the op-by-op model paths,
+/// where torch::matmul would call BLAS kernels chosen by CPU.
+torch::Tensor ordered_matmul(const torch::Tensor& a, const torch::Tensor& b);
+
+}  // namespace internal
+}  // namespace phnn

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# tests/kernels/dispatch_test.sh PHNN PYTHON — the same bits under every CPU
+# dispatch setting this machine can run (docs/METHOD.md "Deterministic
+# kernels"): one small Duffing cell (seeds 0-1, 200 Adam steps) of every model
+# x integrator and of each regularizer, trained under OPENBLAS_CORETYPE
+# (default / Haswell), ATEN_CPU_CAPABILITY (default / avx2 / avx512) and
+# PHNN_KERNEL_ISA (avx512 / avx2 / baseline); the per-run MSEs, validation
+# losses, trajectory errors and final weights must be bitwise equal to the
+# first setting's. Exit 77 (skip) without h5py.
+set -euo pipefail
+PHNN=$1
+PYTHON=${2:-/usr/bin/python3}
+"$PYTHON" -c "import h5py, numpy" 2>/dev/null || { echo "skip: no h5py/numpy"; exit 77; }
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+
+CELLS="node-rk2 node-rk4 phnn-s-rk2 phnn-s-dg phnn-s-rk4 phnn-s-dg4 phnn-jr-rk2 phnn-jr-dg
+       phnn-jr-rk4 phnn-jr-dg4 phnn-jr-rk2:cn phnn-s-dg:sn phnn-s-rk2:sr"
+# OPENBLAS_CORETYPE:ATEN_CPU_CAPABILITY:PHNN_KERNEL_ISA; the first is the reference.
+SETTINGS="Haswell:avx2:avx2 default:default:avx512 default:avx512:avx512 default:avx512:baseline"
+
+train() {  # setting cell
+  local ob at isa model reg
+  IFS=: read -r ob at isa <<< "$1"
+  IFS=: read -r model reg <<< "$2"
+  local env=(ATEN_CPU_CAPABILITY="$at" PHNN_KERNEL_ISA="$isa")
+  [ "$ob" = default ] || env+=(OPENBLAS_CORETYPE="$ob")
+  env "${env[@]}" "$PHNN" train --system duffing --model "$model" --reg "${reg:-none}" \
+      --steps 200 --eval-every 100 --seeds 0-1 --n-train 25 --quiet \
+      --out "$WORK/$1-$2.h5" > "$WORK/$1-$2.log" 2>&1 ||
+    { cat "$WORK/$1-$2.log"; echo "FAIL: phnn train under $1 for $2"; exit 1; }
+}
+
+for s in $SETTINGS; do
+  for c in $CELLS; do
+    # The baseline kernels without FMA hardware are slow: three cells only.
+    if [[ $s == *baseline && $c != node-rk2 && $c != phnn-jr-rk2:cn && $c != phnn-s-dg ]]; then
+      continue
+    fi
+    train "$s" "$c"
+  done
+done
+
+"$PYTHON" - "$WORK" $SETTINGS <<'PY'
+import glob, os, sys
+import h5py, numpy as np
+work, settings = sys.argv[1], sys.argv[2:]
+ref_setting, failures, compared = settings[0], 0, 0
+def load(path):
+    with h5py.File(path, "r") as f:
+        r = f["runs"]
+        return {"mse": r["mse"][...], "best_validation_loss": r["best_validation_loss"][...],
+                "trajectory_errors": r["trajectory_errors"][...], "weights": f["weights"][...]}
+for ref_path in sorted(glob.glob(os.path.join(work, ref_setting + "-*.h5"))):
+    cell = os.path.basename(ref_path)[len(ref_setting) + 1:-3]
+    ref = load(ref_path)
+    for s in settings[1:]:
+        path = os.path.join(work, s + "-" + cell + ".h5")
+        if not os.path.exists(path):
+            continue
+        got, compared = load(path), compared + 1
+        for key in ref:
+            if ref[key].shape != got[key].shape or ref[key].tobytes() != got[key].tobytes():
+                failures += 1
+                print(f"DIFFERS: {cell} {key} under {s} vs {ref_setting}")
+print(f"{compared} cells compared bit for bit against {ref_setting}; {failures} differences")
+sys.exit(1 if failures or compared == 0 else 0)
+PY

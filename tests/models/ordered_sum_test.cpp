@@ -1,0 +1,56 @@
+// tests/models/ordered_sum_test.cpp — the fixed-order sums: values equal the
+// left-to-right loop bit for bit, gradients are the broadcast of the
+// adjoint (first and second order), float32 too.
+#include "models/ordered_sum.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+namespace phnn {
+namespace internal {
+namespace {
+
+TEST(OrderedSumTest, LeftToRightBitForBit) {
+  torch::manual_seed(3);
+  // Values of very different sizes, so another order would round differently.
+  const auto t = torch::randn({3, 5, 7}, torch::kFloat64) * torch::pow(10.0, torch::randint(-8, 8, {3, 5, 7}).to(torch::kFloat64));
+  const auto s = ordered_sum(t, 2);
+  ASSERT_EQ(s.sizes(), torch::IntArrayRef({3}));
+  for (int64_t o = 0; o < 3; ++o) {
+    double acc = 0;
+    for (int64_t i = 0; i < 5; ++i)
+      for (int64_t k = 0; k < 7; ++k) acc += t[o][i][k].item<double>();
+    EXPECT_EQ(s[o].item<double>(), acc) << o;
+  }
+  EXPECT_TRUE(torch::equal(ordered_sum(t, 0), t));
+  EXPECT_TRUE(torch::allclose(ordered_sum(t, 3), t.sum().reshape({}), 1e-12, 1e-6));
+  // A strided (non-contiguous) input sums in its logical order.
+  const auto tt = t.transpose(1, 2);
+  EXPECT_TRUE(torch::equal(ordered_sum(tt, 2), ordered_sum(tt.contiguous(), 2)));
+  EXPECT_TRUE(torch::equal(ordered_mean(t, 1), ordered_sum(t, 1) / 7.0));
+}
+
+TEST(OrderedSumTest, GradientsFirstAndSecondOrder) {
+  torch::manual_seed(4);
+  const auto x = torch::randn({4, 6}, torch::kFloat64).requires_grad_(true);
+  const auto w = torch::randn({4}, torch::kFloat64);
+  // d/dx sum_o w_o sum_k x_ok^3 = 3 w_o x_ok^2; second order through the graph.
+  const auto y = (ordered_sum(x * x * x, 1) * w).sum();
+  const auto g = torch::autograd::grad({y}, {x}, {}, /*retain_graph=*/true, /*create_graph=*/true)[0];
+  EXPECT_TRUE(torch::allclose(g, 3 * w.unsqueeze(1) * x * x, 1e-14, 0));
+  const auto gg = torch::autograd::grad({g.sum()}, {x})[0];
+  EXPECT_TRUE(torch::allclose(gg, 6 * w.unsqueeze(1) * x, 1e-14, 0));
+  // The mean's gradient is 1 / count.
+  const auto xm = torch::randn({2, 3, 5}, torch::kFloat64).requires_grad_(true);
+  ordered_mean(xm, 2).sum().backward();
+  EXPECT_TRUE(torch::allclose(xm.grad(), torch::full_like(xm, 1.0 / 15.0), 0, 0));
+}
+
+TEST(OrderedSumTest, Float32) {
+  const auto t = torch::tensor({1e8f, 1.0f, -1e8f, 1.0f}, torch::kFloat32).reshape({1, 4});
+  EXPECT_EQ(ordered_sum(t, 1)[0].item<float>(), 1.0f);  // ((1e8 + 1) - 1e8) + 1 in float
+}
+
+}  // namespace
+}  // namespace internal
+}  // namespace phnn
