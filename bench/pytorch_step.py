@@ -8,13 +8,20 @@ What it measures
            from torch.autograd.grad(..., create_graph=True). This is the same
            model as bench_training's `baseline` mode. Reported: µs per step,
            timed over 1000 steps after 100 warm-up steps (random data).
+  stacked  The same model for 10 members at once, as a skilled PyTorch user
+           writes it: weights [E, in, out], every layer one torch.baddbmm
+           over the members, one Adam over the stacked tensors; µs per
+           member-step = µs per step / 10.
   phnn     The same cell trained by the C++ trainer with 10 members stacked:
            `bench_training run phnn-jr rk2 none STEPS` for STEPS = 200 and
            1200; µs per member-step = (T1200 - T200) / (1000 * 10) * 1e6, so
            data generation, evaluation and inference cancel out.
 
-The two are timed interleaved, `--repeats` times; the table shows the medians
-and the ratio PyTorch µs/step / phnn µs/member-step.
+The three are timed interleaved, `--repeats` times; the table shows the
+medians, the ratios to phnn, and the FLOP bound: the multiply-adds of the
+step's matrix products (forward with the gradH jet, backward: ~3x the
+forward), counted below, at this core's peak of 2 FMA x 4 doubles per cycle
+(AVX2/AVX-512 on Zen 4) at --ghz.
 
 How to run (from anywhere; needs Debian's python3-torch and a built
 bench_training: cmake --build build --target bench_training)
@@ -91,6 +98,64 @@ class PhnnJr(torch.nn.Module):
         return ((self.J - self.dissipation(x, u)) @ e).squeeze(-1)[:, :2]
 
 
+class StackedPhnnJr(torch.nn.Module):
+    """PhnnJr for E members at once: layer l is x @ W_l + b_l by baddbmm on [E, B, n]."""
+
+    def __init__(self, members):
+        super().__init__()
+        self.E = members
+        def stack(n_in, n_out):
+            sizes = [n_in, 16, 16, n_out]
+            ws = torch.nn.ParameterList()
+            bs = torch.nn.ParameterList()
+            for a, b in zip(sizes[:-1], sizes[1:]):
+                bound = 1.0 / a ** 0.5
+                ws.append(torch.nn.Parameter(torch.empty(members, a, b).uniform_(-bound, bound)))
+                bs.append(torch.nn.Parameter(torch.empty(members, 1, b).uniform_(-bound, bound)))
+            return ws, bs
+        self.wh, self.bh = stack(2, 3)
+        self.wr, self.br = stack(3, 6)
+        self.register_buffer("J", torch.tensor([[0.0, 1.0, 0.0],
+                                                [-1.0, 0.0, -1.0],
+                                                [0.0, 1.0, 0.0]]))
+        self.register_buffer("tril", torch.tril_indices(3, 3))
+
+    @staticmethod
+    def mlp(ws, bs, x):
+        for i, (w, b) in enumerate(zip(ws, bs)):
+            x = torch.baddbmm(b, x, w)
+            if i + 1 < len(ws):
+                x = torch.tanh(x)
+        return x
+
+    def hamiltonian(self, x):  # x [E, B, 2]
+        o = self.mlp(self.wh, self.bh, x)
+        q, p = x[..., 0], x[..., 1]
+        v0 = torch.nn.functional.softplus(o[..., 0]) * q
+        v1 = o[..., 1] * q + torch.nn.functional.softplus(o[..., 2]) * p
+        return 0.5 * (v0 * v0 + v1 * v1)
+
+    def forward(self, x, u):
+        if not x.requires_grad:
+            x = x.detach().requires_grad_(True)
+        g = torch.autograd.grad(self.hamiltonian(x).sum(), x, create_graph=True)[0]
+        l = self.mlp(self.wr, self.br, torch.cat([x, u], dim=-1))
+        L = l.new_zeros(*l.shape[:2], 3, 3)
+        L[..., self.tril[0], self.tril[1]] = l
+        e = torch.cat([g, u], dim=-1).unsqueeze(-1)
+        return ((self.J - L.transpose(-1, -2) @ L) @ e).squeeze(-1)[..., :2]
+
+
+def flops_per_member_step():
+    """Multiply-adds of one member's step: RK2 = 2 field evaluations; each is
+    L_R's forward (B x (3*16 + 16*16 + 16*6)) and L_H's forward with the
+    2-direction tangent jet (3 channels: B x 3 x (2*16 + 16*16 + 16*3)); the
+    backward costs ~2x the forward (input and weight adjoints). 2 FLOPs each."""
+    lr = BATCH * (3 * 16 + 16 * 16 + 16 * 6)
+    lh = BATCH * 3 * (2 * 16 + 16 * 16 + 16 * 3)
+    return 2 * 2 * (lr + lh) * 3
+
+
 def rk2(model, x, u, h=H_STEP):
     return x + h * model(x + 0.5 * h * model(x, u), u)
 
@@ -123,6 +188,27 @@ def pytorch_us_per_step(seed):
     for _ in range(TIMED_STEPS):
         step()
     return (time.perf_counter() - t0) / TIMED_STEPS * 1e6
+
+
+def stacked_us_per_member_step(seed):
+    """The stacked model: µs per step over TIMED_STEPS, divided by MEMBERS."""
+    torch.manual_seed(seed)
+    model = StackedPhnnJr(MEMBERS)
+    adam = torch.optim.Adam(model.parameters(), lr=1e-3)
+    x, u, x_next = (t.unsqueeze(0).expand(MEMBERS, *t.shape).contiguous() for t in random_batch())
+
+    def step():
+        loss = (x_next - rk2(model, x, u)).abs().mean((1, 2)).sum() / H_STEP
+        adam.zero_grad()
+        loss.backward()
+        adam.step()
+
+    for _ in range(WARMUP_STEPS):
+        step()
+    t0 = time.perf_counter()
+    for _ in range(TIMED_STEPS):
+        step()
+    return (time.perf_counter() - t0) / TIMED_STEPS * 1e6 / MEMBERS
 
 
 # ------------------------------------------------------------------ gradient check
@@ -173,6 +259,8 @@ def parse_args():
                         help="interleaved PyTorch/phnn runs; medians are reported (default 3)")
     parser.add_argument("--binary", type=Path, default=REPO_ROOT / "build" / "bench_training",
                         help="path to bench_training (default: build/bench_training in the repository)")
+    parser.add_argument("--ghz", type=float, default=3.7,
+                        help="core clock for the FLOP bound (default 3.7, this machine's EPYC)")
     parser.add_argument("--check", action="store_true",
                         help="first verify autograd gradH against central differences of H")
     args = parser.parse_args()
@@ -199,20 +287,25 @@ def main():
     print(f"torch {torch.__version__}, float64, {torch.get_num_threads()} thread, eager")
     print(f"phnn set-up: {setup}; binary {args.binary}")
 
-    torch_us, phnn_us = [], []
+    torch_us, stacked_us, phnn_us = [], [], []
     for r in range(args.repeats):
         torch_us.append(pytorch_us_per_step(seed=r))
+        stacked_us.append(stacked_us_per_member_step(seed=r))
         phnn_us.append(phnn_us_per_member_step(args.binary, env))
         print(f"  run {r + 1}/{args.repeats}: PyTorch {torch_us[-1]:.0f} µs/step, "
+              f"stacked PyTorch {stacked_us[-1]:.0f} µs/member-step, "
               f"phnn {phnn_us[-1]:.0f} µs/member-step", flush=True)
 
-    t, p = statistics.median(torch_us), statistics.median(phnn_us)
+    t, s, p = (statistics.median(v) for v in (torch_us, stacked_us, phnn_us))
+    bound = flops_per_member_step() / (args.ghz * 1e9 * 2 * 2 * 4) * 1e6
     print(f"\nsmall PHNN-JR-RK2, batch {BATCH}, median of {args.repeats} interleaved runs\n")
-    print("| implementation | µs per model-step |")
-    print("|---|---|")
-    print(f"| PyTorch eager, one model per step | {t:.0f} |")
-    print(f"| phnn, {MEMBERS} members stacked (per member-step) | {p:.0f} |")
-    print(f"| ratio PyTorch / phnn | {t / p:.2f}x |")
+    print("| implementation | µs per model-step | / phnn |")
+    print("|---|---|---|")
+    print(f"| PyTorch eager, one model per step | {t:.0f} | {t / p:.1f}x |")
+    print(f"| PyTorch eager, {MEMBERS} members stacked (baddbmm) | {s:.0f} | {s / p:.1f}x |")
+    print(f"| phnn, {MEMBERS} members stacked | {p:.0f} | 1 |")
+    print(f"| FLOP bound ({flops_per_member_step() / 1e6:.2f} MFLOP at {args.ghz} GHz x 16 "
+          f"FLOP/cycle) | {bound:.1f} | {bound / p:.2f}x |")
     return 0
 
 
