@@ -52,7 +52,43 @@ class OrderedSum : public torch::autograd::Function<OrderedSum> {
   }
 };
 
+// t summed down to `shape` (same dimension count; 1 where t was broadcast),
+// one broadcast dimension at a time, each by ordered_sum.
+torch::Tensor sum_to_shape(torch::Tensor t, const std::vector<int64_t>& shape) {
+  for (int64_t d = 0; d < t.dim(); ++d) {
+    if (shape[static_cast<std::size_t>(d)] == 1 && t.size(d) != 1) {
+      t = ordered_sum(t.movedim(d, -1), 1).unsqueeze(d);
+    }
+  }
+  return t;
+}
+
+class OrderedBroadcastMul : public torch::autograd::Function<OrderedBroadcastMul> {
+ public:
+  static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& a,
+                               const torch::Tensor& b) {
+    ctx->save_for_backward({a, b});
+    return a * b;
+  }
+  static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
+                                               torch::autograd::tensor_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const auto &a = saved[0], &b = saved[1];
+    torch::Tensor ga, gb;
+    if (ctx->needs_input_grad(0)) ga = sum_to_shape(ordered_broadcast_mul(grads[0], b), a.sizes().vec());
+    if (ctx->needs_input_grad(1)) gb = sum_to_shape(ordered_broadcast_mul(grads[0], a), b.sizes().vec());
+    return {ga, gb};
+  }
+};
+
 }  // namespace
+
+torch::Tensor ordered_broadcast_mul(const torch::Tensor& a, const torch::Tensor& b) {
+  PHNN_CHECK(a.dim() == b.dim(), "ordered_broadcast_mul: expected operands of one dimension "
+                                 "count, got " << a.sizes() << " and " << b.sizes());
+  if (!torch::GradMode::is_enabled() || !(a.requires_grad() || b.requires_grad())) return a * b;
+  return OrderedBroadcastMul::apply(a, b);
+}
 
 torch::Tensor ordered_sum(const torch::Tensor& t, int64_t dims) {
   PHNN_CHECK(dims >= 0 && dims <= t.dim(),
@@ -74,7 +110,12 @@ torch::Tensor ordered_matmul(const torch::Tensor& a, const torch::Tensor& b) {
   PHNN_CHECK(a.dim() >= 2 && b.dim() >= 2 && a.size(-1) == b.size(-2),
              "ordered_matmul: shapes do not match: " << a.sizes() << " @ " << b.sizes());
   // [..., n, m, 1] * [..., 1, m, k] -> [..., n, k, m], summed over m.
-  return ordered_sum((a.unsqueeze(-1) * b.unsqueeze(-3)).transpose(-1, -2), 1);
+  // Batch dimensions padded to one count, so the product's backward can sum
+  // each operand's broadcast dimensions in order.
+  torch::Tensor ea = a.unsqueeze(-1), eb = b.unsqueeze(-3);
+  while (ea.dim() < eb.dim()) ea = ea.unsqueeze(0);
+  while (eb.dim() < ea.dim()) eb = eb.unsqueeze(0);
+  return ordered_sum(ordered_broadcast_mul(ea, eb).transpose(-1, -2), 1);
 }
 
 }  // namespace internal

@@ -21,6 +21,12 @@ torch::Tensor ordered_sum(const torch::Tensor& t, int64_t dims);
 /// ordered_sum(t, dims) / (number of summed elements).
 torch::Tensor ordered_mean(const torch::Tensor& t, int64_t dims);
 
+/// a * b with broadcasting, whose backward sums each operand's adjoint over
+/// its broadcast dimensions by ordered_sum (LibTorch's autograd would use
+/// its own sum there, in an order set by the vector width). Same dimension
+/// count for both operands.
+torch::Tensor ordered_broadcast_mul(const torch::Tensor& a, const torch::Tensor& b);
+
 /// torch::matmul(a, b) for a [..., n, m] and b [..., m, k] (batch
 /// dimensions broadcast; at least 2-D each), each element summed over m in
 /// order by ordered_sum: for the small products of the op-by-op model paths,

@@ -397,11 +397,13 @@ FieldEval PortHamiltonianModel::discrete_gradient4_field(const torch::Tensor& x,
   const Jet phi = field_from_effort(effort, m, u, /*order=*/2, /*dissipation_fixed=*/false);
   const auto v = phi.v;                               // [E, B, 2]
   const auto A = phi.g.transpose(-1, -2);             // [E, B, component, direction]
-  const auto vv = v.unsqueeze(-1) * v.unsqueeze(-2);  // [E, B, i, j]
-  // Sums in one fixed order (ordered_sum.h), not matmul's BLAS kernels.
-  const auto second = internal::ordered_sum((phi.h * vv.unsqueeze(-1)).movedim(-1, 2), 2);  // [E, B, n]
-  const auto Av = internal::ordered_sum(A * v.unsqueeze(-2), 1);                             // [E, B, n]
-  const auto AAv = internal::ordered_sum(A * Av.unsqueeze(-2), 1);
+  // Products and sums in one fixed order, backward included (ordered_sum.h).
+  using internal::ordered_broadcast_mul;
+  const auto vv = ordered_broadcast_mul(v.unsqueeze(-1), v.unsqueeze(-2));  // [E, B, i, j]
+  const auto second =
+      internal::ordered_sum(ordered_broadcast_mul(phi.h, vv.unsqueeze(-1)).movedim(-1, 2), 2);
+  const auto Av = internal::ordered_sum(ordered_broadcast_mul(A, v.unsqueeze(-2)), 1);  // [E, B, n]
+  const auto AAv = internal::ordered_sum(ordered_broadcast_mul(A, Av.unsqueeze(-2)), 1);
   FieldEval out;
   out.f = v + (h * h) * (second / 24.0 - AAv / 12.0);
   out.dfdx = A;

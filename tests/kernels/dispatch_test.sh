@@ -2,7 +2,9 @@
 # tests/kernels/dispatch_test.sh PHNN PYTHON — the same bits under every CPU
 # dispatch setting this machine can run (docs/METHOD.md "Deterministic
 # kernels"): one small Duffing cell (seeds 0-1, 200 Adam steps) of every model
-# x integrator and of each regularizer, trained under OPENBLAS_CORETYPE
+# x integrator and of each regularizer, and three cells of the 4-state coupled
+# Duffing system file (DG: the LU Newton; DG4: ordered products), trained
+# under OPENBLAS_CORETYPE
 # (default / Haswell), ATEN_CPU_CAPABILITY (default / avx2 / avx512) and
 # PHNN_KERNEL_ISA (avx512 / avx2 / baseline); the per-run MSEs, validation
 # losses, trajectory errors and final weights must be bitwise equal to the
@@ -15,17 +17,20 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 
 CELLS="node-rk2 node-rk4 phnn-s-rk2 phnn-s-dg phnn-s-rk4 phnn-s-dg4 phnn-jr-rk2 phnn-jr-dg
-       phnn-jr-rk4 phnn-jr-dg4 phnn-jr-rk2:cn phnn-s-dg:sn phnn-s-rk2:sr"
+       phnn-jr-rk4 phnn-jr-dg4 phnn-jr-rk2:cn phnn-s-dg:sn phnn-s-rk2:sr
+       phnn-s-dg::coupled phnn-jr-dg4::coupled node-rk4::coupled"
+COUPLED="$(cd "$(dirname "$0")/../.." && pwd)/sweeps/systems/coupled-duffing.toml"
 # OPENBLAS_CORETYPE:ATEN_CPU_CAPABILITY:PHNN_KERNEL_ISA; the first is the reference.
 SETTINGS="Haswell:avx2:avx2 default:default:avx512 default:avx512:avx512 default:avx512:baseline"
 
 train() {  # setting cell
-  local ob at isa model reg
+  local ob at isa model reg system
   IFS=: read -r ob at isa <<< "$1"
-  IFS=: read -r model reg <<< "$2"
+  IFS=: read -r model reg system <<< "$2"
+  [ "$system" = coupled ] && system=$COUPLED || system=duffing
   local env=(ATEN_CPU_CAPABILITY="$at" PHNN_KERNEL_ISA="$isa")
   [ "$ob" = default ] || env+=(OPENBLAS_CORETYPE="$ob")
-  env "${env[@]}" "$PHNN" train --system duffing --model "$model" --reg "${reg:-none}" \
+  env "${env[@]}" "$PHNN" train --system "$system" --model "$model" --reg "${reg:-none}" \
       --steps 200 --eval-every 100 --seeds 0-1 --n-train 25 --quiet \
       --out "$WORK/$1-$2.h5" > "$WORK/$1-$2.log" 2>&1 ||
     { cat "$WORK/$1-$2.log"; echo "FAIL: phnn train under $1 for $2"; exit 1; }
