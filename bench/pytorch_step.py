@@ -169,6 +169,16 @@ def random_batch(seed=0):
     return x, u, x_next
 
 
+def time_steps(step):
+    """µs per call of step() over TIMED_STEPS, after WARMUP_STEPS."""
+    for _ in range(WARMUP_STEPS):
+        step()
+    t0 = time.perf_counter()
+    for _ in range(TIMED_STEPS):
+        step()
+    return (time.perf_counter() - t0) / TIMED_STEPS * 1e6
+
+
 def pytorch_us_per_step(seed):
     """Fresh model and Adam; µs per training step over TIMED_STEPS after warm-up."""
     torch.manual_seed(seed)
@@ -182,12 +192,7 @@ def pytorch_us_per_step(seed):
         loss.backward()
         adam.step()
 
-    for _ in range(WARMUP_STEPS):
-        step()
-    t0 = time.perf_counter()
-    for _ in range(TIMED_STEPS):
-        step()
-    return (time.perf_counter() - t0) / TIMED_STEPS * 1e6
+    return time_steps(step)
 
 
 def stacked_us_per_member_step(seed):
@@ -203,12 +208,7 @@ def stacked_us_per_member_step(seed):
         loss.backward()
         adam.step()
 
-    for _ in range(WARMUP_STEPS):
-        step()
-    t0 = time.perf_counter()
-    for _ in range(TIMED_STEPS):
-        step()
-    return (time.perf_counter() - t0) / TIMED_STEPS * 1e6 / MEMBERS
+    return time_steps(step) / MEMBERS
 
 
 # ------------------------------------------------------------------ gradient check
