@@ -40,9 +40,9 @@ torch::Tensor triangle_placement(int64_t n, int64_t outputs, bool transpose, int
 
 Jet jet_sum(const Jet& a) {
   Jet out;
-  out.v = a.v.sum(-1, /*keepdim=*/true);
-  if (a.g.defined()) out.g = a.g.sum(-1, true);
-  if (a.h.defined()) out.h = a.h.sum(-1, true);
+  out.v = internal::ordered_sum(a.v, 1).unsqueeze(-1);  // fixed order (ordered_sum.h)
+  if (a.g.defined()) out.g = internal::ordered_sum(a.g, 1).unsqueeze(-1);
+  if (a.h.defined()) out.h = internal::ordered_sum(a.h, 1).unsqueeze(-1);
   return out;
 }
 

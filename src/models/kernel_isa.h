@@ -31,7 +31,8 @@ constexpr int kKernelSet = 1;
 std::string kernel_description();
 
 /// For tests: kernel_isa() returns `isa` (capped by the CPU) while this
-/// object lives, so one process can compare every instruction set.
+/// object lives, so one process can compare every instruction set. One
+/// process-wide setting: do not overlap scopes on several threads.
 class ScopedKernelIsa {
  public:
   explicit ScopedKernelIsa(KernelIsa isa);

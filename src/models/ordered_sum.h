@@ -14,8 +14,10 @@ namespace internal {
 /// s[o] = (((t[o, 0] + t[o, 1]) + t[o, 2]) + ...) over the last `dims`
 /// dimensions of t (row-major), one rounding per addition, left to right.
 /// float64 or float32; dims = 0 returns t. Differentiable to any order (the
-/// adjoint of a sum is a broadcast). Example: ordered_sum(x, 2) of [E, B, n]
-/// is [E].
+/// adjoint of a sum is a broadcast); first derivatives keep the fixed order,
+/// second derivatives sum the broadcast's adjoint with LibTorch's sum (none
+/// of our training paths takes them). Example: ordered_sum(x, 2) of
+/// [E, B, n] is [E].
 torch::Tensor ordered_sum(const torch::Tensor& t, int64_t dims);
 
 /// ordered_sum(t, dims) / (number of summed elements).

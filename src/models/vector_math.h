@@ -21,7 +21,8 @@ namespace internal {
 /// has no branch and vectorizes.
 void tanh_array(const double* x, double* y, int64_t n);
 
-/// exp(x) for x <= 0 (0 below -745.2, NaN stays NaN), within 2 ulp of
+/// exp(x) for x <= 0 (0 below -745.2, NaN stays NaN; x > 0 falls back to
+/// std::exp), within 2 ulp of
 /// std::exp (tested). Our own, like tanh_array: glibc picks its exp by CPU
 /// (an FMA variant), which could change last bits between machines.
 double exp_nonpositive(double x);
