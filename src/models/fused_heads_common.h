@@ -20,13 +20,19 @@ using torch::Tensor;
 using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
+// sigmoid(x) from z = exp(-|x|), without overflow for either sign.
+inline double sigmoid_from(double x, double z) { return x >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z); }
+
+// sigmoid(x) alone (one exp).
+inline double sigmoid_of(double x) { return sigmoid_from(x, exp_nonpositive(-std::fabs(x))); }
+
 // softplus(x) and sigmoid(x) from one exp(-|x|); above x = 20 softplus is x
 // and its slope 1, as in LibTorch's softplus (threshold 20).
 struct SoftplusSigmoid {
   double softplus, sigmoid, slope;
   explicit SoftplusSigmoid(double x) {
     const double z = exp_nonpositive(-std::fabs(x));
-    sigmoid = x >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z);
+    sigmoid = sigmoid_from(x, z);
     softplus = x > 20.0 ? x : std::fmax(x, 0.0) + log1p_unit(z);
     slope = x > 20.0 ? 1.0 : sigmoid;
   }

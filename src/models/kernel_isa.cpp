@@ -17,6 +17,9 @@ KernelIsa cpu_isa() {
   return KernelIsa::kBaseline;
 }
 
+// The lower of two sets: a request never raises what the CPU has.
+KernelIsa lower(KernelIsa a, KernelIsa b) { return static_cast<int>(a) < static_cast<int>(b) ? a : b; }
+
 KernelIsa decide() {
   const KernelIsa best = cpu_isa();
   const char* env = std::getenv("PHNN_KERNEL_ISA");
@@ -33,7 +36,7 @@ KernelIsa decide() {
     throw std::runtime_error("PHNN_KERNEL_ISA=" + v +
                              ": expected baseline, avx2 or avx512 (or unset: the CPU's best)");
   }
-  return static_cast<int>(asked) < static_cast<int>(best) ? asked : best;
+  return lower(asked, best);
 }
 
 KernelIsa decided() {
@@ -51,8 +54,7 @@ KernelIsa kernel_isa() {
 }
 
 ScopedKernelIsa::ScopedKernelIsa(KernelIsa isa) : previous_(forced.load()) {
-  const KernelIsa best = cpu_isa();
-  forced.store(static_cast<int>(static_cast<int>(isa) < static_cast<int>(best) ? isa : best));
+  forced.store(static_cast<int>(lower(isa, cpu_isa())));
 }
 
 ScopedKernelIsa::~ScopedKernelIsa() { forced.store(previous_); }

@@ -189,15 +189,13 @@ __attribute__((target("arch=x86-64-v3"))) void run_avx2(const Problem<double>& q
   for (; i < q.rows; ++i) rows_avx2<1>(q, i);
 }
 
-void run_baseline(const Problem<double>& q) { gemm_body(q); }
-
 void run(const Problem<double>& q) {
   switch (kernel_isa()) {
     case KernelIsa::kAvx512: return run_avx512(q);
     case KernelIsa::kAvx2: return run_avx2(q);
     case KernelIsa::kBaseline: break;
   }
-  run_baseline(q);
+  gemm_body(q);
 }
 
 // float (float32 training only): the portable tiles, compiled per set.
@@ -211,7 +209,7 @@ void gemm_members(int64_t members, int64_t rows, int64_t K, int64_t cols, Matrix
   if (pack) packed.resize(static_cast<std::size_t>(K * cols));
   for (int64_t e = 0; e < members; ++e) {
     const T* be = b.data + e * b.member_stride;
-    if (pack) {
+    if (pack && (e == 0 || b.member_stride != 0)) {  // a broadcast B is packed once
       for (int64_t p = 0; p < K; ++p)
         for (int64_t j = 0; j < cols; ++j)
           packed[static_cast<std::size_t>(p * cols + j)] = be[p * b.row_stride + j * b.col_stride];

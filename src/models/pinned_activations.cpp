@@ -24,7 +24,7 @@ torch::Tensor map_elements(const torch::Tensor& x, F f) {
 }
 
 torch::Tensor sigmoid_values(const torch::Tensor& x) {
-  return map_elements(x, [](double v) { return heads::SoftplusSigmoid(v).sigmoid; });
+  return map_elements(x, [](double v) { return heads::sigmoid_of(v); });
 }
 
 class SigmoidFn : public torch::autograd::Function<SigmoidFn> {

@@ -7,28 +7,6 @@
 
 namespace phnn {
 
-FlatAdam::FlatAdam(torch::Tensor values, torch::Tensor gradients, const TrainerOptions& options)
-    : p_(std::move(values)),
-      g_(std::move(gradients)),
-      lr_(options.learning_rate),
-      b1_(options.adam_beta1),
-      b2_(options.adam_beta2),
-      eps_(options.adam_eps) {
-  PHNN_CHECK(p_.is_contiguous() && g_.is_contiguous() && p_.sizes() == g_.sizes(),
-             "FlatAdam needs contiguous value and gradient buffers of one shape");
-  m_ = torch::zeros_like(p_, torch::MemoryFormat::Preserve);
-  v_ = torch::zeros_like(p_, torch::MemoryFormat::Preserve);
-}
-
-void FlatAdam::restore(const torch::Tensor& m, const torch::Tensor& v, int64_t steps_taken) {
-  torch::NoGradGuard no_grad;
-  m_.copy_(m);
-  v_.copy_(v);
-  t_ = steps_taken;
-}
-
-void FlatAdam::zero_grad() { g_.zero_(); }
-
 namespace {
 
 // b^t by repeated squaring: the same few correctly rounded products on
@@ -73,6 +51,28 @@ void adam_update(const torch::Tensor& p_t, const torch::Tensor& g_t, const torch
 }
 
 }  // namespace
+
+FlatAdam::FlatAdam(torch::Tensor values, torch::Tensor gradients, const TrainerOptions& options)
+    : p_(std::move(values)),
+      g_(std::move(gradients)),
+      lr_(options.learning_rate),
+      b1_(options.adam_beta1),
+      b2_(options.adam_beta2),
+      eps_(options.adam_eps) {
+  PHNN_CHECK(p_.is_contiguous() && g_.is_contiguous() && p_.sizes() == g_.sizes(),
+             "FlatAdam needs contiguous value and gradient buffers of one shape");
+  m_ = torch::zeros_like(p_, torch::MemoryFormat::Preserve);
+  v_ = torch::zeros_like(p_, torch::MemoryFormat::Preserve);
+}
+
+void FlatAdam::restore(const torch::Tensor& m, const torch::Tensor& v, int64_t steps_taken) {
+  torch::NoGradGuard no_grad;
+  m_.copy_(m);
+  v_.copy_(v);
+  t_ = steps_taken;
+}
+
+void FlatAdam::zero_grad() { g_.zero_(); }
 
 void FlatAdam::step() {
   ++t_;
