@@ -1,7 +1,8 @@
 // bench/bench_system_data.cpp — cost of generating a data set (the paper's
 // splits: 400 train pairs, 2500 validation pairs, 100 inference trajectories
 // of 2000 DG steps) for the built-in systems and for system files.
-// Usage: bench_system_data [repeats=5] [sweeps/systems]. Prints CSV:
+// Usage: bench_system_data [repeats=5] [sweeps/systems] [only=NAME] (NAME: one
+// system file's name, for profiling; the built-ins are skipped). Prints CSV:
 // system,source,n_x,median_s,min_s,steps,us_per_dg_step.
 #include <algorithm>
 #include <chrono>
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   using namespace phnn;
   const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
   const std::string dir = argc > 2 ? argv[2] : "sweeps/systems";
+  const std::string only = argc > 3 ? argv[3] : "";
   const DatasetOptions options;
   std::cout << "system,source,n_x,median_s,min_s,steps,us_per_dg_step\n";
   auto report = [&](const std::string& name, const std::string& source, int nx,
@@ -51,6 +53,7 @@ int main(int argc, char** argv) {
               << steps << "," << 1e6 * median / static_cast<double>(steps) << "\n";
   };
   for (SystemKind kind : all_systems()) {
+    if (!only.empty()) break;
     SystemData data;
     const auto s = time_runs(repeats, [&] {
       data = make_system_data(OscillatorOptions::defaults(kind), options, 400);
@@ -61,6 +64,7 @@ int main(int argc, char** argv) {
   }
   for (const std::string name : {"harmonic", "duffing", "self-sustained", "pendulum",
                                  "coupled-duffing", "mass-chain"}) {
+    if (!only.empty() && name != only) continue;
     const auto system = load_system_file(dir + "/" + name + ".toml");
     PhSystemData data;
     const auto s = time_runs(repeats, [&] { data = make_ph_system_data(*system, options, 400); });

@@ -38,6 +38,7 @@
 
 #include <torch/torch.h>
 
+#include "models/member_gemm.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"
@@ -329,8 +330,13 @@ double time_general_cell(CellSpec cell, const phnn::PhSystemData& data, const ph
 
 // µs per member-step, (T(700) - T(100)) / (600 E), medians of `repeats`;
 // at n_x = 2 the built-in fused path on the same harmonic system, interleaved.
+// The FLOP bound: the member GEMMs' multiply-adds per member-step (counted,
+// the same difference), 2 FLOPs each, at kGhz x 16 FLOP/cycle (2 FMA units
+// x 4 doubles x 2).
+constexpr double kGhz = 3.7;  // this machine's EPYC (bench/pytorch_step.py)
 int general(int repeats) {
-  std::printf("| model | n_x | general µs/member-step | fused 2-state µs/member-step |\n");
+  std::printf("| model | n_x | general µs/member-step | fused 2-state µs/member-step | GEMM "
+              "MFLOP/member-step | FLOP bound µs | general / bound |\n");
   for (int k = 1; k <= 4; ++k) {
     const auto system = phnn::compile_system(chain_text(k), "chain.toml");
     phnn::DatasetOptions options;
@@ -347,9 +353,14 @@ int general(int repeats) {
       cell.n_train = 64;
       cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
       std::vector<double> general_us, fused_us;
+      double mflop = 0.0;
       for (int r = 0; r < repeats; ++r) {
+        const std::uint64_t m0 = phnn::internal::gemm_multiply_adds();
         const double a = time_general_cell(cell, data, *system, 100);
+        const std::uint64_t m1 = phnn::internal::gemm_multiply_adds();
         const double b = time_general_cell(cell, data, *system, 700);
+        const std::uint64_t m2 = phnn::internal::gemm_multiply_adds();
+        mflop = 2.0 * (static_cast<double>(m2 - m1) - static_cast<double>(m1 - m0)) / 6000.0 / 1e6;
         general_us.push_back((b - a) / 6000.0 * 1e6);
         if (k == 1) {
           cell.training.eval_every = 1000000;
@@ -363,8 +374,11 @@ int general(int repeats) {
           fused_us.push_back((seconds_since(t0) - c) / 6000.0 * 1e6);
         }
       }
-      std::printf("| %s | %d | %.0f | %s |\n", phnn::model_label(model, integrator).c_str(), 2 * k,
-                  median(general_us), k == 1 ? std::to_string(static_cast<int>(median(fused_us) + 0.5)).c_str() : "");
+      const double bound_us = mflop * 1e6 / (kGhz * 1e9 * 16.0) * 1e6;
+      std::printf("| %s | %d | %.0f | %s | %.2f | %.1f | %.1f× |\n",
+                  phnn::model_label(model, integrator).c_str(), 2 * k, median(general_us),
+                  k == 1 ? std::to_string(static_cast<int>(median(fused_us) + 0.5)).c_str() : "",
+                  mflop, bound_us, median(general_us) / bound_us);
       std::fflush(stdout);
     }
   }

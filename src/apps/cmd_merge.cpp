@@ -27,10 +27,16 @@ int run_merge(int argc, char** argv, int first) {
   if (!parser.flag_set("mix-kernels")) {
     std::string reference;
     for (const std::string& shard : parser.rest()) {
-      const auto sessions = ResultsFile::open_read_only(shard).read_sessions();
-      if (sessions.empty()) continue;
-      if (reference.empty()) reference = kernel_set_of(sessions.front());
-      const std::string problem = kernel_mix_problem(sessions, reference, shard);
+      const ResultsFile file = ResultsFile::open_read_only(shard);
+      const auto sessions = file.read_sessions();
+      const auto finished =
+          file.has_run_times() ? file.read_finished_utc() : std::vector<std::string>{};
+      const std::vector<bool> computed = sessions_with_runs(sessions, finished);
+      for (std::size_t k = 0; k < sessions.size() && reference.empty(); ++k) {
+        if (computed[k]) reference = kernel_set_of(sessions[k]);
+      }
+      if (reference.empty()) continue;  // no finished run yet
+      const std::string problem = kernel_mix_problem(sessions, finished, reference, shard);
       if (!problem.empty()) throw cli::UsageError{"phnn merge: " + problem};
     }
   }

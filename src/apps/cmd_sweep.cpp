@@ -119,8 +119,9 @@ void declare_options(cli::Parser* parser) {
                  "0");
   parser->flag("static", "static round-robin scheduling instead of the MPI-3 shared counter");
   parser->flag("retry-failed", "re-run runs whose status is failed (done/diverged are kept)");
-  parser->flag("mix-kernels", "resume a results file whose runs another kernel set computed "
-                              "(results differ by round-off; refused without it)");
+  parser->flag("mix-kernels", "resume a results file whose runs another kernel set computed, "
+                              "or whose stored data sets this binary does not regenerate bit for "
+                              "bit (results differ by round-off; refused without it)");
   parser->option("shard",
                  "I/N: train only cells c with c % N == I (cells largest first), into "
                  "<output>.shard-I-of-N.h5 unless --out is given; one shard per Slurm array "
@@ -263,10 +264,14 @@ class SweepRun {
         copy_file(out_, scratch);
         file.emplace(ResultsFile::open(scratch, MPI_COMM_NULL, spec_.text_hash));
         const std::string problem =
-            kernel_mix_problem(file->read_sessions(), kernel_set_of(session), out_);
+            kernel_mix_problem(file->read_sessions(),
+                               file->has_run_times() ? file->read_finished_utc()
+                                                     : std::vector<std::string>{},
+                               kernel_set_of(session), out_);
         if (!problem.empty() && !parser_.flag_set("mix-kernels")) {
           throw cli::UsageError{"phnn sweep: " + problem};
         }
+        if (!parser_.flag_set("mix-kernels")) check_stored_data(*file);
       } else {
         std::vector<std::string> studies;
         for (const auto& s : grid_.run_studies) studies.push_back(join(s, ","));
@@ -280,6 +285,20 @@ class SweepRun {
       file->close();
     });
     return codes;
+  }
+
+  // A resume regenerates each system's data set: it must be the stored one
+  // (a measured data file has its own checksum, checked where it is read).
+  void check_stored_data(const ResultsFile& file) {
+    std::set<std::string> systems;
+    for (const RunConfig& run : grid_.runs) systems.insert(run.system_name());
+    for (const std::string& name : systems) {
+      const SweepSystemFile* system_file = spec_.system_file(name);
+      if (!file.has_system_data(name) || (system_file && system_file->is_data())) continue;
+      data_.make(name);
+      const std::string problem = data_.stored_data_problem(name, file);
+      if (!problem.empty()) throw cli::UsageError{"phnn sweep: " + out_ + ": " + problem};
+    }
   }
 
   // /data/<system> for every system of the grid: written at creation, and

@@ -98,9 +98,12 @@ std::string kernel_set_of(const Provenance& session) {
   return "no phnn kernels (BLAS and LibTorch chose by CPU)";
 }
 
-std::string kernel_mix_problem(const std::vector<Provenance>& sessions, const std::string& ours,
-                               const std::string& file) {
+std::string kernel_mix_problem(const std::vector<Provenance>& sessions,
+                               const std::vector<std::string>& finished_utc,
+                               const std::string& ours, const std::string& file) {
+  const std::vector<bool> computed = sessions_with_runs(sessions, finished_utc);
   for (std::size_t k = 0; k < sessions.size(); ++k) {
+    if (!computed[k]) continue;
     const std::string theirs = kernel_set_of(sessions[k]);
     if (theirs == ours) continue;
     return file + ": session " + std::to_string(k) + " computed its runs with " + theirs +

@@ -3,6 +3,7 @@
 #include "apps/sweep_data.h"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 
 #include "phnn/store/ph_dataset_file.h"
@@ -53,6 +54,75 @@ void SweepDataSets::store(const std::string& system_name, ResultsFile* results) 
     results->store_file_system_data(system_name, *d.file,
                                     spec_.system_file(system_name)->entry);
   }
+}
+
+namespace {
+
+// Bitwise equality of two states (Vec2 or VecX) or inputs.
+template <class V>
+bool same_bits(const V& a, const V& b) {
+  if (a.size() != b.size()) return false;
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    if (std::memcmp(&a(i), &b(i), sizeof(double)) != 0) return false;
+  }
+  return true;
+}
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// The first of `count` pairs (or inference trajectories) where a and b differ, or -1.
+template <class Pairs>
+long first_different_pair(const Pairs& a, const Pairs& b, std::size_t count) {
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!same_bits(a.x[i], b.x[i]) || !same_bits(a.x_next[i], b.x_next[i]) ||
+        !same_bits(a.u[i], b.u[i])) {
+      return static_cast<long>(i);
+    }
+  }
+  return -1;
+}
+template <class Inference>
+long first_different_trajectory(const Inference& a, const Inference& b) {
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a.states[i].size() != b.states[i].size()) return static_cast<long>(i);
+    for (std::size_t n = 0; n < a.states[i].size(); ++n) {
+      if (!same_bits(a.states[i][n], b.states[i][n])) return static_cast<long>(i);
+    }
+  }
+  return -1;
+}
+
+template <class Data>
+std::string data_difference(const Data& made, const Data& stored) {
+  if (made.validation.size() != stored.validation.size() ||
+      made.inference.size() != stored.inference.size()) {
+    return "its validation or inference split has another size";
+  }
+  const std::size_t train = std::min(made.train.size(), stored.train.size());
+  if (long i = first_different_pair(made.train, stored.train, train); i >= 0) {
+    return "training pair " + std::to_string(i) + " differs";
+  }
+  if (long i = first_different_pair(made.validation, stored.validation, made.validation.size());
+      i >= 0) {
+    return "validation pair " + std::to_string(i) + " differs";
+  }
+  if (long i = first_different_trajectory(made.inference, stored.inference); i >= 0) {
+    return "inference trajectory " + std::to_string(i) + " differs";
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string SweepDataSets::stored_data_problem(const std::string& system_name,
+                                               const ResultsFile& results) const {
+  const DataSet& d = at(system_name);
+  const std::string what = d.builtin ? data_difference(*d.builtin, results.read_system_data(system_name))
+                                     : data_difference(*d.file, results.read_file_system_data(system_name));
+  if (what.empty()) return "";
+  return "the data this binary generates for " + system_name + " differ from the data set stored in "
+         "the file (" + what + "): another phnn version or another C library generated it, and runs "
+         "trained on the two would differ. Write to another file, or pass --mix-kernels to mix them "
+         "anyway.";
 }
 
 std::vector<RunResult> SweepDataSets::train(const CellSpec& cell, const std::string& system_name,

@@ -32,6 +32,14 @@ class SweepDataSets {
   void make(const std::string& system_name);
   /// Collective: stores the data set under /data/<system_name> (make first).
   void store(const std::string& system_name, ResultsFile* results) const;
+  /// "" when the data set of `system_name` (make first) has the bits of the
+  /// one stored in `results` (its validation and inference splits, and the
+  /// training pairs both hold), else what differs: a resumed sweep
+  /// regenerates its data, and a data generator that changed (another
+  /// phnn version, another libm for sin/exp) must not mix its runs with
+  /// the file's.
+  std::string stored_data_problem(const std::string& system_name,
+                                  const ResultsFile& results) const;
   /// Trains one cell of `system_name` (make first): train_cell on its data.
   std::vector<RunResult> train(const CellSpec& cell, const std::string& system_name,
                                const ProgressCallback& progress,

@@ -51,6 +51,49 @@ bool finished(double residual, const VecX& dx, int it, const DiscreteGradientOpt
   return false;
 }
 
+// LU with partial pivoting (the first largest |pivot|) of a small matrix,
+// factored once and solved many times: Eigen's PartialPivLU on dynamic sizes
+// takes its blocked path and was a seventh of a system file's DG step.
+class SmallLu {
+ public:
+  void compute(const MatX& m) {
+    lu_ = m;
+    const int n = static_cast<int>(m.rows());
+    perm_.resize(n);
+    for (int k = 0; k < n; ++k) {
+      int pivot = k;
+      for (int i = k + 1; i < n; ++i) {
+        if (std::fabs(lu_(i, k)) > std::fabs(lu_(pivot, k))) pivot = i;
+      }
+      perm_[k] = pivot;
+      if (pivot != k) lu_.row(k).swap(lu_.row(pivot));
+      for (int i = k + 1; i < n; ++i) {
+        lu_(i, k) /= lu_(k, k);
+        for (int j = k + 1; j < n; ++j) lu_(i, j) -= lu_(i, k) * lu_(k, j);
+      }
+    }
+  }
+  /// x with M x = b (M of compute()).
+  VecX solve(VecX b) const {
+    const int n = static_cast<int>(lu_.rows());
+    for (int k = 0; k < n; ++k) {  // the row swaps in order, then L
+      if (perm_[k] != k) std::swap(b(k), b(perm_[k]));
+    }
+    for (int k = 0; k < n; ++k) {
+      for (int i = k + 1; i < n; ++i) b(i) -= lu_(i, k) * b(k);
+    }
+    for (int i = n - 1; i >= 0; --i) {
+      for (int j = i + 1; j < n; ++j) b(i) -= lu_(i, j) * b(j);
+      b(i) /= lu_(i, i);
+    }
+    return b;
+  }
+
+ private:
+  MatX lu_;
+  Eigen::Matrix<int, Eigen::Dynamic, 1, 0, kMaxDimension, 1> perm_;
+};
+
 }  // namespace
 
 // Simplified Newton: the matrix I - h dF/de d dg/d dx and its LU are kept
@@ -62,7 +105,7 @@ PhImplicitStep ph_discrete_gradient_step(const PhSystem& system, const VecX& x, 
   const int n = system.n_x();
   PhImplicitStep out;
   VecX dx = ph_rk2_step(system, x, u, h) - x;
-  Eigen::PartialPivLU<MatX> lu;
+  SmallLu lu;
   bool have_matrix = false;
   double previous = std::numeric_limits<double>::infinity();
   for (int it = 0;; ++it) {

@@ -201,9 +201,12 @@ void run(const Problem<double>& q) {
 // float (float32 training only): the portable tiles, compiled per set.
 PHNN_KERNEL_VARIANTS(void, run, (const Problem<float>& q), (q), gemm_body)
 
+thread_local std::uint64_t g_multiply_adds = 0;
+
 template <typename T>
 void gemm_members(int64_t members, int64_t rows, int64_t K, int64_t cols, MatrixView<T> a,
                   MatrixView<T> b, T* c, bool accumulate) {
+  g_multiply_adds += static_cast<std::uint64_t>(members * rows * K * cols);
   thread_local std::vector<T> packed;  // B with unit column stride, when it has not
   const bool pack = b.col_stride != 1;
   if (pack) packed.resize(static_cast<std::size_t>(K * cols));
@@ -222,6 +225,8 @@ void gemm_members(int64_t members, int64_t rows, int64_t K, int64_t cols, Matrix
 }
 
 }  // namespace
+
+std::uint64_t gemm_multiply_adds() { return g_multiply_adds; }
 
 void member_gemm(int64_t members, int64_t rows, int64_t K, int64_t cols, MatrixView<double> a,
                  MatrixView<double> b, double* c, bool accumulate) {

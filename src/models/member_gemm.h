@@ -35,5 +35,10 @@ void member_gemm(int64_t members, int64_t rows, int64_t K, int64_t cols, MatrixV
 void member_gemm(int64_t members, int64_t rows, int64_t K, int64_t cols, MatrixView<float> a,
                  MatrixView<float> b, float* c, bool accumulate);
 
+/// Multiply-adds of every member_gemm call of this thread so far
+/// (members x rows x K x cols each): bench/ counts a step's matrix products
+/// with it (the FLOP bound of docs/BENCHMARKS.md).
+std::uint64_t gemm_multiply_adds();
+
 }  // namespace internal
 }  // namespace phnn

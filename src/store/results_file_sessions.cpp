@@ -8,6 +8,40 @@ namespace phnn {
 
 using namespace results_io;
 
+namespace {
+
+std::string value_of(const Provenance& session, const std::string& key) {
+  for (const auto& [k, v] : session) {
+    if (k == key) return v.substr(0, v.find('\0'));  // "finished" is NUL-padded until set
+  }
+  return "";
+}
+
+}  // namespace
+
+// UTC stamps "YYYY-MM-DDTHH:MM:SSZ" order as strings.
+std::vector<bool> sessions_with_runs(const std::vector<Provenance>& sessions,
+                                     const std::vector<std::string>& finished_utc) {
+  std::vector<bool> out(sessions.size(), finished_utc.empty());
+  if (finished_utc.empty()) return out;  // no run times recorded: every session counts
+  for (std::size_t k = 0; k < sessions.size(); ++k) {
+    const std::string begin = value_of(sessions[k], "started");
+    if (begin.empty()) {
+      out[k] = true;
+      continue;
+    }
+    std::string end = value_of(sessions[k], "finished");
+    if (end.empty() && k + 1 < sessions.size()) end = value_of(sessions[k + 1], "started");
+    for (const std::string& t : finished_utc) {
+      if (!t.empty() && t >= begin && (end.empty() || t <= end)) {
+        out[k] = true;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
 void ResultsFile::write_run_times(int row, const std::string& started,
                                   const std::string& finished) {
   Impl& impl = *impl_;

@@ -13,27 +13,49 @@ namespace phnn {
 
 // Written as loops over S: these systems are small and S is sparse, and
 // dynamic-size block products would allocate per call.
-PhFlows PhSystem::flows(const VecX& effort, const VecX& u) const {
-  const MatX& s = S();
-  const int nx = n_x(), nw = n_w(), nu = n_u();
-  auto row = [&](int r, const VecX* z) {
-    double acc = 0.0;
-    for (int j = 0; j < nx; ++j) acc += s(r, j) * effort(j);
-    if (z != nullptr) {
-      for (int j = 0; j < nw; ++j) acc += s(r, nx + j) * (*z)(j);
+const PhSystem::Couplings& PhSystem::couplings() const {
+  std::call_once(couplings_once_, [this] {
+    const MatX& s = S();
+    couplings_.start.push_back(0);
+    for (int r = 0; r < s.rows(); ++r) {
+      for (int c = 0; c < s.cols(); ++c) {
+        if (s(r, c) == 0.0) continue;
+        couplings_.column.push_back(c);
+        couplings_.value.push_back(s(r, c));
+      }
+      couplings_.start.push_back(static_cast<int>(couplings_.column.size()));
     }
-    for (int j = 0; j < nu; ++j) acc += s(r, nx + nw + j) * u(j);
+  });
+  return couplings_;
+}
+
+// Each row of [x_dot; w; y] = S [e; z; u] sums its nonzero couplings in
+// column order: for finite operands the same bits as the dense row
+// (acc + (+-0) = acc, and acc is never -0), at a fraction of the work.
+PhFlows PhSystem::flows(const VecX& effort, const VecX& u) const {
+  const Couplings& c = couplings();
+  const int nx = n_x(), nw = n_w(), nu = n_u();
+  std::array<double, kMaxDimension> operand;  // [e; z; u]
+  for (int j = 0; j < nx; ++j) operand[static_cast<std::size_t>(j)] = effort(j);
+  for (int j = 0; j < nu; ++j) operand[static_cast<std::size_t>(nx + nw + j)] = u(j);
+  auto row = [&](int r) {
+    double acc = 0.0;
+    for (int k = c.start[static_cast<std::size_t>(r)]; k < c.start[static_cast<std::size_t>(r) + 1]; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      acc += c.value[kk] * operand[static_cast<std::size_t>(c.column[kk])];
+    }
     return acc;
   };
   PhFlows out;
   // S_ww = 0: w depends on the effort and u only.
   out.w.resize(nw);
-  for (int k = 0; k < nw; ++k) out.w(k) = row(nx + k, nullptr);
+  for (int k = 0; k < nw; ++k) out.w(k) = row(nx + k);
   out.z = dissipation(out.w);
+  for (int j = 0; j < nw; ++j) operand[static_cast<std::size_t>(nx + j)] = out.z(j);
   out.x_dot.resize(nx);
-  for (int i = 0; i < nx; ++i) out.x_dot(i) = row(i, &out.z);
+  for (int i = 0; i < nx; ++i) out.x_dot(i) = row(i);
   out.y.resize(nu);
-  for (int k = 0; k < nu; ++k) out.y(k) = row(nx + nw + k, &out.z);
+  for (int k = 0; k < nu; ++k) out.y(k) = row(nx + nw + k);
   return out;
 }
 

@@ -30,6 +30,14 @@ std::string to_c(const GiNaC::ex& e) {
   return os.str();
 }
 
+// The exact rational value of a finite double: v = m 2^(e - 53), m an
+// integer of at most 53 bits.
+GiNaC::numeric exact(double v) {
+  int e = 0;
+  const double m = std::ldexp(std::frexp(v, &e), 53);
+  return GiNaC::numeric(static_cast<long>(m)) * GiNaC::numeric(2).power(e - 53);
+}
+
 const Eigen::IOFormat kRow(Eigen::StreamPrecision, Eigen::DontAlignCols, ", ", ", ");
 
 std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
@@ -193,7 +201,11 @@ class FileSystem : public PhSystem {
                                             const std::string& what) const;
 
   SystemDefinition def_;
-  Symbols syms_;  // one set: GiNaC symbols of equal names are still distinct
+  Symbols syms_;
+  // Each parameter's exact value (the rational its double stands for):
+  // substituted before compiling, so GiNaC folds products of parameters and
+  // numbers exactly (k3/4, 1/m) and muParser evaluates one constant each.
+  GiNaC::exmap parameter_values_;  // one set: GiNaC symbols of equal names are still distinct
   std::unique_ptr<double[]> vars_;
   std::size_t w_offset_ = 0, d_offset_ = 0;
   std::unique_ptr<CompiledExpressions> energy_, gradient_, hessian_, dissipation_,
@@ -210,7 +222,7 @@ std::unique_ptr<CompiledExpressions> FileSystem::make(const std::vector<GiNaC::e
   const std::string key = what.rfind("z", 0) == 0 ? "z" : "H";
   std::vector<std::string> c;
   try {
-    for (const auto& e : exprs) c.push_back(internal::muparser_source(e));
+    for (const auto& e : exprs) c.push_back(internal::muparser_source(e.subs(parameter_values_)));
   } catch (const std::invalid_argument& e) {
     throw SystemFileError(def_.file, def_.line_of(key),
                           "cannot evaluate " + what + " (it contains " + e.what() +
@@ -232,7 +244,10 @@ void FileSystem::compile() {
   const Symbols& s = syms_;
   const std::size_t nx = s.x.size(), np = s.params.size(), nw = s.w.size();
   vars_.reset(new double[s.names.size()]());
-  for (std::size_t i = 0; i < np; ++i) vars_[nx + i] = def_.parameters[i].second;
+  for (std::size_t i = 0; i < np; ++i) {
+    vars_[nx + i] = def_.parameters[i].second;
+    parameter_values_[s.params[i]] = exact(def_.parameters[i].second);
+  }
   w_offset_ = nx + np;
   d_offset_ = w_offset_ + nw + nx;  // after the ports and the midpoint symbols a
   if (!def_.has_energy()) return;  // structure only: nothing to evaluate

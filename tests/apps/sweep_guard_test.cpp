@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
@@ -19,6 +20,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "apps/provenance.h"
 #include "h5/h5file.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/journal.h"
@@ -429,6 +431,58 @@ TEST(SweepGuardTest, ResumeRefusesAnotherKernelSetUnlessTold) {
     file.write_run(0, RunResult{});  // pending again: a resume would train it
   }
   expect_every_rank_exits(2, "sweep " + sweep + " --quiet --out " + out, 2, "--mix-kernels");
+  EXPECT_EQ(ResultsFile::open_read_only(out).read_sessions().size(), 1u);
+  EXPECT_EQ(ResultsFile::open_read_only(out).read_statuses()[0], RunStatus::kPending);
+  std::string log;
+  EXPECT_EQ(run_ranks(1, "sweep " + sweep + " --quiet --mix-kernels --out " + out, &log), 0) << log;
+  EXPECT_EQ(ResultsFile::open_read_only(out).read_statuses()[0], RunStatus::kDone);
+}
+
+// Only sessions that finished a run decide a resume's or a merge's kernel
+// check: a session of another kernel set that was stopped at once (or was
+// refused) mixes nothing into the file.
+TEST(SweepGuardTest, SessionsWithRunsAreThoseARunFinishedIn) {
+  const std::vector<Provenance> sessions = {
+      {{"kernels", "phnn kernels 1; avx512"}, {"started", "2026-11-26T08:00:00Z"},
+       {"finished", "2026-11-26T09:00:00Z"}},
+      {{"kernels", "phnn kernels 0; avx2"}, {"started", "2026-11-26T09:30:00Z"}},
+      {{"kernels", "phnn kernels 1; avx2"}, {"started", "2026-11-26T10:00:00Z"}}};
+  // Runs finished in sessions 0 and 2 only (session 1 ends where 2 starts).
+  std::vector<std::string> finished = {"2026-11-26T08:10:00Z", "", "2026-11-26T10:05:00Z"};
+  EXPECT_EQ(sessions_with_runs(sessions, finished), (std::vector<bool>{true, false, true}));
+  finished[1] = "2026-11-26T09:45:00Z";  // now one in session 1's window
+  EXPECT_EQ(sessions_with_runs(sessions, finished), (std::vector<bool>{true, true, true}));
+  // Boundaries: a run finished at the second session 0 ended is session 0's.
+  EXPECT_EQ(sessions_with_runs({sessions[0]}, {"2026-11-26T09:00:00Z"}), (std::vector<bool>{true}));
+  EXPECT_EQ(sessions_with_runs({sessions[0]}, {"2026-11-26T09:00:01Z"}), (std::vector<bool>{false}));
+  EXPECT_EQ(sessions_with_runs({sessions[0]}, {"2026-11-26T07:59:59Z"}), (std::vector<bool>{false}));
+  // Nothing to tell: a session without `started`, a file without run times.
+  EXPECT_EQ(sessions_with_runs({{{"kernels", "phnn kernels 0"}}}, {""}), (std::vector<bool>{true}));
+  EXPECT_EQ(sessions_with_runs(sessions, {}), (std::vector<bool>{true, true, true}));
+}
+
+// A resume regenerates the data sets: if they are not the stored bits
+// (another phnn version or C library made them), it is refused on every
+// rank, naming the split and the way out, and changes nothing.
+TEST(SweepGuardTest, ResumeRefusesDataThatAreNotTheStoredOnes) {
+  const std::string dir = temp_dir("stored-data");
+  const std::string sweep = write_file(dir + "/tiny.toml", kTinySweep);
+  const std::string out = dir + "/out.h5";
+  run_tiny(sweep, out, 1);
+  const std::string hash = ResultsFile::open_read_only(out).sweep_hash();
+  {
+    h5::File file = h5::File::open(out, h5::Access::kReadWrite);
+    std::vector<double> row = file.read_doubles("/data/harmonic/validation/x_next", 3, 1);
+    row[1] = std::nextafter(row[1], 1e300);  // one ulp: what another generator gives
+    file.write_rows("/data/harmonic/validation/x_next", 3, 1, row.data());
+  }
+  {
+    ResultsFile file = ResultsFile::open(out, MPI_COMM_NULL, hash);
+    file.write_run(0, RunResult{});  // pending again: a resume would train it
+  }
+  expect_every_rank_exits(2, "sweep " + sweep + " --quiet --out " + out, 2,
+                          "differ from the data set stored in the file (validation pair 3 "
+                          "differs)");
   EXPECT_EQ(ResultsFile::open_read_only(out).read_sessions().size(), 1u);
   EXPECT_EQ(ResultsFile::open_read_only(out).read_statuses()[0], RunStatus::kPending);
   std::string log;

@@ -54,6 +54,16 @@ struct ResultsLayout {
 /// command_line, started (UTC); end_session adds finished.
 using Provenance = std::vector<std::pair<std::string, std::string>>;
 
+/// Per session of `sessions` (ResultsFile::read_sessions): true when at
+/// least one run finished in it, i.e. one of `finished_utc`
+/// (ResultsFile::read_finished_utc, "" for runs not done) lies between the
+/// session's `started` and its end (its `finished`, else the next session's
+/// `started`, else open). Sessions without `started` count as having runs,
+/// and so does every session when `finished_utc` is empty (a file that
+/// records no run times).
+std::vector<bool> sessions_with_runs(const std::vector<Provenance>& sessions,
+                                     const std::vector<std::string>& finished_utc);
+
 /// Largest stored strings; create() refuses longer canonical configs and
 /// studies, write_run() truncates longer messages (ending them in "...").
 constexpr std::size_t kCanonicalLength = 1024;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -173,6 +174,18 @@ class PhSystem {
   /// Below this ||dx|| the generic Gonzalez quotient is dropped (tau,
   /// docs/METHOD.md §4).
   static constexpr double kMinDxNorm = 6e-6;
+
+ private:
+  /// The nonzero entries of S() row by row (columns ascending), built on
+  /// first use: flows() sums only these (S is mostly zeros and ones).
+  struct Couplings {
+    std::vector<int> start;  // row r: entries start[r] .. start[r + 1] - 1
+    std::vector<int> column;
+    std::vector<double> value;
+  };
+  const Couplings& couplings() const;
+  mutable std::once_flag couplings_once_;
+  mutable Couplings couplings_;
 };
 
 /// The rng_id of a system name: 0, 1, 2 for "harmonic", "duffing",
