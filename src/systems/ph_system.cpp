@@ -11,8 +11,9 @@
 
 namespace phnn {
 
-// Written as loops over S: these systems are small and S is sparse, and
-// dynamic-size block products would allocate per call.
+// flows() and flow_jacobian() are written as loops over S: these systems
+// are small and S is sparse, and dynamic-size block products would allocate
+// per call.
 const PhSystem::Couplings& PhSystem::couplings() const {
   std::call_once(couplings_once_, [this] {
     const MatX& s = S();

@@ -201,11 +201,11 @@ class FileSystem : public PhSystem {
                                             const std::string& what) const;
 
   SystemDefinition def_;
-  Symbols syms_;
+  Symbols syms_;  // one set: GiNaC symbols of equal names are still distinct
   // Each parameter's exact value (the rational its double stands for):
   // substituted before compiling, so GiNaC folds products of parameters and
   // numbers exactly (k3/4, 1/m) and muParser evaluates one constant each.
-  GiNaC::exmap parameter_values_;  // one set: GiNaC symbols of equal names are still distinct
+  GiNaC::exmap parameter_values_;
   std::unique_ptr<double[]> vars_;
   std::size_t w_offset_ = 0, d_offset_ = 0;
   std::unique_ptr<CompiledExpressions> energy_, gradient_, hessian_, dissipation_,
