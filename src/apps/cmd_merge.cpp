@@ -29,14 +29,12 @@ int run_merge(int argc, char** argv, int first) {
     for (const std::string& shard : parser.rest()) {
       const ResultsFile file = ResultsFile::open_read_only(shard);
       const auto sessions = file.read_sessions();
-      const auto finished =
-          file.has_run_times() ? file.read_finished_utc() : std::vector<std::string>{};
-      const std::vector<bool> computed = sessions_with_runs(sessions, finished);
+      const std::vector<bool> computed = file.sessions_with_runs();
       for (std::size_t k = 0; k < sessions.size() && reference.empty(); ++k) {
         if (computed[k]) reference = kernel_set_of(sessions[k]);
       }
       if (reference.empty()) continue;  // no finished run yet
-      const std::string problem = kernel_mix_problem(sessions, finished, reference, shard);
+      const std::string problem = kernel_mix_problem(sessions, computed, reference, shard);
       if (!problem.empty()) throw cli::UsageError{"phnn merge: " + problem};
     }
   }

@@ -264,9 +264,7 @@ class SweepRun {
         copy_file(out_, scratch);
         file.emplace(ResultsFile::open(scratch, MPI_COMM_NULL, spec_.text_hash));
         const std::string problem =
-            kernel_mix_problem(file->read_sessions(),
-                               file->has_run_times() ? file->read_finished_utc()
-                                                     : std::vector<std::string>{},
+            kernel_mix_problem(file->read_sessions(), file->sessions_with_runs(),
                                kernel_set_of(session), out_);
         if (!problem.empty() && !parser_.flag_set("mix-kernels")) {
           throw cli::UsageError{"phnn sweep: " + problem};

@@ -99,11 +99,10 @@ std::string kernel_set_of(const Provenance& session) {
 }
 
 std::string kernel_mix_problem(const std::vector<Provenance>& sessions,
-                               const std::vector<std::string>& finished_utc,
-                               const std::string& ours, const std::string& file) {
-  const std::vector<bool> computed = sessions_with_runs(sessions, finished_utc);
+                               const std::vector<bool>& with_runs, const std::string& ours,
+                               const std::string& file) {
   for (std::size_t k = 0; k < sessions.size(); ++k) {
-    if (!computed[k]) continue;
+    if (!with_runs[k]) continue;
     const std::string theirs = kernel_set_of(sessions[k]);
     if (theirs == ours) continue;
     return file + ": session " + std::to_string(k) + " computed its runs with " + theirs +

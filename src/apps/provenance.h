@@ -26,15 +26,15 @@ Provenance session_provenance(MPI_Comm comm, int argc, char** argv);
 /// existed, "no phnn kernels (BLAS and LibTorch chose by CPU)".
 std::string kernel_set_of(const Provenance& session);
 
-/// "" when every session in `sessions` that finished a run
-/// (store/results_file.h sessions_with_runs) used `ours` (kernel_set_of), else a message naming
+/// "" when every session in `sessions` that finished a run (`with_runs`:
+/// ResultsFile::sessions_with_runs) used `ours` (kernel_set_of), else a message naming
 /// the first that did not, its set and the way out; for resume and merge,
 /// which refuse to mix kernel sets (their results differ by round-off)
 /// unless told to (--mix-kernels). A session that finished no run (stopped
 /// at once, or refused) mixes nothing.
 std::string kernel_mix_problem(const std::vector<Provenance>& sessions,
-                               const std::vector<std::string>& finished_utc,
-                               const std::string& ours, const std::string& file);
+                               const std::vector<bool>& with_runs, const std::string& ours,
+                               const std::string& file);
 
 /// `phnn --version`: one `key: value` line per build_provenance() entry.
 std::string version_text();

@@ -6,9 +6,12 @@
 #include <cmath>
 #include <limits>
 
+#include <array>
+
 #include <Eigen/LU>
 
 #include "phnn/common/check.h"
+#include "phnn/common/small_lu.h"
 
 namespace phnn {
 
@@ -51,48 +54,63 @@ bool finished(double residual, const VecX& dx, int it, const DiscreteGradientOpt
   return false;
 }
 
-// LU with partial pivoting (the first largest |pivot|) of a small matrix,
-// factored once and solved many times: Eigen's PartialPivLU on dynamic sizes
-// takes its blocked path and was a seventh of a system file's DG step.
+// The Newton matrix's LU (common/small_lu.h), factored once and solved
+// many times: Eigen's PartialPivLU on dynamic sizes takes its blocked path
+// and was a seventh of a system file's DG step.
 class SmallLu {
  public:
   void compute(const MatX& m) {
-    lu_ = m;
-    const int n = static_cast<int>(m.rows());
-    perm_.resize(n);
-    for (int k = 0; k < n; ++k) {
-      int pivot = k;
-      for (int i = k + 1; i < n; ++i) {
-        if (std::fabs(lu_(i, k)) > std::fabs(lu_(pivot, k))) pivot = i;
-      }
-      perm_[k] = pivot;
-      if (pivot != k) lu_.row(k).swap(lu_.row(pivot));
-      for (int i = k + 1; i < n; ++i) {
-        lu_(i, k) /= lu_(k, k);
-        for (int j = k + 1; j < n; ++j) lu_(i, j) -= lu_(i, k) * lu_(k, j);
-      }
+    n_ = static_cast<int>(m.rows());
+    for (int i = 0; i < n_; ++i) {
+      for (int j = 0; j < n_; ++j) lu_[i * n_ + j] = m(i, j);
     }
+    lu_factor(lu_.data(), perm_.data(), n_);
   }
-  /// x with M x = b (M of compute()).
-  VecX solve(VecX b) const {
-    const int n = static_cast<int>(lu_.rows());
-    for (int k = 0; k < n; ++k) {  // the row swaps in order, then L
-      if (perm_[k] != k) std::swap(b(k), b(perm_[k]));
-    }
-    for (int k = 0; k < n; ++k) {
-      for (int i = k + 1; i < n; ++i) b(i) -= lu_(i, k) * b(k);
-    }
-    for (int i = n - 1; i >= 0; --i) {
-      for (int j = i + 1; j < n; ++j) b(i) -= lu_(i, j) * b(j);
-      b(i) /= lu_(i, i);
-    }
-    return b;
-  }
+  /// b <- x with M x = b (M of compute()).
+  void solve_in_place(VecX* b) const { lu_solve(lu_.data(), perm_.data(), b->data(), n_); }
 
  private:
-  MatX lu_;
-  Eigen::Matrix<int, Eigen::Dynamic, 1, 0, kMaxDimension, 1> perm_;
+  int n_ = 0;
+  std::array<double, kMaxDimension * kMaxDimension> lu_;  // row-major
+  std::array<int, kMaxDimension> perm_;
 };
+
+// I - h F G with each entry's sum over k in order (Eigen's coefficient-
+// based product gives the same bits up to n = 9, its blocked GEMM above).
+// F = dF/de is mostly zeros: skipping F_ik = 0 adds nothing but +-0 to a
+// sum that starts at +0 (same bits for a finite G).
+MatX newton_matrix(const MatX& F, const MatX& G, double h) {
+  const int n = static_cast<int>(F.rows());
+  MatX m(n, n);
+  for (int i = 0; i < n; ++i) {
+    int nonzero[kMaxDimension];
+    int count = 0;
+    for (int k = 0; k < n; ++k) {
+      if (F(i, k) != 0.0) nonzero[count++] = k;
+    }
+    for (int j = 0; j < n; ++j) {
+      double sum = 0.0;
+      for (int c = 0; c < count; ++c) sum += F(i, nonzero[c]) * G(nonzero[c], j);
+      m(i, j) = (i == j ? 1.0 : 0.0) - h * sum;
+    }
+  }
+  return m;
+}
+
+// r = dx - h F; returns max |r_i| (NaN if any r_i is NaN).
+double newton_residual(const VecX& dx, const VecX& F, double h, VecX* r) {
+  const int n = static_cast<int>(dx.size());
+  r->resize(n);
+  double norm = 0.0;
+  bool nan = false;
+  for (int i = 0; i < n; ++i) {
+    (*r)(i) = dx(i) - h * F(i);
+    const double a = std::fabs((*r)(i));
+    nan = nan || std::isnan(a);
+    if (a > norm) norm = a;
+  }
+  return nan ? std::numeric_limits<double>::quiet_NaN() : norm;
+}
 
 }  // namespace
 
@@ -104,24 +122,27 @@ PhImplicitStep ph_discrete_gradient_step(const PhSystem& system, const VecX& x, 
   require_step(h, "ph_discrete_gradient_step");
   const int n = system.n_x();
   PhImplicitStep out;
-  VecX dx = ph_rk2_step(system, x, u, h) - x;
+  VecX dx = ph_rk2_step(system, x, u, h);
+  for (int i = 0; i < n; ++i) dx(i) -= x(i);
+  VecX r;
   SmallLu lu;
   bool have_matrix = false;
   double previous = std::numeric_limits<double>::infinity();
   for (int it = 0;; ++it) {
-    out.flows = system.flows(system.discrete_gradient(x, dx), u);
-    const VecX r = dx - h * out.flows.x_dot;
-    const double residual = r.lpNorm<Eigen::Infinity>();
+    system.flows(system.discrete_gradient(x, dx), u, &out.flows);
+    const double residual = newton_residual(dx, out.flows.x_dot, h, &r);
     if (finished(residual, dx, it, options, &out)) break;
     if (!have_matrix || residual > 0.1 * previous) {
-      lu.compute(MatX::Identity(n, n) - h * system.flow_jacobian(out.flows.w) *
-                                            system.discrete_gradient_jacobian(x, dx));
+      lu.compute(newton_matrix(system.flow_jacobian(out.flows.w),
+                               system.discrete_gradient_jacobian(x, dx), h));
       have_matrix = true;
     }
     previous = residual;
-    dx -= lu.solve(r);
+    lu.solve_in_place(&r);
+    for (int i = 0; i < n; ++i) dx(i) -= r(i);
   }
-  out.x_next = x + dx;
+  out.x_next.resize(n);
+  for (int i = 0; i < n; ++i) out.x_next(i) = x(i) + dx(i);
   return out;
 }
 

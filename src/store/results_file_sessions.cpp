@@ -68,6 +68,12 @@ std::vector<std::string> ResultsFile::read_finished_utc() const {
   return impl_->strings(kFinishedUtc);
 }
 
+std::vector<bool> ResultsFile::sessions_with_runs() const {
+  return phnn::sessions_with_runs(read_sessions(), impl_->has_run_times
+                                                       ? impl_->strings(kFinishedUtc)
+                                                       : std::vector<std::string>{});
+}
+
 // "finished" is reserved at the start with kFinishedWidth NUL bytes, so
 // end_session overwrites the value in place: ending a session allocates
 // nothing, and cannot fail for a full disk.

@@ -17,6 +17,9 @@ namespace phnn {
 const PhSystem::Couplings& PhSystem::couplings() const {
   std::call_once(couplings_once_, [this] {
     const MatX& s = S();
+    couplings_.nx = n_x();
+    couplings_.nw = n_w();
+    couplings_.nu = n_u();
     couplings_.start.push_back(0);
     for (int r = 0; r < s.rows(); ++r) {
       for (int c = 0; c < s.cols(); ++c) {
@@ -30,39 +33,49 @@ const PhSystem::Couplings& PhSystem::couplings() const {
   return couplings_;
 }
 
-// Each row of [x_dot; w; y] = S [e; z; u] sums its nonzero couplings in
-// column order: for finite operands the same bits as the dense row
-// (acc + (+-0) = acc, and acc is never -0), at a fraction of the work.
 PhFlows PhSystem::flows(const VecX& effort, const VecX& u) const {
-  const Couplings& c = couplings();
-  const int nx = n_x(), nw = n_w(), nu = n_u();
-  std::array<double, kMaxDimension> operand;  // [e; z; u]
-  for (int j = 0; j < nx; ++j) operand[static_cast<std::size_t>(j)] = effort(j);
-  for (int j = 0; j < nu; ++j) operand[static_cast<std::size_t>(nx + nw + j)] = u(j);
-  auto row = [&](int r) {
-    double acc = 0.0;
-    for (int k = c.start[static_cast<std::size_t>(r)]; k < c.start[static_cast<std::size_t>(r) + 1]; ++k) {
-      const auto kk = static_cast<std::size_t>(k);
-      acc += c.value[kk] * operand[static_cast<std::size_t>(c.column[kk])];
-    }
-    return acc;
-  };
   PhFlows out;
-  // S_ww = 0: w depends on the effort and u only.
-  out.w.resize(nw);
-  for (int k = 0; k < nw; ++k) out.w(k) = row(nx + k);
-  out.z = dissipation(out.w);
-  for (int j = 0; j < nw; ++j) operand[static_cast<std::size_t>(nx + j)] = out.z(j);
-  out.x_dot.resize(nx);
-  for (int i = 0; i < nx; ++i) out.x_dot(i) = row(i);
-  out.y.resize(nu);
-  for (int k = 0; k < nu; ++k) out.y(k) = row(nx + nw + k);
+  port_flows(effort, u, true, &out);
   return out;
 }
 
+void PhSystem::flows(const VecX& effort, const VecX& u, PhFlows* out) const {
+  port_flows(effort, u, true, out);
+}
+
+// Each row of [x_dot; w; y] = S [e; z; u] sums its nonzero couplings in
+// column order: for finite operands the same bits as the dense row
+// (acc + (+-0) = acc, and acc is never -0), at a fraction of the work.
+void PhSystem::port_flows(const VecX& effort, const VecX& u, bool outputs, PhFlows* out) const {
+  const Couplings& c = couplings();
+  const int nx = c.nx, nw = c.nw, nu = c.nu;
+  const int* start = c.start.data();
+  const int* column = c.column.data();
+  const double* value = c.value.data();
+  double operand[kMaxDimension];  // [e; z; u]
+  for (int j = 0; j < nx; ++j) operand[j] = effort(j);
+  for (int j = 0; j < nu; ++j) operand[nx + nw + j] = u(j);
+  auto row = [&](int r) {
+    double acc = 0.0;
+    for (int k = start[r]; k < start[r + 1]; ++k) acc += value[k] * operand[column[k]];
+    return acc;
+  };
+  // S_ww = 0: w depends on the effort and u only.
+  out->w.resize(nw);
+  for (int k = 0; k < nw; ++k) out->w(k) = row(nx + k);
+  if (nw > 0) out->z = dissipation(out->w);
+  else out->z.resize(0);
+  for (int j = 0; j < nw; ++j) operand[nx + j] = out->z(j);
+  out->x_dot.resize(nx);
+  for (int i = 0; i < nx; ++i) out->x_dot(i) = row(i);
+  out->y.resize(outputs ? nu : 0);
+  for (int k = 0; k < out->y.size(); ++k) out->y(k) = row(nx + nw + k);
+}
+
 MatX PhSystem::flow_jacobian(const VecX& w) const {
+  const Couplings& c = couplings();
+  const int nx = c.nx, nw = c.nw;
   const MatX& s = S();
-  const int nx = n_x(), nw = n_w();
   MatX jac = s.topLeftCorner(nx, nx);
   if (nw == 0) return jac;
   const MatX dz = dissipation_jacobian(w);
@@ -79,7 +92,9 @@ MatX PhSystem::flow_jacobian(const VecX& w) const {
 }
 
 VecX PhSystem::vector_field(const VecX& x, const VecX& u) const {
-  return flows(grad_hamiltonian(x), u).x_dot;
+  PhFlows f;
+  port_flows(grad_hamiltonian(x), u, false, &f);
+  return f.x_dot;
 }
 
 // dg(x, dx) = gradH(m) + D / |dx|^2 dx,  m = x + dx/2,

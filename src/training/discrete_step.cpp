@@ -7,6 +7,7 @@
 
 #include "models/ordered_sum.h"
 #include "phnn/common/check.h"
+#include "phnn/common/small_lu.h"
 
 namespace phnn {
 
@@ -66,33 +67,10 @@ torch::Tensor discrete_loss(const torch::Tensor& x_next, const torch::Tensor& x_
 namespace {
 
 // x with M x = r for every row (M [.., n, n], r [.., n], float64, no
-// gradient): Gaussian elimination with partial pivoting (the first largest
-// |pivot|), then back substitution, in one fixed order. LAPACK's solve
-// (torch::linalg_solve) runs OpenBLAS kernels chosen by CPU, so its last
-// bits changed between machines; it also threw on a singular M, where
+// gradient): common/small_lu.h, one fixed order of operations. LAPACK's
+// solve (torch::linalg_solve) runs OpenBLAS kernels chosen by CPU, so its
+// last bits changed between machines; it also threw on a singular M, where
 // this gives inf/NaN and the rollout marks the row diverged.
-void lu_solve_one(double* A, double* b, double* x, int64_t n) {
-  for (int64_t k = 0; k < n; ++k) {
-    int64_t pivot = k;
-    for (int64_t i = k + 1; i < n; ++i)
-      if (std::fabs(A[i * n + k]) > std::fabs(A[pivot * n + k])) pivot = i;
-    if (pivot != k) {
-      for (int64_t j = 0; j < n; ++j) std::swap(A[k * n + j], A[pivot * n + j]);
-      std::swap(b[k], b[pivot]);
-    }
-    for (int64_t i = k + 1; i < n; ++i) {
-      const double f = A[i * n + k] / A[k * n + k];
-      for (int64_t j = k + 1; j < n; ++j) A[i * n + j] -= f * A[k * n + j];
-      b[i] -= f * b[k];
-    }
-  }
-  for (int64_t i = n - 1; i >= 0; --i) {
-    double s = b[i];
-    for (int64_t j = i + 1; j < n; ++j) s -= A[i * n + j] * x[j];
-    x[i] = s / A[i * n + i];
-  }
-}
-
 torch::Tensor lu_solve_rows(const torch::Tensor& M, const torch::Tensor& r) {
   PHNN_CHECK(r.scalar_type() == torch::kFloat64 && !(torch::GradMode::is_enabled() && (M.requires_grad() || r.requires_grad())),
              "lu_solve_rows: float64 inference only");
@@ -102,11 +80,14 @@ torch::Tensor lu_solve_rows(const torch::Tensor& M, const torch::Tensor& r) {
   torch::Tensor A = torch::empty(shape, r.options()), b = torch::empty(r.sizes(), r.options());
   A.copy_(M.expand(shape));
   b.copy_(r);
-  torch::Tensor x = torch::empty_like(b);
-  double *pa = A.data_ptr<double>(), *pb = b.data_ptr<double>(), *px = x.data_ptr<double>();
-  for (int64_t row = 0; row < b.numel() / n; ++row)
-    lu_solve_one(pa + row * n * n, pb + row * n, px + row * n, n);
-  return x;
+  double *pa = A.data_ptr<double>(), *pb = b.data_ptr<double>();
+  std::vector<int> perm(static_cast<std::size_t>(n));
+  const int size = static_cast<int>(n);
+  for (int64_t row = 0; row < b.numel() / n; ++row) {
+    lu_factor(pa + row * n * n, perm.data(), size);
+    lu_solve(pa + row * n * n, perm.data(), pb + row * n, size);
+  }
+  return b;
 }
 
 // The Newton update delta = -M^{-1} r of every row by Cramer's rule, with

@@ -220,6 +220,9 @@ class ResultsFile {
   /// journal, or an older file).
   std::vector<std::string> read_started_utc() const;
   std::vector<std::string> read_finished_utc() const;
+  /// sessions_with_runs(read_sessions(), read_finished_utc()), every
+  /// session counting in a file that records no run times.
+  std::vector<bool> sessions_with_runs() const;
 
   /// Integrity (docs/RESULTS_FORMAT.md, "Checksums"): every row written by
   /// write_run carries a checksum of what it stores. The rows with a result

@@ -166,6 +166,8 @@ class PhSystem {
 
   /// Flows at effort e (in place of gradH) and input u.
   PhFlows flows(const VecX& effort, const VecX& u) const;
+  /// The same, written into *out (the integrators' inner loops: no copies).
+  void flows(const VecX& effort, const VecX& u, PhFlows* out) const;
   /// dF/de = S_xx + S_xw z'(w) S_wx (n_x x n_x), F = x_dot of flows().
   MatX flow_jacobian(const VecX& w) const;
   /// f(x, u) = flows(gradH(x), u).x_dot.
@@ -179,11 +181,14 @@ class PhSystem {
   /// The nonzero entries of S() row by row (columns ascending), built on
   /// first use: flows() sums only these (S is mostly zeros and ones).
   struct Couplings {
+    int nx = 0, nw = 0, nu = 0;  // n_x(), n_w(), n_u() (virtual calls) once
     std::vector<int> start;  // row r: entries start[r] .. start[r + 1] - 1
     std::vector<int> column;
     std::vector<double> value;
   };
   const Couplings& couplings() const;
+  /// flows() without y when `outputs` is false (vector_field needs x_dot).
+  void port_flows(const VecX& effort, const VecX& u, bool outputs, PhFlows* out) const;
   mutable std::once_flag couplings_once_;
   mutable Couplings couplings_;
 };
