@@ -123,8 +123,9 @@ def ordered_models(labels):
 
 
 # --------------------------------------------------------------------------------------- loading
-def load(path):
-    """All of /runs as numpy arrays/lists, plus the sweep's name and its parsed TOML text."""
+def load(path, round_k=None):
+    """All of /runs as numpy arrays/lists, plus the sweep's name and its parsed TOML text; of an
+    adaptive sweep only the runs its rounds asked for (up to round `round_k` when given)."""
     with h5py.File(path, "r") as f:
         if f.attrs.get("format", b"") not in (b"phnn-results", "phnn-results"):
             sys.exit(f"{path}: not a phnn results file (no format = phnn-results attribute)")
@@ -146,7 +147,8 @@ def load(path):
     runs["rows"] = np.arange(len(runs["status"]))
     if "adaptive" in sweep:  # only the runs its rounds asked for (phnn reduce --per-run)
         from phnn_tool import run_csv
-        asked = {r["run_id"] for r in run_csv("reduce", path, "--per-run")}
+        extra = ("--round", str(round_k)) if round_k is not None else ()
+        asked = {r["run_id"] for r in run_csv("reduce", path, "--per-run", *extra)}
         keep = np.array([i in asked for i in runs["id"]], dtype=bool)
         runs = {k: (v if k in ("states", "has_weights") else
                     v[keep] if isinstance(v, np.ndarray) else [x for x, k2 in zip(v, keep) if k2])
@@ -773,12 +775,17 @@ def main():
         description="The figures of a results file (the module's docstring lists them).")
     parser.add_argument("results", help="results file written by `phnn sweep` or `phnn train`")
     parser.add_argument("outdir", help="directory for the figures (created)")
+    parser.add_argument("--round", type=int, default=None, metavar="K",
+                        help="adaptive sweeps: the runs of rounds 0..K only (0: every cell's "
+                        "first seeds)")
     args = parser.parse_args()
+    if args.round is not None and args.round < 0:
+        parser.error("--round K needs K >= 0")
     path, out = args.results, args.outdir
     if not os.path.exists(path):
         sys.exit(f"{path}: no such file; run `phnn sweep` first")
     os.makedirs(out, exist_ok=True)
-    runs, name, sweep = load(path)
+    runs, name, sweep = load(path, args.round)
     name = name or os.path.basename(path)
     written = []
     for make in (mse_boxplots,):
