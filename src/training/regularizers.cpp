@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "models/ordered_sum.h"
+#include "training/jacobian_spectrum.h"
 
 namespace phnn {
 namespace {
@@ -19,12 +20,12 @@ torch::Tensor safe_sqrt(const torch::Tensor& s) {
 
 JacobianStats jacobian_stats_general(const torch::Tensor& jacobian, double eps) {
   const int64_t n = jacobian.size(-1);
-  const auto sigma = torch::linalg_svdvals(jacobian);  // descending
+  const auto sigma = internal::singular_values(jacobian);  // descending
   JacobianStats out;
   out.sigma_max = sigma.select(-1, 0);
   out.sigma_min = sigma.select(-1, n - 1);
   out.kappa = out.sigma_max / (out.sigma_min + eps);
-  const auto re = torch::real(torch::linalg_eigvals(jacobian)).abs();
+  const auto re = internal::eigenvalue_real_parts(jacobian).abs();
   out.rho = std::get<0>(re.max(-1)) / (std::get<0>(re.min(-1)) + eps);
   return out;
 }

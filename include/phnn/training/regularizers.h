@@ -20,9 +20,11 @@ struct JacobianStats {
 };
 ///
 /// For n x n Jacobians with n != 2 (file-defined systems) the same
-/// quantities come from torch::linalg_svdvals (sigma) and the real parts of
-/// torch::linalg_eigvals (rho), both differentiable; jacobian_stats_general
-/// is that path for any n (tests compare it with the closed form at n = 2).
+/// quantities come from the singular values and the real parts of the
+/// eigenvalues (src/training/jacobian_spectrum.h: Eigen's Jacobi SVD and
+/// real Schur form, compiled code, so the same bits on every CPU, unlike
+/// LAPACK's), differentiable; jacobian_stats_general is that path for any n
+/// (tests compare it with the closed form at n = 2 and with LAPACK).
 JacobianStats jacobian_stats(const torch::Tensor& jacobian, double eps);
 JacobianStats jacobian_stats_general(const torch::Tensor& jacobian, double eps);
 
