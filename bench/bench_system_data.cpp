@@ -2,7 +2,9 @@
 // splits: 400 train pairs, 2500 validation pairs, 100 inference trajectories
 // of 2000 DG steps) for the built-in systems and for system files.
 // Usage: bench_system_data [repeats=5] [sweeps/systems] [only=NAME] (NAME: one
-// system file's name, for profiling; the built-ins are skipped). Prints CSV:
+// system file's name, or generic-harmonic / generic-self-sustained for a
+// built-in through the general step, for profiling; the built-ins' own
+// path is skipped). Prints CSV:
 // system,source,n_x,median_s,min_s,steps,us_per_dg_step.
 #include <algorithm>
 #include <chrono>

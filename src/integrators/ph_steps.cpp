@@ -3,10 +3,9 @@
 #include "phnn/integrators/ph_steps.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
-
-#include <array>
 
 #include <Eigen/LU>
 

@@ -25,10 +25,20 @@ torch::Tensor matrices_of(const torch::Tensor& jacobian) {
   return jacobian.detach().to(torch::kFloat64).contiguous().reshape({-1, n, n});
 }
 
-std::vector<int64_t> values_shape(const torch::Tensor& jacobian) {
+// The forward's result: `values` [R, n] in J's batch shape [.., n] and
+// dtype; J's shape is kept for the backward.
+torch::Tensor values_like(AutogradContext* ctx, const torch::Tensor& jacobian,
+                          const torch::Tensor& values) {
+  ctx->saved_data["shape"] = jacobian.sizes().vec();
   std::vector<int64_t> shape = jacobian.sizes().vec();
   shape.pop_back();
-  return shape;
+  return values.reshape(shape).to(jacobian.scalar_type());
+}
+
+// The backward's result: `grad` [R, n, n] in J's shape and the gradient's dtype.
+variable_list gradient_like(AutogradContext* ctx, const torch::Tensor& grad,
+                            const torch::Tensor& upstream) {
+  return {grad.reshape(ctx->saved_data["shape"].toIntVector()).to(upstream.scalar_type())};
 }
 
 // grad_J(a, b) = sum_k g_k (L(a, k) R(b, k) - L2(a, k) R2(b, k)) per matrix,
@@ -66,21 +76,21 @@ struct SingularValues : public torch::autograd::Function<SingularValues> {
     const int64_t rows = in.size(0), n = in.size(1);
     torch::Tensor sigma = torch::empty({rows, n}, in.options());
     torch::Tensor u = torch::empty({rows, n, n}, in.options()), v = torch::empty_like(u);
+    const double* pin = in.data_ptr<double>();
+    double *ps = sigma.data_ptr<double>(), *pu = u.data_ptr<double>(), *pv = v.data_ptr<double>();
     for (int64_t m = 0; m < rows; ++m) {
-      const Eigen::Map<const RowMat> a(in.data_ptr<double>() + m * n * n, n, n);
+      const Eigen::Map<const RowMat> a(pin + m * n * n, n, n);
       const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
-      for (int64_t k = 0; k < n; ++k) sigma.data_ptr<double>()[m * n + k] = svd.singularValues()(k);
-      Eigen::Map<RowMat>(u.data_ptr<double>() + m * n * n, n, n) = svd.matrixU();
-      Eigen::Map<RowMat>(v.data_ptr<double>() + m * n * n, n, n) = svd.matrixV();
+      for (int64_t k = 0; k < n; ++k) ps[m * n + k] = svd.singularValues()(k);
+      Eigen::Map<RowMat>(pu + m * n * n, n, n) = svd.matrixU();
+      Eigen::Map<RowMat>(pv + m * n * n, n, n) = svd.matrixV();
     }
     ctx->save_for_backward({u, v});
-    ctx->saved_data["shape"] = jacobian.sizes().vec();
-    return sigma.reshape(values_shape(jacobian)).to(jacobian.scalar_type());
+    return values_like(ctx, jacobian, sigma);
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
-    const variable_list saved = ctx->get_saved_variables();
-    const torch::Tensor grad = outer_sum(grads[0], saved[0], saved[1], {}, {});
-    return {grad.reshape(ctx->saved_data["shape"].toIntVector()).to(grads[0].scalar_type())};
+    const variable_list s = ctx->get_saved_variables();
+    return gradient_like(ctx, outer_sum(grads[0], s[0], s[1], {}, {}), grads[0]);
   }
 };
 
@@ -94,30 +104,31 @@ struct EigenvalueRealParts : public torch::autograd::Function<EigenvalueRealPart
     // left(a, k) = (V^-1)(k, a), right(b, k) = V(b, k): real and imaginary parts.
     torch::Tensor lr = torch::empty({rows, n, n}, in.options()), li = torch::empty_like(lr);
     torch::Tensor rr = torch::empty_like(lr), ri = torch::empty_like(lr);
+    const double* pin = in.data_ptr<double>();
+    double *pre = re.data_ptr<double>(), *plr = lr.data_ptr<double>(), *pli = li.data_ptr<double>();
+    double *prr = rr.data_ptr<double>(), *pri = ri.data_ptr<double>();
     for (int64_t m = 0; m < rows; ++m) {
-      const Eigen::Map<const RowMat> a(in.data_ptr<double>() + m * n * n, n, n);
+      const Eigen::Map<const RowMat> a(pin + m * n * n, n, n);
       const Eigen::EigenSolver<Eigen::MatrixXd> solver(a, true);
       const Eigen::MatrixXcd vec = solver.eigenvectors();
       const Eigen::MatrixXcd inv = vec.partialPivLu().inverse();
       const int64_t base = m * n * n;
       for (int64_t k = 0; k < n; ++k) {
-        re.data_ptr<double>()[m * n + k] = solver.eigenvalues()(k).real();
+        pre[m * n + k] = solver.eigenvalues()(k).real();
         for (int64_t i = 0; i < n; ++i) {
-          lr.data_ptr<double>()[base + i * n + k] = inv(k, i).real();
-          li.data_ptr<double>()[base + i * n + k] = inv(k, i).imag();
-          rr.data_ptr<double>()[base + i * n + k] = vec(i, k).real();
-          ri.data_ptr<double>()[base + i * n + k] = vec(i, k).imag();
+          plr[base + i * n + k] = inv(k, i).real();
+          pli[base + i * n + k] = inv(k, i).imag();
+          prr[base + i * n + k] = vec(i, k).real();
+          pri[base + i * n + k] = vec(i, k).imag();
         }
       }
     }
     ctx->save_for_backward({lr, rr, li, ri});
-    ctx->saved_data["shape"] = jacobian.sizes().vec();
-    return re.reshape(values_shape(jacobian)).to(jacobian.scalar_type());
+    return values_like(ctx, jacobian, re);
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const variable_list s = ctx->get_saved_variables();
-    const torch::Tensor grad = outer_sum(grads[0], s[0], s[1], s[2], s[3]);
-    return {grad.reshape(ctx->saved_data["shape"].toIntVector()).to(grads[0].scalar_type())};
+    return gradient_like(ctx, outer_sum(grads[0], s[0], s[1], s[2], s[3]), grads[0]);
   }
 };
 
