@@ -52,15 +52,20 @@ class OrderedSum : public torch::autograd::Function<OrderedSum> {
   }
 };
 
-// t summed down to `shape` (same dimension count; 1 where t was broadcast),
-// one broadcast dimension at a time, each by ordered_sum.
-torch::Tensor sum_to_shape(torch::Tensor t, const std::vector<int64_t>& shape) {
+// t summed down to `shape` (same dimension count; 1 where t was broadcast):
+// all broadcast dimensions at once by ordered_sum, their elements in
+// row-major order (the order LibTorch's scalar reduction takes for the small
+// sums of the 2-state paths, whose bits stay as they were).
+torch::Tensor sum_to_shape(const torch::Tensor& t, const std::vector<int64_t>& shape) {
+  std::vector<int64_t> kept, summed;
   for (int64_t d = 0; d < t.dim(); ++d) {
-    if (shape[static_cast<std::size_t>(d)] == 1 && t.size(d) != 1) {
-      t = ordered_sum(t.movedim(d, -1), 1).unsqueeze(d);
-    }
+    const bool broadcast = shape[static_cast<std::size_t>(d)] == 1 && t.size(d) != 1;
+    (broadcast ? summed : kept).push_back(d);
   }
-  return t;
+  if (summed.empty()) return t;
+  std::vector<int64_t> order(kept);
+  order.insert(order.end(), summed.begin(), summed.end());
+  return ordered_sum(t.permute(order), static_cast<int64_t>(summed.size())).reshape(shape);
 }
 
 class OrderedBroadcastMul : public torch::autograd::Function<OrderedBroadcastMul> {

@@ -5,6 +5,7 @@
 
 #include "models/fused_mlp.h"
 #include "models/stacked_matmul.h"
+#include "models/ordered_sum.h"
 #include "models/pinned_activations.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
@@ -62,7 +63,7 @@ Jet Jet::cat(const std::vector<Jet>& parts) {
 namespace {
 // Outer product of direction gradients: [E,B,d,n] x [E,B,d,n] -> [E,B,d,d,n].
 torch::Tensor direction_outer(const torch::Tensor& a, const torch::Tensor& b) {
-  return a.unsqueeze(-2) * b.unsqueeze(-3);
+  return internal::ordered_broadcast_mul(a.unsqueeze(-2), b.unsqueeze(-3));
 }
 
 // phi(a) given phi(v), phi'(v), phi''(v).
@@ -70,9 +71,11 @@ Jet apply(const Jet& a, const torch::Tensor& f0, const torch::Tensor& f1,
           const torch::Tensor& f2) {
   Jet out;
   out.v = f0;
-  if (a.g.defined()) out.g = f1.unsqueeze(-2) * a.g;
+  using internal::ordered_broadcast_mul;
+  if (a.g.defined()) out.g = ordered_broadcast_mul(f1.unsqueeze(-2), a.g);
   if (a.h.defined()) {
-    out.h = f1.unsqueeze(-2).unsqueeze(-2) * a.h + f2.unsqueeze(-2).unsqueeze(-2) * direction_outer(a.g, a.g);
+    out.h = ordered_broadcast_mul(f1.unsqueeze(-2).unsqueeze(-2), a.h) +
+            ordered_broadcast_mul(f2.unsqueeze(-2).unsqueeze(-2), direction_outer(a.g, a.g));
   }
   return out;
 }
@@ -96,12 +99,14 @@ Jet jet_sub(const Jet& a, const Jet& b) {
 
 Jet jet_mul(const Jet& a, const Jet& b) {
   Jet out;
-  out.v = a.v * b.v;
+  using internal::ordered_broadcast_mul;
+  out.v = ordered_broadcast_mul(a.v, b.v);
   if (a.g.defined() && b.g.defined()) {
-    out.g = a.g * b.v.unsqueeze(-2) + b.g * a.v.unsqueeze(-2);
+    out.g = ordered_broadcast_mul(a.g, b.v.unsqueeze(-2)) + ordered_broadcast_mul(b.g, a.v.unsqueeze(-2));
   }
   if (a.h.defined() && b.h.defined()) {
-    out.h = a.h * b.v.unsqueeze(-2).unsqueeze(-2) + b.h * a.v.unsqueeze(-2).unsqueeze(-2) +
+    out.h = ordered_broadcast_mul(a.h, b.v.unsqueeze(-2).unsqueeze(-2)) +
+            ordered_broadcast_mul(b.h, a.v.unsqueeze(-2).unsqueeze(-2)) +
             direction_outer(a.g, b.g) + direction_outer(b.g, a.g);
   }
   return out;

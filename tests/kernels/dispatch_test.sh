@@ -2,8 +2,9 @@
 # tests/kernels/dispatch_test.sh PHNN PYTHON — the same bits under every CPU
 # dispatch setting this machine can run (docs/METHOD.md "Deterministic
 # kernels"): one small Duffing cell (seeds 0-1, 200 Adam steps) of every model
-# x integrator and of each regularizer, and three cells of the 4-state coupled
-# Duffing system file (DG: the LU Newton; DG4: ordered products), trained
+# x integrator and of each regularizer, and six cells of the 4-state coupled
+# Duffing system file (DG: the LU Newton; DG4: ordered products; CN and SR:
+# the op-by-op jets' ordered broadcast sums, Eigen's spectra), trained
 # under OPENBLAS_CORETYPE
 # (default / Haswell), ATEN_CPU_CAPABILITY (default / avx2 / avx512) and
 # PHNN_KERNEL_ISA (avx512 / avx2 / baseline); the per-run MSEs, validation
@@ -18,7 +19,8 @@ trap 'rm -rf "$WORK"' EXIT
 
 CELLS="node-rk2 node-rk4 phnn-s-rk2 phnn-s-dg phnn-s-rk4 phnn-s-dg4 phnn-jr-rk2 phnn-jr-dg
        phnn-jr-rk4 phnn-jr-dg4 phnn-jr-rk2:cn phnn-s-dg:sn phnn-s-rk2:sr
-       phnn-s-dg::coupled phnn-jr-dg4::coupled node-rk4::coupled"
+       phnn-s-dg::coupled phnn-jr-dg4::coupled node-rk4::coupled
+       phnn-s-rk2:cn:coupled phnn-jr-rk2:sr:coupled phnn-s-dg4::coupled"
 COUPLED="$(cd "$(dirname "$0")/../.." && pwd)/sweeps/systems/coupled-duffing.toml"
 # OPENBLAS_CORETYPE:ATEN_CPU_CAPABILITY:PHNN_KERNEL_ISA; the first is the reference.
 SETTINGS="Haswell:avx2:avx2 default:default:avx512 default:avx512:avx512 default:avx512:baseline"

@@ -1,6 +1,7 @@
 // tests/models/ordered_sum_test.cpp — the fixed-order sums: values equal the
 // left-to-right loop bit for bit, gradients are the broadcast of the
-// adjoint (first and second order), float32 too.
+// adjoint (first and second order), float32 too; the broadcast product's
+// backward sums its broadcast dimensions in row-major order.
 #include "models/ordered_sum.h"
 
 #include <gtest/gtest.h>
@@ -44,6 +45,31 @@ TEST(OrderedSumTest, GradientsFirstAndSecondOrder) {
   const auto xm = torch::randn({2, 3, 5}, torch::kFloat64).requires_grad_(true);
   ordered_mean(xm, 2).sum().backward();
   EXPECT_TRUE(torch::allclose(xm.grad(), torch::full_like(xm, 1.0 / 15.0), 0, 0));
+}
+
+// a [2, 1, 3, 1] * b [2, 4, 3, 5]: a's adjoint sums 4 x 5 = 20 products per
+// element over two broadcast dimensions that are not adjacent, in the order
+// (j, l) row-major, one rounding per addition (the loop below).
+TEST(OrderedSumTest, BroadcastProductSumsItsAdjointInRowMajorOrder) {
+  torch::manual_seed(5);
+  const auto scale = [](std::vector<int64_t> shape) {
+    return torch::pow(10.0, torch::randint(-8, 8, shape).to(torch::kFloat64));
+  };
+  const auto a = (torch::randn({2, 1, 3, 1}, torch::kFloat64)).requires_grad_(true);
+  const auto b = torch::randn({2, 4, 3, 5}, torch::kFloat64);
+  const auto adj = torch::randn({2, 4, 3, 5}, torch::kFloat64) * scale({2, 4, 3, 5});
+  const auto y = ordered_broadcast_mul(a, b);
+  EXPECT_TRUE(torch::equal(y, a * b));
+  const auto ga = torch::autograd::grad({y}, {a}, {adj})[0];
+  ASSERT_EQ(ga.sizes(), a.sizes());
+  for (int64_t i = 0; i < 2; ++i) {
+    for (int64_t k = 0; k < 3; ++k) {
+      double acc = 0;
+      for (int64_t j = 0; j < 4; ++j)
+        for (int64_t l = 0; l < 5; ++l) acc += adj[i][j][k][l].item<double>() * b[i][j][k][l].item<double>();
+      EXPECT_EQ(ga[i][0][k][0].item<double>(), acc) << i << ", " << k;
+    }
+  }
 }
 
 TEST(OrderedSumTest, Float32) {
