@@ -24,9 +24,9 @@ torch::Tensor ordered_sum(const torch::Tensor& t, int64_t dims);
 torch::Tensor ordered_mean(const torch::Tensor& t, int64_t dims);
 
 /// a * b with broadcasting, whose backward sums each operand's adjoint over
-/// its broadcast dimensions by ordered_sum (LibTorch's autograd would use
-/// its own sum there, in an order set by the vector width). Same dimension
-/// count for both operands.
+/// all its broadcast dimensions at once by ordered_sum, their elements in
+/// row-major order (LibTorch's autograd would use its own sum there, in an
+/// order set by the vector width). Same dimension count for both operands.
 torch::Tensor ordered_broadcast_mul(const torch::Tensor& a, const torch::Tensor& b);
 
 /// torch::matmul(a, b) for a [..., n, m] and b [..., m, k] (batch

@@ -4,9 +4,9 @@
 #include <cmath>
 
 #include "models/fused_mlp.h"
-#include "models/stacked_matmul.h"
 #include "models/ordered_sum.h"
 #include "models/pinned_activations.h"
+#include "models/stacked_matmul.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
 

@@ -5,8 +5,8 @@
 // Why not torch::linalg_svdvals / linalg_eigvals: they run LAPACK in
 // OpenBLAS, whose inner kernels (dnrm2, drot, dgemv, ...) are chosen at run
 // time by CPU, so their last bits may change from one machine to the next
-// (not observed on the dispatch test's cells, docs/METHOD.md "Not yet
-// pinned"; the pin is by construction). Eigen's JacobiSVD and
+// (not observed on the dispatch test's cells; the pin is by construction,
+// docs/METHOD.md "n-dimensional systems and models"). Eigen's JacobiSVD and
 // EigenSolver are compiled into this binary with fixed flags: the same
 // operations on every x86-64 CPU. Forward: per matrix; backward by the
 // first-order formulas (simple singular values and eigenvalues):

@@ -30,7 +30,10 @@ struct Jet {
   static Jet cat(const std::vector<Jet>& parts);
 };
 
-/// Elementwise and arithmetic jet operations (chain and product rules).
+/// Elementwise and arithmetic jet operations (chain and product rules). The
+/// broadcasting products (jet_mul, the chain rule of tanh and softplus, the
+/// order-2 outer products) sum their adjoints in one fixed order
+/// (ordered_broadcast_mul), so their gradients do not depend on the CPU.
 Jet jet_add(const Jet& a, const Jet& b);
 Jet jet_sub(const Jet& a, const Jet& b);
 Jet jet_mul(const Jet& a, const Jet& b);
