@@ -18,6 +18,7 @@ PACKAGES=(
   libcli11-dev                       # CLI11: the command-line parser of `phnn`
   libginac-dev                       # GiNaC: parses and differentiates system-file expressions
   libmuparser-dev                    # muParser: evaluates them fast (bytecode)
+  libmpfr-dev                        # GNU MPFR: correctly rounded sin, cos, exp, ... (same bits on every CPU)
   python3-h5py python3-numpy python3-matplotlib python3-pandas  # analysis/ only
   python3-torch                      # bench/pytorch_step.py only
 )

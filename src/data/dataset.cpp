@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "phnn/common/check.h"
+#include "phnn/common/cr_math.h"
 #include "phnn/data/counter_rng.h"
 
 namespace phnn {
@@ -139,8 +140,8 @@ TrajectorySpec trajectory_spec(const Oscillator& system,
     const double theta = ic.uniform(0.0, kTwoPi);
     const double r = ic.uniform(options.energy_min, options.energy_max);
     const double e0 = options.energy_sampling == EnergySampling::kDirect ? r : std::sqrt(r);
-    spec.x0 = Vec2(std::sqrt(2.0 * e0 / p.stiffness) * std::sin(theta),
-                   std::sqrt(2.0 * p.mass * e0) * std::cos(theta));
+    spec.x0 = Vec2(std::sqrt(2.0 * e0 / p.stiffness) * cr::sin(theta),
+                   std::sqrt(2.0 * p.mass * e0) * cr::cos(theta));
   }
   if (system.kind() == SystemKind::kSelfSustained) {
     // Algorithm 4: w ~ U(I_w), u = -w.

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "phnn/common/check.h"
+#include "phnn/common/cr_math.h"
 #include "phnn/data/counter_rng.h"
 
 namespace phnn {
@@ -261,7 +262,7 @@ std::vector<double> add_measurement_noise(PhSystemData* data, int rng_id,
   // Box-Muller: z = sqrt(-2 ln(1 - u1)) cos(2 pi u2), u in [0, 1).
   const auto normal = [](CounterRng* rng) {
     const double u1 = rng->uniform(), u2 = rng->uniform();
-    return std::sqrt(-2.0 * std::log(1.0 - u1)) * std::cos(2.0 * M_PI * u2);
+    return std::sqrt(-2.0 * cr::log(1.0 - u1)) * cr::cos(2.0 * M_PI * u2);
   };
   for (PhPairSet* p : {&data->train, &data->validation}) {
     for (std::size_t i = 0; i < p->size(); ++i) {

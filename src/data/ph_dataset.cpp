@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "phnn/common/check.h"
+#include "phnn/common/cr_math.h"
 #include "phnn/data/counter_rng.h"
 #include "phnn/integrators/ph_steps.h"
 
@@ -59,7 +60,7 @@ VecX algorithm1(const PhSystem& system, const InitialConditionDesign& d,
   const double e0 = options.energy_sampling == EnergySampling::kDirect ? r : std::sqrt(r);
   const MatX h0 = system.hessian(VecX::Zero(2));
   VecX x(2);
-  x << std::sqrt(2.0 * e0 / h0(0, 0)) * std::sin(theta), std::sqrt(2.0 * e0 / h0(1, 1)) * std::cos(theta);
+  x << std::sqrt(2.0 * e0 / h0(0, 0)) * cr::sin(theta), std::sqrt(2.0 * e0 / h0(1, 1)) * cr::cos(theta);
   return x;
 }
 
@@ -211,10 +212,10 @@ std::vector<VecX> input_samples(const PhSystem& system, const DatasetOptions& op
       const double t = k * hs;
       double v = offset;
       if (c.design == ControlDesign::Design::kSines) {
-        for (std::size_t j = 0; j < m; ++j) v += a[j] * std::sin(two_pi * c.frequencies[j] * t + phi[j]);
+        for (std::size_t j = 0; j < m; ++j) v += a[j] * cr::sin(two_pi * c.frequencies[j] * t + phi[j]);
       } else {
         const double f0 = c.frequencies[0], f1 = c.frequencies[1];
-        v += a[0] * std::sin(two_pi * (f0 * t + (f1 - f0) * t * t / (2.0 * duration)) + phi[0]);
+        v += a[0] * cr::sin(two_pi * (f0 * t + (f1 - f0) * t * t / (2.0 * duration)) + phi[0]);
       }
       out[static_cast<std::size_t>(k)](i) = v;
     }

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "models/kernel_isa.h"
+#include "phnn/common/cr_math.h"
 
 namespace phnn {
 namespace internal {
@@ -67,7 +68,7 @@ PHNN_KERNEL_INLINE void tanh_body(const double* x, double* y, int64_t n) {
 // come out right; 0 below.
 double exp_nonpositive(double x) {
   if (x != x) return x;
-  if (x >= 0.0) return x == 0.0 ? 1.0 : std::exp(x);  // outside the domain: the C library
+  if (x >= 0.0) return x == 0.0 ? 1.0 : cr::exp(x);  // outside the domain: correctly rounded
   if (x < -745.2) return 0.0;
   constexpr double kLog2e = 1.4426950408889634073599;
   constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;

@@ -9,29 +9,33 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "phnn/common/cr_math.h"
+
 namespace phnn {
 namespace internal {
 namespace {
 
 using Fn1 = double (*)(double);
 
-// GiNaC function name -> the one-argument function muParser calls for it.
+// GiNaC function name -> the one-argument function muParser calls for it:
+// correctly rounded (common/cr_math.h), so a system file's data are the
+// same bits whichever variant of the C library's functions a CPU gets.
 const std::map<std::string, Fn1>& functions() {
   static const std::map<std::string, Fn1> table = {
-      {"sin", [](double a) { return std::sin(a); }},
-      {"cos", [](double a) { return std::cos(a); }},
-      {"tan", [](double a) { return std::tan(a); }},
-      {"asin", [](double a) { return std::asin(a); }},
-      {"acos", [](double a) { return std::acos(a); }},
-      {"atan", [](double a) { return std::atan(a); }},
-      {"sinh", [](double a) { return std::sinh(a); }},
-      {"cosh", [](double a) { return std::cosh(a); }},
-      {"tanh", [](double a) { return std::tanh(a); }},
-      {"asinh", [](double a) { return std::asinh(a); }},
-      {"acosh", [](double a) { return std::acosh(a); }},
-      {"atanh", [](double a) { return std::atanh(a); }},
-      {"exp", [](double a) { return std::exp(a); }},
-      {"log", [](double a) { return std::log(a); }},
+      {"sin", [](double a) { return cr::sin(a); }},
+      {"cos", [](double a) { return cr::cos(a); }},
+      {"tan", [](double a) { return cr::tan(a); }},
+      {"asin", [](double a) { return cr::asin(a); }},
+      {"acos", [](double a) { return cr::acos(a); }},
+      {"atan", [](double a) { return cr::atan(a); }},
+      {"sinh", [](double a) { return cr::sinh(a); }},
+      {"cosh", [](double a) { return cr::cosh(a); }},
+      {"tanh", [](double a) { return cr::tanh(a); }},
+      {"asinh", [](double a) { return cr::asinh(a); }},
+      {"acosh", [](double a) { return cr::acosh(a); }},
+      {"atanh", [](double a) { return cr::atanh(a); }},
+      {"exp", [](double a) { return cr::exp(a); }},
+      {"log", [](double a) { return cr::log(a); }},
       {"abs", [](double a) { return std::fabs(a); }},
       {"csgn", [](double a) { return a > 0 ? 1.0 : (a < 0 ? -1.0 : 0.0); }},
       {"step", [](double a) { return a > 0 ? 1.0 : (a < 0 ? 0.0 : 0.5); }},
@@ -85,7 +89,7 @@ std::string power_source(const GiNaC::ex& base, const GiNaC::ex& exponent) {
     if (a == 1) positive = b;
     if (!positive.empty()) return n.is_negative() ? "phnn_inv(" + positive + ")" : positive;
   }
-  return "(" + b + "^" + muparser_source(exponent) + ")";
+  return "phnn_pow(" + b + "," + muparser_source(exponent) + ")";
 }
 
 }  // namespace
@@ -121,6 +125,7 @@ CompiledExpressions::CompiledExpressions(const std::vector<std::string>& sources
   for (std::size_t i = 0; i < names.size(); ++i) parser_.DefineVar(names[i], vars + i);
   for (const auto& [name, f] : functions()) parser_.DefineFun("phnn_" + name, f);
   for (const auto& [name, f] : power_functions()) parser_.DefineFun("phnn_" + name, f);
+  parser_.DefineFun("phnn_pow", static_cast<double (*)(double, double)>(cr::pow));
   std::string joined;
   for (const std::string& s : sources) joined += (joined.empty() ? "" : ",") + s;
   parser_.SetExpr(joined);

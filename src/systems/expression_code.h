@@ -22,8 +22,9 @@ namespace internal {
 
 /// muParser source of `e`: fully parenthesized, operands of sums and
 /// products sorted by their text, numbers with 17 significant digits,
-/// powers with muParser's ^, functions as phnn_<name>(...). Throws std::invalid_argument naming a
-/// function it cannot evaluate.
+/// powers as products, phnn_sqrt, phnn_inv or phnn_pow(b, e), functions as phnn_<name>(...), all
+/// correctly rounded (common/cr_math.h). Throws std::invalid_argument naming a function it cannot
+/// evaluate.
 std::string muparser_source(const GiNaC::ex& e);
 
 /// Expressions (muparser_source text) compiled by muParser over variables

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "phnn/common/check.h"
+#include "phnn/common/cr_math.h"
 #include "phnn/common/closest_name.h"
 
 namespace phnn {
@@ -256,7 +257,7 @@ Vec2 Oscillator::equilibrium(double u) const {
   if (options_.kind == SystemKind::kHarmonic) return Vec2(-u / k, 0.0);
   // k q + k3 q^3 = -u: strictly increasing in q, Newton from the linear guess.
   const double k3 = options_.cubic_stiffness;
-  double q = std::cbrt(-u / k3);
+  double q = cr::cbrt(-u / k3);
   if (std::abs(-u / k) < std::abs(q)) q = -u / k;
   for (int it = 0; it < 100; ++it) {
     const double r = k * q + k3 * q * q * q + u;

@@ -1,0 +1,472 @@
+// src/common/cr_math.cpp — correctly rounded elementary functions
+// (include/phnn/common/cr_math.h): GNU MPFR for every function, and a
+// double-double fast path with a rounding test (Ziv's strategy) for sin, cos,
+// exp and log, the ones data generation and system files call per step.
+//
+// The fast path: reduce the argument in double-double (x = k c + r with c =
+// pi/2 or ln 2 held as three doubles), sum the function's series in r (or
+// r^2) with its first terms in double-double and the tail in double, and
+// return round(y) when both ends of [y - eps |y|, y + eps |y|] round to the
+// same double (eps = 2^-63, at least twice the paths' error, which is ~2^-65
+// from the tails' double rounding; the fast-path and MPFR results are compared on
+// millions of arguments in tests/common/cr_math_test.cpp). Every operation is an
+// IEEE add, multiply or divide in a fixed order (products exact by Dekker's
+// split, no FMA; the build pins -ffp-contract=off), so even the rounding test
+// itself gives the same answer on every CPU.
+#include "phnn/common/cr_math.h"
+
+#include <mpfr.h>
+
+#include <cfloat>
+#include <cmath>
+
+namespace phnn {
+namespace cr {
+namespace {
+
+thread_local long fallbacks = 0;
+
+// ---- MPFR: correctly rounded to binary64, subnormals included ----------
+
+struct Scratch {
+  mpfr_t a, b, y;
+  Scratch() { mpfr_inits2(53, a, b, y, static_cast<mpfr_ptr>(nullptr)); }
+  ~Scratch() { mpfr_clears(a, b, y, static_cast<mpfr_ptr>(nullptr)); }
+};
+
+Scratch& scratch() {
+  thread_local Scratch s;
+  return s;
+}
+
+// MPFR's exponent range narrowed to binary64's for one call (exponents of
+// MPFR's [1/2, 1) mantissas: 2^-1074 has -1073, DBL_MAX has 1024), so that
+// mpfr_subnormalize rounds tiny results as IEEE arithmetic does.
+class Binary64Range {
+ public:
+  Binary64Range() : emin_(mpfr_get_emin()), emax_(mpfr_get_emax()) {
+    mpfr_set_emin(-1073);
+    mpfr_set_emax(1024);
+  }
+  ~Binary64Range() {
+    mpfr_set_emin(emin_);
+    mpfr_set_emax(emax_);
+  }
+  Binary64Range(const Binary64Range&) = delete;
+  Binary64Range& operator=(const Binary64Range&) = delete;
+
+ private:
+  mpfr_exp_t emin_, emax_;
+};
+
+using Unary = int (*)(mpfr_ptr, mpfr_srcptr, mpfr_rnd_t);
+
+double by_mpfr(Unary f, double x) {
+  Scratch& s = scratch();
+  const Binary64Range range;
+  mpfr_set_d(s.a, x, MPFR_RNDN);
+  const int ternary = f(s.y, s.a, MPFR_RNDN);
+  mpfr_subnormalize(s.y, ternary, MPFR_RNDN);
+  return mpfr_get_d(s.y, MPFR_RNDN);
+}
+
+double fallback(Unary f, double x) {
+  ++fallbacks;
+  return by_mpfr(f, x);
+}
+
+// ---- double-double arithmetic (Knuth, Dekker; the QD library's forms) ----
+
+struct Dd {
+  double hi, lo;
+};
+
+// a + b = s + e exactly.
+inline Dd two_sum(double a, double b) {
+  const double s = a + b;
+  const double bb = s - a;
+  return {s, (a - (s - bb)) + (b - bb)};
+}
+
+// The same for |a| >= |b| or a = 0.
+inline Dd fast_two_sum(double a, double b) {
+  const double s = a + b;
+  return {s, b - (s - a)};
+}
+
+// Veltkamp's split a = hi + lo, each with at most 26 significant bits.
+inline Dd split(double a) {
+  const double c = 134217729.0 * a;  // (2^27 + 1) a
+  const double hi = c - (c - a);
+  return {hi, a - hi};
+}
+
+// a b = p + e exactly (|a|, |b| far from overflow and underflow). The error
+// e is unique, so the FMA clone (one fused multiply-add) and Dekker's split
+// (baseline x86-64) give the same bits.
+template <bool kFma>
+[[gnu::always_inline]] inline Dd two_prod(double a, double b) {
+  const double p = a * b;
+  if (kFma) return {p, __builtin_fma(a, b, -p)};
+  const Dd x = split(a), y = split(b);
+  return {p, ((x.hi * y.hi - p) + x.hi * y.lo + x.lo * y.hi) + x.lo * y.lo};
+}
+
+inline Dd dd_add(Dd a, Dd b) {
+  Dd s = two_sum(a.hi, b.hi);
+  const Dd t = two_sum(a.lo, b.lo);
+  s.lo += t.hi;
+  s = fast_two_sum(s.hi, s.lo);
+  s.lo += t.lo;
+  return fast_two_sum(s.hi, s.lo);
+}
+
+template <bool kFma>
+[[gnu::always_inline]] inline Dd dd_mul(Dd a, Dd b) {
+  Dd p = two_prod<kFma>(a.hi, b.hi);
+  p.lo += a.hi * b.lo + a.lo * b.hi;
+  return fast_two_sum(p.hi, p.lo);
+}
+
+template <bool kFma>
+[[gnu::always_inline]] inline Dd dd_mul_d(Dd a, double b) {
+  Dd p = two_prod<kFma>(a.hi, b);
+  p.lo += a.lo * b;
+  return fast_two_sum(p.hi, p.lo);
+}
+
+inline Dd dd_neg(Dd a) { return {-a.hi, -a.lo}; }
+
+// a / b with three quotient digits (QD's accurate division).
+template <bool kFma>
+[[gnu::always_inline]] inline Dd dd_div(Dd a, Dd b) {
+  const double q1 = a.hi / b.hi;
+  Dd r = dd_add(a, dd_mul_d<kFma>(b, -q1));
+  const double q2 = r.hi / b.hi;
+  r = dd_add(r, dd_mul_d<kFma>(b, -q2));
+  const double q3 = r.hi / b.hi;
+  return dd_add(fast_two_sum(q1, q2), Dd{q3, 0.0});
+}
+
+// ---- constants, from MPFR at 256 bits ----------------------------------
+
+constexpr int kLead = 5;   // series terms summed in double-double (at most)
+constexpr int kTerms = 18; // series terms in all (at most)
+
+struct Series {
+  Dd lead[kLead];
+  double tail[kTerms];
+  int n_lead, n_terms;
+};
+
+// sum_j c_j t^j: the terms j >= n_lead by Horner in double on t.hi, the
+// first n_lead in double-double.
+template <bool kFma>
+[[gnu::always_inline]] inline Dd sum_series(const Series& c, Dd t) {
+  double tail = c.tail[c.n_terms - 1];
+  for (int j = c.n_terms - 2; j >= c.n_lead; --j) tail = tail * t.hi + c.tail[j];
+  Dd acc{tail, 0.0};
+  for (int j = c.n_lead - 1; j >= 0; --j) acc = dd_add(dd_mul<kFma>(acc, t), c.lead[j]);
+  return acc;
+}
+
+constexpr int kTableSize = 52;  // |r| <= pi/4 + a hair < 52.5 / 64
+
+struct Constants {
+  double pio2[3], two_over_pi;  // pi/2 = pio2[0] + pio2[1] + pio2[2] (+ 2^-160 or so)
+  double ln2[3], inv_ln2;
+  Dd sin_a[kTableSize + 1], cos_a[kTableSize + 1];  // sin(i/64), cos(i/64), i = 0..52
+  double sin_t[4], cos_t[4];  // (-1)^(j+1) / (2j+3)!, (-1)^(j+1) / (2j+2)!, j = 0..3
+  Series exp_r;   // e^r = sum r^j / j!
+  Series atanh_f; // atanh f / f = sum s^j / (2j+1), s = f^2
+};
+
+// v as d[0] + d[1] + ... + d[n-1], each the double nearest to what remains.
+void split_constant(mpfr_t v, double* d, int n) {
+  mpfr_t rest;
+  mpfr_init2(rest, 256);
+  mpfr_set(rest, v, MPFR_RNDN);
+  for (int i = 0; i < n; ++i) {
+    d[i] = mpfr_get_d(rest, MPFR_RNDN);
+    mpfr_sub_d(rest, rest, d[i], MPFR_RNDN);
+  }
+  mpfr_clear(rest);
+}
+
+// c_j = sign^j / (denominator of term j), as lead double-doubles and tail doubles.
+template <typename Denominator>
+Series make_series(int n_lead, int n_terms, int sign, Denominator denominator) {
+  Series s{};
+  s.n_lead = n_lead;
+  s.n_terms = n_terms;
+  mpfr_t c;
+  mpfr_init2(c, 256);
+  for (int j = 0; j < n_terms; ++j) {
+    mpfr_set_ui(c, 1, MPFR_RNDN);
+    mpfr_div(c, c, denominator(j), MPFR_RNDN);
+    if (sign < 0 && j % 2 == 1) mpfr_neg(c, c, MPFR_RNDN);
+    double parts[2];
+    split_constant(c, parts, 2);
+    if (j < n_lead) s.lead[j] = Dd{parts[0], parts[1]};
+    s.tail[j] = parts[0];
+  }
+  mpfr_clear(c);
+  return s;
+}
+
+// n! as an MPFR number (exact at 256 bits for the n used here).
+class Factorial {
+ public:
+  Factorial() { mpfr_init2(v_, 256); }
+  ~Factorial() { mpfr_clear(v_); }
+  Factorial(const Factorial&) = delete;
+  Factorial& operator=(const Factorial&) = delete;
+  mpfr_ptr of(unsigned long n) {
+    mpfr_fac_ui(v_, n, MPFR_RNDN);
+    return v_;
+  }
+  mpfr_ptr integer(unsigned long n) {
+    mpfr_set_ui(v_, n, MPFR_RNDN);
+    return v_;
+  }
+
+ private:
+  mpfr_t v_;
+};
+
+Constants make_constants() {
+  Constants k{};
+  mpfr_t v;
+  mpfr_init2(v, 256);
+  mpfr_const_pi(v, MPFR_RNDN);
+  mpfr_div_ui(v, v, 2, MPFR_RNDN);
+  split_constant(v, k.pio2, 3);
+  mpfr_ui_div(v, 1, v, MPFR_RNDN);
+  k.two_over_pi = mpfr_get_d(v, MPFR_RNDN);
+  mpfr_const_log2(v, MPFR_RNDN);
+  split_constant(v, k.ln2, 3);
+  mpfr_ui_div(v, 1, v, MPFR_RNDN);
+  k.inv_ln2 = mpfr_get_d(v, MPFR_RNDN);
+  mpfr_clear(v);
+  Factorial f;
+  const auto odd_factorial = [&f](int j) { return f.of(2 * j + 1); };
+  const auto even_factorial = [&f](int j) { return f.of(2 * j); };
+  const auto factorial = [&f](int j) { return f.of(j); };
+  const auto odd = [&f](int j) { return f.integer(2 * j + 1); };
+  mpfr_t a, t;
+  mpfr_inits2(256, a, t, static_cast<mpfr_ptr>(nullptr));
+  for (int i = 0; i <= kTableSize; ++i) {
+    mpfr_set_si(a, i, MPFR_RNDN);
+    mpfr_div_ui(a, a, 64, MPFR_RNDN);
+    double parts[2];
+    mpfr_sin(t, a, MPFR_RNDN);
+    split_constant(t, parts, 2);
+    k.sin_a[i] = Dd{parts[0], parts[1]};
+    mpfr_cos(t, a, MPFR_RNDN);
+    split_constant(t, parts, 2);
+    k.cos_a[i] = Dd{parts[0], parts[1]};
+  }
+  mpfr_clears(a, t, static_cast<mpfr_ptr>(nullptr));
+  for (int j = 0; j < 4; ++j) {
+    const double sign = j % 2 == 0 ? -1.0 : 1.0;
+    k.sin_t[j] = sign / mpfr_get_d(odd_factorial(j + 1), MPFR_RNDN);
+    k.cos_t[j] = sign / mpfr_get_d(even_factorial(j + 1), MPFR_RNDN);
+  }
+  k.exp_r = make_series(5, 17, +1, factorial);
+  k.atanh_f = make_series(3, 14, +1, odd);
+  return k;
+}
+
+const Constants& constants() {
+  static const Constants k = make_constants();
+  return k;
+}
+
+// ---- the fast paths -----------------------------------------------------
+
+constexpr double kEps = 0x1p-63;  // relative error bound of every fast path
+
+// The double nearest to v, if |v - (y.hi + y.lo)| <= kEps |y.hi| decides it.
+inline bool decided(Dd y, double* out) {
+  const double e = kEps * std::fabs(y.hi);
+  const double up = y.hi + (y.lo + e);
+  const double down = y.hi + (y.lo - e);
+  if (up != down) return false;
+  *out = up;
+  return true;
+}
+
+// x - k (c[0] + c[1] + c[2]) as a double-double. x - k c[0] rounded is exact:
+// with k = round(x / c) != 0 it is at most half of |x| and |k c[0]|' binade
+// (Sterbenz), and with k = 0 it is x.
+template <bool kFma>
+[[gnu::always_inline]] inline Dd reduce(double x, double k, const double* c) {
+  const Dd p = two_prod<kFma>(k, c[0]);
+  Dd r = two_sum(x - p.hi, -p.lo);
+  r = dd_add(r, dd_neg(two_prod<kFma>(k, c[1])));
+  return dd_add(r, Dd{-(k * c[2]), 0.0});
+}
+
+constexpr double kTrigLimit = 0x1p20;  // |x| reduced in double-double below this
+
+// sin or cos of x = k pi/2 + r, |r| <= pi/4: quadrant q = k mod 4 picks
+// +-sin r or +-cos r. Then r = a + t with a = i/64 from a table of sin a
+// and cos a (double-doubles) and |t| <= 1/128:
+//   sin r = S + S Q + C t + C t P,   cos r = C + C Q - S t - S t P,
+//   P = sin t / t - 1 = -t^2/6 + ..., Q = cos t - 1 = -t^2/2 + ...,
+// S t and C t as exact products, everything below 2^-14 |result| in double
+// (P and Q to t^8: their first omitted terms are ~2^-74 and ~2^-92).
+template <bool kFma>
+[[gnu::always_inline]] inline bool trig_fast(double x, bool cosine, double* out) {
+  const Constants& c = constants();
+  const double k = std::nearbyint(x * c.two_over_pi);
+  const Dd r = k == 0.0 ? Dd{x, 0.0} : reduce<kFma>(x, k, c.pio2);
+  const double i = std::nearbyint(r.hi * 64.0);
+  const int n = static_cast<int>(std::fabs(i));
+  // r.hi - i/64 is exact: r.hi and i/64 are within a factor 2 of each other (Sterbenz), or i = 0.
+  const Dd t = two_sum(r.hi - i / 64.0, r.lo);
+  const double sign = i < 0.0 ? -1.0 : 1.0;
+  const Dd sa{sign * c.sin_a[n].hi, sign * c.sin_a[n].lo}, ca = c.cos_a[n];
+  const double s = t.hi * t.hi;
+  const double p = s * (c.sin_t[0] + s * (c.sin_t[1] + s * (c.sin_t[2] + s * c.sin_t[3])));
+  const double q = s * (c.cos_t[0] + s * (c.cos_t[1] + s * (c.cos_t[2] + s * c.cos_t[3])));
+  const long quadrant = (static_cast<long>(k) + (cosine ? 1 : 0)) & 3;
+  Dd y;
+  if (quadrant % 2 == 0) {  // sin r
+    const Dd ct = two_prod<kFma>(ca.hi, t.hi);
+    y = two_sum(sa.hi, ct.hi);
+    y.lo += (((ct.lo + sa.lo) + sa.hi * q) + (ca.hi * t.lo + ca.lo * t.hi)) + ct.hi * p;
+  } else {  // cos r
+    const Dd st = two_prod<kFma>(sa.hi, t.hi);
+    y = two_sum(ca.hi, -st.hi);
+    y.lo += (((ca.lo - st.lo) + ca.hi * q) - (sa.hi * t.lo + sa.lo * t.hi)) - st.hi * p;
+  }
+  y = fast_two_sum(y.hi, y.lo);
+  if (quadrant >= 2) y = dd_neg(y);
+  return decided(y, out);
+}
+
+// x = k ln 2 + r, |r| <= ln 2 / 2: e^x = 2^k e^r (2^k applied by the caller).
+template <bool kFma>
+[[gnu::always_inline]] inline bool exp_fast(double x, double* out, int* k_out) {
+  const Constants& c = constants();
+  const double k = std::nearbyint(x * c.inv_ln2);
+  *k_out = static_cast<int>(k);
+  return decided(sum_series<kFma>(c.exp_r, reduce<kFma>(x, k, c.ln2)), out);
+}
+
+// x = 2^e m, m in [sqrt(1/2), sqrt(2)): log x = e ln 2 + 2 atanh f with
+// f = (m - 1) / (m + 1), |f| <= 0.172 (m - 1 is exact: Sterbenz).
+template <bool kFma>
+[[gnu::always_inline]] inline bool log_fast(double x, double* out) {
+  const Constants& c = constants();
+  int e = 0;
+  double m = std::frexp(x, &e);
+  if (m < M_SQRT1_2) {
+    m *= 2.0;
+    e -= 1;
+  }
+  const Dd f = dd_div<kFma>(Dd{m - 1.0, 0.0}, two_sum(m, 1.0));
+  const Dd series = sum_series<kFma>(c.atanh_f, dd_mul<kFma>(f, f));
+  const Dd log_m = dd_mul_d<kFma>(dd_mul<kFma>(f, series), 2.0);
+  const double de = static_cast<double>(e);
+  const Dd e_ln2 = dd_add(two_prod<kFma>(de, c.ln2[0]), Dd{de * c.ln2[1], 0.0});
+  return decided(dd_add(e_ln2, log_m), out);
+}
+
+// Two builds of each fast path: with the FMA instruction (two_prod in one
+// fused multiply-add) and without (Dekker's split). Same bits: the FMA is
+// used only where it computes an exact product error.
+struct FastPaths {
+  bool (*trig)(double, bool, double*);
+  bool (*exp)(double, double*, int*);
+  bool (*log)(double, double*);
+};
+
+[[gnu::target("fma")]] bool trig_fma(double x, bool cosine, double* out) {
+  return trig_fast<true>(x, cosine, out);
+}
+[[gnu::target("fma")]] bool exp_fma(double x, double* out, int* k) {
+  return exp_fast<true>(x, out, k);
+}
+[[gnu::target("fma")]] bool log_fma(double x, double* out) { return log_fast<true>(x, out); }
+bool trig_base(double x, bool cosine, double* out) { return trig_fast<false>(x, cosine, out); }
+bool exp_base(double x, double* out, int* k) { return exp_fast<false>(x, out, k); }
+bool log_base(double x, double* out) { return log_fast<false>(x, out); }
+
+bool baseline_only = false;  // set by tests (internal::use_baseline_fast_paths)
+
+const FastPaths& fast_paths() {
+  static const FastPaths base{trig_base, exp_base, log_base};
+  static const FastPaths detected =
+      __builtin_cpu_supports("fma") ? FastPaths{trig_fma, exp_fma, log_fma} : base;
+  return baseline_only ? base : detected;
+}
+
+}  // namespace
+
+long fallback_count() { return fallbacks; }
+
+namespace internal {
+void use_baseline_fast_paths(bool on) { baseline_only = on; }
+}  // namespace internal
+
+// |x| < 2^-26: sin x = x (1 - x^2/6 + ...) is within 2^-54.5 |x| of x, under
+// half an ulp even below a power of two.
+double sin(double x) {
+  if (std::fabs(x) < 0x1p-26) return x;
+  double y;
+  if (std::fabs(x) < kTrigLimit && fast_paths().trig(x, false, &y)) return y;
+  return fallback(mpfr_sin, x);
+}
+
+// |x| < 2^-27: cos x = 1 - x^2/2 + ... is within 2^-55 of 1, under half an
+// ulp below 1 (2^-54).
+double cos(double x) {
+  if (std::fabs(x) < 0x1p-27) return 1.0;
+  double y;
+  if (std::fabs(x) < kTrigLimit && fast_paths().trig(x, true, &y)) return y;
+  return fallback(mpfr_cos, x);
+}
+
+// The scaling by 2^k is exact while the result is normal (|x| <= 700).
+// |x| < 2^-60: 1 + x + ... rounds to 1.
+double exp(double x) {
+  if (std::fabs(x) < 0x1p-60) return 1.0;
+  double y;
+  int k = 0;
+  if (std::fabs(x) <= 700.0 && fast_paths().exp(x, &y, &k)) return std::ldexp(y, k);
+  return fallback(mpfr_exp, x);
+}
+
+double log(double x) {
+  if (x == 1.0) return 0.0;
+  double y;
+  if (x >= DBL_MIN && x <= DBL_MAX && fast_paths().log(x, &y)) return y;
+  return fallback(mpfr_log, x);
+}
+
+double tan(double x) { return by_mpfr(mpfr_tan, x); }
+double asin(double x) { return by_mpfr(mpfr_asin, x); }
+double acos(double x) { return by_mpfr(mpfr_acos, x); }
+double atan(double x) { return by_mpfr(mpfr_atan, x); }
+double sinh(double x) { return by_mpfr(mpfr_sinh, x); }
+double cosh(double x) { return by_mpfr(mpfr_cosh, x); }
+double tanh(double x) { return by_mpfr(mpfr_tanh, x); }
+double asinh(double x) { return by_mpfr(mpfr_asinh, x); }
+double acosh(double x) { return by_mpfr(mpfr_acosh, x); }
+double atanh(double x) { return by_mpfr(mpfr_atanh, x); }
+double cbrt(double x) { return by_mpfr(mpfr_cbrt, x); }
+
+double pow(double x, double y) {
+  Scratch& s = scratch();
+  const Binary64Range range;
+  mpfr_set_d(s.a, x, MPFR_RNDN);
+  mpfr_set_d(s.b, y, MPFR_RNDN);
+  const int ternary = mpfr_pow(s.y, s.a, s.b, MPFR_RNDN);
+  mpfr_subnormalize(s.y, ternary, MPFR_RNDN);
+  return mpfr_get_d(s.y, MPFR_RNDN);
+}
+
+}  // namespace cr
+}  // namespace phnn
