@@ -1,151 +1,53 @@
 // src/common/cr_math.cpp — correctly rounded elementary functions
-// (include/phnn/common/cr_math.h): GNU MPFR for every function, and a
-// double-double fast path with a rounding test (Ziv's strategy) for sin, cos,
-// exp and log, the ones data generation and system files call per step.
+// (include/phnn/common/cr_math.h): GNU MPFR for every function
+// (common/mpfr_binary64.h), and a fast path in double-double arithmetic
+// (common/double_double.h) with a rounding test (Ziv's strategy) for sin,
+// cos, exp and log, the ones data generation and system files call per step.
 //
-// The fast path: reduce the argument in double-double (x = k c + r with c =
-// pi/2 or ln 2 held as three doubles), sum the function's series in r (or
-// r^2) with its first terms in double-double and the tail in double, and
-// return round(y) when both ends of [y - eps |y|, y + eps |y|] round to the
-// same double (eps = 2^-63, at least twice the paths' error, which is ~2^-65
-// from the tails' double rounding; the fast-path and MPFR results are compared on
-// millions of arguments in tests/common/cr_math_test.cpp). Every operation is an
-// IEEE add, multiply or divide in a fixed order (products exact by Dekker's
-// split, no FMA; the build pins -ffp-contract=off), so even the rounding test
-// itself gives the same answer on every CPU.
+// The fast paths: reduce the argument (x = k c + r, c = pi/2 or ln 2 held as
+// three doubles), then sin/cos from a table of sin(i/64), cos(i/64) and short
+// series in the remainder, exp and log from their series with the leading
+// terms in double-double; return round(y) when both ends of
+// [y - eps |y|, y + eps |y|] round to the same double (eps = 2^-63, at least
+// twice the paths' error, ~2^-65, from the terms summed in double). MPFR
+// decides the rest (~0.15 % of calls). tests/common/cr_math_test.cpp compares
+// both builds (FMA and baseline) with MPFR on ~10^6 arguments. Every
+// operation is an IEEE add, multiply or divide in a fixed order (the build
+// pins -ffp-contract=off), so even the rounding test gives the same answer on
+// every CPU.
 #include "phnn/common/cr_math.h"
+
+#ifdef __FAST_MATH__
+#error "cr_math.cpp needs IEEE arithmetic in the order written: no -ffast-math"
+#endif
 
 #include <mpfr.h>
 
 #include <cfloat>
 #include <cmath>
 
+#include "common/double_double.h"
+#include "common/mpfr_binary64.h"
+
 namespace phnn {
 namespace cr {
 namespace {
 
+using internal::dd_add;
+using internal::dd_div;
+using internal::dd_mul;
+using internal::dd_mul_d;
+using internal::dd_neg;
+using internal::Dd;
+using internal::fast_two_sum;
+using internal::two_prod;
+using internal::two_sum;
+
 thread_local long fallbacks = 0;
 
-// ---- MPFR: correctly rounded to binary64, subnormals included ----------
-
-struct Scratch {
-  mpfr_t a, b, y;
-  Scratch() { mpfr_inits2(53, a, b, y, static_cast<mpfr_ptr>(nullptr)); }
-  ~Scratch() { mpfr_clears(a, b, y, static_cast<mpfr_ptr>(nullptr)); }
-};
-
-Scratch& scratch() {
-  thread_local Scratch s;
-  return s;
-}
-
-// MPFR's exponent range narrowed to binary64's for one call (exponents of
-// MPFR's [1/2, 1) mantissas: 2^-1074 has -1073, DBL_MAX has 1024), so that
-// mpfr_subnormalize rounds tiny results as IEEE arithmetic does.
-class Binary64Range {
- public:
-  Binary64Range() : emin_(mpfr_get_emin()), emax_(mpfr_get_emax()) {
-    mpfr_set_emin(-1073);
-    mpfr_set_emax(1024);
-  }
-  ~Binary64Range() {
-    mpfr_set_emin(emin_);
-    mpfr_set_emax(emax_);
-  }
-  Binary64Range(const Binary64Range&) = delete;
-  Binary64Range& operator=(const Binary64Range&) = delete;
-
- private:
-  mpfr_exp_t emin_, emax_;
-};
-
-using Unary = int (*)(mpfr_ptr, mpfr_srcptr, mpfr_rnd_t);
-
-double by_mpfr(Unary f, double x) {
-  Scratch& s = scratch();
-  const Binary64Range range;
-  mpfr_set_d(s.a, x, MPFR_RNDN);
-  const int ternary = f(s.y, s.a, MPFR_RNDN);
-  mpfr_subnormalize(s.y, ternary, MPFR_RNDN);
-  return mpfr_get_d(s.y, MPFR_RNDN);
-}
-
-double fallback(Unary f, double x) {
+double fallback(internal::MpfrUnary f, double x) {
   ++fallbacks;
-  return by_mpfr(f, x);
-}
-
-// ---- double-double arithmetic (Knuth, Dekker; the QD library's forms) ----
-
-struct Dd {
-  double hi, lo;
-};
-
-// a + b = s + e exactly.
-inline Dd two_sum(double a, double b) {
-  const double s = a + b;
-  const double bb = s - a;
-  return {s, (a - (s - bb)) + (b - bb)};
-}
-
-// The same for |a| >= |b| or a = 0.
-inline Dd fast_two_sum(double a, double b) {
-  const double s = a + b;
-  return {s, b - (s - a)};
-}
-
-// Veltkamp's split a = hi + lo, each with at most 26 significant bits.
-inline Dd split(double a) {
-  const double c = 134217729.0 * a;  // (2^27 + 1) a
-  const double hi = c - (c - a);
-  return {hi, a - hi};
-}
-
-// a b = p + e exactly (|a|, |b| far from overflow and underflow). The error
-// e is unique, so the FMA clone (one fused multiply-add) and Dekker's split
-// (baseline x86-64) give the same bits.
-template <bool kFma>
-[[gnu::always_inline]] inline Dd two_prod(double a, double b) {
-  const double p = a * b;
-  if (kFma) return {p, __builtin_fma(a, b, -p)};
-  const Dd x = split(a), y = split(b);
-  return {p, ((x.hi * y.hi - p) + x.hi * y.lo + x.lo * y.hi) + x.lo * y.lo};
-}
-
-inline Dd dd_add(Dd a, Dd b) {
-  Dd s = two_sum(a.hi, b.hi);
-  const Dd t = two_sum(a.lo, b.lo);
-  s.lo += t.hi;
-  s = fast_two_sum(s.hi, s.lo);
-  s.lo += t.lo;
-  return fast_two_sum(s.hi, s.lo);
-}
-
-template <bool kFma>
-[[gnu::always_inline]] inline Dd dd_mul(Dd a, Dd b) {
-  Dd p = two_prod<kFma>(a.hi, b.hi);
-  p.lo += a.hi * b.lo + a.lo * b.hi;
-  return fast_two_sum(p.hi, p.lo);
-}
-
-template <bool kFma>
-[[gnu::always_inline]] inline Dd dd_mul_d(Dd a, double b) {
-  Dd p = two_prod<kFma>(a.hi, b);
-  p.lo += a.lo * b;
-  return fast_two_sum(p.hi, p.lo);
-}
-
-inline Dd dd_neg(Dd a) { return {-a.hi, -a.lo}; }
-
-// a / b with three quotient digits (QD's accurate division).
-template <bool kFma>
-[[gnu::always_inline]] inline Dd dd_div(Dd a, Dd b) {
-  const double q1 = a.hi / b.hi;
-  Dd r = dd_add(a, dd_mul_d<kFma>(b, -q1));
-  const double q2 = r.hi / b.hi;
-  r = dd_add(r, dd_mul_d<kFma>(b, -q2));
-  const double q3 = r.hi / b.hi;
-  return dd_add(fast_two_sum(q1, q2), Dd{q3, 0.0});
+  return internal::by_mpfr(f, x);
 }
 
 // ---- constants, from MPFR at 256 bits ----------------------------------
@@ -315,7 +217,7 @@ constexpr double kTrigLimit = 0x1p20;  // |x| reduced in double-double below thi
 //   sin r = S + S Q + C t + C t P,   cos r = C + C Q - S t - S t P,
 //   P = sin t / t - 1 = -t^2/6 + ..., Q = cos t - 1 = -t^2/2 + ...,
 // S t and C t as exact products, everything below 2^-14 |result| in double
-// (P and Q to t^8: their first omitted terms are ~2^-74 and ~2^-92).
+// (P and Q to t^8: their first omitted terms are ~2^-95 and ~2^-92).
 template <bool kFma>
 [[gnu::always_inline]] inline bool trig_fast(double x, bool cosine, double* out) {
   const Constants& c = constants();
@@ -362,7 +264,7 @@ template <bool kFma>
   const Constants& c = constants();
   int e = 0;
   double m = std::frexp(x, &e);
-  if (m < M_SQRT1_2) {
+  if (m < 0.70710678118654752440) {  // sqrt(1/2): any nearby threshold works
     m *= 2.0;
     e -= 1;
   }
@@ -446,27 +348,19 @@ double log(double x) {
   return fallback(mpfr_log, x);
 }
 
-double tan(double x) { return by_mpfr(mpfr_tan, x); }
-double asin(double x) { return by_mpfr(mpfr_asin, x); }
-double acos(double x) { return by_mpfr(mpfr_acos, x); }
-double atan(double x) { return by_mpfr(mpfr_atan, x); }
-double sinh(double x) { return by_mpfr(mpfr_sinh, x); }
-double cosh(double x) { return by_mpfr(mpfr_cosh, x); }
-double tanh(double x) { return by_mpfr(mpfr_tanh, x); }
-double asinh(double x) { return by_mpfr(mpfr_asinh, x); }
-double acosh(double x) { return by_mpfr(mpfr_acosh, x); }
-double atanh(double x) { return by_mpfr(mpfr_atanh, x); }
-double cbrt(double x) { return by_mpfr(mpfr_cbrt, x); }
+double tan(double x) { return internal::by_mpfr(mpfr_tan, x); }
+double asin(double x) { return internal::by_mpfr(mpfr_asin, x); }
+double acos(double x) { return internal::by_mpfr(mpfr_acos, x); }
+double atan(double x) { return internal::by_mpfr(mpfr_atan, x); }
+double sinh(double x) { return internal::by_mpfr(mpfr_sinh, x); }
+double cosh(double x) { return internal::by_mpfr(mpfr_cosh, x); }
+double tanh(double x) { return internal::by_mpfr(mpfr_tanh, x); }
+double asinh(double x) { return internal::by_mpfr(mpfr_asinh, x); }
+double acosh(double x) { return internal::by_mpfr(mpfr_acosh, x); }
+double atanh(double x) { return internal::by_mpfr(mpfr_atanh, x); }
+double cbrt(double x) { return internal::by_mpfr(mpfr_cbrt, x); }
 
-double pow(double x, double y) {
-  Scratch& s = scratch();
-  const Binary64Range range;
-  mpfr_set_d(s.a, x, MPFR_RNDN);
-  mpfr_set_d(s.b, y, MPFR_RNDN);
-  const int ternary = mpfr_pow(s.y, s.a, s.b, MPFR_RNDN);
-  mpfr_subnormalize(s.y, ternary, MPFR_RNDN);
-  return mpfr_get_d(s.y, MPFR_RNDN);
-}
+double pow(double x, double y) { return internal::by_mpfr(mpfr_pow, x, y); }
 
 }  // namespace cr
 }  // namespace phnn

@@ -12,7 +12,8 @@
 // MPFR computes it. Used wherever a result depends on an elementary
 // function: data generation (initial states, controls, measurement noise)
 // and system-file expressions. The models' activations have their own
-// pinned kernels (src/models/pinned_activations.h).
+// pinned kernels (src/models/pinned_activations.h). Assumes the default
+// rounding mode (to nearest), which nothing in phnn changes.
 #pragma once
 
 namespace phnn {
