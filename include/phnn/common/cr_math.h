@@ -36,8 +36,10 @@ double log(double x);
 double cbrt(double x);
 double pow(double x, double y);
 
-/// How many calls of the fast paths (sin, cos, exp, log) in this thread
-/// fell back to MPFR: for tests and benchmarks.
+/// How many calls of sin, cos, exp and log in this thread MPFR computed
+/// (the fast path's rounding test did not decide, or the argument is outside
+/// its range: |x| >= 2^20 for sin/cos, |x| > 700 for exp, 0, subnormal or
+/// non-finite for log): for tests and benchmarks.
 long fallback_count();
 
 namespace internal {
