@@ -50,6 +50,8 @@ int main(int argc, char** argv) {
       {"cos", -7.0, 7.0, [](double x) { return std::cos(x); }, phnn::cr::cos},
       {"exp", -5.0, 5.0, [](double x) { return std::exp(x); }, phnn::cr::exp},
       {"log", 1e-3, 1e3, [](double x) { return std::log(x); }, phnn::cr::log},
+      {"tanh", -3.0, 3.0, [](double x) { return std::tanh(x); }, phnn::cr::tanh},
+      {"sinh", -3.0, 3.0, [](double x) { return std::sinh(x); }, phnn::cr::sinh},
       {"atan", -5.0, 5.0, [](double x) { return std::atan(x); }, phnn::cr::atan},
   };
   std::printf("function,range,libc_ns,cr_ns,cr_over_libc,mpfr_fallbacks_per_1e6\n");

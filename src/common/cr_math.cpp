@@ -2,12 +2,15 @@
 // (include/phnn/common/cr_math.h): GNU MPFR for every function
 // (common/mpfr_binary64.h), and a fast path in double-double arithmetic
 // (common/double_double.h) with a rounding test (Ziv's strategy) for sin,
-// cos, exp and log, the ones data generation and system files call per step.
+// cos, exp, log, sinh, cosh and tanh, the ones data generation and system
+// files call per step.
+// Size: one table of constants and the fast paths that share it (sin/cos,
+// exp, log, sinh/cosh/tanh); apart, they would need a header of internals.
 //
 // The fast paths: reduce the argument (x = k c + r, c = pi/2 or ln 2 held as
 // three doubles), then sin/cos from a table of sin(i/64), cos(i/64) and short
 // series in the remainder, exp and log from their series with the leading
-// terms in double-double; return round(y) when both ends of
+// terms in double-double, sinh, cosh and tanh from e^x - 1 in double-double; return round(y) when both ends of
 // [y - eps |y|, y + eps |y|] round to the same double (eps = 2^-63, at least
 // twice the paths' error, ~2^-65, from the terms summed in double). MPFR
 // decides the rest (~0.15 % of calls). tests/common/cr_math_test.cpp compares
@@ -25,6 +28,8 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "common/double_double.h"
 #include "common/mpfr_binary64.h"
@@ -52,7 +57,7 @@ double fallback(internal::MpfrUnary f, double x) {
 
 // ---- constants, from MPFR at 256 bits ----------------------------------
 
-constexpr int kLead = 5;   // series terms summed in double-double (at most)
+constexpr int kLead = 6;   // series terms summed in double-double (at most)
 constexpr int kTerms = 18; // series terms in all (at most)
 
 struct Series {
@@ -80,6 +85,7 @@ struct Constants {
   Dd sin_a[kTableSize + 1], cos_a[kTableSize + 1];  // sin(i/64), cos(i/64), i = 0..52
   double sin_t[4], cos_t[4];  // (-1)^(j+1) / (2j+3)!, (-1)^(j+1) / (2j+2)!, j = 0..3
   Series exp_r;   // e^r = sum r^j / j!
+  Series expm1_r; // (e^r - 1) / r = sum r^j / (j+1)!
   Series atanh_f; // atanh f / f = sum s^j / (2j+1), s = f^2
 };
 
@@ -99,6 +105,10 @@ void split_constant(mpfr_t v, double* d, int n) {
 template <typename Denominator>
 Series make_series(int n_lead, int n_terms, int sign, Denominator denominator) {
   Series s{};
+  if (n_lead > kLead || n_terms > kTerms || n_lead > n_terms) {
+    std::fputs("cr_math: a series longer than kLead / kTerms\n", stderr);
+    std::abort();
+  }
   s.n_lead = n_lead;
   s.n_terms = n_terms;
   mpfr_t c;
@@ -175,6 +185,8 @@ Constants make_constants() {
     k.cos_t[j] = sign / mpfr_get_d(even_factorial(j + 1), MPFR_RNDN);
   }
   k.exp_r = make_series(5, 17, +1, factorial);
+  const auto next_factorial = [&f](int j) { return f.of(j + 1); };
+  k.expm1_r = make_series(6, 17, +1, next_factorial);
   k.atanh_f = make_series(3, 14, +1, odd);
   return k;
 }
@@ -276,6 +288,41 @@ template <bool kFma>
   return decided(dd_add(e_ln2, log_m), out);
 }
 
+// e^x - 1 as a double-double, |x| <= 700: the series of (e^r - 1) / r when
+// k = 0 (no cancellation near 0), else 2^k e^r - 1 (at least 0.41 then).
+template <bool kFma>
+[[gnu::always_inline]] inline Dd expm1_dd(double x) {
+  const Constants& c = constants();
+  const double k = std::nearbyint(x * c.inv_ln2);
+  if (k == 0.0) return dd_mul_d<kFma>(sum_series<kFma>(c.expm1_r, Dd{x, 0.0}), x);
+  const Dd e = sum_series<kFma>(c.exp_r, reduce<kFma>(x, k, c.ln2));
+  const int n = static_cast<int>(k);
+  return dd_add(Dd{std::ldexp(e.hi, n), std::ldexp(e.lo, n)}, Dd{-1.0, 0.0});
+}
+
+enum class Hyperbolic { kSinh, kCosh, kTanh };
+
+// x > 0 (the callers use the symmetries), x <= 700. With m = e^x - 1:
+// sinh x = m (m + 2) / (2 (m + 1)) below 1 (no cancellation), (e^x - e^-x) / 2
+// above (no overflow of m^2; the difference loses < 1 bit), cosh x =
+// (e^x + e^-x) / 2, tanh x = m' / (m' + 2) with m' = e^(2x) - 1 (2x <= 40).
+template <bool kFma>
+[[gnu::always_inline]] inline bool hyperbolic_fast(double x, Hyperbolic f, double* out) {
+  if (f == Hyperbolic::kTanh) {
+    const Dd m = expm1_dd<kFma>(2.0 * x);
+    return decided(dd_div<kFma>(m, dd_add(m, Dd{2.0, 0.0})), out);
+  }
+  const Dd m = expm1_dd<kFma>(x);
+  const Dd e = dd_add(m, Dd{1.0, 0.0});
+  if (f == Hyperbolic::kSinh && x < 1.0) {
+    return decided(dd_div<kFma>(dd_mul<kFma>(m, dd_add(m, Dd{2.0, 0.0})), dd_mul_d<kFma>(e, 2.0)),
+                   out);
+  }
+  const Dd inverse = dd_div<kFma>(Dd{1.0, 0.0}, e);
+  return decided(dd_mul_d<kFma>(dd_add(e, f == Hyperbolic::kSinh ? dd_neg(inverse) : inverse), 0.5),
+                 out);
+}
+
 // Two builds of each fast path: with the FMA instruction (two_prod in one
 // fused multiply-add) and without (Dekker's split). Same bits: the FMA is
 // used only where it computes an exact product error.
@@ -283,6 +330,7 @@ struct FastPaths {
   bool (*trig)(double, bool, double*);
   bool (*exp)(double, double*, int*);
   bool (*log)(double, double*);
+  bool (*hyperbolic)(double, Hyperbolic, double*);
 };
 
 [[gnu::target("fma")]] bool trig_fma(double x, bool cosine, double* out) {
@@ -292,16 +340,22 @@ struct FastPaths {
   return exp_fast<true>(x, out, k);
 }
 [[gnu::target("fma")]] bool log_fma(double x, double* out) { return log_fast<true>(x, out); }
+[[gnu::target("fma")]] bool hyperbolic_fma(double x, Hyperbolic f, double* out) {
+  return hyperbolic_fast<true>(x, f, out);
+}
 bool trig_base(double x, bool cosine, double* out) { return trig_fast<false>(x, cosine, out); }
 bool exp_base(double x, double* out, int* k) { return exp_fast<false>(x, out, k); }
 bool log_base(double x, double* out) { return log_fast<false>(x, out); }
+bool hyperbolic_base(double x, Hyperbolic f, double* out) {
+  return hyperbolic_fast<false>(x, f, out);
+}
 
 bool baseline_only = false;  // set by tests (internal::use_baseline_fast_paths)
 
 const FastPaths& fast_paths() {
-  static const FastPaths base{trig_base, exp_base, log_base};
+  static const FastPaths base{trig_base, exp_base, log_base, hyperbolic_base};
   static const FastPaths detected =
-      __builtin_cpu_supports("fma") ? FastPaths{trig_fma, exp_fma, log_fma} : base;
+      __builtin_cpu_supports("fma") ? FastPaths{trig_fma, exp_fma, log_fma, hyperbolic_fma} : base;
   return baseline_only ? base : detected;
 }
 
@@ -352,9 +406,34 @@ double tan(double x) { return internal::by_mpfr(mpfr_tan, x); }
 double asin(double x) { return internal::by_mpfr(mpfr_asin, x); }
 double acos(double x) { return internal::by_mpfr(mpfr_acos, x); }
 double atan(double x) { return internal::by_mpfr(mpfr_atan, x); }
-double sinh(double x) { return internal::by_mpfr(mpfr_sinh, x); }
-double cosh(double x) { return internal::by_mpfr(mpfr_cosh, x); }
-double tanh(double x) { return internal::by_mpfr(mpfr_tanh, x); }
+// |x| < 2^-26: sinh x = x (1 + x^2/6 + ...) rounds to x (as sin x does).
+double sinh(double x) {
+  const double a = std::fabs(x);
+  if (a < 0x1p-26) return x;
+  double y;
+  if (a <= 700.0 && fast_paths().hyperbolic(a, Hyperbolic::kSinh, &y)) return x < 0 ? -y : y;
+  return fallback(mpfr_sinh, x);
+}
+
+// |x| < 2^-27: cosh x = 1 + x^2/2 + ... is within 2^-55 of 1: rounds to 1.
+double cosh(double x) {
+  const double a = std::fabs(x);
+  if (a < 0x1p-27) return 1.0;
+  double y;
+  if (a <= 700.0 && fast_paths().hyperbolic(a, Hyperbolic::kCosh, &y)) return y;
+  return fallback(mpfr_cosh, x);
+}
+
+// |x| < 2^-27: tanh x = x (1 - x^2/3 + ...) rounds to x. |x| > 20:
+// 1 - tanh |x| < 2 e^-40 < 2^-54, half an ulp below 1: rounds to +-1.
+double tanh(double x) {
+  const double a = std::fabs(x);
+  if (a < 0x1p-27 || a != a) return x;
+  if (a > 20.0) return x < 0 ? -1.0 : 1.0;
+  double y;
+  if (fast_paths().hyperbolic(a, Hyperbolic::kTanh, &y)) return x < 0 ? -y : y;
+  return fallback(mpfr_tanh, x);
+}
 double asinh(double x) { return internal::by_mpfr(mpfr_asinh, x); }
 double acosh(double x) { return internal::by_mpfr(mpfr_acosh, x); }
 double atanh(double x) { return internal::by_mpfr(mpfr_atanh, x); }

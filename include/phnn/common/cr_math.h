@@ -6,10 +6,10 @@
 // ~0.1 % of arguments (measured: docs/METHOD.md "Deterministic kernels").
 // A correctly rounded result is defined by the argument alone, so these
 // functions give one answer wherever they run: the double nearest to the
-// exact value (ties to even). sin, cos, exp and log take a fast path in
-// double-double arithmetic and return its result when an error bound proves
-// which double is nearest; otherwise, and for every other function, GNU
-// MPFR computes it. Used wherever a result depends on an elementary
+// exact value (ties to even). sin, cos, exp, log, sinh, cosh and tanh take
+// a fast path in double-double arithmetic and return its result when an
+// error bound proves which double is nearest; otherwise, and for every other
+// function, GNU MPFR computes it. Used wherever a result depends on an elementary
 // function: data generation (initial states, controls, measurement noise)
 // and system-file expressions. The models' activations have their own
 // pinned kernels (src/models/pinned_activations.h). Assumes the default
@@ -36,10 +36,11 @@ double log(double x);
 double cbrt(double x);
 double pow(double x, double y);
 
-/// How many calls of sin, cos, exp and log in this thread MPFR computed
-/// (the fast path's rounding test did not decide, or the argument is outside
-/// its range: |x| >= 2^20 for sin/cos, |x| > 700 for exp, 0, subnormal or
-/// non-finite for log): for tests and benchmarks.
+/// How many calls of the fast-path functions (sin, cos, exp, log, sinh,
+/// cosh, tanh) in this thread MPFR computed: the rounding test did not
+/// decide, or the argument is outside the path's range (|x| >= 2^20 for
+/// sin/cos, |x| > 700 for exp/sinh/cosh, 0, subnormal or non-finite for
+/// log). For tests and benchmarks.
 long fallback_count();
 
 namespace internal {
