@@ -10,9 +10,10 @@
 // The fast paths: reduce the argument (x = k c + r, c = pi/2 or ln 2 held as
 // three doubles), then sin/cos from a table of sin(i/64), cos(i/64) and short
 // series in the remainder, exp and log from their series with the leading
-// terms in double-double, sinh, cosh and tanh from e^x - 1 in double-double; return round(y) when both ends of
-// [y - eps |y|, y + eps |y|] round to the same double (eps = 2^-63, at least
-// twice the paths' error, ~2^-65, from the terms summed in double). MPFR
+// terms in double-double, sinh, cosh and tanh from e^x - 1 in double-double;
+// return round(y) when both ends of [y - eps |y|, y + eps |y|] round to the
+// same double (eps = 2^-63, at least twice the paths' error, ~2^-65, from the
+// terms summed in double). MPFR
 // decides the rest (~0.15 % of calls). tests/common/cr_math_test.cpp compares
 // both builds (FMA and baseline) with MPFR on ~10^6 arguments. Every
 // operation is an IEEE add, multiply or divide in a fixed order (the build
@@ -260,13 +261,19 @@ template <bool kFma>
   return decided(y, out);
 }
 
-// x = k ln 2 + r, |r| <= ln 2 / 2: e^x = 2^k e^r (2^k applied by the caller).
+// x = k ln 2 + r, |r| <= ln 2 / 2 with k = round(x / ln 2): e^r.
+template <bool kFma>
+[[gnu::always_inline]] inline Dd exp_of_remainder(double x, double k) {
+  const Constants& c = constants();
+  return sum_series<kFma>(c.exp_r, reduce<kFma>(x, k, c.ln2));
+}
+
+// e^x = 2^k e^r (2^k applied by the caller).
 template <bool kFma>
 [[gnu::always_inline]] inline bool exp_fast(double x, double* out, int* k_out) {
-  const Constants& c = constants();
-  const double k = std::nearbyint(x * c.inv_ln2);
+  const double k = std::nearbyint(x * constants().inv_ln2);
   *k_out = static_cast<int>(k);
-  return decided(sum_series<kFma>(c.exp_r, reduce<kFma>(x, k, c.ln2)), out);
+  return decided(exp_of_remainder<kFma>(x, k), out);
 }
 
 // x = 2^e m, m in [sqrt(1/2), sqrt(2)): log x = e ln 2 + 2 atanh f with
@@ -295,7 +302,7 @@ template <bool kFma>
   const Constants& c = constants();
   const double k = std::nearbyint(x * c.inv_ln2);
   if (k == 0.0) return dd_mul_d<kFma>(sum_series<kFma>(c.expm1_r, Dd{x, 0.0}), x);
-  const Dd e = sum_series<kFma>(c.exp_r, reduce<kFma>(x, k, c.ln2));
+  const Dd e = exp_of_remainder<kFma>(x, k);
   const int n = static_cast<int>(k);
   return dd_add(Dd{std::ldexp(e.hi, n), std::ldexp(e.lo, n)}, Dd{-1.0, 0.0});
 }
@@ -402,10 +409,6 @@ double log(double x) {
   return fallback(mpfr_log, x);
 }
 
-double tan(double x) { return internal::by_mpfr(mpfr_tan, x); }
-double asin(double x) { return internal::by_mpfr(mpfr_asin, x); }
-double acos(double x) { return internal::by_mpfr(mpfr_acos, x); }
-double atan(double x) { return internal::by_mpfr(mpfr_atan, x); }
 // |x| < 2^-26: sinh x = x (1 + x^2/6 + ...) rounds to x (as sin x does).
 double sinh(double x) {
   const double a = std::fabs(x);
@@ -434,6 +437,12 @@ double tanh(double x) {
   if (fast_paths().hyperbolic(a, Hyperbolic::kTanh, &y)) return x < 0 ? -y : y;
   return fallback(mpfr_tanh, x);
 }
+
+// MPFR only.
+double tan(double x) { return internal::by_mpfr(mpfr_tan, x); }
+double asin(double x) { return internal::by_mpfr(mpfr_asin, x); }
+double acos(double x) { return internal::by_mpfr(mpfr_acos, x); }
+double atan(double x) { return internal::by_mpfr(mpfr_atan, x); }
 double asinh(double x) { return internal::by_mpfr(mpfr_asinh, x); }
 double acosh(double x) { return internal::by_mpfr(mpfr_acosh, x); }
 double atanh(double x) { return internal::by_mpfr(mpfr_atanh, x); }
