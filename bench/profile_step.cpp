@@ -1,6 +1,6 @@
 // bench/profile_step.cpp — per-operator profile of training steps (chrome
 // trace JSON from the LibTorch autograd profiler), for finding hot spots.
-//   profile_step MODEL INTEGRATOR MEMBERS STEPS OUT.json
+//   profile_step MODEL INTEGRATOR MEMBERS STEPS OUT.json [float32]
 #include <cstdlib>
 #include <string>
 
@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   for (int s = 0; s < std::atoi(argv[3]); ++s) cell.seeds.push_back(s);
   cell.training.steps = std::atoi(argv[4]);
   cell.training.eval_every = 1000000;
+  if (argc > 6 && std::string(argv[6]) == "float32") cell.training.precision = phnn::Precision::kFloat32;
   torch::autograd::profiler::RecordProfile guard(argv[5]);
   phnn::train_cell(cell, data);
   return 0;

@@ -52,6 +52,12 @@ std::string grid_text(const CellSpec& cell, const std::string& system) {
   return s.str();
 }
 
+// `precision = "float32"` in [training] when not the default.
+std::string precision_line(const CellSpec& cell) {
+  if (cell.training.precision == Precision::kFloat64) return "";
+  return "\nprecision = \"" + to_string(cell.training.precision) + "\"";
+}
+
 // The cell as a one-study sweep file, so that `phnn train --out` writes a
 // results file that `phnn reduce` and analysis/ read like any sweep's.
 std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
@@ -66,7 +72,8 @@ std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
   s << "\n\n[training]\nsteps = " << cell.training.steps
     << "\nlearning_rate = " << g17(cell.training.learning_rate)
     << "\nbatch_size = " << cell.training.batch_size
-    << "\neval_every = " << cell.training.eval_every << "\n\n[physics." << system << "]\n"
+    << "\neval_every = " << cell.training.eval_every << precision_line(cell)
+    << "\n\n[physics." << system << "]\n"
     << "mass = " << g17(data.system.mass) << "\nstiffness = " << g17(data.system.stiffness) << "\n";
   if (data.system.kind == SystemKind::kDuffing) {
     s << "cubic_stiffness = " << g17(data.system.cubic_stiffness) << "\n";
@@ -91,7 +98,7 @@ std::string cell_sweep_text(const CellSpec& cell, const PhSystemData& data,
     << "\n\n[training]\nsteps = " << cell.training.steps
     << "\nlearning_rate = " << g17(cell.training.learning_rate)
     << "\nbatch_size = " << cell.training.batch_size
-    << "\neval_every = " << cell.training.eval_every << "\n\n"
+    << "\neval_every = " << cell.training.eval_every << precision_line(cell) << "\n\n"
     << grid_text(cell, system_entry);
   return s.str();
 }
@@ -158,6 +165,8 @@ void declare_train_options(cli::Parser* parser) {
   parser->option("lr", "learning rate", "1e-3");
   parser->option("batch", "minibatch size", "64");
   parser->option("eval-every", "validation cadence in steps", "500");
+  parser->option("precision", "float64 | float32 (float32 trains only; inference stays float64)",
+                 "float64");
   parser->option("data", "read the data set from this file (`phnn data`) instead of generating it");
   parser->option("data-seed", "data-set seed when generating", "0");
   parser->option("damping", "c of z(w) = c w [N s/m] when generating", "0.14737");
@@ -217,6 +226,7 @@ CellSpec cell_from_options(const cli::Parser& parser) {
   cell.training.learning_rate = parser.get_double("lr");
   cell.training.batch_size = parser.get_int_in("batch", 1, kMax);
   cell.training.eval_every = parser.get_int_in("eval-every", 1, kMax);
+  cell.training.precision = parse_precision(parser.get("precision"));
   return cell;
 }
 

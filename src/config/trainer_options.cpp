@@ -51,6 +51,13 @@ std::string to_string(Precision precision) {
 
 std::vector<Precision> all_precisions() { return {Precision::kFloat64, Precision::kFloat32}; }
 
+Precision parse_precision(const std::string& name) {
+  for (Precision p : all_precisions()) {
+    if (name == to_string(p)) return p;
+  }
+  throw std::invalid_argument("unknown precision \"" + name + "\"; expected one of: float64, float32");
+}
+
 std::string to_string(InferenceWeights weights) {
   switch (weights) {
     case InferenceWeights::kBestValidation: return "best-validation";

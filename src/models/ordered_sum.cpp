@@ -86,6 +86,21 @@ class OrderedBroadcastMul : public torch::autograd::Function<OrderedBroadcastMul
   }
 };
 
+// t.expand(sizes) whose backward sums the adjoint down to t's shape by
+// sum_to_shape (autograd's ExpandBackward would use LibTorch's sum).
+class OrderedExpand : public torch::autograd::Function<OrderedExpand> {
+ public:
+  static torch::Tensor forward(torch::autograd::AutogradContext* ctx, const torch::Tensor& t,
+                               std::vector<int64_t> sizes) {
+    ctx->saved_data["shape"] = t.sizes().vec();
+    return t.expand(sizes);
+  }
+  static torch::autograd::tensor_list backward(torch::autograd::AutogradContext* ctx,
+                                               torch::autograd::tensor_list grads) {
+    return {sum_to_shape(grads[0], ctx->saved_data["shape"].toIntVector()), torch::Tensor()};
+  }
+};
+
 }  // namespace
 
 torch::Tensor ordered_broadcast_mul(const torch::Tensor& a, const torch::Tensor& b) {
@@ -93,6 +108,13 @@ torch::Tensor ordered_broadcast_mul(const torch::Tensor& a, const torch::Tensor&
                                  "count, got " << a.sizes() << " and " << b.sizes());
   if (!torch::GradMode::is_enabled() || !(a.requires_grad() || b.requires_grad())) return a * b;
   return OrderedBroadcastMul::apply(a, b);
+}
+
+torch::Tensor ordered_expand(const torch::Tensor& t, const std::vector<int64_t>& sizes) {
+  PHNN_CHECK(static_cast<int64_t>(sizes.size()) == t.dim(),
+             "ordered_expand: expected " << t.dim() << " sizes, got " << sizes.size());
+  if (!torch::GradMode::is_enabled() || !t.requires_grad()) return t.expand(sizes);
+  return OrderedExpand::apply(t, sizes);
 }
 
 torch::Tensor ordered_sum(const torch::Tensor& t, int64_t dims) {

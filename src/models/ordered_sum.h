@@ -6,6 +6,8 @@
 // (docs/METHOD.md "Deterministic kernels").
 #pragma once
 
+#include <vector>
+
 #include <torch/torch.h>
 
 namespace phnn {
@@ -28,6 +30,12 @@ torch::Tensor ordered_mean(const torch::Tensor& t, int64_t dims);
 /// row-major order (LibTorch's autograd would use its own sum there, in an
 /// order set by the vector width). Same dimension count for both operands.
 torch::Tensor ordered_broadcast_mul(const torch::Tensor& a, const torch::Tensor& b);
+
+/// t.expand(sizes) (same dimension count; t's broadcast dimensions of size
+/// 1), whose backward sums the adjoint over the expanded dimensions at once
+/// by ordered_sum, in row-major order: a bias added to a batch, a weight row
+/// broadcast over a batch.
+torch::Tensor ordered_expand(const torch::Tensor& t, const std::vector<int64_t>& sizes);
 
 /// torch::matmul(a, b) for a [..., n, m] and b [..., m, k] (batch
 /// dimensions broadcast; at least 2-D each), each element summed over m in

@@ -13,14 +13,37 @@ namespace {
 using torch::autograd::AutogradContext;
 using torch::autograd::tensor_list;
 
+// f on every element; float32 elements are widened, mapped by the float64
+// function and rounded back (float32 training: one rounding of a pinned
+// double, the same bits on every CPU, where LibTorch's float kernels differ
+// between its vectorized and scalar builds).
 template <typename F>
 torch::Tensor map_elements(const torch::Tensor& x, F f) {
   const torch::Tensor in = x.contiguous();
   torch::Tensor out = torch::empty_like(in);
+  if (in.scalar_type() == torch::kFloat32) {
+    const float* p = in.data_ptr<float>();
+    float* q = out.data_ptr<float>();
+    for (int64_t k = 0; k < in.numel(); ++k) q[k] = static_cast<float>(f(static_cast<double>(p[k])));
+    return out;
+  }
   const double* p = in.data_ptr<double>();
   double* q = out.data_ptr<double>();
   for (int64_t k = 0; k < in.numel(); ++k) q[k] = f(p[k]);
   return out;
+}
+
+torch::Tensor tanh_values(const torch::Tensor& x) {
+  if (x.scalar_type() == torch::kFloat32) {
+    const torch::Tensor wide = x.to(torch::kFloat64).contiguous();
+    torch::Tensor t = torch::empty_like(wide);
+    tanh_array(wide.data_ptr<double>(), t.data_ptr<double>(), wide.numel());
+    return t.to(torch::kFloat32);
+  }
+  const torch::Tensor in = x.contiguous();
+  torch::Tensor t = torch::empty_like(in);
+  tanh_array(in.data_ptr<double>(), t.data_ptr<double>(), in.numel());
+  return t;
 }
 
 torch::Tensor sigmoid_values(const torch::Tensor& x) {
@@ -56,9 +79,7 @@ class SoftplusFn : public torch::autograd::Function<SoftplusFn> {
 class TanhFn : public torch::autograd::Function<TanhFn> {
  public:
   static torch::Tensor forward(AutogradContext* ctx, const torch::Tensor& x) {
-    const torch::Tensor in = x.contiguous();
-    torch::Tensor t = torch::empty_like(in);
-    tanh_array(in.data_ptr<double>(), t.data_ptr<double>(), in.numel());
+    const torch::Tensor t = tanh_values(x);
     ctx->save_for_backward({t});
     return t;
   }
@@ -68,7 +89,9 @@ class TanhFn : public torch::autograd::Function<TanhFn> {
   }
 };
 
-bool pinned(const torch::Tensor& x) { return x.scalar_type() == torch::kFloat64; }
+bool pinned(const torch::Tensor& x) {
+  return x.scalar_type() == torch::kFloat64 || x.scalar_type() == torch::kFloat32;
+}
 
 }  // namespace
 

@@ -11,15 +11,15 @@
 namespace phnn {
 namespace internal {
 
-/// tanh(x), float64 (float32 falls back to torch::tanh: float32 training is
-/// not pinned).
+/// tanh(x), float64 or float32 (float32 elements: the float64 kernel's
+/// value rounded to float, so float32 training is pinned too).
 torch::Tensor pinned_tanh(const torch::Tensor& x);
 
 /// log(1 + e^x), and x above 20 as LibTorch's threshold; slope sigmoid(x)
-/// (1 above 20). float64 (float32: torch::softplus).
+/// (1 above 20). float64 or float32 (as pinned_tanh).
 torch::Tensor pinned_softplus(const torch::Tensor& x);
 
-/// 1 / (1 + e^-x), slope s (1 - s). float64 (float32: torch::sigmoid).
+/// 1 / (1 + e^-x), slope s (1 - s). float64 or float32 (as pinned_tanh).
 torch::Tensor pinned_sigmoid(const torch::Tensor& x);
 
 }  // namespace internal

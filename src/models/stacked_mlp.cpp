@@ -197,11 +197,21 @@ Jet StackedMlp::forward_input(const torch::Tensor& x, int directions, int order)
   return Jet{out.v, out.g, out.h};
 }
 
+namespace {
+// x W + b; the bias's adjoint is summed over the batch in order
+// (ordered_expand), not by autograd's broadcast sum, whose order LibTorch
+// sets by the CPU's vector width.
+torch::Tensor affine(const torch::Tensor& x, const torch::Tensor& w, const torch::Tensor& b) {
+  const auto xw = internal::stacked_matmul(x, w);
+  return xw + internal::ordered_expand(b, xw.sizes().vec());
+}
+}  // namespace
+
 torch::Tensor StackedMlp::reference_forward(const torch::Tensor& x) const {
   torch::Tensor a = x;
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
-    a = internal::stacked_matmul(a, weights_[l]) + biases_[l];
+    a = affine(a, weights_[l], biases_[l]);
     if (l < last) a = internal::pinned_tanh(a);
   }
   return a;
@@ -224,7 +234,7 @@ Jet StackedMlp::reference_forward(const Jet& x) const {
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 0; l < weights_.size(); ++l) {
     Jet z;
-    z.v = internal::stacked_matmul(a.v, weights_[l]) + biases_[l];
+    z.v = affine(a.v, weights_[l], biases_[l]);
     if (a.g.defined()) z.g = batched_linear(a.g, weights_[l]);
     if (a.h.defined()) z.h = batched_linear(a.h, weights_[l]);
     a = l < last ? jet_tanh(z) : z;
@@ -238,21 +248,23 @@ Jet StackedMlp::reference_forward_input(const torch::Tensor& x, int directions,
   const int64_t E = x.size(0), B = x.size(1);
   // Layer 0: z = x W + b, dz/dx_i = W[i, :], d2z = 0.
   Jet z;
-  z.v = internal::stacked_matmul(x, weights_[0]) + biases_[0];
-  z.g = weights_[0].narrow(1, 0, directions).unsqueeze(1).expand({E, B, directions, weights_[0].size(2)});
+  z.v = affine(x, weights_[0], biases_[0]);
+  z.g = internal::ordered_expand(weights_[0].narrow(1, 0, directions).unsqueeze(1),
+                                 {E, B, directions, weights_[0].size(2)});
   Jet a;
   if (weights_.size() == 1) return z;
   const auto t = internal::pinned_tanh(z.v);
   const auto d1 = 1.0 - t * t;
   a.v = t;
-  a.g = d1.unsqueeze(-2) * z.g;
+  a.g = internal::ordered_broadcast_mul(d1.unsqueeze(-2), z.g);
   if (order >= 2) {
-    a.h = (-2.0 * t * d1).unsqueeze(-2).unsqueeze(-2) * direction_outer(z.g, z.g);
+    a.h = internal::ordered_broadcast_mul((-2.0 * t * d1).unsqueeze(-2).unsqueeze(-2),
+                                          direction_outer(z.g, z.g));
   }
   const std::size_t last = weights_.size() - 1;
   for (std::size_t l = 1; l < weights_.size(); ++l) {
     Jet y;
-    y.v = internal::stacked_matmul(a.v, weights_[l]) + biases_[l];
+    y.v = affine(a.v, weights_[l], biases_[l]);
     y.g = batched_linear(a.g, weights_[l]);
     if (a.h.defined()) y.h = batched_linear(a.h, weights_[l]);
     a = l < last ? jet_tanh(y) : y;

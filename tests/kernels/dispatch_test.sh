@@ -2,7 +2,8 @@
 # tests/kernels/dispatch_test.sh PHNN PYTHON — the same bits under every CPU
 # dispatch setting this machine can run (docs/METHOD.md "Deterministic
 # kernels"): one small Duffing cell (seeds 0-1, 200 Adam steps) of every model
-# x integrator and of each regularizer, and six cells of the 4-state coupled
+# x integrator and of each regularizer, three float32 cells (LibTorch's float
+# kernels replaced by pinned ones), and six cells of the 4-state coupled
 # Duffing system file (DG: the LU Newton; DG4: ordered products; CN and SR:
 # the op-by-op jets' ordered broadcast sums, Eigen's spectra), trained
 # under OPENBLAS_CORETYPE
@@ -22,20 +23,21 @@ trap 'rm -rf "$WORK"' EXIT
 CELLS="node-rk2 node-rk4 phnn-s-rk2 phnn-s-dg phnn-s-rk4 phnn-s-dg4 phnn-jr-rk2 phnn-jr-dg
        phnn-jr-rk4 phnn-jr-dg4 phnn-jr-rk2:cn phnn-s-dg:sn phnn-s-rk2:sr
        phnn-s-dg::coupled phnn-jr-dg4::coupled node-rk4::coupled
-       phnn-s-rk2:cn:coupled phnn-jr-rk2:sr:coupled phnn-s-dg4::coupled"
+       phnn-s-rk2:cn:coupled phnn-jr-rk2:sr:coupled phnn-s-dg4::coupled
+       phnn-jr-rk2:cn::float32 phnn-s-dg:sr::float32 node-rk4:::float32"
 COUPLED="$(cd "$(dirname "$0")/../.." && pwd)/sweeps/systems/coupled-duffing.toml"
 # OPENBLAS_CORETYPE:ATEN_CPU_CAPABILITY:PHNN_KERNEL_ISA; the first is the reference.
 SETTINGS="Haswell:avx2:avx2 default:default:avx512 default:avx512:avx512 default:avx512:baseline"
 
 train() {  # setting cell
-  local ob at isa model reg system
+  local ob at isa model reg system precision
   IFS=: read -r ob at isa <<< "$1"
-  IFS=: read -r model reg system <<< "$2"
+  IFS=: read -r model reg system precision <<< "$2"
   [ "$system" = coupled ] && system=$COUPLED || system=duffing
   local env=(ATEN_CPU_CAPABILITY="$at" PHNN_KERNEL_ISA="$isa")
   [ "$ob" = default ] || env+=(OPENBLAS_CORETYPE="$ob")
   env "${env[@]}" "$PHNN" train --system "$system" --model "$model" --reg "${reg:-none}" \
-      --steps 200 --eval-every 100 --seeds 0-1 --n-train 25 --quiet \
+      --steps 200 --eval-every 100 --seeds 0-1 --n-train 25 --precision "${precision:-float64}" --quiet \
       --out "$WORK/$1-$2.h5" > "$WORK/$1-$2.log" 2>&1 ||
     { cat "$WORK/$1-$2.log"; echo "FAIL: phnn train under $1 for $2"; exit 1; }
 }
@@ -43,7 +45,8 @@ train() {  # setting cell
 for s in $SETTINGS; do
   for c in $CELLS; do
     # The baseline kernels without FMA hardware are slow: three cells only.
-    if [[ $s == *baseline && $c != node-rk2 && $c != phnn-jr-rk2:cn && $c != phnn-s-dg ]]; then
+    if [[ $s == *baseline && $c != node-rk2 && $c != phnn-jr-rk2:cn && $c != phnn-s-dg &&
+          $c != phnn-jr-rk2:cn::float32 ]]; then
       continue
     fi
     train "$s" "$c"

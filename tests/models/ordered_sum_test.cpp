@@ -1,7 +1,8 @@
 // tests/models/ordered_sum_test.cpp — the fixed-order sums: values equal the
 // left-to-right loop bit for bit, gradients are the broadcast of the
 // adjoint (first and second order), float32 too; the broadcast product's
-// backward sums its broadcast dimensions in row-major order.
+// backward sums its broadcast dimensions in row-major order, and so does an
+// ordered expand's.
 #include "models/ordered_sum.h"
 
 #include <gtest/gtest.h>
@@ -75,6 +76,32 @@ TEST(OrderedSumTest, BroadcastProductSumsItsAdjointInRowMajorOrder) {
 TEST(OrderedSumTest, Float32) {
   const auto t = torch::tensor({1e8f, 1.0f, -1e8f, 1.0f}, torch::kFloat32).reshape({1, 4});
   EXPECT_EQ(ordered_sum(t, 1)[0].item<float>(), 1.0f);  // ((1e8 + 1) - 1e8) + 1 in float
+}
+
+// A bias [E, 1, n] expanded over a batch of B: its adjoint is summed over
+// the batch in order, for a row of 48 floats (long enough for LibTorch's
+// vectorized sum, whose order follows the vector width).
+TEST(OrderedSumTest, ExpandSumsItsAdjointInRowMajorOrder) {
+  torch::manual_seed(6);
+  const auto bias = torch::randn({2, 1, 48}, torch::kFloat32).requires_grad_(true);
+  const auto adj = torch::randn({2, 64, 48}, torch::kFloat32) *
+                   torch::pow(10.0, torch::randint(-6, 6, {2, 64, 48})).to(torch::kFloat32);
+  const auto y = ordered_expand(bias, {2, 64, 48});
+  EXPECT_TRUE(torch::equal(y, bias.expand({2, 64, 48})));
+  const auto g = torch::autograd::grad({y}, {bias}, {adj})[0];
+  ASSERT_EQ(g.sizes(), bias.sizes());
+  const auto a = adj.accessor<float, 3>();
+  for (int64_t e = 0; e < 2; ++e) {
+    for (int64_t k = 0; k < 48; ++k) {
+      float acc = 0;
+      for (int64_t b = 0; b < 64; ++b) acc += a[e][b][k];
+      EXPECT_EQ(g[e][0][k].item<float>(), acc) << e << ", " << k;
+    }
+  }
+  // Without a gradient to track it is a plain expand.
+  const auto plain = ordered_expand(bias.detach(), {2, 64, 48});
+  EXPECT_FALSE(plain.requires_grad());
+  EXPECT_THROW(ordered_expand(bias, {64, 48}), std::exception);
 }
 
 }  // namespace

@@ -40,6 +40,8 @@ enum class Precision { kFloat64 = 0, kFloat32 = 1 };
 std::string to_string(Precision precision);
 /// Every Precision, default first.
 std::vector<Precision> all_precisions();
+/// "float64" or "float32"; throws std::invalid_argument naming both.
+Precision parse_precision(const std::string& name);
 
 /// The weights inference uses (docs/DECISIONS.md, "Ablation knobs"):
 ///   kBestValidation (the default): each member's weights at its lowest
