@@ -16,6 +16,7 @@
 #include "apps/commands.h"
 #include "apps/provenance.h"
 #include "apps/sweep_report.h"
+#include "apps/train_cell_file.h"
 #include "phnn/common/check.h"
 #include "phnn/common/closest_name.h"
 #include "phnn/common/utc_time.h"
@@ -33,104 +34,6 @@
 namespace phnn {
 namespace apps {
 namespace {
-
-std::string g17(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-// The [grid] table of a one-cell sweep on `system` (a name or a system file).
-std::string grid_text(const CellSpec& cell, const std::string& system) {
-  std::ostringstream s;
-  s << "[grid]\nsystems = [\"" << system << "\"]\nmodels = [\"" << to_string(cell.model) << "-"
-    << to_string(cell.integrator) << "\"]\nsizes = [\"" << to_string(cell.size)
-    << "\"]\nn_train = [" << cell.n_train << "]\nregularizers = [\"" << to_string(cell.regularizer)
-    << "\"]\nseeds = [";
-  for (std::size_t i = 0; i < cell.seeds.size(); ++i) s << (i ? ", " : "") << cell.seeds[i];
-  s << "]\n";
-  return s.str();
-}
-
-// `precision = "float32"` in [training] when not the default.
-std::string precision_line(const CellSpec& cell) {
-  if (cell.training.precision == Precision::kFloat64) return "";
-  return "\nprecision = \"" + to_string(cell.training.precision) + "\"";
-}
-
-// The cell as a one-study sweep file, so that `phnn train --out` writes a
-// results file that `phnn reduce` and analysis/ read like any sweep's.
-std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
-  std::ostringstream s;
-  const std::string system = to_string(data.system.kind);
-  s << "# written by `phnn train --out`\n"
-    << "name = \"train-" << system << "-" << to_string(cell.model) << "-"
-    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed;
-  if (data.options.energy_sampling != EnergySampling::kAlgorithm1) {  // a --data file's
-    s << "\nenergy_sampling = \"" << to_string(data.options.energy_sampling) << "\"";
-  }
-  s << "\n\n[training]\nsteps = " << cell.training.steps
-    << "\nlearning_rate = " << g17(cell.training.learning_rate)
-    << "\nbatch_size = " << cell.training.batch_size
-    << "\neval_every = " << cell.training.eval_every << precision_line(cell)
-    << "\n\n[physics." << system << "]\n"
-    << "mass = " << g17(data.system.mass) << "\nstiffness = " << g17(data.system.stiffness) << "\n";
-  if (data.system.kind == SystemKind::kDuffing) {
-    s << "cubic_stiffness = " << g17(data.system.cubic_stiffness) << "\n";
-  }
-  if (data.system.kind == SystemKind::kSelfSustained) {
-    s << "z_coefficients = [" << g17(data.system.z_coefficients[0]) << ", "
-      << g17(data.system.z_coefficients[1]) << ", " << g17(data.system.z_coefficients[2]) << "]\n";
-  } else {
-    s << "damping = " << g17(data.system.damping) << "\n";
-  }
-  s << "\n" << grid_text(cell, system);
-  return s.str();
-}
-
-// The same for a system file's cell (`system_entry`: its path as given).
-std::string cell_sweep_text(const CellSpec& cell, const PhSystemData& data,
-                            const std::string& system_entry) {
-  std::ostringstream s;
-  s << "# written by `phnn train --out`\n"
-    << "name = \"train-" << data.system_name << "-" << to_string(cell.model) << "-"
-    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed
-    << "\n\n[training]\nsteps = " << cell.training.steps
-    << "\nlearning_rate = " << g17(cell.training.learning_rate)
-    << "\nbatch_size = " << cell.training.batch_size
-    << "\neval_every = " << cell.training.eval_every << precision_line(cell) << "\n\n"
-    << grid_text(cell, system_entry);
-  return s.str();
-}
-
-// Writes the cell's results file: the runs of `text` (a one-cell sweep whose
-// system files `read` supplies), the data set (`store_data`), the results.
-void write_cell_file(const std::string& path, const CellSpec& cell, const std::string& text,
-                     const SystemFileReader& read,
-                     const std::function<void(ResultsFile*)>& store_data,
-                     const std::vector<RunResult>& results, const Provenance& provenance,
-                     const std::string& started) {
-  const SweepSpec spec = parse_sweep_text(text, path + "@sweep_text", read);
-  const Grid grid = expand_grid(spec);
-  PHNN_CHECK(grid.runs.size() == results.size(), "cell sweep text expands to "
-                                                     << grid.runs.size() << " runs, not "
-                                                     << results.size());
-  std::vector<std::string> studies(grid.runs.size(), "grid");
-  ResultsFile file = ResultsFile::create(path, MPI_COMM_NULL, grid.runs, studies, spec.name, text,
-                                         spec.text_hash, program_version(),
-                                         ResultsLayout::for_runs(grid.runs));
-  file.begin_session(provenance);
-  store_data(&file);
-  const std::string finished = utc_now();
-  // Grid rows are ordered by seed, like the cell's members.
-  for (std::size_t i = 0; i < grid.runs.size(); ++i) {
-    const auto it = std::find(cell.seeds.begin(), cell.seeds.end(), grid.runs[i].seed);
-    file.write_run_times(static_cast<int>(i), started, finished);
-    file.write_run(static_cast<int>(i), results[static_cast<std::size_t>(it - cell.seeds.begin())]);
-  }
-  file.end_session(finished);
-  file.close();
-}
 
 std::string provenance_value(const Provenance& provenance, const std::string& key) {
   for (const auto& [k, v] : provenance) {
