@@ -33,13 +33,9 @@ torch::Tensor map_elements(const torch::Tensor& x, F f) {
   return out;
 }
 
+// tanh_array on the elements; float32 as in map_elements (widened, rounded back).
 torch::Tensor tanh_values(const torch::Tensor& x) {
-  if (x.scalar_type() == torch::kFloat32) {
-    const torch::Tensor wide = x.to(torch::kFloat64).contiguous();
-    torch::Tensor t = torch::empty_like(wide);
-    tanh_array(wide.data_ptr<double>(), t.data_ptr<double>(), wide.numel());
-    return t.to(torch::kFloat32);
-  }
+  if (x.scalar_type() == torch::kFloat32) return tanh_values(x.to(torch::kFloat64)).to(torch::kFloat32);
   const torch::Tensor in = x.contiguous();
   torch::Tensor t = torch::empty_like(in);
   tanh_array(in.data_ptr<double>(), t.data_ptr<double>(), in.numel());
