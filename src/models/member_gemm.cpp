@@ -77,29 +77,37 @@ PHNN_KERNEL_INLINE void gemm_body(const Problem<T>& q) {
 // registers: a tile is MR rows x NV vectors of columns, the last vector
 // masked (lanes past the last column are neither loaded nor stored). Each
 // lane runs the same chain as tile() above: same bits, ~3x its speed.
+// The problem's fields are read into locals before the loop over p: read
+// through `q` inside it, GCC could not keep the accumulators in registers
+// (it stored all of them to the stack on every p).
 template <int MR, int NV>
 __attribute__((target("arch=x86-64-v4"))) void tile_avx512(const Problem<double>& q, int64_t i,
                                                            int64_t j, __mmask8 tail) {
-  __mmask8 mask[NV];
-  for (int v = 0; v < NV; ++v) mask[v] = v + 1 == NV ? tail : __mmask8(0xFF);
+  const int64_t K = q.K, a_row = q.a_row, a_col = q.a_col, ldb = q.ldb, ldc = q.cols;
+  const double* const a = q.a + i * a_row;
+  const double* const b = q.b + j;
+  double* const c = q.c + i * ldc + j;
+  const auto mask = [tail](int v) { return v + 1 == NV ? tail : __mmask8(0xFF); };
   __m512d s[MR][NV];
-  for (int r = 0; r < MR; ++r)
-    for (int v = 0; v < NV; ++v)
-      s[r][v] = q.accumulate ? _mm512_maskz_loadu_pd(mask[v], q.c + (i + r) * q.cols + j + 8 * v)
-                             : _mm512_setzero_pd();
-  const double* a = q.a + i * q.a_row;
-  for (int64_t p = 0; p < q.K; ++p) {
-    const double* bp = q.b + p * q.ldb + j;
+  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_setzero_pd();
+  if (q.accumulate) {
+    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_maskz_loadu_pd(mask(v), c + r * ldc + 8 * v);
+  }
+  for (int64_t p = 0; p < K; ++p) {
+    const double* bp = b + p * ldb;
+    const double* ap = a + p * a_col;
     __m512d bv[NV];
-    for (int v = 0; v < NV; ++v) bv[v] = _mm512_maskz_loadu_pd(mask[v], bp + 8 * v);
-    for (int r = 0; r < MR; ++r) {
-      const __m512d ar = _mm512_set1_pd(a[r * q.a_row + p * q.a_col]);
-      for (int v = 0; v < NV; ++v) s[r][v] = _mm512_fmadd_pd(ar, bv[v], s[r][v]);
+    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v)
+      bv[v] = v + 1 == NV ? _mm512_maskz_loadu_pd(mask(v), bp + 8 * v) : _mm512_loadu_pd(bp + 8 * v);
+    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r) {
+      const __m512d ar = _mm512_set1_pd(ap[r * a_row]);
+      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_fmadd_pd(ar, bv[v], s[r][v]);
     }
   }
-  for (int r = 0; r < MR; ++r)
-    for (int v = 0; v < NV; ++v)
-      _mm512_mask_storeu_pd(q.c + (i + r) * q.cols + j + 8 * v, mask[v], s[r][v]);
+  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) _mm512_mask_storeu_pd(c + r * ldc + 8 * v, mask(v), s[r][v]);
 }
 
 template <int MR>
@@ -124,9 +132,9 @@ __attribute__((target("arch=x86-64-v3"))) __m256i lanes_avx2(int64_t n) {
   return _mm256_cmpgt_epi64(_mm256_set1_epi64x(n), _mm256_setr_epi64x(0, 1, 2, 3));
 }
 
-template <bool kMasked>
-__attribute__((target("arch=x86-64-v3"))) inline __m256d load_avx2(const double* p, __m256i mask) {
-  return kMasked ? _mm256_maskload_pd(p, mask) : _mm256_loadu_pd(p);
+__attribute__((target("arch=x86-64-v3"))) inline __m256d load_avx2(const double* p, __m256i mask,
+                                                                    bool masked) {
+  return masked ? _mm256_maskload_pd(p, mask) : _mm256_loadu_pd(p);
 }
 
 template <bool kMasked>
@@ -139,36 +147,38 @@ __attribute__((target("arch=x86-64-v3"))) inline void store_avx2(double* p, __m2
 }
 
 // MR rows x NV vectors; when kMasked, the last vector holds `tail` lanes.
+// Locals and unroll pragmas as in tile_avx512.
 template <int MR, int NV, bool kMasked>
 __attribute__((target("arch=x86-64-v3"))) void tile_avx2(const Problem<double>& q, int64_t i,
                                                          int64_t j, int64_t tail) {
+  const int64_t K = q.K, a_row = q.a_row, a_col = q.a_col, ldb = q.ldb, ldc = q.cols;
+  const double* const a = q.a + i * a_row;
+  const double* const b = q.b + j;
+  double* const c = q.c + i * ldc + j;
   const __m256i mask = lanes_avx2(tail);
   __m256d s[MR][NV];
-  for (int r = 0; r < MR; ++r)
-    for (int v = 0; v < NV; ++v) {
-      const double* c = q.c + (i + r) * q.cols + j + 4 * v;
-      s[r][v] = !q.accumulate       ? _mm256_setzero_pd()
-                : v + 1 == NV       ? load_avx2<kMasked>(c, mask)
-                                    : _mm256_loadu_pd(c);
-    }
-  const double* a = q.a + i * q.a_row;
-  for (int64_t p = 0; p < q.K; ++p) {
-    const double* bp = q.b + p * q.ldb + j;
+  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm256_setzero_pd();
+  if (q.accumulate) {
+    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = load_avx2(c + r * ldc + 4 * v, mask, kMasked && v + 1 == NV);
+  }
+  for (int64_t p = 0; p < K; ++p) {
+    const double* bp = b + p * ldb;
+    const double* ap = a + p * a_col;
     __m256d bv[NV];
-    for (int v = 0; v < NV; ++v)
-      bv[v] = v + 1 == NV ? load_avx2<kMasked>(bp + 4 * v, mask) : _mm256_loadu_pd(bp + 4 * v);
-    for (int r = 0; r < MR; ++r) {
-      const __m256d ar = _mm256_set1_pd(a[r * q.a_row + p * q.a_col]);
-      for (int v = 0; v < NV; ++v) s[r][v] = _mm256_fmadd_pd(ar, bv[v], s[r][v]);
+    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) bv[v] = load_avx2(bp + 4 * v, mask, kMasked && v + 1 == NV);
+    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r) {
+      const __m256d ar = _mm256_set1_pd(ap[r * a_row]);
+      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm256_fmadd_pd(ar, bv[v], s[r][v]);
     }
   }
-  for (int r = 0; r < MR; ++r)
-    for (int v = 0; v < NV; ++v) {
-      double* c = q.c + (i + r) * q.cols + j + 4 * v;
+  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) {
       if (v + 1 == NV) {
-        store_avx2<kMasked>(c, mask, s[r][v]);
+        store_avx2<kMasked>(c + r * ldc + 4 * v, mask, s[r][v]);
       } else {
-        _mm256_storeu_pd(c, s[r][v]);
+        _mm256_storeu_pd(c + r * ldc + 4 * v, s[r][v]);
       }
     }
 }
