@@ -8,8 +8,9 @@
 // Blocking: C is cut into tiles of MR rows x NR columns held in registers
 // while the inner index p runs 0..K-1; a tile's element (i, j) is the chain
 //   s = c0;  for p: s = fma(A(i, p), B(p, j), s)
-// and nothing else, so the tile shape (16, 8, 4, 1 columns; 4 or 1 rows)
-// changes the speed, never the value.
+// and nothing else, so the tile shape (16, 8, 4, 1 columns; 8, 4, 3, 2 or 1
+// rows), or AVX-512's lanes running over rows instead of columns, changes
+// the speed, never the value.
 #include "models/member_gemm.h"
 
 #include <immintrin.h>
@@ -89,10 +90,10 @@ __attribute__((target("arch=x86-64-v4"))) void tile_avx512(const Problem<double>
   double* const c = q.c + i * ldc + j;
   const auto mask = [tail](int v) { return v + 1 == NV ? tail : __mmask8(0xFF); };
   __m512d s[MR][NV];
-  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
     _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_setzero_pd();
   if (q.accumulate) {
-    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
       _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_maskz_loadu_pd(mask(v), c + r * ldc + 8 * v);
   }
   for (int64_t p = 0; p < K; ++p) {
@@ -101,12 +102,12 @@ __attribute__((target("arch=x86-64-v4"))) void tile_avx512(const Problem<double>
     __m512d bv[NV];
     _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v)
       bv[v] = v + 1 == NV ? _mm512_maskz_loadu_pd(mask(v), bp + 8 * v) : _mm512_loadu_pd(bp + 8 * v);
-    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r) {
+    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r) {
       const __m512d ar = _mm512_set1_pd(ap[r * a_row]);
       _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_fmadd_pd(ar, bv[v], s[r][v]);
     }
   }
-  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
     _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) _mm512_mask_storeu_pd(c + r * ldc + 8 * v, mask(v), s[r][v]);
 }
 
@@ -119,10 +120,78 @@ __attribute__((target("arch=x86-64-v4"))) void rows_avx512(const Problem<double>
   else if (rest > 0) tile_avx512<MR, 1>(q, i, j, static_cast<__mmask8>((1u << rest) - 1));
 }
 
+// Fewer than 8 columns with A's rows at unit stride (A is a transpose: the
+// weight gradients x^T dY): the lanes run over 8 rows of C instead of its
+// columns, 16 rows and NC columns at a time (2 NC independent chains where
+// the row tiles had MR). Lane (i, j) is still the chain over p in order.
+template <int NC>
+__attribute__((target("arch=x86-64-v4"))) void columns_avx512(const Problem<double>& q) {
+  const int64_t K = q.K, a_col = q.a_col, ldb = q.ldb, ldc = q.cols;
+  const __m512i lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m512i to_row = _mm512_mullo_epi64(lane, _mm512_set1_epi64(ldc));  // lane -> C offset
+  for (int64_t i = 0; i < q.rows; i += 16) {
+    const int64_t left = q.rows - i;
+    const __mmask8 m0 = left >= 8 ? __mmask8(0xFF) : static_cast<__mmask8>((1u << left) - 1);
+    const __mmask8 m1 = left >= 16 ? __mmask8(0xFF)
+                        : left > 8 ? static_cast<__mmask8>((1u << (left - 8)) - 1)
+                                   : __mmask8(0);
+    double* const c = q.c + i * ldc;
+    __m512d s0[NC], s1[NC];
+    _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+      s0[j] = _mm512_setzero_pd();
+      s1[j] = _mm512_setzero_pd();
+    }
+    if (q.accumulate) {
+      _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+        s0[j] = _mm512_mask_i64gather_pd(s0[j], m0, to_row, c + j, 8);
+        s1[j] = _mm512_mask_i64gather_pd(s1[j], m1, to_row, c + 8 * ldc + j, 8);
+      }
+    }
+    const double* const a = q.a + i;  // A(i + l, p) = a[l + p * a_col]
+    for (int64_t p = 0; p < K; ++p) {
+      const __m512d a0 = _mm512_maskz_loadu_pd(m0, a + p * a_col);
+      const __m512d a1 = _mm512_maskz_loadu_pd(m1, a + p * a_col + 8);
+      const double* bp = q.b + p * ldb;
+      _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+        const __m512d bj = _mm512_set1_pd(bp[j]);
+        s0[j] = _mm512_fmadd_pd(a0, bj, s0[j]);
+        s1[j] = _mm512_fmadd_pd(a1, bj, s1[j]);
+      }
+    }
+    _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+      _mm512_mask_i64scatter_pd(c + j, m0, to_row, s0[j], 8);
+      _mm512_mask_i64scatter_pd(c + 8 * ldc + j, m1, to_row, s1[j], 8);
+    }
+  }
+}
+
+__attribute__((target("arch=x86-64-v4"))) bool columns_avx512_for(const Problem<double>& q) {
+  if (q.a_row != 1 || q.rows < 8) return false;
+  switch (q.cols) {
+    case 1: columns_avx512<1>(q); return true;
+    case 2: columns_avx512<2>(q); return true;
+    case 3: columns_avx512<3>(q); return true;
+    case 4: columns_avx512<4>(q); return true;
+    case 5: columns_avx512<5>(q); return true;
+    case 6: columns_avx512<6>(q); return true;
+    case 7: columns_avx512<7>(q); return true;
+    default: return false;
+  }
+}
+
+// Row blocks of 8 (8 or 16 independent chains per tile), then 4, then the
+// 1-3 rows left in one tile.
 __attribute__((target("arch=x86-64-v4"))) void run_avx512(const Problem<double>& q) {
+  if (columns_avx512_for(q)) return;
   int64_t i = 0;
+  for (; i + 8 <= q.rows; i += 8) rows_avx512<8>(q, i);
   for (; i + 4 <= q.rows; i += 4) rows_avx512<4>(q, i);
-  for (; i < q.rows; ++i) rows_avx512<1>(q, i);
+  switch (q.rows - i) {
+    case 3: rows_avx512<3>(q, i); break;
+    case 2: rows_avx512<2>(q, i); break;
+    case 1: rows_avx512<1>(q, i); break;
+    default: break;
+  }
 }
 
 // AVX2: 4 lanes. Full vectors use plain loads and stores; only the last,
@@ -157,10 +226,10 @@ __attribute__((target("arch=x86-64-v3"))) void tile_avx2(const Problem<double>& 
   double* const c = q.c + i * ldc + j;
   const __m256i mask = lanes_avx2(tail);
   __m256d s[MR][NV];
-  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
     _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm256_setzero_pd();
   if (q.accumulate) {
-    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
       _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = load_avx2(c + r * ldc + 4 * v, mask, kMasked && v + 1 == NV);
   }
   for (int64_t p = 0; p < K; ++p) {
@@ -168,12 +237,12 @@ __attribute__((target("arch=x86-64-v3"))) void tile_avx2(const Problem<double>& 
     const double* ap = a + p * a_col;
     __m256d bv[NV];
     _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) bv[v] = load_avx2(bp + 4 * v, mask, kMasked && v + 1 == NV);
-    _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r) {
+    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r) {
       const __m256d ar = _mm256_set1_pd(ap[r * a_row]);
       _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm256_fmadd_pd(ar, bv[v], s[r][v]);
     }
   }
-  _Pragma("GCC unroll 4") for (int r = 0; r < MR; ++r)
+  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
     _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) {
       if (v + 1 == NV) {
         store_avx2<kMasked>(c + r * ldc + 4 * v, mask, s[r][v]);
