@@ -38,6 +38,40 @@ struct SoftplusSigmoid {
   }
 };
 
+// SoftplusSigmoid of some columns of a row-major [rows, width] array, for
+// all rows in one softplus_sigmoid_array call (vectorized; the same bits as
+// SoftplusSigmoid row by row). Stored in `data` [3][columns][rows]
+// (softplus, sigmoid, slope), which a head may save for its backward.
+class SoftplusColumns {
+ public:
+  static int64_t size(int columns, int64_t rows) { return 3 * columns * rows; }
+  static SoftplusColumns compute(const double* o, int64_t width, const std::vector<int>& columns,
+                                 int64_t rows, double* data) {
+    const auto n = static_cast<int64_t>(columns.size()) * rows;
+    thread_local std::vector<double> in;
+    in.resize(static_cast<std::size_t>(n));
+    int64_t k = 0;
+    for (const int column : columns)
+      for (int64_t r = 0; r < rows; ++r) in[static_cast<std::size_t>(k++)] = o[r * width + column];
+    softplus_sigmoid_array(in.data(), n, data, data + n, data + 2 * n);
+    return saved(static_cast<int>(columns.size()), rows, data);
+  }
+  static SoftplusColumns saved(int columns, int64_t rows, const double* data) {
+    return SoftplusColumns(columns, rows, data);
+  }
+  // Of the k-th column asked for, row r.
+  double softplus(int k, int64_t r) const { return data_[k * rows_ + r]; }
+  double sigmoid(int k, int64_t r) const { return data_[(columns_ + k) * rows_ + r]; }
+  double slope(int k, int64_t r) const { return data_[(2 * columns_ + k) * rows_ + r]; }
+
+ private:
+  SoftplusColumns(int columns, int64_t rows, const double* data)
+      : columns_(columns), rows_(rows), data_(data) {}
+  int columns_;
+  int64_t rows_;
+  const double* data_;
+};
+
 inline Tensor dense(const Tensor& t) { return t.contiguous(); }
 
 // Rows of an [E, B, ...] tensor: one member and one batch element each.

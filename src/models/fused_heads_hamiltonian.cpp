@@ -24,14 +24,14 @@ using namespace heads;
 //   q~ = c~0 v0 s0 + c~1 v1 + v0~ l00 + v1~ l10,  p~ = c~2 v1 s2 + v1~ l11
 //   o0~ = l00~ softplus'(o0) + c~0 v0 q s0 (1 - s0),  o1~ = l10~,
 //   o2~ = l11~ softplus'(o2) + c~2 v1 p s2 (1 - s2).
-// The forward keeps (l00, l11, s0, s2, softplus'(o0), softplus'(o2)) per row
-// for the backward.
-constexpr int kAux = 6;
+// The forward keeps softplus, sigmoid and softplus' of o0 and o2, column
+// by column ([6, rows]: one softplus_sigmoid_array call over both outputs
+// of every row), for the backward.
 struct HamiltonianRow {
   double q, p, l00, l10, l11, s0, s2, v0, v1;
-  HamiltonianRow(const double* o, const double* x, const double* aux)
-      : q(x[0]), p(x[1]), l00(aux[0]), l10(o[1]), l11(aux[1]), s0(aux[2]), s2(aux[3]),
-        v0(l00 * q), v1(l10 * q + l11 * p) {}
+  HamiltonianRow(const double* o, const double* x, const SoftplusColumns& f, int64_t r)
+      : q(x[0]), p(x[1]), l00(f.softplus(0, r)), l10(o[1]), l11(f.softplus(1, r)),
+        s0(f.sigmoid(0, r)), s2(f.sigmoid(1, r)), v0(l00 * q), v1(l10 * q + l11 * p) {}
   double c(int k) const { return k == 0 ? v0 * s0 * q : k == 1 ? v1 * q : v1 * s2 * p; }
 };
 
@@ -45,17 +45,14 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
     const int64_t rows = o.size(0) * o.size(1);
     Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
     Tensor grad = with_grad ? torch::empty({o.size(0), o.size(1), 2}, o.options()) : Tensor();
-    Tensor aux = torch::empty({rows, kAux}, o.options());
+    Tensor aux = torch::empty({SoftplusColumns::size(2, rows)}, o.options());
     const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
     const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
-    double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
+    double* ph = h.data_ptr<double>();
     double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
+    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data_ptr<double>());
     for (int64_t r = 0; r < rows; ++r) {
-      const SoftplusSigmoid f0(po[3 * r]), f2(po[3 * r + 2]);
-      double* a = pa + kAux * r;
-      a[0] = f0.softplus, a[1] = f2.softplus, a[2] = f0.sigmoid, a[3] = f2.sigmoid;
-      a[4] = f0.slope, a[5] = f2.slope;
-      const HamiltonianRow row(po + 3 * r, px + 2 * r, a);
+      const HamiltonianRow row(po + 3 * r, px + 2 * r, f, r);
       ph[r] = 0.5 * (row.v0 * row.v0 + row.v1 * row.v1);
       if (!with_grad) continue;
       const double* og = pog + 6 * r;
@@ -78,14 +75,14 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
     Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
     Tensor o_g_bar = with_grad ? torch::zeros_like(saved[1]) : Tensor();
     const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
-    const double *phb = h_bar.data_ptr<double>(), *pa = aux.data_ptr<double>();
+    const double* phb = h_bar.data_ptr<double>();
+    const SoftplusColumns f = SoftplusColumns::saved(2, rows, aux.data_ptr<double>());
     const double* pog = g_bar.defined() ? saved[1].data_ptr<double>() : nullptr;
     const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
     double* pogb = g_bar.defined() ? o_g_bar.data_ptr<double>() : nullptr;
     double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
     for (int64_t r = 0; r < rows; ++r) {
-      const double* a = pa + kAux * r;
-      const HamiltonianRow row(po + 3 * r, px + 2 * r, a);
+      const HamiltonianRow row(po + 3 * r, px + 2 * r, f, r);
       const double hb = phb[r];
       double gb[2] = {0.0, 0.0}, cb[3] = {0.0, 0.0, 0.0};
       if (pgb) {
@@ -106,9 +103,9 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
       const double l10b = gb[0] * row.v1 + v1b * row.q;
       const double l11b = gb[1] * row.v1 + v1b * row.p;
       double* ob = pob + 3 * r;
-      ob[0] = l00b * a[4] + cb[0] * row.v0 * row.q * row.s0 * (1.0 - row.s0);
+      ob[0] = l00b * f.slope(0, r) + cb[0] * row.v0 * row.q * row.s0 * (1.0 - row.s0);
       ob[1] = l10b;
-      ob[2] = l11b * a[5] + cb[2] * row.v1 * row.p * row.s2 * (1.0 - row.s2);
+      ob[2] = l11b * f.slope(1, r) + cb[2] * row.v1 * row.p * row.s2 * (1.0 - row.s2);
       double* xb = pxb + 2 * r;
       xb[0] = cb[0] * row.v0 * row.s0 + cb[1] * row.v1 + v0b * row.l00 + v1b * row.l10;
       xb[1] = cb[2] * row.v1 * row.s2 + v1b * row.l11;
@@ -132,11 +129,15 @@ struct CurvatureRow {
   double q, p, a, c, d, a1, d1, a2, d2, ai[2], ci[2], di[2], aij[2][2], cij[2][2], dij[2][2];
   double v0, v1, v0i[2], v1i[2], v0ij[2][2], v1ij[2][2];
 
-  CurvatureRow(const double* o, const double* og, const double* oh, const double* x) {
+  double a_slope, d_slope;  // softplus' of o0 and o2
+
+  // f: SoftplusColumns of o's columns 0 and 2; r: this row.
+  CurvatureRow(const double* o, const double* og, const double* oh, const double* x,
+               const SoftplusColumns& f, int64_t r) {
     q = x[0], p = x[1];
-    const SoftplusSigmoid f0(o[0]), f2(o[2]);
-    a = f0.softplus, c = o[1], d = f2.softplus;
-    a1 = f0.sigmoid, d1 = f2.sigmoid;
+    a = f.softplus(0, r), c = o[1], d = f.softplus(1, r);
+    a1 = f.sigmoid(0, r), d1 = f.sigmoid(1, r);
+    a_slope = f.slope(0, r), d_slope = f.slope(1, r);
     a2 = a1 * (1.0 - a1), d2 = d1 * (1.0 - d1);
     for (int i = 0; i < 2; ++i) {
       ai[i] = a1 * og[3 * i], ci[i] = og[3 * i + 1], di[i] = d1 * og[3 * i + 2];
@@ -164,7 +165,7 @@ struct CurvatureRow {
   }
 
   // Adjoints of (o, og, oh, x) from those of G (gb[2]) and K (kb[2][2]).
-  void backward(const double* o, const double* og, const double* oh, const double* gb,
+  void backward(const double* og, const double* oh, const double* gb,
                 const double* kb, double* ob, double* ogb, double* ohb, double* xb) const {
     double v0b = 0, v1b = 0, v0ib[2] = {0, 0}, v1ib[2] = {0, 0}, v0ijb[2][2], v1ijb[2][2];
     for (int i = 0; i < 2; ++i) {
@@ -214,10 +215,9 @@ struct CurvatureRow {
       ogb[3 * i + 1] += cib[i];
       d1b += dib[i] * og[3 * i + 2], ogb[3 * i + 2] += dib[i] * d1;
     }
-    const SoftplusSigmoid f0(o[0]), f2(o[2]);
-    ob[0] = ab * f0.slope + a1b * a2 + a2b * a2 * (1.0 - 2.0 * a1);
+    ob[0] = ab * a_slope + a1b * a2 + a2b * a2 * (1.0 - 2.0 * a1);
     ob[1] = cb;
-    ob[2] = db * f2.slope + d1b * d2 + d2b * d2 * (1.0 - 2.0 * d1);
+    ob[2] = db * d_slope + d1b * d2 + d2b * d2 * (1.0 - 2.0 * d1);
     xb[0] = qb, xb[1] = pb;
   }
 };
@@ -232,8 +232,11 @@ class CurvatureFunction : public torch::autograd::Function<CurvatureFunction> {
     const double *po = o.data_ptr<double>(), *pg = og.data_ptr<double>();
     const double *ph = oh.data_ptr<double>(), *px = x.data_ptr<double>();
     double *pgr = grad.data_ptr<double>(), *phs = hess.data_ptr<double>();
+    thread_local std::vector<double> aux;
+    aux.resize(static_cast<std::size_t>(SoftplusColumns::size(2, rows)));
+    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data());
     for (int64_t r = 0; r < rows; ++r) {
-      const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r);
+      const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
       for (int i = 0; i < 2; ++i) {
         pgr[2 * r + i] = row.grad(i);
         for (int j = 0; j < 2; ++j) phs[4 * r + 2 * i + j] = row.hessian(i, j);
@@ -257,10 +260,13 @@ class CurvatureFunction : public torch::autograd::Function<CurvatureFunction> {
     const double *pgb = gb.data_ptr<double>(), *pkb = kb.data_ptr<double>();
     double *pob = o_bar.data_ptr<double>(), *pogb = og_bar.data_ptr<double>();
     double *pohb = oh_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
+    thread_local std::vector<double> aux;
+    aux.resize(static_cast<std::size_t>(SoftplusColumns::size(2, rows)));
+    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data());
     for (int64_t r = 0; r < rows; ++r) {
-      const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r);
-      row.backward(po + 3 * r, pg + 6 * r, ph + 12 * r, pgb + 2 * r, pkb + 4 * r, pob + 3 * r,
-                   pogb + 6 * r, pohb + 12 * r, pxb + 2 * r);
+      const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
+      row.backward(pg + 6 * r, ph + 12 * r, pgb + 2 * r, pkb + 4 * r, pob + 3 * r, pogb + 6 * r,
+                   pohb + 12 * r, pxb + 2 * r);
     }
     return {o_bar, og_bar, oh_bar, x_bar};
   }

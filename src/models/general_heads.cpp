@@ -60,12 +60,15 @@ class GeneralHamiltonianFunction
     double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
     double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
     std::vector<double> v(n), c(K);
+    std::vector<int> diagonal(n);
+    for (int i = 0; i < n; ++i) diagonal[i] = tri(i, i);
+    thread_local std::vector<double> columns;
+    columns.resize(static_cast<std::size_t>(SoftplusColumns::size(n, rows)));
+    const SoftplusColumns f = SoftplusColumns::compute(po, K, diagonal, rows, columns.data());
     for (int64_t r = 0; r < rows; ++r) {
       double* a = pa + 3 * n * r;
-      for (int i = 0; i < n; ++i) {
-        const SoftplusSigmoid f(po[K * r + tri(i, i)]);
-        a[3 * i] = f.softplus, a[3 * i + 1] = f.sigmoid, a[3 * i + 2] = f.slope;
-      }
+      for (int i = 0; i < n; ++i)
+        a[3 * i] = f.softplus(i, r), a[3 * i + 1] = f.sigmoid(i, r), a[3 * i + 2] = f.slope(i, r);
       const LowerFactor L{po + K * r, a};
       const double* xr = px + n * r;
       lower_times(L, xr, n, v.data());

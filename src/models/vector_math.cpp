@@ -61,6 +61,59 @@ PHNN_KERNEL_INLINE void tanh_body(const double* x, double* y, int64_t n) {
   for (int64_t i = 0; i < n; ++i) y[i] = tanh_one(x[i]);
 }
 
+// exp_nonpositive(x) for x = -|v| (so x <= 0 or NaN) without a branch, for
+// softplus_sigmoid_array: the same operations in the same order, with
+// nearbyint(x log2 e) by the shifter (round half to even, as nearbyint in
+// the default rounding mode) and 2^k1, 2^k2 (normal) built from their bits
+// instead of ldexp; the selects at the end give NaN, 0 below -745.2 and 1
+// at 0, as the scalar function's early returns do.
+PHNN_KERNEL_INLINE int64_t bits_of(double v) {
+  int64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+PHNN_KERNEL_INLINE double power_of_two(int64_t k) {  // 2^k, -1022 <= k <= 1023
+  const int64_t b = (k + 1023) << 52;
+  double v;
+  std::memcpy(&v, &b, sizeof v);
+  return v;
+}
+PHNN_KERNEL_INLINE double exp_nonpositive_lane(double x) {
+  constexpr double kLog2e = 1.4426950408889634073599;
+  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
+  constexpr double kShifter = 6755399441055744.0;  // 1.5 * 2^52
+  const double xc = x < -745.2 ? -745.2 : x == x ? x : 0.0;  // the lanes selected away stay finite
+  const double t = xc * kLog2e + kShifter;
+  const double k = t - kShifter;
+  const double r = (xc - k * kLn2Hi) - k * kLn2Lo;
+  const double e = exp_pade(r);
+  const int64_t ki = bits_of(t) - bits_of(kShifter);
+  const int64_t k1 = ki / 2, k2 = ki - k1;
+  const double value = e * power_of_two(k1) * power_of_two(k2);
+  return x != x ? x : x < -745.2 ? 0.0 : x == 0.0 ? 1.0 : value;
+}
+
+// log1p_unit(z) without its NaN branch (NaN flows through the same series).
+PHNN_KERNEL_INLINE double log1p_unit_lane(double z) {
+  const double s = z / (2.0 + z), s2 = s * s;
+  double sum = 1.0 / 39.0;
+  _Pragma("GCC unroll 19") for (int k = 18; k >= 0; --k) sum = sum * s2 + 1.0 / (2 * k + 1);
+  return 2.0 * s * sum;
+}
+
+PHNN_KERNEL_INLINE void softplus_sigmoid_body(const double* x, int64_t n, double* softplus,
+                                              double* sigmoid, double* slope) {
+  for (int64_t i = 0; i < n; ++i) {
+    const double v = x[i];
+    const double z = exp_nonpositive_lane(-std::fabs(v));
+    const double s = v >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z);
+    const double l = log1p_unit_lane(z);
+    softplus[i] = v > 20.0 ? v : (v > 0.0 ? v : 0.0) + l;
+    sigmoid[i] = s;
+    slope[i] = v > 20.0 ? 1.0 : s;
+  }
+}
+
 }  // namespace
 
 // exp(x), x <= 0: the reduction and Pade form of exp_reduced(), with 2^k
@@ -92,6 +145,10 @@ double log1p_unit(double z) {
 
 PHNN_KERNEL_VARIANTS(void, tanh_array, (const double* x, double* y, int64_t n), (x, y, n),
                      tanh_body)
+
+PHNN_KERNEL_VARIANTS(void, softplus_sigmoid_array,
+                     (const double* x, int64_t n, double* softplus, double* sigmoid, double* slope),
+                     (x, n, softplus, sigmoid, slope), softplus_sigmoid_body)
 
 }  // namespace internal
 }  // namespace phnn

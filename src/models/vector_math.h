@@ -31,5 +31,13 @@ double exp_nonpositive(double x);
 /// the series of 2 atanh(z / (2 + z)), for the same reason.
 double log1p_unit(double z);
 
+/// softplus(x[i]), sigmoid(x[i]) and softplus'(x[i]) for i < n, bit for bit
+/// what heads::SoftplusSigmoid(x[i]) gives (fused_heads_common.h: one
+/// exp(-|x|), softplus = x and slope 1 above 20), written without branches
+/// so the loop vectorizes (tested against the scalar form, NaN and +-inf
+/// included). The fused heads call it once per tensor instead of per row.
+void softplus_sigmoid_array(const double* x, int64_t n, double* softplus, double* sigmoid,
+                            double* slope);
+
 }  // namespace internal
 }  // namespace phnn

@@ -4,12 +4,15 @@
 #include "models/fused_mlp.h"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include "models/fused_heads_common.h"
+#include "models/kernel_isa.h"
 #include "models/vector_math.h"
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/discrete_step.h"
@@ -229,6 +232,43 @@ TEST(VectorTanhTest, ExpAndLog1pWithinTwoUlpOfStd) {
   EXPECT_EQ(internal::exp_nonpositive(-800.0), 0.0);
   EXPECT_EQ(internal::log1p_unit(0.0), 0.0);
   EXPECT_TRUE(std::isnan(internal::exp_nonpositive(std::numeric_limits<double>::quiet_NaN())));
+}
+
+// The vectorized softplus/sigmoid is the scalar SoftplusSigmoid bit for bit
+// (NaN for NaN), on every instruction set this CPU has: across the exp
+// reduction's range, both sides of 0 and of the softplus threshold 20, the
+// exp underflow at |x| = 745.2, subnormal inputs, +-inf and NaN.
+TEST(VectorTanhTest, SoftplusSigmoidArrayIsTheScalarFormBitForBit) {
+  std::vector<double> x;
+  for (double e = -320.0; e <= 3.0; e += 0.0137) {
+    x.push_back(std::pow(10.0, e));
+    x.push_back(-std::pow(10.0, e));
+  }
+  for (double v = -800.0; v <= 40.0; v += 0.0731) x.push_back(v);
+  for (double v : {0.0, -0.0, 20.0, std::nextafter(20.0, 21.0), -745.2, std::nextafter(-745.2, 0.0),
+                   745.2, 4.9e-324, -4.9e-324, std::numeric_limits<double>::infinity(),
+                   -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
+    x.push_back(v);
+  const auto n = static_cast<int64_t>(x.size());
+  const auto same = [](double a, double b) {
+    return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0;
+  };
+  for (const auto isa : {internal::KernelIsa::kBaseline, internal::KernelIsa::kAvx2,
+                         internal::KernelIsa::kAvx512}) {
+    const internal::ScopedKernelIsa scope(isa);
+    std::vector<double> sp(x.size()), sg(x.size()), sl(x.size());
+    internal::softplus_sigmoid_array(x.data(), n, sp.data(), sg.data(), sl.data());
+    int differ = 0;
+    for (int64_t i = 0; i < n; ++i) {
+      const internal::heads::SoftplusSigmoid f(x[i]);
+      const bool ok = same(sp[i], f.softplus) && same(sg[i], f.sigmoid) && same(sl[i], f.slope);
+      if (!ok && ++differ <= 3)
+        ADD_FAILURE() << internal::kernel_isa_name(internal::kernel_isa()) << " x = " << x[i]
+                      << ": " << sp[i] << " " << sg[i] << " " << sl[i] << " against "
+                      << f.softplus << " " << f.sigmoid << " " << f.slope;
+    }
+    EXPECT_EQ(differ, 0);
+  }
 }
 
 }  // namespace
