@@ -179,6 +179,36 @@ def verdict(comparisons):
     return ("partly" if r_ok else "not supported"), counts
 
 
+def decided(comparisons):
+    """What the resolved comparisons alone decide, the directions of tied medians ignored (they
+    flip from one draw of seeds to the next when two cells are truly alike):
+
+      holds              every comparison with an interval resolved in the paper's direction
+      for, in part       some resolved for it, none against
+      undecided          none resolved (ties only)
+      against / split    resolved against it (split: some resolved for it too)
+      by direction only  no comparison has an interval (dispersion, Jacobian, absences seen
+                         nowhere): seeds cannot decide it
+    """
+    intervals = [c for c in comparisons if c.resolved is not None]
+    if not intervals:
+        return "by direction only"
+    r_for = sum(1 for c in intervals if c.ok and c.resolved)
+    r_against = sum(1 for c in intervals if not c.ok and c.resolved)
+    if r_against:
+        return "split" if r_for else "against"
+    if r_for == len(intervals):
+        return "holds"
+    return "for, in part" if r_for else "undecided"
+
+
+def verdict_name(comparisons):
+    return verdict(comparisons)[0]
+
+
+JUDGES = {"verdict": verdict_name, "decided": decided}
+
+
 # ------------------------------------------------------------------ the statements
 def study_one(res):
     out = []
@@ -520,13 +550,14 @@ def run_value(r):
     return math.inf if math.isnan(v) else v
 
 
-def stability(stat_rows, run_rows, resamples, seed=0, inner=1000):
+def stability(stat_rows, run_rows, resamples, seed=0, inner=1000, judge=verdict_name):
     """Per statement tag, the share of `resamples` bootstrap resamples of every cell's finished
     seeds (each cell resampled once per round, shared by every study that shows it) that give the
-    verdict the file gives. Per-run quantities (the Jacobian statement) use the same resample."""
+    verdict the file gives (judge: verdict_name, or decided for the resolved-only reading).
+    Per-run quantities (the Jacobian statement) use the same resample."""
     import numpy as np
     rng = np.random.default_rng(seed)
-    base = {tag: verdict(comps)[0] for tag, _, comps in all_claims(Results(stat_rows, run_rows))}
+    base = {tag: judge(comps) for tag, _, comps in all_claims(Results(stat_rows, run_rows))}
     cells = {}
     for r in run_rows:
         if r["status"] in ("done", "diverged"):
@@ -548,7 +579,7 @@ def stability(stat_rows, run_rows, resamples, seed=0, inner=1000):
                 new_stats.append(row)
         new_runs = [r for rows in drawn.values() for r in rows]
         for tag, _, comps in all_claims(Results(new_stats, new_runs)):
-            if tag in same and verdict(comps)[0] == base[tag]:
+            if tag in same and judge(comps) == base[tag]:
                 same[tag] += 1
     return {tag: same[tag] / resamples for tag in base}
 

@@ -7,7 +7,9 @@ one adaptive sweep after different rounds: one row per statement, one column per
 
 FILE@K reads an adaptive sweep as it stood after round K (`phnn reduce --round K`; @0: every cell
 at its first seeds). A row whose verdicts differ is marked; --stability N adds, per column, the
-share of N bootstrap resamples of the seeds that give that column's verdict.
+share of N bootstrap resamples of the seeds that give that column's verdict. --decided prints
+what the resolved comparisons alone decide instead (paper_claims.decided: holds, for in part,
+undecided, against, split, by direction only), blind to the directions of tied medians.
 """
 import argparse
 import sys
@@ -15,15 +17,15 @@ import sys
 import paper_claims as pc
 
 
-def verdicts(spec, resamples=0):
+def verdicts(spec, resamples=0, judge=pc.verdict_name):
     """{tag: (verdict, share or None)} of one FILE[@K]."""
     path, _, round_ = spec.partition("@")
     extra = ("--round", round_) if round_ else ()
     run_rows = pc.reduce_csv(path, "--per-run", *extra)
     stat_rows = pc.reduce_csv(path, *extra)
     claims = pc.all_claims(pc.Results(stat_rows, run_rows))
-    stable = pc.stability(stat_rows, run_rows, resamples) if resamples else {}
-    return {tag: (pc.verdict(comps)[0], stable.get(tag)) for tag, _, comps in claims if comps}
+    stable = pc.stability(stat_rows, run_rows, resamples, judge=judge) if resamples else {}
+    return {tag: (judge(comps), stable.get(tag)) for tag, _, comps in claims if comps}
 
 
 def table(columns, labels):
@@ -49,8 +51,11 @@ def main(argv=None):
                         help="results files; @K: an adaptive sweep after round K")
     parser.add_argument("--stability", type=int, default=0, metavar="N",
                         help="add each verdict's share of N bootstrap resamples (! below 90 %%)")
+    parser.add_argument("--decided", action="store_true",
+                        help="what the resolved comparisons alone decide, instead of the verdict")
     args = parser.parse_args(argv)
-    columns = [verdicts(f, args.stability) for f in args.files]
+    judge = pc.decided if args.decided else pc.verdict_name
+    columns = [verdicts(f, args.stability, judge) for f in args.files]
     print(table(columns, args.files))
     return 0
 

@@ -147,6 +147,20 @@ class Stability(unittest.TestCase):
                 "column": column, "expected": str(len(values))}
         return runs, pc.resampled_stat_row(base, values, np.random.default_rng(1), 2000)
 
+    def test_decided_reads_resolved_comparisons_only(self):
+        def c(ok, resolved):
+            return pc.Comparison("x", ok, resolved)
+        self.assertEqual(pc.decided([c(True, True)] * 2), "holds")
+        self.assertEqual(pc.decided([c(True, True), c(False, False)]), "for, in part")
+        # The verdicts "same direction", "partly" and "not supported" of ties alone differ by the
+        # directions of the tied medians; decided() gives all three the same answer.
+        for ties in ([c(True, False)] * 2, [c(True, False), c(False, False)], [c(False, False)]):
+            self.assertEqual(pc.decided(ties), "undecided")
+        self.assertEqual(pc.decided([c(False, True), c(True, False)]), "against")
+        self.assertEqual(pc.decided([c(False, True), c(True, True)]), "split")
+        self.assertEqual(pc.decided([c(True, None), c(False, None)]), "by direction only")
+        self.assertEqual(pc.decided([c(True, None), c(True, True)]), "holds")  # intervals only
+
     def stability_of(self, low_n, high_n):
         r25, s25 = self.cell_rows("25", low_n)
         r100, s100 = self.cell_rows("100", high_n)
@@ -166,6 +180,16 @@ class Stability(unittest.TestCase):
         # N_train 100 a hair below 25 on most seeds: the direction flips in some resamples.
         marginal = self.stability_of([1.0 + k for k in range(10)], [0.9 + k for k in range(10)])
         self.assertLess(marginal, 0.9)
+
+    def test_a_tie_whose_direction_flips_is_stably_undecided(self):
+        # Two alike cells: the medians' order flips between resamples, so the verdict ("same
+        # direction" / "not supported") is unstable, but "undecided" holds in every resample.
+        r25, s25 = self.cell_rows("25", [1.0 + k for k in range(10)])
+        r100, s100 = self.cell_rows("100", [1.0 + k + 0.01 * (-1) ** k for k in range(10)])
+        judged = pc.stability([s25, s100], r25 + r100, resamples=60, inner=300, judge=pc.decided)
+        self.assertEqual(judged["I.1"], 1.0)
+        plain = pc.stability([s25, s100], r25 + r100, resamples=60, inner=300)
+        self.assertLess(plain["I.1"], 0.9)
 
     def test_the_report_shows_the_share_and_marks_unstable_ones(self):
         r25, s25 = self.cell_rows("25", [1.0 + k for k in range(10)])
