@@ -183,13 +183,7 @@ void linear_forward(const Plan& plan, int64_t l, const double* a, const Tensor& 
   const int64_t n_in = plan.widths[l], n_out = plan.widths[l + 1];
   gemm_nn(plan.E, static_cast<int>(plan.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
           a, w.data_ptr<double>(), z, /*transpose_b=*/false);
-  const double* pb = b.data_ptr<double>();
-  for (int64_t e = 0; e < plan.E; ++e) {
-    double* ze = z + e * plan.block(n_out);
-    const double* be = pb + e * n_out;
-    for (int64_t r = 0; r < plan.B; ++r)
-      for (int64_t k = 0; k < n_out; ++k) ze[r * n_out + k] += be[k];
-  }
+  add_bias(plan.E, plan.B, n_out, plan.block(n_out), b.data_ptr<double>(), z);
 }
 
 // Unpacks Z_L into the jet's [E, B, ...] outputs.
@@ -294,9 +288,7 @@ variable_list FusedMlpBackward::apply(variable_list&& grads) {
     if (sink || should_compute_output(static_cast<std::size_t>(3 + L + l))) {  // b~ = sum_batch Z~_0
       Tensor b_bar = torch::zeros({E, 1, n_out}, torch::kFloat64);
       double* pb = b_bar.data_ptr<double>();
-      for (int64_t e = 0; e < E; ++e)
-        for (int64_t r = 0; r < p.B; ++r)
-          for (int64_t k = 0; k < n_out; ++k) pb[e * n_out + k] += z_bar[e * p.block(n_out) + r * n_out + k];
+      sum_bias(E, p.B, n_out, p.block(n_out), z_bar, pb);
       if (sink) {
         double* dst = sinks_[static_cast<std::size_t>(L) + ul].data_ptr<double>();
         for (int64_t k = 0; k < E * n_out; ++k) dst[k] += pb[k];

@@ -110,7 +110,35 @@ PHNN_KERNEL_INLINE void backward_body(int64_t d, int64_t order, int64_t E, int64
   }
 }
 
+PHNN_KERNEL_INLINE void add_bias_body(int64_t E, int64_t B, int64_t n, int64_t stride, In b,
+                                      Out z) {
+  for (int64_t e = 0; e < E; ++e)
+    for (int64_t r = 0; r < B; ++r) {
+      double* __restrict__ row = z + e * stride + r * n;
+      const double* __restrict__ be = b + e * n;
+      for (int64_t k = 0; k < n; ++k) row[k] += be[k];
+    }
+}
+
+PHNN_KERNEL_INLINE void sum_bias_body(int64_t E, int64_t B, int64_t n, int64_t stride, In z_bar,
+                                      Out b_bar) {
+  for (int64_t e = 0; e < E; ++e)
+    for (int64_t r = 0; r < B; ++r) {
+      const double* __restrict__ row = z_bar + e * stride + r * n;
+      double* __restrict__ be = b_bar + e * n;
+      for (int64_t k = 0; k < n; ++k) be[k] += row[k];
+    }
+}
+
 }  // namespace
+
+PHNN_KERNEL_VARIANTS(void, add_bias,
+                     (int64_t E, int64_t B, int64_t n, int64_t stride, const double* b, double* z),
+                     (E, B, n, stride, b, z), add_bias_body)
+PHNN_KERNEL_VARIANTS(void, sum_bias,
+                     (int64_t E, int64_t B, int64_t n, int64_t stride, const double* z_bar,
+                      double* b_bar),
+                     (E, B, n, stride, z_bar, b_bar), sum_bias_body)
 
 PHNN_KERNEL_VARIANTS(void, tanh_jet_forward,
                      (int64_t d, int64_t order, int64_t E, int64_t n, const double* z,
