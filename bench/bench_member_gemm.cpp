@@ -79,7 +79,8 @@ int main(int argc, char** argv) {
     if (phnn::internal::kernel_isa() != isa) continue;  // this CPU lacks it
     std::printf("\n%s, E = 10, best of %d x 300 calls\n\n", phnn::internal::kernel_isa_name(isa),
                 repeats);
-    std::printf("| product | rows x K x cols | µs per call | G multiply-adds/s |\n|---|---|---|---|\n");
+    std::printf("| product | rows x K x cols | µs per call | G multiply-adds/s |\n");
+    std::printf("|---|---|---|---|\n");
     double total = 0.0;
     for (const Shape& s : kShapes) {
       const double t = best_seconds(s, repeats, a, b, c);

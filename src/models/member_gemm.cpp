@@ -78,9 +78,9 @@ PHNN_KERNEL_INLINE void gemm_body(const Problem<T>& q) {
 // registers: a tile is MR rows x NV vectors of columns, the last vector
 // masked (lanes past the last column are neither loaded nor stored). Each
 // lane runs the same chain as tile() above: same bits, ~3x its speed.
-// The problem's fields are read into locals before the loop over p: read
-// through `q` inside it, GCC could not keep the accumulators in registers
-// (it stored all of them to the stack on every p).
+// The tile loops over r and v are unrolled by pragma: otherwise GCC kept the
+// accumulators in a stack array and stored all of them on every p (8
+// stores per 8 FMAs).
 template <int MR, int NV>
 __attribute__((target("arch=x86-64-v4"))) void tile_avx512(const Problem<double>& q, int64_t i,
                                                            int64_t j, __mmask8 tail) {
@@ -90,25 +90,31 @@ __attribute__((target("arch=x86-64-v4"))) void tile_avx512(const Problem<double>
   double* const c = q.c + i * ldc + j;
   const auto mask = [tail](int v) { return v + 1 == NV ? tail : __mmask8(0xFF); };
   __m512d s[MR][NV];
-  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
-    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_setzero_pd();
-  if (q.accumulate) {
-    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
-      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_maskz_loadu_pd(mask(v), c + r * ldc + 8 * v);
-  }
+#pragma GCC unroll 8
+  for (int r = 0; r < MR; ++r)
+#pragma GCC unroll 2
+    for (int v = 0; v < NV; ++v)
+      s[r][v] = q.accumulate ? _mm512_maskz_loadu_pd(mask(v), c + r * ldc + 8 * v)
+                             : _mm512_setzero_pd();
   for (int64_t p = 0; p < K; ++p) {
     const double* bp = b + p * ldb;
     const double* ap = a + p * a_col;
     __m512d bv[NV];
-    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v)
-      bv[v] = v + 1 == NV ? _mm512_maskz_loadu_pd(mask(v), bp + 8 * v) : _mm512_loadu_pd(bp + 8 * v);
-    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r) {
+#pragma GCC unroll 2
+    for (int v = 0; v < NV; ++v)
+      bv[v] = v + 1 == NV ? _mm512_maskz_loadu_pd(mask(v), bp + 8 * v)
+                          : _mm512_loadu_pd(bp + 8 * v);
+#pragma GCC unroll 8
+    for (int r = 0; r < MR; ++r) {
       const __m512d ar = _mm512_set1_pd(ap[r * a_row]);
-      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm512_fmadd_pd(ar, bv[v], s[r][v]);
+#pragma GCC unroll 2
+      for (int v = 0; v < NV; ++v) s[r][v] = _mm512_fmadd_pd(ar, bv[v], s[r][v]);
     }
   }
-  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
-    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) _mm512_mask_storeu_pd(c + r * ldc + 8 * v, mask(v), s[r][v]);
+#pragma GCC unroll 8
+  for (int r = 0; r < MR; ++r)
+#pragma GCC unroll 2
+    for (int v = 0; v < NV; ++v) _mm512_mask_storeu_pd(c + r * ldc + 8 * v, mask(v), s[r][v]);
 }
 
 template <int MR>
@@ -137,12 +143,14 @@ __attribute__((target("arch=x86-64-v4"))) void columns_avx512(const Problem<doub
                                    : __mmask8(0);
     double* const c = q.c + i * ldc;
     __m512d s0[NC], s1[NC];
-    _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+#pragma GCC unroll 8
+    for (int j = 0; j < NC; ++j) {
       s0[j] = _mm512_setzero_pd();
       s1[j] = _mm512_setzero_pd();
     }
     if (q.accumulate) {
-      _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+#pragma GCC unroll 8
+      for (int j = 0; j < NC; ++j) {
         s0[j] = _mm512_mask_i64gather_pd(s0[j], m0, to_row, c + j, 8);
         s1[j] = _mm512_mask_i64gather_pd(s1[j], m1, to_row, c + 8 * ldc + j, 8);
       }
@@ -152,13 +160,15 @@ __attribute__((target("arch=x86-64-v4"))) void columns_avx512(const Problem<doub
       const __m512d a0 = _mm512_maskz_loadu_pd(m0, a + p * a_col);
       const __m512d a1 = _mm512_maskz_loadu_pd(m1, a + p * a_col + 8);
       const double* bp = q.b + p * ldb;
-      _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+#pragma GCC unroll 8
+      for (int j = 0; j < NC; ++j) {
         const __m512d bj = _mm512_set1_pd(bp[j]);
         s0[j] = _mm512_fmadd_pd(a0, bj, s0[j]);
         s1[j] = _mm512_fmadd_pd(a1, bj, s1[j]);
       }
     }
-    _Pragma("GCC unroll 8") for (int j = 0; j < NC; ++j) {
+#pragma GCC unroll 8
+    for (int j = 0; j < NC; ++j) {
       _mm512_mask_i64scatter_pd(c + j, m0, to_row, s0[j], 8);
       _mm512_mask_i64scatter_pd(c + 8 * ldc + j, m1, to_row, s1[j], 8);
     }
@@ -216,7 +226,7 @@ __attribute__((target("arch=x86-64-v3"))) inline void store_avx2(double* p, __m2
 }
 
 // MR rows x NV vectors; when kMasked, the last vector holds `tail` lanes.
-// Locals and unroll pragmas as in tile_avx512.
+// Unrolled by pragma as tile_avx512.
 template <int MR, int NV, bool kMasked>
 __attribute__((target("arch=x86-64-v3"))) void tile_avx2(const Problem<double>& q, int64_t i,
                                                          int64_t j, int64_t tail) {
@@ -226,24 +236,29 @@ __attribute__((target("arch=x86-64-v3"))) void tile_avx2(const Problem<double>& 
   double* const c = q.c + i * ldc + j;
   const __m256i mask = lanes_avx2(tail);
   __m256d s[MR][NV];
-  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
-    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm256_setzero_pd();
-  if (q.accumulate) {
-    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
-      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = load_avx2(c + r * ldc + 4 * v, mask, kMasked && v + 1 == NV);
-  }
+#pragma GCC unroll 4
+  for (int r = 0; r < MR; ++r)
+#pragma GCC unroll 2
+    for (int v = 0; v < NV; ++v)
+      s[r][v] = q.accumulate ? load_avx2(c + r * ldc + 4 * v, mask, kMasked && v + 1 == NV)
+                             : _mm256_setzero_pd();
   for (int64_t p = 0; p < K; ++p) {
     const double* bp = b + p * ldb;
     const double* ap = a + p * a_col;
     __m256d bv[NV];
-    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) bv[v] = load_avx2(bp + 4 * v, mask, kMasked && v + 1 == NV);
-    _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r) {
+#pragma GCC unroll 2
+    for (int v = 0; v < NV; ++v) bv[v] = load_avx2(bp + 4 * v, mask, kMasked && v + 1 == NV);
+#pragma GCC unroll 4
+    for (int r = 0; r < MR; ++r) {
       const __m256d ar = _mm256_set1_pd(ap[r * a_row]);
-      _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) s[r][v] = _mm256_fmadd_pd(ar, bv[v], s[r][v]);
+#pragma GCC unroll 2
+      for (int v = 0; v < NV; ++v) s[r][v] = _mm256_fmadd_pd(ar, bv[v], s[r][v]);
     }
   }
-  _Pragma("GCC unroll 8") for (int r = 0; r < MR; ++r)
-    _Pragma("GCC unroll 2") for (int v = 0; v < NV; ++v) {
+#pragma GCC unroll 4
+  for (int r = 0; r < MR; ++r)
+#pragma GCC unroll 2
+    for (int v = 0; v < NV; ++v) {
       if (v + 1 == NV) {
         store_avx2<kMasked>(c + r * ldc + 4 * v, mask, s[r][v]);
       } else {

@@ -245,9 +245,9 @@ TEST(VectorTanhTest, SoftplusSigmoidArrayIsTheScalarFormBitForBit) {
     x.push_back(-std::pow(10.0, e));
   }
   for (double v = -800.0; v <= 40.0; v += 0.0731) x.push_back(v);
+  const double inf = std::numeric_limits<double>::infinity();
   for (double v : {0.0, -0.0, 20.0, std::nextafter(20.0, 21.0), -745.2, std::nextafter(-745.2, 0.0),
-                   745.2, 4.9e-324, -4.9e-324, std::numeric_limits<double>::infinity(),
-                   -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
+                   745.2, 4.9e-324, -4.9e-324, inf, -inf, std::numeric_limits<double>::quiet_NaN()})
     x.push_back(v);
   const auto n = static_cast<int64_t>(x.size());
   const auto same = [](double a, double b) {

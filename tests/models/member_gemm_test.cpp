@@ -79,10 +79,11 @@ TEST(MemberGemmTest, EveryInstructionSetGivesTheDocumentedChainBitForBit) {
   // Columns around the 16/8/4/1 tiles, rows around the 8- and 4-row blocks
   // and their 1-3 row rests, K = 0; with a transposed A, fewer than 8
   // columns over 8, 16 and 16 + 3 rows (the kernels over rows).
-  const std::vector<Shape> shapes{{2, 1, 1, 1},    {3, 4, 16, 16},   {2, 5, 3, 17},  {1, 7, 2, 31},
-                                  {2, 9, 16, 3},   {1, 64, 16, 16},  {2, 3, 0, 5},   {1, 13, 33, 12},
-                                  {2, 192, 2, 16}, {1, 16, 192, 16}, {2, 19, 40, 6}, {1, 16, 7, 7},
-                                  {2, 8, 5, 1},    {1, 26, 3, 2},    {1, 14, 9, 4},  {2, 11, 4, 9}};
+  const std::vector<Shape> shapes{
+      {2, 1, 1, 1},     {3, 4, 16, 16}, {2, 5, 3, 17},  {1, 7, 2, 31}, {2, 9, 16, 3},
+      {1, 64, 16, 16},  {2, 3, 0, 5},   {1, 13, 33, 12}, {2, 192, 2, 16}, {1, 16, 192, 16},
+      {2, 19, 40, 6},   {1, 16, 7, 7},  {2, 8, 5, 1},   {1, 26, 3, 2},  {1, 14, 9, 4},
+      {2, 11, 4, 9}};
   for (const auto& s : shapes)
     for (int flags = 0; flags < 16; ++flags) {
       check_shape<double>(s, flags & 1, flags & 2, flags & 4, flags & 8);

@@ -97,9 +97,9 @@ TEST(FlatAdamTest, EveryInstructionSetGivesTheSameBits) {
         auto g = torch::zeros_like(p);
         FlatAdam adam(p, g, TrainerOptions{});
         for (int step = 0; step < 5; ++step) {
-          g.copy_(torch::randn({n}, torch::kFloat64).mul(torch::pow(10.0, torch::randint(-8, 3, {n})))
-                      .mul(torch::rand({n}) > 0.1)
-                      .to(dtype));
+          const auto scale = torch::pow(10.0, torch::randint(-8, 3, {n}));
+          const auto kept = torch::rand({n}) > 0.1;
+          g.copy_(torch::randn({n}, torch::kFloat64).mul(scale).mul(kept).to(dtype));
           adam.step();
         }
         finals.push_back(p.clone());
