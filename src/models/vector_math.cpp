@@ -11,6 +11,26 @@ namespace phnn {
 namespace internal {
 namespace {
 
+// The exp reduction x = k ln 2 + r shared by the functions below: ln 2 in two
+// parts (k ln2_hi exact), and the shifter whose addition rounds x log2 e to
+// an integer (round half to even, as nearbyint in the default rounding mode)
+// that the low mantissa bits of the sum then hold.
+constexpr double kLog2e = 1.4426950408889634073599;
+constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
+constexpr double kShifter = 6755399441055744.0;  // 1.5 * 2^52: t - kShifter = round(t)
+
+PHNN_KERNEL_INLINE int64_t bits_of(double v) {
+  int64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+PHNN_KERNEL_INLINE double power_of_two(int64_t k) {  // 2^k, -1022 <= k <= 1023
+  const int64_t b = (k + 1023) << 52;
+  double v;
+  std::memcpy(&v, &b, sizeof v);
+  return v;
+}
+
 // exp(r) for |r| <= ln2 / 2: Cephes' Pade form
 // exp r = 1 + 2 r P(r^2) / (Q(r^2) - r P(r^2)).
 PHNN_KERNEL_INLINE double exp_pade(double r) {
@@ -23,24 +43,13 @@ PHNN_KERNEL_INLINE double exp_pade(double r) {
   return e;
 }
 
-// exp(x) for 0 <= x <= 44 (the caller clamps), Cephes' exp.c.
+// exp(x) for 0 <= x <= 44 (the caller clamps), Cephes' exp.c; 2^k from the
+// bits of the shifted sum.
 PHNN_KERNEL_INLINE double exp_reduced(double x) {
-  constexpr double kLog2e = 1.4426950408889634073599;
-  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
-  constexpr double kShifter = 6755399441055744.0;  // 1.5 * 2^52: t - kShifter = round(t)
   const double t = x * kLog2e + kShifter;
   const double k = t - kShifter;
   const double r = (x - k * kLn2Hi) - k * kLn2Lo;
-  const double e = exp_pade(r);
-  // 2^k from its bits: the low mantissa bits of t hold k.
-  int64_t t_bits, shifter_bits;
-  std::memcpy(&t_bits, &t, sizeof t);
-  constexpr double kShifterCopy = kShifter;
-  std::memcpy(&shifter_bits, &kShifterCopy, sizeof shifter_bits);
-  const int64_t scale_bits = ((t_bits - shifter_bits) + 1023) << 52;
-  double scale;
-  std::memcpy(&scale, &scale_bits, sizeof scale);
-  return e * scale;
+  return exp_pade(r) * power_of_two(bits_of(t) - bits_of(kShifter));
 }
 
 PHNN_KERNEL_INLINE double tanh_one(double x) {
@@ -61,27 +70,12 @@ PHNN_KERNEL_INLINE void tanh_body(const double* x, double* y, int64_t n) {
   for (int64_t i = 0; i < n; ++i) y[i] = tanh_one(x[i]);
 }
 
-// exp_nonpositive(x) for x = -|v| (so x <= 0 or NaN) without a branch, for
-// softplus_sigmoid_array: the same operations in the same order, with
-// nearbyint(x log2 e) by the shifter (round half to even, as nearbyint in
-// the default rounding mode) and 2^k1, 2^k2 (normal) built from their bits
-// instead of ldexp; the selects at the end give NaN, 0 below -745.2 and 1
-// at 0, as the scalar function's early returns do.
-PHNN_KERNEL_INLINE int64_t bits_of(double v) {
-  int64_t b;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
-PHNN_KERNEL_INLINE double power_of_two(int64_t k) {  // 2^k, -1022 <= k <= 1023
-  const int64_t b = (k + 1023) << 52;
-  double v;
-  std::memcpy(&v, &b, sizeof v);
-  return v;
-}
+// exp(x) for x <= 0 or NaN without a branch (exp_nonpositive and
+// softplus_sigmoid_array): the reduction and Pade form of exp_reduced(),
+// with 2^k applied in two normal halves 2^k1 2^k2 so results down to the
+// subnormals (x > -745.2) come out right; the selects at the end give NaN,
+// 0 below -745.2 and 1 at 0.
 PHNN_KERNEL_INLINE double exp_nonpositive_lane(double x) {
-  constexpr double kLog2e = 1.4426950408889634073599;
-  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
-  constexpr double kShifter = 6755399441055744.0;  // 1.5 * 2^52
   const double xc = x < -745.2 ? -745.2 : x == x ? x : 0.0;  // the lanes selected away stay finite
   const double t = xc * kLog2e + kShifter;
   const double k = t - kShifter;
@@ -93,7 +87,9 @@ PHNN_KERNEL_INLINE double exp_nonpositive_lane(double x) {
   return x != x ? x : x < -745.2 ? 0.0 : x == 0.0 ? 1.0 : value;
 }
 
-// log1p_unit(z) without its NaN branch (NaN flows through the same series).
+// log(1 + z) = 2 atanh(s), s = z / (2 + z) in [0, 1/3] for z in [0, 1]:
+// atanh s = s (1 + s^2/3 + s^4/5 + ...), 19 terms (s^38/39 < 2^-60). NaN
+// flows through the series (no branch).
 PHNN_KERNEL_INLINE double log1p_unit_lane(double z) {
   const double s = z / (2.0 + z), s2 = s * s;
   double sum = 1.0 / 39.0;
@@ -116,32 +112,12 @@ PHNN_KERNEL_INLINE void softplus_sigmoid_body(const double* x, int64_t n, double
 
 }  // namespace
 
-// exp(x), x <= 0: the reduction and Pade form of exp_reduced(), with 2^k
-// applied in two halves so results down to the subnormals (x > -745.2)
-// come out right; 0 below.
-double exp_nonpositive(double x) {
-  if (x != x) return x;
-  if (x >= 0.0) return x == 0.0 ? 1.0 : cr::exp(x);  // outside the domain: correctly rounded
-  if (x < -745.2) return 0.0;
-  constexpr double kLog2e = 1.4426950408889634073599;
-  constexpr double kLn2Hi = 6.93145751953125e-1, kLn2Lo = 1.42860682030941723212e-6;
-  const double k = std::nearbyint(x * kLog2e);
-  const double r = (x - k * kLn2Hi) - k * kLn2Lo;
-  const double e = exp_pade(r);
-  const auto ki = static_cast<int>(k);
-  const int k1 = ki / 2, k2 = ki - k1;  // both >= -538: normal powers of two
-  return e * std::ldexp(1.0, k1) * std::ldexp(1.0, k2);
-}
+// The scalar forms of the two loop bodies above (the same operations, so the
+// same bits as softplus_sigmoid_array); x > 0 falls back to the correctly
+// rounded exp.
+double exp_nonpositive(double x) { return x > 0.0 ? cr::exp(x) : exp_nonpositive_lane(x); }
 
-// log(1 + z) = 2 atanh(s), s = z / (2 + z) in [0, 1/3] for z in [0, 1]:
-// atanh s = s (1 + s^2/3 + s^4/5 + ...), 19 terms (s^38/39 < 2^-60).
-double log1p_unit(double z) {
-  if (z != z) return z;
-  const double s = z / (2.0 + z), s2 = s * s;
-  double sum = 1.0 / 39.0;
-  for (int k = 18; k >= 0; --k) sum = sum * s2 + 1.0 / (2 * k + 1);
-  return 2.0 * s * sum;
-}
+double log1p_unit(double z) { return z != z ? z : log1p_unit_lane(z); }
 
 PHNN_KERNEL_VARIANTS(void, tanh_array, (const double* x, double* y, int64_t n), (x, y, n),
                      tanh_body)
