@@ -63,27 +63,50 @@ PHNN_KERNEL_INLINE void diagonal_pair_backward(In t, In zi, In zp, In abp, Out z
   }
 }
 
-// Order 1 with two directions (the 2-state models' L_H), each pass above in
-// one loop: the same operations per element in the same order (so the same
-// bits), t and z~_0 read once instead of three times.
-PHNN_KERNEL_INLINE void forward_order1_d2(In t, In z1, In z2, Out a0, Out a1, Out a2, int64_t n) {
+// Order 1 with D <= 4 directions (L_H of the 2- to 4-state models): the
+// passes above fused into one loop per element, with the same operations in
+// the same order (so the same bits), t and z~_0 read once instead of D + 1
+// times. Channel c of a member's block starts at c n.
+template <int D>
+PHNN_KERNEL_INLINE void forward_order1(In t, In z, Out a, int64_t n) {
   for (int64_t k = 0; k < n; ++k) {
     const double s = 1.0 - t[k] * t[k];
-    a0[k] = t[k];
-    a1[k] = s * z1[k];
-    a2[k] = s * z2[k];
+    a[k] = t[k];
+#pragma GCC unroll 4
+    for (int i = 1; i <= D; ++i) a[i * n + k] = s * z[i * n + k];
   }
 }
-PHNN_KERNEL_INLINE void backward_order1_d2(In t, In z1, In z2, In ab0, In ab1, In ab2, Out zb0,
-                                           Out zb1, Out zb2, int64_t n) {
+template <int D>
+PHNN_KERNEL_INLINE void backward_order1(In t, In z, In ab, Out zb, int64_t n) {
   for (int64_t k = 0; k < n; ++k) {
     const double s = 1.0 - t[k] * t[k];
-    double value = s * ab0[k];
-    value += -2.0 * t[k] * s * ab1[k] * z1[k];
-    zb1[k] = s * ab1[k];
-    value += -2.0 * t[k] * s * ab2[k] * z2[k];
-    zb2[k] = s * ab2[k];
-    zb0[k] = value;
+    double value = s * ab[k];
+#pragma GCC unroll 4
+    for (int i = 1; i <= D; ++i) {
+      value += -2.0 * t[k] * s * ab[i * n + k] * z[i * n + k];
+      zb[i * n + k] = s * ab[i * n + k];
+    }
+    zb[k] = value;
+  }
+}
+
+// Runs the fused order-1 loops for d <= 4; false for the general passes.
+PHNN_KERNEL_INLINE bool order1_forward(int64_t d, In t, In z, Out a, int64_t n) {
+  switch (d) {
+    case 1: forward_order1<1>(t, z, a, n); return true;
+    case 2: forward_order1<2>(t, z, a, n); return true;
+    case 3: forward_order1<3>(t, z, a, n); return true;
+    case 4: forward_order1<4>(t, z, a, n); return true;
+    default: return false;
+  }
+}
+PHNN_KERNEL_INLINE bool order1_backward(int64_t d, In t, In z, In ab, Out zb, int64_t n) {
+  switch (d) {
+    case 1: backward_order1<1>(t, z, ab, zb, n); return true;
+    case 2: backward_order1<2>(t, z, ab, zb, n); return true;
+    case 3: backward_order1<3>(t, z, ab, zb, n); return true;
+    case 4: backward_order1<4>(t, z, ab, zb, n); return true;
+    default: return false;
   }
 }
 
@@ -94,10 +117,7 @@ PHNN_KERNEL_INLINE void forward_body(int64_t d, int64_t order, int64_t E, int64_
     const double* ze = z + e * C * n;
     const double* te = t + e * n;
     double* ae = a + e * C * n;
-    if (order == 1 && d == 2) {
-      forward_order1_d2(te, ze + n, ze + 2 * n, ae, ae + n, ae + 2 * n, n);
-      continue;
-    }
+    if (order == 1 && order1_forward(d, te, ze, ae, n)) continue;
     for (int64_t k = 0; k < n; ++k) ae[k] = te[k];
     if (order < 1) continue;
     for (int64_t i = 0; i < d; ++i) tangent_forward(te, ze + (1 + i) * n, ae + (1 + i) * n, n);
@@ -118,11 +138,7 @@ PHNN_KERNEL_INLINE void backward_body(int64_t d, int64_t order, int64_t E, int64
     const double* te = t + e * n;
     const double* ab = a_bar + e * C * n;
     double* zb = z_bar + e * C * n;
-    if (order == 1 && d == 2) {
-      backward_order1_d2(te, ze + n, ze + 2 * n, ab, ab + n, ab + 2 * n, zb, zb + n, zb + 2 * n,
-                         n);
-      continue;
-    }
+    if (order == 1 && order1_backward(d, te, ze, ab, zb, n)) continue;
     value_backward(te, ab, zb, n);
     if (order < 1) continue;
     for (int64_t i = 0; i < d; ++i) {
