@@ -123,7 +123,8 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
 //   v0_ij = a_ij q + a_i [j=0] + a_j [i=0]
 //   v1_ij = c_ij q + c_i [j=0] + c_j [i=0] + d_ij p + d_i [j=1] + d_j [i=1]
 //   G_i = v0 v0_i + v1 v1_i,   K_ij = v0_i v0_j + v0 v0_ij + v1_i v1_j + v1 v1_ij.
-// The backward runs these lines in reverse (CurvatureRow::backward).
+// The backward runs these lines in reverse (CurvatureRow::backward); the
+// forward saves softplus, sigmoid and softplus' of o0 and o2 for it.
 struct CurvatureRow {
   // Forward values.
   double q, p, a, c, d, a1, d1, a2, d2, ai[2], ci[2], di[2], aij[2][2], cij[2][2], dij[2][2];
@@ -232,9 +233,8 @@ class CurvatureFunction : public torch::autograd::Function<CurvatureFunction> {
     const double *po = o.data_ptr<double>(), *pg = og.data_ptr<double>();
     const double *ph = oh.data_ptr<double>(), *px = x.data_ptr<double>();
     double *pgr = grad.data_ptr<double>(), *phs = hess.data_ptr<double>();
-    thread_local std::vector<double> aux;
-    aux.resize(static_cast<std::size_t>(SoftplusColumns::size(2, rows)));
-    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data());
+    Tensor aux = torch::empty({SoftplusColumns::size(2, rows)}, o.options());
+    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data_ptr<double>());
     for (int64_t r = 0; r < rows; ++r) {
       const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
       for (int i = 0; i < 2; ++i) {
@@ -242,7 +242,7 @@ class CurvatureFunction : public torch::autograd::Function<CurvatureFunction> {
         for (int j = 0; j < 2; ++j) phs[4 * r + 2 * i + j] = row.hessian(i, j);
       }
     }
-    ctx->save_for_backward({o, og, oh, x});
+    ctx->save_for_backward({o, og, oh, x, aux});
     return {grad, hess};
   }
 
@@ -260,9 +260,7 @@ class CurvatureFunction : public torch::autograd::Function<CurvatureFunction> {
     const double *pgb = gb.data_ptr<double>(), *pkb = kb.data_ptr<double>();
     double *pob = o_bar.data_ptr<double>(), *pogb = og_bar.data_ptr<double>();
     double *pohb = oh_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
-    thread_local std::vector<double> aux;
-    aux.resize(static_cast<std::size_t>(SoftplusColumns::size(2, rows)));
-    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data());
+    const SoftplusColumns f = SoftplusColumns::saved(2, rows, saved[4].data_ptr<double>());
     for (int64_t r = 0; r < rows; ++r) {
       const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
       row.backward(pg + 6 * r, ph + 12 * r, pgb + 2 * r, pkb + 4 * r, pob + 3 * r, pogb + 6 * r,
