@@ -32,6 +32,11 @@ FieldEval DynamicsModel::discrete_gradient4_field(const torch::Tensor&, const to
   return {};
 }
 
+torch::Tensor DynamicsModel::rk2_mean_l1_step(const torch::Tensor&, const torch::Tensor&,
+                                              const torch::Tensor&, double) const {
+  return {};
+}
+
 torch::Tensor DynamicsModel::hamiltonian(const torch::Tensor&) const {
   PHNN_REQUIRE(false, "hamiltonian: " << to_string(options_.kind) << " has no Hamiltonian");
   return {};

@@ -32,56 +32,70 @@ inline void lower_transpose_times(const double* o, const double* a, double* z) {
   z[2] = o[5] * a[2];
 }
 
+}  // namespace
+
+Tensor jr_field_forward(const Tensor& e_in, const Tensor& o_in, const Tensor& u_in,
+                        const std::array<std::array<double, 3>, 3>& J) {
+  const Tensor e = dense(e_in), o = dense(o_in), u = dense(u_in);
+  const int64_t rows = e.size(0) * e.size(1);
+  Tensor f = torch::empty_like(e);
+  const double *pe = e.data_ptr<double>(), *po = o.data_ptr<double>(), *pu = u.data_ptr<double>();
+  double* pf = f.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+    double v[3], rv[3];
+    lower_times(po + 6 * r, eps, v);
+    lower_transpose_times(po + 6 * r, v, rv);
+    for (int i = 0; i < 2; ++i) {
+      pf[2 * r + i] = J[i][0] * eps[0] + J[i][1] * eps[1] + J[i][2] * eps[2] - rv[i];
+    }
+  }
+  return f;
+}
+
+JrFieldAdjoints jr_field_backward(const Tensor& e_in, const Tensor& o_in, const Tensor& u_in,
+                                  const std::array<std::array<double, 3>, 3>& J, const Tensor& f_bar_in) {
+  const Tensor e = dense(e_in), o = dense(o_in), u = dense(u_in), fb = dense(f_bar_in);
+  const int64_t rows = e.size(0) * e.size(1);
+  JrFieldAdjoints out{torch::empty_like(e), torch::empty_like(o), torch::empty_like(u)};
+  const double *pe = e.data_ptr<double>(), *po = o.data_ptr<double>(), *pu = u.data_ptr<double>();
+  const double* pfb = fb.data_ptr<double>();
+  double *peb = out.effort.data_ptr<double>(), *pob = out.o.data_ptr<double>();
+  double* pub = out.u.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+    const double f_bar[3] = {pfb[2 * r], pfb[2 * r + 1], 0.0};
+    double v[3], w[3], ltw[3];
+    lower_times(po + 6 * r, eps, v);
+    lower_times(po + 6 * r, f_bar, w);
+    lower_transpose_times(po + 6 * r, w, ltw);
+    double eps_bar[3];
+    for (int j = 0; j < 3; ++j) eps_bar[j] = J[0][j] * f_bar[0] + J[1][j] * f_bar[1] - ltw[j];
+    peb[2 * r] = eps_bar[0];
+    peb[2 * r + 1] = eps_bar[1];
+    pub[r] = eps_bar[2];
+    double* ob = pob + 6 * r;
+    for (int k = 0; k < 6; ++k) ob[k] = -(v[kRow[k]] * f_bar[kCol[k]] + w[kRow[k]] * eps[kCol[k]]);
+  }
+  return out;
+}
+
+namespace {
+
 class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
  public:
   static Tensor forward(AutogradContext* ctx, const Tensor& effort_in, const Tensor& o_in,
                         const Tensor& u_in, std::array<std::array<double, 3>, 3> J) {
     const Tensor e = dense(effort_in), o = dense(o_in), u = dense(u_in);
-    const int64_t rows = e.size(0) * e.size(1);
-    Tensor f = torch::empty_like(e);
-    const double *pe = e.data_ptr<double>(), *po = o.data_ptr<double>(), *pu = u.data_ptr<double>();
-    double* pf = f.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
-      double v[3], rv[3];
-      lower_times(po + 6 * r, eps, v);
-      lower_transpose_times(po + 6 * r, v, rv);
-      for (int i = 0; i < 2; ++i) {
-        pf[2 * r + i] = J[i][0] * eps[0] + J[i][1] * eps[1] + J[i][2] * eps[2] - rv[i];
-      }
-    }
     ctx->save_for_backward({e, o, u});
     save_matrix(ctx, J);
-    return f;
+    return jr_field_forward(e, o, u, J);
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &e = saved[0], &o = saved[1], &u = saved[2];
-    const auto J = load_matrix<3, 3>(ctx);
-    const Tensor fb = dense(grads[0]);
-    const int64_t rows = e.size(0) * e.size(1);
-    Tensor e_bar = torch::empty_like(e), o_bar = torch::empty_like(o), u_bar = torch::empty_like(u);
-    const double *pe = e.data_ptr<double>(), *po = o.data_ptr<double>(), *pu = u.data_ptr<double>();
-    const double* pfb = fb.data_ptr<double>();
-    double *peb = e_bar.data_ptr<double>(), *pob = o_bar.data_ptr<double>();
-    double* pub = u_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
-      const double f_bar[3] = {pfb[2 * r], pfb[2 * r + 1], 0.0};
-      double v[3], w[3], ltw[3];
-      lower_times(po + 6 * r, eps, v);
-      lower_times(po + 6 * r, f_bar, w);
-      lower_transpose_times(po + 6 * r, w, ltw);
-      double eps_bar[3];
-      for (int j = 0; j < 3; ++j) eps_bar[j] = J[0][j] * f_bar[0] + J[1][j] * f_bar[1] - ltw[j];
-      peb[2 * r] = eps_bar[0];
-      peb[2 * r + 1] = eps_bar[1];
-      pub[r] = eps_bar[2];
-      double* ob = pob + 6 * r;
-      for (int k = 0; k < 6; ++k) ob[k] = -(v[kRow[k]] * f_bar[kCol[k]] + w[kRow[k]] * eps[kCol[k]]);
-    }
-    return {e_bar, o_bar, u_bar, Tensor()};
+    const JrFieldAdjoints adj = jr_field_backward(saved[0], saved[1], saved[2], load_matrix<3, 3>(ctx), grads[0]);
+    return {adj.effort, adj.o, adj.u, Tensor()};
   }
 };
 

@@ -23,6 +23,20 @@ struct HamiltonianHead {
 HamiltonianHead hamiltonian_head(const torch::Tensor& o, const torch::Tensor& o_g,
                                  const torch::Tensor& x);
 
+/// hamiltonian_head without an autograd node, for a hand-written step
+/// (models/jr_rk2_step.cpp): the same forward, with what its backward
+/// reads in *tape, and the same backward (adjoints h~, g~; undefined = 0).
+struct HamiltonianTape {
+  torch::Tensor o, o_g, x, aux;  // o_g undefined: H only
+};
+HamiltonianHead hamiltonian_head_taped(const torch::Tensor& o, const torch::Tensor& o_g,
+                                       const torch::Tensor& x, HamiltonianTape* tape);
+struct HamiltonianAdjoints {
+  torch::Tensor o, o_g, x;
+};
+HamiltonianAdjoints hamiltonian_head_backward(const HamiltonianTape& tape, const torch::Tensor& h_bar,
+                                              const torch::Tensor& g_bar);
+
 /// gradH [E, B, 2] and the Hessian of H [E, B, 2, 2] (symmetric; [i][k] =
 /// d2H / dx_i dx_k) from the L_H outputs o [E, B, 3] and their first and
 /// second x-derivatives o_g [E, B, 2, 3], o_h [E, B, 2, 2, 3]: the order-2
@@ -38,6 +52,17 @@ HamiltonianCurvature hamiltonian_curvature_head(const torch::Tensor& o, const to
 /// triangle of L_R) and u [E, B, 1]:  f = [(J - L_R^T L_R) (e, u)]_{1:2}.
 torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
                             const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J);
+
+/// jr_field_head without an autograd node (u already [E, B, 1]), and its
+/// backward from f~: the adjoints of the effort, of o and of u.
+torch::Tensor jr_field_forward(const torch::Tensor& effort, const torch::Tensor& o,
+                               const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J);
+struct JrFieldAdjoints {
+  torch::Tensor effort, o, u;
+};
+JrFieldAdjoints jr_field_backward(const torch::Tensor& effort, const torch::Tensor& o,
+                                  const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J,
+                                  const torch::Tensor& f_bar);
 
 /// The PHNN-JR field and its x-derivatives (first-order jet) from the effort
 /// e [E, B, 2] with its tangents e_g [E, B, 2 (direction), 2], the L_R outputs

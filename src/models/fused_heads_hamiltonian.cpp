@@ -35,82 +35,105 @@ struct HamiltonianRow {
   double c(int k) const { return k == 0 ? v0 * s0 * q : k == 1 ? v1 * q : v1 * s2 * p; }
 };
 
+}  // namespace
+
+HamiltonianHead hamiltonian_head_taped(const Tensor& o_in, const Tensor& o_g_in, const Tensor& x_in,
+                                       HamiltonianTape* tape) {
+  const Tensor o = dense(o_in), x = dense(x_in);
+  const bool with_grad = o_g_in.defined();
+  const Tensor o_g = with_grad ? dense(o_g_in) : Tensor();
+  const int64_t rows = o.size(0) * o.size(1);
+  Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
+  Tensor grad = with_grad ? torch::empty({o.size(0), o.size(1), 2}, o.options()) : Tensor();
+  Tensor aux = torch::empty({SoftplusColumns::size(2, rows)}, o.options());
+  const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+  const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
+  double* ph = h.data_ptr<double>();
+  double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
+  const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data_ptr<double>());
+  for (int64_t r = 0; r < rows; ++r) {
+    const HamiltonianRow row(po + 3 * r, px + 2 * r, f, r);
+    ph[r] = 0.5 * (row.v0 * row.v0 + row.v1 * row.v1);
+    if (!with_grad) continue;
+    const double* og = pog + 6 * r;
+    const double c[3] = {row.c(0), row.c(1), row.c(2)};
+    pg[2 * r] = row.l00 * row.v0 + row.l10 * row.v1 + og[0] * c[0] + og[1] * c[1] + og[2] * c[2];
+    pg[2 * r + 1] = row.l11 * row.v1 + og[3] * c[0] + og[4] * c[1] + og[5] * c[2];
+  }
+  *tape = HamiltonianTape{o, o_g, x, aux};
+  return {h, grad};
+}
+
+HamiltonianAdjoints hamiltonian_head_backward(const HamiltonianTape& tape, const Tensor& h_bar_in,
+                                              const Tensor& g_bar_in) {
+  const Tensor &o = tape.o, &x = tape.x;
+  const bool with_grad = tape.o_g.defined();
+  const int64_t rows = o.size(0) * o.size(1);
+  const Tensor h_bar = h_bar_in.defined() ? dense(h_bar_in) : torch::zeros_like(o.narrow(-1, 0, 1));
+  const Tensor g_bar = with_grad && g_bar_in.defined() ? dense(g_bar_in) : Tensor();
+  HamiltonianAdjoints out{torch::empty_like(o), with_grad ? torch::zeros_like(tape.o_g) : Tensor(),
+                          torch::empty_like(x)};
+  const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+  const double* phb = h_bar.data_ptr<double>();
+  const SoftplusColumns f = SoftplusColumns::saved(2, rows, tape.aux.data_ptr<double>());
+  const double* pog = g_bar.defined() ? tape.o_g.data_ptr<double>() : nullptr;
+  const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
+  double* pogb = g_bar.defined() ? out.o_g.data_ptr<double>() : nullptr;
+  double *pob = out.o.data_ptr<double>(), *pxb = out.x.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const HamiltonianRow row(po + 3 * r, px + 2 * r, f, r);
+    const double hb = phb[r];
+    double gb[2] = {0.0, 0.0}, cb[3] = {0.0, 0.0, 0.0};
+    if (pgb) {
+      const double* og = pog + 6 * r;
+      double* ogb = pogb + 6 * r;
+      gb[0] = pgb[2 * r];
+      gb[1] = pgb[2 * r + 1];
+      for (int k = 0; k < 3; ++k) {
+        cb[k] = gb[0] * og[k] + gb[1] * og[3 + k];
+        ogb[k] = gb[0] * row.c(k);
+        ogb[3 + k] = gb[1] * row.c(k);
+      }
+    }
+    const double v0b = hb * row.v0 + gb[0] * row.l00 + cb[0] * row.s0 * row.q;
+    const double v1b = hb * row.v1 + gb[0] * row.l10 + gb[1] * row.l11 + cb[1] * row.q +
+                       cb[2] * row.s2 * row.p;
+    const double l00b = gb[0] * row.v0 + v0b * row.q;
+    const double l10b = gb[0] * row.v1 + v1b * row.q;
+    const double l11b = gb[1] * row.v1 + v1b * row.p;
+    double* ob = pob + 3 * r;
+    ob[0] = l00b * f.slope(0, r) + cb[0] * row.v0 * row.q * row.s0 * (1.0 - row.s0);
+    ob[1] = l10b;
+    ob[2] = l11b * f.slope(1, r) + cb[2] * row.v1 * row.p * row.s2 * (1.0 - row.s2);
+    double* xb = pxb + 2 * r;
+    xb[0] = cb[0] * row.v0 * row.s0 + cb[1] * row.v1 + v0b * row.l00 + v1b * row.l10;
+    xb[1] = cb[2] * row.v1 * row.s2 + v1b * row.l11;
+  }
+  return out;
+}
+
+namespace {
+
+// The autograd node of hamiltonian_head: the taped forward and backward.
 class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction> {
  public:
   static variable_list forward(AutogradContext* ctx, const Tensor& o_in,
                                const c10::optional<Tensor>& o_g_in, const Tensor& x_in) {
-    const Tensor o = dense(o_in), x = dense(x_in);
+    HamiltonianTape tape;
     const bool with_grad = o_g_in.has_value();
-    const Tensor o_g = with_grad ? dense(*o_g_in) : Tensor();
-    const int64_t rows = o.size(0) * o.size(1);
-    Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
-    Tensor grad = with_grad ? torch::empty({o.size(0), o.size(1), 2}, o.options()) : Tensor();
-    Tensor aux = torch::empty({SoftplusColumns::size(2, rows)}, o.options());
-    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
-    const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
-    double* ph = h.data_ptr<double>();
-    double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
-    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data_ptr<double>());
-    for (int64_t r = 0; r < rows; ++r) {
-      const HamiltonianRow row(po + 3 * r, px + 2 * r, f, r);
-      ph[r] = 0.5 * (row.v0 * row.v0 + row.v1 * row.v1);
-      if (!with_grad) continue;
-      const double* og = pog + 6 * r;
-      const double c[3] = {row.c(0), row.c(1), row.c(2)};
-      pg[2 * r] = row.l00 * row.v0 + row.l10 * row.v1 + og[0] * c[0] + og[1] * c[1] + og[2] * c[2];
-      pg[2 * r + 1] = row.l11 * row.v1 + og[3] * c[0] + og[4] * c[1] + og[5] * c[2];
-    }
-    ctx->save_for_backward({o, with_grad ? o_g : o, x, aux});
+    const HamiltonianHead head = hamiltonian_head_taped(o_in, with_grad ? *o_g_in : Tensor(), x_in, &tape);
+    ctx->save_for_backward({tape.o, with_grad ? tape.o_g : tape.o, tape.x, tape.aux});
     ctx->saved_data["with_grad"] = with_grad;
-    return with_grad ? variable_list{h, grad} : variable_list{h};
+    return with_grad ? variable_list{head.h, head.grad} : variable_list{head.h};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &o = saved[0], &x = saved[2], &aux = saved[3];
     const bool with_grad = ctx->saved_data["with_grad"].toBool();
-    const int64_t rows = o.size(0) * o.size(1);
-    const Tensor h_bar = grads[0].defined() ? dense(grads[0]) : torch::zeros_like(o.narrow(-1, 0, 1));
-    const Tensor g_bar = with_grad && grads[1].defined() ? dense(grads[1]) : Tensor();
-    Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
-    Tensor o_g_bar = with_grad ? torch::zeros_like(saved[1]) : Tensor();
-    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
-    const double* phb = h_bar.data_ptr<double>();
-    const SoftplusColumns f = SoftplusColumns::saved(2, rows, aux.data_ptr<double>());
-    const double* pog = g_bar.defined() ? saved[1].data_ptr<double>() : nullptr;
-    const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
-    double* pogb = g_bar.defined() ? o_g_bar.data_ptr<double>() : nullptr;
-    double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const HamiltonianRow row(po + 3 * r, px + 2 * r, f, r);
-      const double hb = phb[r];
-      double gb[2] = {0.0, 0.0}, cb[3] = {0.0, 0.0, 0.0};
-      if (pgb) {
-        const double* og = pog + 6 * r;
-        double* ogb = pogb + 6 * r;
-        gb[0] = pgb[2 * r];
-        gb[1] = pgb[2 * r + 1];
-        for (int k = 0; k < 3; ++k) {
-          cb[k] = gb[0] * og[k] + gb[1] * og[3 + k];
-          ogb[k] = gb[0] * row.c(k);
-          ogb[3 + k] = gb[1] * row.c(k);
-        }
-      }
-      const double v0b = hb * row.v0 + gb[0] * row.l00 + cb[0] * row.s0 * row.q;
-      const double v1b = hb * row.v1 + gb[0] * row.l10 + gb[1] * row.l11 + cb[1] * row.q +
-                         cb[2] * row.s2 * row.p;
-      const double l00b = gb[0] * row.v0 + v0b * row.q;
-      const double l10b = gb[0] * row.v1 + v1b * row.q;
-      const double l11b = gb[1] * row.v1 + v1b * row.p;
-      double* ob = pob + 3 * r;
-      ob[0] = l00b * f.slope(0, r) + cb[0] * row.v0 * row.q * row.s0 * (1.0 - row.s0);
-      ob[1] = l10b;
-      ob[2] = l11b * f.slope(1, r) + cb[2] * row.v1 * row.p * row.s2 * (1.0 - row.s2);
-      double* xb = pxb + 2 * r;
-      xb[0] = cb[0] * row.v0 * row.s0 + cb[1] * row.v1 + v0b * row.l00 + v1b * row.l10;
-      xb[1] = cb[2] * row.v1 * row.s2 + v1b * row.l11;
-    }
-    return {o_bar, o_g_bar, x_bar};
+    const HamiltonianTape tape{saved[0], with_grad ? saved[1] : Tensor(), saved[2], saved[3]};
+    const HamiltonianAdjoints adj =
+        hamiltonian_head_backward(tape, grads[0], with_grad ? grads[1] : Tensor());
+    return {adj.o, adj.o_g, adj.x};
   }
 };
 

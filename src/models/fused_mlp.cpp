@@ -233,6 +233,91 @@ void pack_output_adjoint(const Plan& plan, const torch::autograd::variable_list&
   }
 }
 
+// The adjoint of x_v's channel `channel` ([E, B, n_0]) from the packed A~_0.
+Tensor input_adjoint(const Plan& plan, const double* a_bar, int64_t channel) {
+  const int64_t n = plan.widths[0];
+  Tensor t = torch::empty({plan.E, plan.B, n}, torch::kFloat64);
+  scatter_3d(a_bar + channel * plan.B * n, plan.block(n), &t);
+  return t;
+}
+
+// Adjoint of x_h [E, B, d, d, n]: pack_input read x_h[i][j] (i <= j) only;
+// the adjoint is split evenly over both symmetric copies.
+Tensor input_curvature_adjoint(const Plan& plan, const double* a_bar) {
+  const Channels& ch = plan.ch;
+  const int64_t n = plan.widths[0];
+  Tensor out = torch::zeros({plan.E, plan.B, ch.d, ch.d, n}, torch::kFloat64);
+  for (std::size_t q = 0; q < ch.pairs.size(); ++q) {
+    const auto [i, j] = ch.pairs[q];
+    const Tensor src = input_adjoint(plan, a_bar, ch.pair(q));
+    if (i == j) {
+      out.select(2, i).select(2, j).copy_(src);
+    } else {
+      out.select(2, i).select(2, j).copy_(0.5 * src);
+      out.select(2, j).select(2, i).copy_(0.5 * src);
+    }
+  }
+  return out;
+}
+
+// The backward of one call, given the output adjoints `grads` (v~, g~, h~;
+// undefined = 0): parameter gradients added into `sinks` (or, without
+// sinks, returned as out[3 + l] and out[3 + L + l] where `need` asks), and
+// the input adjoints x_v~, x_g~, x_h~ (out[0..2]) where `need` asks.
+// `need` has one entry per output (3 + 2 L).
+variable_list backward_pass(const Plan& p, const Tensor& workspace,
+                            const std::vector<Tensor>& weights, const std::vector<Tensor>& sinks,
+                            const variable_list& grads, const std::vector<bool>& need) {
+  const int64_t L = p.layers(), E = p.E;
+  const bool need_v = need[0], need_g = need[1], need_h = need[2];
+  const int64_t widest = *std::max_element(p.widths.begin(), p.widths.end());
+  Tensor scratch = reusable_buffer(2 * E * p.block(widest));
+  double* z_bar = scratch.data_ptr<double>();
+  double* a_bar = z_bar + E * p.block(widest);
+  const double* ws = workspace.data_ptr<double>();
+  pack_output_adjoint(p, grads, z_bar);
+  variable_list out(static_cast<std::size_t>(3 + 2 * L));
+  for (int64_t l = L - 1; l >= 0; --l) {
+    const int64_t n_in = p.widths[l], n_out = p.widths[l + 1];
+    const auto ul = static_cast<std::size_t>(l);
+    const bool sink = !sinks.empty();
+    if (sink || need[static_cast<std::size_t>(3 + l)]) {  // W~ = A^T Z~
+      Tensor w_bar = sink ? sinks[ul] : torch::empty({E, n_in, n_out}, torch::kFloat64);
+      gemm_tn(E, static_cast<int>(p.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
+              ws + p.act[ul], z_bar, w_bar.data_ptr<double>(), /*accumulate=*/sink);
+      if (!sink) out[3 + ul] = w_bar;
+    }
+    if (sink || need[static_cast<std::size_t>(3 + L + l)]) {  // b~ = sum_batch Z~_0
+      Tensor b_bar = torch::zeros({E, 1, n_out}, torch::kFloat64);
+      double* pb = b_bar.data_ptr<double>();
+      sum_bias(E, p.B, n_out, p.block(n_out), z_bar, pb);
+      if (sink) {
+        double* dst = sinks[static_cast<std::size_t>(L) + ul].data_ptr<double>();
+        for (int64_t k = 0; k < E * n_out; ++k) dst[k] += pb[k];
+      } else {
+        out[3 + L + ul] = b_bar;
+      }
+    }
+    if (l == 0 && !(need_v || need_g || need_h)) break;
+    gemm_nn(E, static_cast<int>(p.rows()), static_cast<int>(n_out), static_cast<int>(n_in), z_bar,
+            weights[ul].data_ptr<double>(), a_bar, /*transpose_b=*/true);  // A~ = Z~ W^T
+    if (l == 0) break;
+    tanh_jet_backward(p.ch.d, p.ch.order, E, p.B * n_in, ws + p.pre[ul - 1], ws + p.tanh[ul - 1],
+                      a_bar, z_bar);
+  }
+  if (need_v) out[0] = input_adjoint(p, a_bar, 0);
+  if (need_g) {
+    Tensor g = torch::empty({E, p.B, p.ch.d, p.widths[0]}, torch::kFloat64);
+    for (int64_t i = 0; i < p.ch.d; ++i) {
+      Tensor gi = g.select(2, i);
+      scatter_3d(a_bar + p.ch.tangent(i) * p.B * p.widths[0], p.block(p.widths[0]), &gi);
+    }
+    out[1] = g;
+  }
+  if (need_h) out[2] = input_curvature_adjoint(p, a_bar);
+  return out;
+}
+
 // The backward node of one fused call. Holds the forward's workspace (A_l,
 // Z_l, T_l) and the weights; its next edges are, in order, x_v, x_g, x_h,
 // W_0..W_{L-1}, b_0..b_{L-1} (an undefined input has an empty edge).
@@ -250,107 +335,32 @@ class FusedMlpBackward : public torch::autograd::Node {
     weights_.clear();
     sinks_.clear();
   }
-  variable_list apply(variable_list&& grads) override;
+  variable_list apply(variable_list&& grads) override {
+    TORCH_CHECK(workspace_.defined(), "FusedMlpBackward: backward through the graph a second time");
+    std::vector<bool> need(static_cast<std::size_t>(3 + 2 * plan_.layers()));
+    for (std::size_t k = 0; k < need.size(); ++k) need[k] = should_compute_output(k);
+    return backward_pass(plan_, workspace_, weights_, sinks_, grads, need);
+  }
 
  private:
-  Tensor input_adjoint(const double* a_bar, int64_t channel) const;
-  Tensor input_curvature_adjoint(const double* a_bar) const;
-
   Plan plan_;
   Tensor workspace_;
   std::vector<Tensor> weights_;
   std::vector<Tensor> sinks_;  // W_0..W_{L-1}, b_0..b_{L-1} gradient buffers, or empty
 };
 
-variable_list FusedMlpBackward::apply(variable_list&& grads) {
-  TORCH_CHECK(workspace_.defined(), "FusedMlpBackward: backward through the graph a second time");
-  const Plan& p = plan_;
-  const int64_t L = p.layers(), E = p.E;
-  const bool need_v = should_compute_output(0), need_g = should_compute_output(1),
-             need_h = should_compute_output(2);
-  const int64_t widest = *std::max_element(p.widths.begin(), p.widths.end());
-  Tensor scratch = reusable_buffer(2 * E * p.block(widest));
-  double* z_bar = scratch.data_ptr<double>();
-  double* a_bar = z_bar + E * p.block(widest);
-  const double* ws = workspace_.data_ptr<double>();
-  pack_output_adjoint(p, grads, z_bar);
-  variable_list out(static_cast<std::size_t>(3 + 2 * L));
-  for (int64_t l = L - 1; l >= 0; --l) {
-    const int64_t n_in = p.widths[l], n_out = p.widths[l + 1];
-    const auto ul = static_cast<std::size_t>(l);
-    const bool sink = !sinks_.empty();
-    if (sink || should_compute_output(static_cast<std::size_t>(3 + l))) {  // W~ = A^T Z~
-      Tensor w_bar = sink ? sinks_[ul] : torch::empty({E, n_in, n_out}, torch::kFloat64);
-      gemm_tn(E, static_cast<int>(p.rows()), static_cast<int>(n_in), static_cast<int>(n_out),
-              ws + p.act[ul], z_bar, w_bar.data_ptr<double>(), /*accumulate=*/sink);
-      if (!sink) out[3 + ul] = w_bar;
-    }
-    if (sink || should_compute_output(static_cast<std::size_t>(3 + L + l))) {  // b~ = sum_batch Z~_0
-      Tensor b_bar = torch::zeros({E, 1, n_out}, torch::kFloat64);
-      double* pb = b_bar.data_ptr<double>();
-      sum_bias(E, p.B, n_out, p.block(n_out), z_bar, pb);
-      if (sink) {
-        double* dst = sinks_[static_cast<std::size_t>(L) + ul].data_ptr<double>();
-        for (int64_t k = 0; k < E * n_out; ++k) dst[k] += pb[k];
-      } else {
-        out[3 + L + ul] = b_bar;
-      }
-    }
-    if (l == 0 && !(need_v || need_g || need_h)) break;
-    gemm_nn(E, static_cast<int>(p.rows()), static_cast<int>(n_out), static_cast<int>(n_in), z_bar,
-            weights_[ul].data_ptr<double>(), a_bar, /*transpose_b=*/true);  // A~ = Z~ W^T
-    if (l == 0) break;
-    tanh_jet_backward(p.ch.d, p.ch.order, E, p.B * n_in, ws + p.pre[ul - 1], ws + p.tanh[ul - 1],
-                      a_bar, z_bar);
-  }
-  if (need_v) out[0] = input_adjoint(a_bar, 0);
-  if (need_g) {
-    Tensor g = torch::empty({E, p.B, p.ch.d, p.widths[0]}, torch::kFloat64);
-    for (int64_t i = 0; i < p.ch.d; ++i) {
-      Tensor gi = g.select(2, i);
-      scatter_3d(a_bar + p.ch.tangent(i) * p.B * p.widths[0], p.block(p.widths[0]), &gi);
-    }
-    out[1] = g;
-  }
-  if (need_h) out[2] = input_curvature_adjoint(a_bar);
-  return out;
-}
+// The forward of one call: the checks, the plan, the workspace (kept for
+// the backward) and the outputs.
+struct ForwardPass {
+  Plan plan;
+  Tensor workspace;
+  FusedMlpJet jet;
+};
 
-Tensor FusedMlpBackward::input_adjoint(const double* a_bar, int64_t channel) const {
-  const int64_t n = plan_.widths[0];
-  Tensor t = torch::empty({plan_.E, plan_.B, n}, torch::kFloat64);
-  scatter_3d(a_bar + channel * plan_.B * n, plan_.block(n), &t);
-  return t;
-}
-
-// Adjoint of x_h [E, B, d, d, n]: pack_input read x_h[i][j] (i <= j) only;
-// the adjoint is split evenly over both symmetric copies.
-Tensor FusedMlpBackward::input_curvature_adjoint(const double* a_bar) const {
-  const Channels& ch = plan_.ch;
-  const int64_t n = plan_.widths[0];
-  Tensor out = torch::zeros({plan_.E, plan_.B, ch.d, ch.d, n}, torch::kFloat64);
-  for (std::size_t q = 0; q < ch.pairs.size(); ++q) {
-    const auto [i, j] = ch.pairs[q];
-    const Tensor src = input_adjoint(a_bar, ch.pair(q));
-    if (i == j) {
-      out.select(2, i).select(2, j).copy_(src);
-    } else {
-      out.select(2, i).select(2, j).copy_(0.5 * src);
-      out.select(2, j).select(2, i).copy_(0.5 * src);
-    }
-  }
-  return out;
-}
-
-}  // namespace
-
-FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
-                      const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
-                      const torch::Tensor& x_g, const torch::Tensor& x_h,
-                      const FusedMlpOptions& options,
-                      const std::vector<torch::Tensor>& gradient_sinks) {
-  TORCH_CHECK(gradient_sinks.empty() || gradient_sinks.size() == 2 * weights.size(),
-              "fused_mlp: expected one gradient sink per weight and bias");
+ForwardPass forward_pass(const std::vector<torch::Tensor>& weights,
+                         const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
+                         const torch::Tensor& x_g, const torch::Tensor& x_h,
+                         const FusedMlpOptions& options) {
   TORCH_CHECK(x_v.dim() == 3 && x_v.scalar_type() == torch::kFloat64,
               "fused_mlp: expected a float64 input [E, B, n], got ", x_v.sizes());
   TORCH_CHECK(!weights.empty() && weights.size() == biases.size(),
@@ -368,9 +378,10 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
     widths.push_back(weights[l].size(2));
   }
   const Channels ch(options.order >= 1 ? options.directions : 0, options.order);
-  const Plan plan(ch, x_v.size(0), x_v.size(1), widths);
-  Tensor workspace = reusable_buffer(plan.total);
-  double* ws = workspace.data_ptr<double>();
+  ForwardPass pass{Plan(ch, x_v.size(0), x_v.size(1), widths), Tensor(), {}};
+  const Plan& plan = pass.plan;
+  pass.workspace = reusable_buffer(plan.total);
+  double* ws = pass.workspace.data_ptr<double>();
   pack_input(x_v, x_g, x_h, plan, ws + plan.act[0]);
   for (int64_t l = 0; l < plan.layers(); ++l) {
     const auto ul = static_cast<std::size_t>(l);
@@ -383,7 +394,21 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
     for (int64_t e = 0; e < plan.E; ++e) tanh_array(z + e * plan.block(n), t + e * plan.B * n, plan.B * n);
     tanh_jet_forward(ch.d, ch.order, plan.E, plan.B * n, z, t, ws + plan.act[ul + 1]);
   }
-  FusedMlpJet jet = unpack_output(plan, ws + plan.out, x_v.options());
+  pass.jet = unpack_output(plan, ws + plan.out, x_v.options());
+  return pass;
+}
+
+}  // namespace
+
+FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
+                      const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
+                      const torch::Tensor& x_g, const torch::Tensor& x_h,
+                      const FusedMlpOptions& options,
+                      const std::vector<torch::Tensor>& gradient_sinks) {
+  TORCH_CHECK(gradient_sinks.empty() || gradient_sinks.size() == 2 * weights.size(),
+              "fused_mlp: expected one gradient sink per weight and bias");
+  ForwardPass pass = forward_pass(weights, biases, x_v, x_g, x_h, options);
+  FusedMlpJet jet = pass.jet;
   std::vector<Tensor> inputs{x_v, x_g, x_h};
   inputs.insert(inputs.end(), weights.begin(), weights.end());
   inputs.insert(inputs.end(), biases.begin(), biases.end());
@@ -392,7 +417,8 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
     return jet;
   }
   auto node = std::shared_ptr<FusedMlpBackward>(
-      new FusedMlpBackward(plan, workspace, weights, gradient_sinks), torch::autograd::deleteNode);
+      new FusedMlpBackward(std::move(pass.plan), std::move(pass.workspace), weights, gradient_sinks),
+      torch::autograd::deleteNode);
   if (!gradient_sinks.empty()) {  // parameters: written into the sinks, no edges
     inputs.resize(3);
     inputs.resize(3 + 2 * weights.size());
@@ -402,6 +428,31 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
     if (t->defined()) torch::autograd::set_history(*t, node);
   }
   return jet;
+}
+
+// The plan and workspace of a taped call (fused_mlp.h).
+struct FusedMlpTape {
+  Plan plan;
+  Tensor workspace;
+};
+
+FusedMlpJet fused_mlp_taped(const std::vector<torch::Tensor>& weights,
+                            const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
+                            const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape) {
+  ForwardPass pass = forward_pass(weights, biases, x_v, {}, {}, options);
+  *tape = std::make_shared<FusedMlpTape>(FusedMlpTape{std::move(pass.plan), std::move(pass.workspace)});
+  return pass.jet;
+}
+
+torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
+                                       const std::vector<torch::Tensor>& weights,
+                                       const std::vector<torch::Tensor>& gradient_sinks,
+                                       const std::vector<torch::Tensor>& grads, bool input_adjoint) {
+  TORCH_CHECK(gradient_sinks.size() == 2 * weights.size(),
+              "fused_mlp_taped_backward: expected one gradient sink per weight and bias");
+  std::vector<bool> need(static_cast<std::size_t>(3 + 2 * tape.plan.layers()), false);
+  need[0] = input_adjoint;
+  return backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need)[0];
 }
 
 }  // namespace internal

@@ -3,6 +3,7 @@
 // networks"). Private to src/models: StackedMlp is its only caller.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <torch/torch.h>
@@ -49,6 +50,24 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
                       const torch::Tensor& x_g, const torch::Tensor& x_h,
                       const FusedMlpOptions& options,
                       const std::vector<torch::Tensor>& gradient_sinks = {});
+
+/// The same forward without an autograd node, for a hand-written step
+/// (models/jr_rk2_step.cpp): the outputs, and in *tape the workspace its
+/// backward reads (held until the tape is dropped). The input jet is the
+/// input coordinates' (x_g, x_h undefined in fused_mlp's terms).
+struct FusedMlpTape;
+FusedMlpJet fused_mlp_taped(const std::vector<torch::Tensor>& weights,
+                            const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
+                            const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape);
+
+/// The backward of a taped call, the same arithmetic as fused_mlp's node:
+/// from the output adjoints `grads` (v~, g~, h~; undefined = 0) the
+/// parameter gradients are added into `gradient_sinks` (one per weight, then
+/// one per bias); returns x_v~ [E, B, n_0] if `input_adjoint`, else undefined.
+torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
+                                       const std::vector<torch::Tensor>& weights,
+                                       const std::vector<torch::Tensor>& gradient_sinks,
+                                       const std::vector<torch::Tensor>& grads, bool input_adjoint);
 
 }  // namespace internal
 }  // namespace phnn

@@ -143,14 +143,21 @@ void CellTrainer::step(int step, BatchSampler& sampler) {
   // A regularizer needs df/dx at the batch; the same evaluation's f is an
   // explicit step's first stage, so RK2/RK4 do not evaluate f(x) twice.
   const bool regularized = cell_.regularizer != Regularizer::kNone;
-  const FieldEval at_x = regularized ? model_->field(x, u, true) : FieldEval{};
-  auto loss = data_loss(x, xn, u, at_x.f);
-  if (regularized) {
-    const auto stats = jacobian_stats(at_x.dfdx, opt_.jacobian_eps);
-    loss = loss + regularizer_penalty(cell_.regularizer, stats, opt_);
-  }
   adam_->zero_grad();
-  loss.sum().backward();
+  // The model's hand-written step where it has one (the same bits, no graph).
+  auto loss = !regularized && cell_.integrator == IntegratorKind::kRk2 &&
+                      opt_.loss_norm == LossNorm::kMeanL1
+                  ? model_->rk2_mean_l1_step(x, xn, u, h_)
+                  : torch::Tensor();
+  if (!loss.defined()) {
+    const FieldEval at_x = regularized ? model_->field(x, u, true) : FieldEval{};
+    loss = data_loss(x, xn, u, at_x.f);
+    if (regularized) {
+      const auto stats = jacobian_stats(at_x.dfdx, opt_.jacobian_eps);
+      loss = loss + regularizer_penalty(cell_.regularizer, stats, opt_);
+    }
+    loss.sum().backward();
+  }
   std::vector<int64_t> dead;
   freeze_non_finite(loss, step, &dead);
   const auto dead_idx = torch::tensor(dead, torch::kLong);

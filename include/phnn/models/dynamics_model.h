@@ -76,6 +76,15 @@ class DynamicsModel {
   virtual FieldEval discrete_gradient4_field(const torch::Tensor& x, const torch::Tensor& dx,
                                              const torch::Tensor& u, double h,
                                              double min_dx_norm) const;
+  /// A hand-written training step, where the model has one: the loss L_d
+  /// of the explicit midpoint (RK2) step in the mean-L1 norm per member [E]
+  /// (discrete_loss with LossNorm::kMeanL1), with its parameter gradients
+  /// added into the flat gradient buffer (after flatten_parameters), in the
+  /// same operations and order as autograd's backward of that loss: the
+  /// same bits, without the graph. Undefined where there is none (the
+  /// caller runs autograd); today: the 2-state fused float64 PHNN-JR.
+  virtual torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                         const torch::Tensor& u, double h) const;
   /// H_theta(x) [E, B] and gradH_theta(x) [E, B, 2] (PH models only).
   virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;

@@ -87,6 +87,12 @@ class StackedMlp {
   /// Trainable parameters of one member.
   long parameter_count() const;
   const StackedMlpOptions& options() const { return options_; }
+  /// For hand-written steps (fused networks after bind_to): W_l [E, n_l,
+  /// n_{l+1}], b_l [E, 1, n_{l+1}], and the buffers their gradients are
+  /// added into (weights', then biases'; empty before bind_to).
+  const std::vector<torch::Tensor>& weights() const { return weights_; }
+  const std::vector<torch::Tensor>& biases() const { return biases_; }
+  const std::vector<torch::Tensor>& gradient_sinks() const { return gradient_sinks_; }
 
  private:
   Jet reference_forward(const Jet& x) const;
