@@ -217,31 +217,81 @@ class JrJetFunction : public torch::autograd::Function<JrJetFunction> {
 //   l~ = 2 l w sum_i f~_i S_i2, w~ = l^2 sum_i f~_i S_i2 (and w's own rule).
 using StructureRows = std::array<std::array<double, 4>, 4>;
 
+}  // namespace
+
+Tensor phnn_s_w_forward(const Tensor& e_in, const Tensor& u_in, const std::array<double, 3>& s) {
+  const Tensor e = dense(e_in), u = dense(u_in);
+  const int64_t rows = e.size(0) * e.size(1);
+  Tensor w = torch::empty({e.size(0), e.size(1), 1}, e.options());
+  const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
+  double* pw = w.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) pw[r] = s[0] * pe[2 * r] + s[1] * pe[2 * r + 1] + s[2] * pu[r];
+  return w;
+}
+
+PhnnSWAdjoints phnn_s_w_backward(const std::array<double, 3>& s, const Tensor& w_bar) {
+  const Tensor wb = dense(w_bar);
+  const int64_t E = wb.size(0), B = wb.size(1), rows = E * B;
+  PhnnSWAdjoints out{torch::empty({E, B, 2}, wb.options()), torch::empty({E, B, 1}, wb.options())};
+  const double* pwb = wb.data_ptr<double>();
+  double *peb = out.effort.data_ptr<double>(), *pub = out.u.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    peb[2 * r] = s[0] * pwb[r], peb[2 * r + 1] = s[1] * pwb[r], pub[r] = s[2] * pwb[r];
+  }
+  return out;
+}
+
+Tensor phnn_s_field_forward(const Tensor& e_in, const Tensor& u_in, const Tensor& l_in,
+                            const Tensor& w_in, const StructureRows& S) {
+  const Tensor e = dense(e_in), u = dense(u_in), l = dense(l_in), w = dense(w_in);
+  const int64_t rows = e.size(0) * e.size(1);
+  Tensor f = torch::empty_like(e);
+  const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
+  const double *pl = l.data_ptr<double>(), *pw = w.data_ptr<double>();
+  double* pf = f.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const double z = pl[r] * pl[r] * pw[r];
+    for (int i = 0; i < 2; ++i) {
+      pf[2 * r + i] = S[i][0] * pe[2 * r] + S[i][1] * pe[2 * r + 1] + S[i][2] * z + S[i][3] * pu[r];
+    }
+  }
+  return f;
+}
+
+PhnnSFieldAdjoints phnn_s_field_backward(const Tensor& l_in, const Tensor& w_in,
+                                         const StructureRows& S, const Tensor& f_bar) {
+  const Tensor l = dense(l_in), w = dense(w_in), fb = dense(f_bar);
+  const int64_t E = l.size(0), B = l.size(1), rows = E * B;
+  PhnnSFieldAdjoints out{torch::empty({E, B, 2}, l.options()), torch::empty_like(l),
+                         torch::empty_like(l), torch::empty_like(w)};
+  const double *pl = l.data_ptr<double>(), *pw = w.data_ptr<double>(), *pfb = fb.data_ptr<double>();
+  double *peb = out.effort.data_ptr<double>(), *pub = out.u.data_ptr<double>();
+  double *plb = out.l.data_ptr<double>(), *pwb = out.w.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const double f0 = pfb[2 * r], f1 = pfb[2 * r + 1];
+    peb[2 * r] = f0 * S[0][0] + f1 * S[1][0];
+    peb[2 * r + 1] = f0 * S[0][1] + f1 * S[1][1];
+    pub[r] = f0 * S[0][3] + f1 * S[1][3];
+    const double zb = f0 * S[0][2] + f1 * S[1][2];
+    plb[r] = 2.0 * pl[r] * pw[r] * zb;
+    pwb[r] = pl[r] * pl[r] * zb;
+  }
+  return out;
+}
+
+namespace {
+
 class PhnnSWFunction : public torch::autograd::Function<PhnnSWFunction> {
  public:
   static Tensor forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& u_in,
                         std::array<double, 3> s) {
-    const Tensor e = dense(e_in), u = dense(u_in);
-    const int64_t rows = e.size(0) * e.size(1);
-    Tensor w = torch::empty({e.size(0), e.size(1), 1}, e.options());
-    const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
-    double* pw = w.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) pw[r] = s[0] * pe[2 * r] + s[1] * pe[2 * r + 1] + s[2] * pu[r];
     ctx->saved_data["s"] = std::vector<double>(s.begin(), s.end());
-    return w;
+    return phnn_s_w_forward(e_in, u_in, s);
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const std::vector<double> s = ctx->saved_data["s"].toDoubleVector();
-    const double s0 = s[0], s1 = s[1], s2 = s[2];
-    const Tensor wb = dense(grads[0]);
-    const int64_t E = wb.size(0), B = wb.size(1), rows = E * B;
-    Tensor e_bar = torch::empty({E, B, 2}, wb.options()), u_bar = torch::empty({E, B, 1}, wb.options());
-    const double* pwb = wb.data_ptr<double>();
-    double *peb = e_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      peb[2 * r] = s0 * pwb[r], peb[2 * r + 1] = s1 * pwb[r], pub[r] = s2 * pwb[r];
-    }
-    return {e_bar, u_bar, Tensor()};
+    const PhnnSWAdjoints adj = phnn_s_w_backward({s[0], s[1], s[2]}, grads[0]);
+    return {adj.effort, adj.u, Tensor()};
   }
 };
 
@@ -249,43 +299,15 @@ class PhnnSFieldFunction : public torch::autograd::Function<PhnnSFieldFunction> 
  public:
   static Tensor forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& u_in,
                         const Tensor& l_in, const Tensor& w_in, StructureRows S) {
-    const Tensor e = dense(e_in), u = dense(u_in), l = dense(l_in), w = dense(w_in);
-    const int64_t rows = e.size(0) * e.size(1);
-    Tensor f = torch::empty_like(e);
-    const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
-    const double *pl = l.data_ptr<double>(), *pw = w.data_ptr<double>();
-    double* pf = f.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double z = pl[r] * pl[r] * pw[r];
-      for (int i = 0; i < 2; ++i) {
-        pf[2 * r + i] = S[i][0] * pe[2 * r] + S[i][1] * pe[2 * r + 1] + S[i][2] * z + S[i][3] * pu[r];
-      }
-    }
+    const Tensor l = dense(l_in), w = dense(w_in);
     ctx->save_for_backward({l, w});
     save_matrix(ctx, S);
-    return f;
+    return phnn_s_field_forward(e_in, u_in, l, w, S);
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &l = saved[0], &w = saved[1];
-    const auto S = load_matrix<4, 4>(ctx);
-    const Tensor fb = dense(grads[0]);
-    const int64_t E = l.size(0), B = l.size(1), rows = E * B;
-    Tensor e_bar = torch::empty({E, B, 2}, l.options()), u_bar = torch::empty_like(l);
-    Tensor l_bar = torch::empty_like(l), w_bar = torch::empty_like(w);
-    const double *pl = l.data_ptr<double>(), *pw = w.data_ptr<double>(), *pfb = fb.data_ptr<double>();
-    double *peb = e_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>();
-    double *plb = l_bar.data_ptr<double>(), *pwb = w_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double f0 = pfb[2 * r], f1 = pfb[2 * r + 1];
-      peb[2 * r] = f0 * S[0][0] + f1 * S[1][0];
-      peb[2 * r + 1] = f0 * S[0][1] + f1 * S[1][1];
-      pub[r] = f0 * S[0][3] + f1 * S[1][3];
-      const double zb = f0 * S[0][2] + f1 * S[1][2];
-      plb[r] = 2.0 * pl[r] * pw[r] * zb;
-      pwb[r] = pl[r] * pl[r] * zb;
-    }
-    return {e_bar, u_bar, l_bar, w_bar, Tensor()};
+    const PhnnSFieldAdjoints adj = phnn_s_field_backward(saved[0], saved[1], load_matrix<4, 4>(ctx), grads[0]);
+    return {adj.effort, adj.u, adj.l, adj.w, Tensor()};
   }
 };
 

@@ -24,7 +24,7 @@ HamiltonianHead hamiltonian_head(const torch::Tensor& o, const torch::Tensor& o_
                                  const torch::Tensor& x);
 
 /// hamiltonian_head without an autograd node, for a hand-written step
-/// (models/jr_rk2_step.cpp): the same forward, with what its backward
+/// (models/manual_step.cpp): the same forward, with what its backward
 /// reads in *tape, and the same backward (adjoints h~, g~; undefined = 0).
 struct HamiltonianTape {
   torch::Tensor o, o_g, x, aux;  // o_g undefined: H only
@@ -83,6 +83,24 @@ torch::Tensor phnn_s_w_head(const torch::Tensor& effort, const torch::Tensor& u,
 torch::Tensor phnn_s_field_head(const torch::Tensor& effort, const torch::Tensor& u,
                                 const torch::Tensor& l, const torch::Tensor& w,
                                 const std::array<std::array<double, 4>, 4>& S);
+
+/// The PHNN-S heads without autograd nodes (u already [E, B, 1]) and their
+/// backwards: w~ -> (e~, u~);  f~ -> (e~, u~, l~, w~).
+torch::Tensor phnn_s_w_forward(const torch::Tensor& effort, const torch::Tensor& u,
+                               const std::array<double, 3>& s_w);
+struct PhnnSWAdjoints {
+  torch::Tensor effort, u;
+};
+PhnnSWAdjoints phnn_s_w_backward(const std::array<double, 3>& s_w, const torch::Tensor& w_bar);
+torch::Tensor phnn_s_field_forward(const torch::Tensor& effort, const torch::Tensor& u,
+                                   const torch::Tensor& l, const torch::Tensor& w,
+                                   const std::array<std::array<double, 4>, 4>& S);
+struct PhnnSFieldAdjoints {
+  torch::Tensor effort, u, l, w;
+};
+PhnnSFieldAdjoints phnn_s_field_backward(const torch::Tensor& l, const torch::Tensor& w,
+                                         const std::array<std::array<double, 4>, 4>& S,
+                                         const torch::Tensor& f_bar);
 
 }  // namespace internal
 }  // namespace phnn

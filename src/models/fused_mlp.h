@@ -52,7 +52,7 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
                       const std::vector<torch::Tensor>& gradient_sinks = {});
 
 /// The same forward without an autograd node, for a hand-written step
-/// (models/jr_rk2_step.cpp): the outputs, and in *tape the workspace its
+/// (models/manual_step.cpp): the outputs, and in *tape the workspace its
 /// backward reads (held until the tape is dropped). The input jet is the
 /// input coordinates' (x_g, x_h undefined in fused_mlp's terms).
 struct FusedMlpTape;

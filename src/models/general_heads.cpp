@@ -172,60 +172,77 @@ double dot(const double* a, const double* b, int n) {
   return s;
 }
 
+}  // namespace
+
+Tensor gonzalez_forward(const Tensor& h0_in, const Tensor& h1_in, const Tensor& g_in,
+                        const Tensor& dx_in, double min_dx_norm) {
+  const Tensor h0 = dense(h0_in), h1 = dense(h1_in), g = dense(g_in), dx = dense(dx_in);
+  const int n = static_cast<int>(g.size(-1));
+  const int64_t rows = rows_of(g);
+  Tensor dg = torch::empty_like(g);
+  const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
+  const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
+  double* out = dg.data_ptr<double>();
+  const double tau2 = min_dx_norm * min_dx_norm;
+  for (int64_t r = 0; r < rows; ++r) {
+    const double *gr = pg + n * r, *d = pd + n * r;
+    const double n2 = dot(d, d, n);
+    const double k = n2 < tau2 ? 0.0 : (p1[r] - p0[r] - dot(gr, d, n)) / n2;
+    for (int i = 0; i < n; ++i) out[n * r + i] = gr[i] + k * d[i];
+  }
+  return dg;
+}
+
+GonzalezAdjoints gonzalez_backward(const Tensor& h0_in, const Tensor& h1_in, const Tensor& g_in,
+                                   const Tensor& dx_in, double min_dx_norm, const Tensor& dg_bar) {
+  const Tensor h0 = dense(h0_in), h1 = dense(h1_in), g = dense(g_in), dx = dense(dx_in);
+  const double tau2 = min_dx_norm * min_dx_norm;
+  const Tensor db = dense(dg_bar);
+  const int n = static_cast<int>(g.size(-1));
+  const int64_t rows = rows_of(g);
+  GonzalezAdjoints out{torch::empty_like(h0), torch::empty_like(h1), torch::empty_like(g),
+                       torch::empty_like(dx)};
+  const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
+  const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>(), *pb = db.data_ptr<double>();
+  double *ph0b = out.h0.data_ptr<double>(), *ph1b = out.h1.data_ptr<double>();
+  double *pgb = out.grad.data_ptr<double>(), *pxb = out.dx.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const double *gr = pg + n * r, *d = pd + n * r, *b = pb + n * r;
+    double *gb = pgb + n * r, *xb = pxb + n * r;
+    const double n2 = dot(d, d, n);
+    if (n2 < tau2) {
+      ph0b[r] = ph1b[r] = 0.0;
+      for (int i = 0; i < n; ++i) gb[i] = b[i], xb[i] = 0.0;
+      continue;
+    }
+    const double k = (p1[r] - p0[r] - dot(gr, d, n)) / n2;
+    const double s = dot(b, d, n) / n2;
+    ph1b[r] = s, ph0b[r] = -s;
+    for (int i = 0; i < n; ++i) {
+      gb[i] = b[i] - s * d[i];
+      xb[i] = k * b[i] - s * (gr[i] + 2.0 * k * d[i]);
+    }
+  }
+  return out;
+}
+
+namespace {
+
 class GeneralGonzalezFunction : public torch::autograd::Function<GeneralGonzalezFunction> {
  public:
   static Tensor forward(AutogradContext* ctx, const Tensor& h0_in, const Tensor& h1_in,
                         const Tensor& g_in, const Tensor& dx_in, double min_dx_norm) {
     const Tensor h0 = dense(h0_in), h1 = dense(h1_in), g = dense(g_in), dx = dense(dx_in);
-    const int n = static_cast<int>(g.size(-1));
-    const int64_t rows = rows_of(g);
-    Tensor dg = torch::empty_like(g);
-    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
-    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>();
-    double* out = dg.data_ptr<double>();
-    const double tau2 = min_dx_norm * min_dx_norm;
-    for (int64_t r = 0; r < rows; ++r) {
-      const double *gr = pg + n * r, *d = pd + n * r;
-      const double n2 = dot(d, d, n);
-      const double k = n2 < tau2 ? 0.0 : (p1[r] - p0[r] - dot(gr, d, n)) / n2;
-      for (int i = 0; i < n; ++i) out[n * r + i] = gr[i] + k * d[i];
-    }
     ctx->save_for_backward({h0, h1, g, dx});
-    ctx->saved_data["tau2"] = tau2;
-    return dg;
+    ctx->saved_data["min_dx_norm"] = min_dx_norm;
+    return gonzalez_forward(h0, h1, g, dx, min_dx_norm);
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &h0 = saved[0], &h1 = saved[1], &g = saved[2], &dx = saved[3];
-    const double tau2 = ctx->saved_data["tau2"].toDouble();
-    const Tensor db = dense(grads[0]);
-    const int n = static_cast<int>(g.size(-1));
-    const int64_t rows = rows_of(g);
-    Tensor h0_bar = torch::empty_like(h0), h1_bar = torch::empty_like(h1);
-    Tensor g_bar = torch::empty_like(g), dx_bar = torch::empty_like(dx);
-    const double *p0 = h0.data_ptr<double>(), *p1 = h1.data_ptr<double>();
-    const double *pg = g.data_ptr<double>(), *pd = dx.data_ptr<double>(), *pb = db.data_ptr<double>();
-    double *ph0b = h0_bar.data_ptr<double>(), *ph1b = h1_bar.data_ptr<double>();
-    double *pgb = g_bar.data_ptr<double>(), *pxb = dx_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double *gr = pg + n * r, *d = pd + n * r, *b = pb + n * r;
-      double *gb = pgb + n * r, *xb = pxb + n * r;
-      const double n2 = dot(d, d, n);
-      if (n2 < tau2) {
-        ph0b[r] = ph1b[r] = 0.0;
-        for (int i = 0; i < n; ++i) gb[i] = b[i], xb[i] = 0.0;
-        continue;
-      }
-      const double k = (p1[r] - p0[r] - dot(gr, d, n)) / n2;
-      const double s = dot(b, d, n) / n2;
-      ph1b[r] = s, ph0b[r] = -s;
-      for (int i = 0; i < n; ++i) {
-        gb[i] = b[i] - s * d[i];
-        xb[i] = k * b[i] - s * (gr[i] + 2.0 * k * d[i]);
-      }
-    }
-    return {h0_bar, h1_bar, g_bar, dx_bar, Tensor()};
+    const auto adj = gonzalez_backward(saved[0], saved[1], saved[2], saved[3],
+                                       ctx->saved_data["min_dx_norm"].toDouble(), grads[0]);
+    return {adj.h0, adj.h1, adj.grad, adj.dx, Tensor()};
   }
 };
 

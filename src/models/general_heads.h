@@ -32,6 +32,18 @@ torch::Tensor general_gonzalez_head(const torch::Tensor& h0, const torch::Tensor
                                     const torch::Tensor& grad_mid, const torch::Tensor& dx,
                                     double min_dx_norm);
 
+/// The same without an autograd node (all [E, B, .] alike), and its backward
+/// from dg~: the adjoints of H0, H1, g and dx.
+torch::Tensor gonzalez_forward(const torch::Tensor& h0, const torch::Tensor& h1,
+                               const torch::Tensor& grad_mid, const torch::Tensor& dx,
+                               double min_dx_norm);
+struct GonzalezAdjoints {
+  torch::Tensor h0, h1, grad, dx;
+};
+GonzalezAdjoints gonzalez_backward(const torch::Tensor& h0, const torch::Tensor& h1,
+                                   const torch::Tensor& grad_mid, const torch::Tensor& dx,
+                                   double min_dx_norm, const torch::Tensor& dg_bar);
+
 /// A linear map y = M [a; b] per row, M row-major rows x (n_a + n_b)
 /// (a structure block): the PHNN-S port variables w = [S_wx S_wu] [e; u].
 torch::Tensor general_linear_head(const torch::Tensor& a, const torch::Tensor& b,

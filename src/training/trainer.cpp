@@ -145,10 +145,13 @@ void CellTrainer::step(int step, BatchSampler& sampler) {
   const bool regularized = cell_.regularizer != Regularizer::kNone;
   adam_->zero_grad();
   // The model's hand-written step where it has one (the same bits, no graph).
-  auto loss = !regularized && cell_.integrator == IntegratorKind::kRk2 &&
-                      opt_.loss_norm == LossNorm::kMeanL1
-                  ? model_->rk2_mean_l1_step(x, xn, u, h_)
-                  : torch::Tensor();
+  torch::Tensor loss;
+  if (!regularized && opt_.loss_norm == LossNorm::kMeanL1) {
+    if (cell_.integrator == IntegratorKind::kRk2) loss = model_->rk2_mean_l1_step(x, xn, u, h_);
+    if (cell_.integrator == IntegratorKind::kDg) {
+      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm);
+    }
+  }
   if (!loss.defined()) {
     const FieldEval at_x = regularized ? model_->field(x, u, true) : FieldEval{};
     loss = data_loss(x, xn, u, at_x.f);

@@ -82,9 +82,13 @@ class DynamicsModel {
   /// added into the flat gradient buffer (after flatten_parameters), in the
   /// same operations and order as autograd's backward of that loss: the
   /// same bits, without the graph. Undefined where there is none (the
-  /// caller runs autograd); today: the 2-state fused float64 PHNN-JR.
+  /// caller runs autograd); today: the 2-state NODE, PHNN-S and PHNN-JR on
+  /// fused float64 networks (models/manual_step.cpp).
   virtual torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                          const torch::Tensor& u, double h) const;
+  /// The same for the DG training step (dg_training_step): PHNN-S and PHNN-JR.
+  virtual torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                        const torch::Tensor& u, double h, double min_dx_norm) const;
   /// H_theta(x) [E, B] and gradH_theta(x) [E, B, 2] (PH models only).
   virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;

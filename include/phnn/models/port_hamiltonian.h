@@ -90,6 +90,10 @@ class PortHamiltonianModel : public DynamicsModel {
 class PhnnS : public PortHamiltonianModel {
  public:
   PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                 const torch::Tensor& u, double h) const override;
+  torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                const torch::Tensor& u, double h, double min_dx_norm) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -106,9 +110,10 @@ class PhnnJr : public PortHamiltonianModel {
   PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   /// R_theta(x, u) [E, B, 3, 3] (for tests: symmetric PSD).
   torch::Tensor dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const;
-  /// The hand-written RK2 step (models/jr_rk2_step.cpp) on the fused float64 networks.
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                  const torch::Tensor& u, double h) const override;
+  torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                const torch::Tensor& u, double h, double min_dx_norm) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -126,6 +131,8 @@ class Node : public DynamicsModel {
   Node(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
+  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                 const torch::Tensor& u, double h) const override;
 };
 
 }  // namespace phnn

@@ -1,0 +1,281 @@
+// src/models/manual_step.cpp — hand-written training steps with the mean-L1
+// loss on fused float64 networks: the explicit midpoint (RK2) step for the
+// 2-state NODE, PHNN-S and PHNN-JR, and the discrete-gradient (DG) step for
+// PHNN-S and PHNN-JR. Forward, loss and backward run without
+// an autograd graph, through the same kernels as the autograd path
+// (fused_mlp_taped, the heads' taped forms) with the same operations in the
+// same order, so loss and gradients are bitwise those of
+// loss.sum().backward() (tests/models/manual_step_test.cpp).
+// Touches only the models' gradient sinks (their flat gradient buffer).
+//
+// Forward (per member, batch rows b, h the step):
+//   k1 = f(x),  x2 = x + (h/2) k1,  k2 = f(x2),  x^ = x + h k2,
+//   L = (sum_{b,i} |(x_next - x^)_bi / h|) / N              (N = 2 B)
+// Backward, as autograd's engine takes it (of the nodes ready at once, the
+// one created last runs first, and an adjoint that several nodes feed is
+// summed in that order):
+//   x^~ = -(((1 / N) sgn(.)) / h),  k2~ = x^~ h,  stage 2 backward -> x2~,
+//   k1~ = x2~ (h/2),  stage 1 backward (no input adjoint: x is data).
+// Parameter gradients are added stage 2 first, then stage 1.
+// DG: x^ = x + h F(dg(x, dx), m), dx = x_next - x, m = x + dx/2 (or x), with
+// dg from H at the ends x, x + dx (one order-0 L_H call on both) and gradH(m)
+// (general_gonzalez_head); backward F~ -> dg~ -> gradH(m)'s networks first,
+// then the ends' (the same order autograd takes); no input adjoints.
+#include <functional>
+#include <memory>
+
+#include "models/fused_heads.h"
+#include "models/fused_mlp.h"
+#include "models/general_heads.h"
+#include "phnn/models/port_hamiltonian.h"
+
+namespace phnn {
+namespace {
+
+using torch::Tensor;
+
+// One field evaluation f(y) and its backward: adds the parameter gradients of
+// f~ . f into the sinks and returns y~ if `input` (else undefined).
+struct TapedField {
+  Tensor f;
+  std::function<Tensor(const Tensor& f_bar, bool input)> backward;
+};
+using FieldRecorder = std::function<TapedField(const Tensor& y)>;
+
+// [x, u] along the last dimension (x [E, B, 2], u [E, B, 1], both dense).
+Tensor cat_rows(const Tensor& x, const Tensor& u) {
+  const int64_t rows = x.size(0) * x.size(1);
+  Tensor out = torch::empty({x.size(0), x.size(1), 3}, x.options());
+  const double *px = x.data_ptr<double>(), *pu = u.data_ptr<double>();
+  double* po = out.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    po[3 * r] = px[2 * r], po[3 * r + 1] = px[2 * r + 1], po[3 * r + 2] = pu[r];
+  }
+  return out;
+}
+
+// out = a + c b, elementwise (two roundings: the build does not contract).
+Tensor add_scaled(const Tensor& a, double c, const Tensor& b) {
+  Tensor out = torch::empty_like(a);
+  const double *pa = a.data_ptr<double>(), *pb = b.data_ptr<double>();
+  double* po = out.data_ptr<double>();
+  for (int64_t k = 0; k < a.numel(); ++k) po[k] = pa[k] + c * pb[k];
+  return out;
+}
+
+// L = (sum_{b,i} |(x_next - x^)_bi / h|) / N per member [E], and in *f_bar
+// the adjoint of f in x^ = x + h f: x^~ h (file comment).
+Tensor mean_l1_loss(const Tensor& x_next, const Tensor& x_hat, double h, Tensor* f_bar) {
+  const int64_t E = x_hat.size(0), n = x_hat.size(1) * x_hat.size(2);
+  const double count = static_cast<double>(n), seed = 1.0 / count;
+  Tensor loss = torch::empty({E}, x_hat.options());
+  *f_bar = torch::empty_like(x_hat);
+  const double *pn = x_next.data_ptr<double>(), *ph = x_hat.data_ptr<double>();
+  double *pl = loss.data_ptr<double>(), *pk = f_bar->data_ptr<double>();
+  for (int64_t e = 0; e < E; ++e) {
+    double sum = 0.0;  // ordered_sum: row-major, left to right
+    for (int64_t k = e * n; k < (e + 1) * n; ++k) {
+      const double scaled = (pn[k] - ph[k]) / h;
+      sum += std::fabs(scaled);
+      const double sign = static_cast<double>((0.0 < scaled) - (scaled < 0.0));
+      pk[k] = (-((seed * sign) / h)) * h;
+    }
+    pl[e] = sum / count;
+  }
+  return loss;
+}
+
+// The RK2 step, its loss and backward (file comment).
+Tensor rk2_mean_l1(const Tensor& x_in, const Tensor& x_next_in, double h, const FieldRecorder& field) {
+  const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
+  const TapedField s1 = field(x);
+  const TapedField s2 = field(add_scaled(x, 0.5 * h, s1.f));
+  Tensor k2_bar;
+  const Tensor loss = mean_l1_loss(x_next, add_scaled(x, h, s2.f), h, &k2_bar);
+  const Tensor x2_bar = s2.backward(k2_bar, true);
+  s1.backward(x2_bar * (0.5 * h), false);
+  return loss;
+}
+
+// The networks a hand-written step can use: fused float64, bound to the flat buffers.
+bool has_manual_step(const std::vector<std::unique_ptr<StackedMlp>>& nets, torch::ScalarType dtype) {
+  for (const auto& net : nets) {
+    if (!net->options().fused || net->gradient_sinks().empty()) return false;
+  }
+  return dtype == torch::kFloat64;
+}
+
+// A network's taped forward and its backward (parameter gradients into its sinks).
+struct TapedNet {
+  const StackedMlp& net;
+  std::shared_ptr<internal::FusedMlpTape> tape;
+  internal::FusedMlpJet forward(const Tensor& y, int directions, int order) {
+    return internal::fused_mlp_taped(net.weights(), net.biases(), y, {directions, order}, &tape);
+  }
+  Tensor backward(const std::vector<Tensor>& grads, bool input) const {
+    return internal::fused_mlp_taped_backward(*tape, net.weights(), net.gradient_sinks(), grads, input);
+  }
+};
+
+// gradH(y) from L_H's first-order jet, kept for its backward.
+struct TapedGradient {
+  TapedNet l_h;
+  internal::HamiltonianTape head;
+  Tensor grad;
+  TapedGradient(const StackedMlp& net, const Tensor& y) : l_h{net, nullptr} {
+    const auto o = l_h.forward(y, 2, 1);
+    grad = internal::hamiltonian_head_taped(o.v, o.g, y, &head).grad;
+  }
+  // y~ = (c + the head's x adjoint b) + L_H's input adjoint a, autograd's
+  // order; c (another node's adjoint of y, created after these) may be undefined.
+  Tensor backward(const Tensor& grad_bar, bool input, const Tensor& c = Tensor()) const {
+    const auto adj = internal::hamiltonian_head_backward(head, Tensor(), grad_bar);
+    const Tensor a = l_h.backward({adj.o, adj.o_g}, input);
+    if (!input) return Tensor();
+    return (c.defined() ? c + adj.x : adj.x) + a;
+  }
+};
+
+// A PH model's field from an effort e, with y the dissipation's point (PHNN-S
+// ignores it): f, and the backward f~ -> (e~, y~ or undefined).
+struct TapedEffortField {
+  Tensor f;
+  std::function<std::pair<Tensor, Tensor>(const Tensor& f_bar, bool input)> backward;
+};
+using EffortFieldRecorder = std::function<TapedEffortField(const Tensor& effort, const Tensor& y)>;
+
+// RK2 of a PH model: f(y) = F(gradH(y), y).
+Tensor ph_rk2_mean_l1(const StackedMlp& l_h, const Tensor& x, const Tensor& x_next, double h,
+                      const EffortFieldRecorder& effort_field) {
+  return rk2_mean_l1(x, x_next, h, [&](const Tensor& y) {
+    auto gradient = std::make_shared<TapedGradient>(l_h, y);
+    const TapedEffortField field = effort_field(gradient->grad, y);
+    TapedField t{field.f, {}};
+    t.backward = [=](const Tensor& f_bar, bool input) {
+      const auto [effort_bar, y_bar] = field.backward(f_bar, input);
+      return gradient->backward(effort_bar, input, y_bar);
+    };
+    return t;
+  });
+}
+
+// The DG step of a PH model, its loss and backward (file comment).
+Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x_in, const Tensor& x_next_in, double h,
+                     double min_dx_norm, bool dissipation_at_start,
+                     const EffortFieldRecorder& effort_field) {
+  const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
+  const int64_t B = x.size(1);
+  const Tensor dx = x_next - x, m = add_scaled(x, 0.5, dx);
+  const Tensor ends = torch::cat({x, add_scaled(x, 1.0, dx)}, /*dim=*/1);
+  TapedNet ends_net{l_h, nullptr};
+  internal::HamiltonianTape ends_head;
+  const Tensor h_ends =
+      internal::hamiltonian_head_taped(ends_net.forward(ends, 0, 0).v, Tensor(), ends, &ends_head).h;
+  const TapedGradient mid(l_h, m);
+  const Tensor h0 = h_ends.narrow(1, 0, B), h1 = h_ends.narrow(1, B, B);
+  const Tensor effort = internal::gonzalez_forward(h0, h1, mid.grad, dx, min_dx_norm);
+  const TapedEffortField field = effort_field(effort, dissipation_at_start ? x : m);
+  Tensor f_bar;
+  const Tensor loss = mean_l1_loss(x_next, add_scaled(x, h, field.f), h, &f_bar);
+  const auto g = internal::gonzalez_backward(h0, h1, mid.grad, dx, min_dx_norm, field.backward(f_bar, false).first);
+  mid.backward(g.grad, false);
+  // The ends' adjoint is two narrow adjoints summed over zeros (-0 becomes +0).
+  const Tensor h_ends_bar = torch::cat({g.h0, g.h1}, /*dim=*/1) + 0.0;
+  const auto ends_adj = internal::hamiltonian_head_backward(ends_head, h_ends_bar, Tensor());
+  ends_net.backward({ends_adj.o}, false);
+  return loss;
+}
+
+// PHNN-JR: F(e, y) = JR(e, L_R(y, u), u). Backward: JR~ -> L_R (y~ = c, its
+// input adjoint), e~; with gradH: y~ = (c + b) + a.
+EffortFieldRecorder jr_effort_field(const StackedMlp& l_r, const Tensor& u,
+                                    const std::array<std::array<double, 3>, 3>& J) {
+  return [&l_r, u, J](const Tensor& effort, const Tensor& y) {
+    auto net_r = std::make_shared<TapedNet>(TapedNet{l_r, nullptr});
+    const Tensor o_r = net_r->forward(cat_rows(y, u), 0, 0).v;
+    TapedEffortField t{internal::jr_field_forward(effort, o_r, u, J), {}};
+    t.backward = [=](const Tensor& f_bar, bool input) {
+      const auto jr = internal::jr_field_backward(effort, o_r, u, J, f_bar);
+      const Tensor c = net_r->backward({jr.o}, input);
+      return std::make_pair(jr.effort, input ? c.narrow(-1, 0, 2) : Tensor());
+    };
+    return t;
+  };
+}
+
+// PHNN-S: w = S_w (e, u), F = S-field(e, u, L_z(w), w). Backward: F~ ->
+// (e~ A, l~, w~ B);  L_z (w~ C);  w~ = B + C -> the w head (e~ D);  e~ = A + D.
+EffortFieldRecorder s_effort_field(const StackedMlp& l_z, const Tensor& u,
+                                   const std::array<std::array<double, 4>, 4>& S) {
+  const std::array<double, 3> s_w{S[2][0], S[2][1], S[2][3]};
+  return [&l_z, u, S, s_w](const Tensor& effort, const Tensor& /*y*/) {
+    auto net_z = std::make_shared<TapedNet>(TapedNet{l_z, nullptr});
+    const Tensor w = internal::phnn_s_w_forward(effort, u, s_w);
+    const Tensor l = net_z->forward(w, 0, 0).v;
+    TapedEffortField t{internal::phnn_s_field_forward(effort, u, l, w, S), {}};
+    t.backward = [=](const Tensor& f_bar, bool /*input*/) {
+      const auto field = internal::phnn_s_field_backward(l, w, S, f_bar);
+      const Tensor w_bar = field.w + net_z->backward({field.l}, true);
+      const auto head = internal::phnn_s_w_backward(s_w, w_bar);
+      return std::make_pair(field.effort + head.effort, Tensor());
+    };
+    return t;
+  };
+}
+
+// u as the rows of x: [E, B, 1], dense.
+Tensor rows_of_u(const Tensor& u, const Tensor& x) {
+  return u.expand({x.size(0), x.size(1), 1}).contiguous();
+}
+
+}  // namespace
+
+torch::Tensor PhnnJr::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                       const torch::Tensor& u, double h) const {
+  if (!has_manual_step(nets_, options().dtype)) return {};
+  torch::NoGradGuard no_grad;
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, jr_effort_field(*nets_[1], rows_of_u(u, x), J_));
+}
+
+torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                      const torch::Tensor& u, double h, double min_dx_norm) const {
+  if (!has_manual_step(nets_, options().dtype)) return {};
+  torch::NoGradGuard no_grad;
+  return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, dissipation_at_start(),
+                       jr_effort_field(*nets_[1], rows_of_u(u, x), J_));
+}
+
+torch::Tensor PhnnS::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                      const torch::Tensor& u, double h) const {
+  if (!has_manual_step(nets_, options().dtype)) return {};
+  torch::NoGradGuard no_grad;
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_of_u(u, x), S_));
+}
+
+torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                     const torch::Tensor& u, double h, double min_dx_norm) const {
+  if (!has_manual_step(nets_, options().dtype)) return {};
+  torch::NoGradGuard no_grad;
+  return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, false,
+                       s_effort_field(*nets_[1], rows_of_u(u, x), S_));
+}
+
+// NODE: f = MLP(y, u); y~ = the first two columns of the input adjoint.
+torch::Tensor Node::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                     const torch::Tensor& u_in, double h) const {
+  if (!has_manual_step(nets_, options().dtype)) return {};
+  torch::NoGradGuard no_grad;
+  const Tensor u = rows_of_u(u_in, x);
+  const StackedMlp& mlp = *nets_[0];
+  return rk2_mean_l1(x, x_next, h, [&](const Tensor& y) {
+    auto net = std::make_shared<TapedNet>(TapedNet{mlp, nullptr});
+    TapedField t{net->forward(cat_rows(y, u), 0, 0).v, {}};
+    t.backward = [=](const Tensor& f_bar, bool input) {
+      const Tensor c = net->backward({f_bar}, input);
+      return input ? c.narrow(-1, 0, 2) : Tensor();
+    };
+    return t;
+  });
+}
+
+}  // namespace phnn
