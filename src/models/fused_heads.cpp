@@ -54,7 +54,8 @@ Tensor jr_field_forward(const Tensor& e_in, const Tensor& o_in, const Tensor& u_
 }
 
 JrFieldAdjoints jr_field_backward(const Tensor& e_in, const Tensor& o_in, const Tensor& u_in,
-                                  const std::array<std::array<double, 3>, 3>& J, const Tensor& f_bar_in) {
+                                  const std::array<std::array<double, 3>, 3>& J,
+                                  const Tensor& f_bar_in) {
   const Tensor e = dense(e_in), o = dense(o_in), u = dense(u_in), fb = dense(f_bar_in);
   const int64_t rows = e.size(0) * e.size(1);
   JrFieldAdjoints out{torch::empty_like(e), torch::empty_like(o), torch::empty_like(u)};
@@ -94,7 +95,8 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const JrFieldAdjoints adj = jr_field_backward(saved[0], saved[1], saved[2], load_matrix<3, 3>(ctx), grads[0]);
+    const JrFieldAdjoints adj =
+        jr_field_backward(saved[0], saved[1], saved[2], load_matrix<3, 3>(ctx), grads[0]);
     return {adj.effort, adj.o, adj.u, Tensor()};
   }
 };
@@ -306,7 +308,8 @@ class PhnnSFieldFunction : public torch::autograd::Function<PhnnSFieldFunction> 
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const PhnnSFieldAdjoints adj = phnn_s_field_backward(saved[0], saved[1], load_matrix<4, 4>(ctx), grads[0]);
+    const PhnnSFieldAdjoints adj =
+        phnn_s_field_backward(saved[0], saved[1], load_matrix<4, 4>(ctx), grads[0]);
     return {adj.effort, adj.u, adj.l, adj.w, Tensor()};
   }
 };

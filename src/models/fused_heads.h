@@ -34,8 +34,8 @@ HamiltonianHead hamiltonian_head_taped(const torch::Tensor& o, const torch::Tens
 struct HamiltonianAdjoints {
   torch::Tensor o, o_g, x;
 };
-HamiltonianAdjoints hamiltonian_head_backward(const HamiltonianTape& tape, const torch::Tensor& h_bar,
-                                              const torch::Tensor& g_bar);
+HamiltonianAdjoints hamiltonian_head_backward(const HamiltonianTape& tape,
+                                              const torch::Tensor& h_bar, const torch::Tensor& g_bar);
 
 /// gradH [E, B, 2] and the Hessian of H [E, B, 2, 2] (symmetric; [i][k] =
 /// d2H / dx_i dx_k) from the L_H outputs o [E, B, 3] and their first and
@@ -56,12 +56,14 @@ torch::Tensor jr_field_head(const torch::Tensor& effort, const torch::Tensor& o,
 /// jr_field_head without an autograd node (u already [E, B, 1]), and its
 /// backward from f~: the adjoints of the effort, of o and of u.
 torch::Tensor jr_field_forward(const torch::Tensor& effort, const torch::Tensor& o,
-                               const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J);
+                               const torch::Tensor& u,
+                               const std::array<std::array<double, 3>, 3>& J);
 struct JrFieldAdjoints {
   torch::Tensor effort, o, u;
 };
 JrFieldAdjoints jr_field_backward(const torch::Tensor& effort, const torch::Tensor& o,
-                                  const torch::Tensor& u, const std::array<std::array<double, 3>, 3>& J,
+                                  const torch::Tensor& u,
+                                  const std::array<std::array<double, 3>, 3>& J,
                                   const torch::Tensor& f_bar);
 
 /// The PHNN-JR field and its x-derivatives (first-order jet) from the effort

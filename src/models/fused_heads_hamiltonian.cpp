@@ -121,7 +121,8 @@ class HamiltonianFunction : public torch::autograd::Function<HamiltonianFunction
                                const c10::optional<Tensor>& o_g_in, const Tensor& x_in) {
     HamiltonianTape tape;
     const bool with_grad = o_g_in.has_value();
-    const HamiltonianHead head = hamiltonian_head_taped(o_in, with_grad ? *o_g_in : Tensor(), x_in, &tape);
+    const HamiltonianHead head =
+        hamiltonian_head_taped(o_in, with_grad ? *o_g_in : Tensor(), x_in, &tape);
     ctx->save_for_backward({tape.o, with_grad ? tape.o_g : tape.o, tape.x, tape.aux});
     ctx->saved_data["with_grad"] = with_grad;
     return with_grad ? variable_list{head.h, head.grad} : variable_list{head.h};

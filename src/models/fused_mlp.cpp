@@ -440,7 +440,8 @@ FusedMlpJet fused_mlp_taped(const std::vector<torch::Tensor>& weights,
                             const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
                             const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape) {
   ForwardPass pass = forward_pass(weights, biases, x_v, {}, {}, options);
-  *tape = std::make_shared<FusedMlpTape>(FusedMlpTape{std::move(pass.plan), std::move(pass.workspace)});
+  *tape = std::make_shared<FusedMlpTape>(
+      FusedMlpTape{std::move(pass.plan), std::move(pass.workspace)});
   return pass.jet;
 }
 

@@ -21,6 +21,7 @@
 // dg from H at the ends x, x + dx (one order-0 L_H call on both) and gradH(m)
 // (general_gonzalez_head); backward F~ -> dg~ -> gradH(m)'s networks first,
 // then the ends' (the same order autograd takes); no input adjoints.
+#include <cmath>
 #include <functional>
 #include <memory>
 
@@ -86,7 +87,8 @@ Tensor mean_l1_loss(const Tensor& x_next, const Tensor& x_hat, double h, Tensor*
 }
 
 // The RK2 step, its loss and backward (file comment).
-Tensor rk2_mean_l1(const Tensor& x_in, const Tensor& x_next_in, double h, const FieldRecorder& field) {
+Tensor rk2_mean_l1(const Tensor& x_in, const Tensor& x_next_in, double h,
+                   const FieldRecorder& field) {
   const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
   const TapedField s1 = field(x);
   const TapedField s2 = field(add_scaled(x, 0.5 * h, s1.f));
@@ -98,7 +100,8 @@ Tensor rk2_mean_l1(const Tensor& x_in, const Tensor& x_next_in, double h, const 
 }
 
 // The networks a hand-written step can use: fused float64, bound to the flat buffers.
-bool has_manual_step(const std::vector<std::unique_ptr<StackedMlp>>& nets, torch::ScalarType dtype) {
+bool has_manual_step(const std::vector<std::unique_ptr<StackedMlp>>& nets,
+                     torch::ScalarType dtype) {
   for (const auto& net : nets) {
     if (!net->options().fused || net->gradient_sinks().empty()) return false;
   }
@@ -113,7 +116,8 @@ struct TapedNet {
     return internal::fused_mlp_taped(net.weights(), net.biases(), y, {directions, order}, &tape);
   }
   Tensor backward(const std::vector<Tensor>& grads, bool input) const {
-    return internal::fused_mlp_taped_backward(*tape, net.weights(), net.gradient_sinks(), grads, input);
+    return internal::fused_mlp_taped_backward(*tape, net.weights(), net.gradient_sinks(), grads,
+                                              input);
   }
 };
 
@@ -170,14 +174,16 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x_in, const Tensor& x_
   TapedNet ends_net{l_h, nullptr};
   internal::HamiltonianTape ends_head;
   const Tensor h_ends =
-      internal::hamiltonian_head_taped(ends_net.forward(ends, 0, 0).v, Tensor(), ends, &ends_head).h;
+      internal::hamiltonian_head_taped(ends_net.forward(ends, 0, 0).v, Tensor(), ends, &ends_head)
+          .h;
   const TapedGradient mid(l_h, m);
   const Tensor h0 = h_ends.narrow(1, 0, B), h1 = h_ends.narrow(1, B, B);
   const Tensor effort = internal::gonzalez_forward(h0, h1, mid.grad, dx, min_dx_norm);
   const TapedEffortField field = effort_field(effort, dissipation_at_start ? x : m);
   Tensor f_bar;
   const Tensor loss = mean_l1_loss(x_next, add_scaled(x, h, field.f), h, &f_bar);
-  const auto g = internal::gonzalez_backward(h0, h1, mid.grad, dx, min_dx_norm, field.backward(f_bar, false).first);
+  const auto g = internal::gonzalez_backward(h0, h1, mid.grad, dx, min_dx_norm,
+                                             field.backward(f_bar, false).first);
   mid.backward(g.grad, false);
   // The ends' adjoint is two narrow adjoints summed over zeros (-0 becomes +0).
   const Tensor h_ends_bar = torch::cat({g.h0, g.h1}, /*dim=*/1) + 0.0;

@@ -5,11 +5,13 @@
 // DG (R at the midpoint and at the start; rows below the Gonzalez threshold
 // included), each built-in structure, two sizes, data expanded over the
 // members (the full-batch view) and gathered per member.
-#include <cstring>
-#include <vector>
-
 #include <gtest/gtest.h>
 #include <torch/torch.h>
+
+#include <cctype>
+#include <cstring>
+#include <string>
+#include <vector>
 
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/discrete_step.h"
@@ -19,8 +21,8 @@ namespace {
 
 bool same_bits(const torch::Tensor& a, const torch::Tensor& b) {
   const auto ca = a.contiguous(), cb = b.contiguous();
-  return ca.sizes() == cb.sizes() &&
-         std::memcmp(ca.data_ptr<double>(), cb.data_ptr<double>(), sizeof(double) * ca.numel()) == 0;
+  return ca.sizes() == cb.sizes() && std::memcmp(ca.data_ptr<double>(), cb.data_ptr<double>(),
+                                                 sizeof(double) * ca.numel()) == 0;
 }
 
 struct Case {
@@ -28,7 +30,7 @@ struct Case {
   IntegratorKind integrator;
   SystemKind structure;
   ModelSize size;
-  bool expanded;  // x, x_next, u one [1, B, .] array viewed by every member
+  bool expanded;          // x, x_next, u one [1, B, .] array viewed by every member
   bool at_start = false;  // DG: R at x_n
 };
 
@@ -60,7 +62,8 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
   const bool dg = c.integrator == IntegratorKind::kDg;
 
   flat.gradients.zero_();
-  const auto x_hat = dg ? dg_training_step(*model, x, x_next, u, h, min_dx_norm) : rk2_step(*model, x, u, h);
+  const auto x_hat =
+      dg ? dg_training_step(*model, x, x_next, u, h, min_dx_norm) : rk2_step(*model, x, u, h);
   const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
   loss.sum().backward();
   const auto autograd_loss = loss.detach().clone(), autograd_grad = flat.gradients.clone();
@@ -68,7 +71,7 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
 
   flat.gradients.zero_();
   const auto manual = dg ? model->dg_mean_l1_step(x, x_next, u, h, min_dx_norm)
-                        : model->rk2_mean_l1_step(x, x_next, u, h);
+                         : model->rk2_mean_l1_step(x, x_next, u, h);
   ASSERT_TRUE(manual.defined());
   EXPECT_TRUE(same_bits(manual, autograd_loss)) << manual << autograd_loss;
   EXPECT_TRUE(same_bits(flat.gradients, autograd_grad))
@@ -78,24 +81,49 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
 
 INSTANTIATE_TEST_SUITE_P(
     Models, ManualStepTest,
-    ::testing::Values(Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kHarmonic, ModelSize::kSmall, true},
-                      Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall, false},
-                      Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kSelfSustained, ModelSize::kSmall, true},
-                      Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kSelfSustained, ModelSize::kMedium, false},
-                      Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kHarmonic, ModelSize::kSmall, false},
-                      Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall, true},
-                      Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kSelfSustained, ModelSize::kMedium, false},
-                      Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall, true},
-                      Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kSelfSustained, ModelSize::kMedium, false},
-                      Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kHarmonic, ModelSize::kSmall, true},
-                      Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kDuffing, ModelSize::kMedium, false},
-                      Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kSelfSustained, ModelSize::kSmall, false, true},
-                      Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kDuffing, ModelSize::kSmall, true},
-                      Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kSelfSustained, ModelSize::kMedium, false}));
+    ::testing::Values(
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kHarmonic, ModelSize::kSmall,
+             true},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall,
+             false},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kSelfSustained,
+             ModelSize::kSmall, true},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kSelfSustained,
+             ModelSize::kMedium, false},
+        Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kHarmonic, ModelSize::kSmall,
+             false},
+        Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall,
+             true},
+        Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kSelfSustained,
+             ModelSize::kMedium, false},
+        Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall, true},
+        Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kSelfSustained, ModelSize::kMedium,
+             false},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kHarmonic, ModelSize::kSmall,
+             true},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kDuffing, ModelSize::kMedium,
+             false},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kSelfSustained, ModelSize::kSmall,
+             false, true},
+        Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kDuffing, ModelSize::kSmall, true},
+        Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kSelfSustained, ModelSize::kMedium,
+             false}),
+    // A readable, deterministic name (the default prints the struct's bytes, padding included).
+    [](const ::testing::TestParamInfo<Case>& case_info) {
+      const Case& c = case_info.param;
+      std::string name = to_string(c.kind) + "_" + to_string(c.integrator) + "_" +
+                         to_string(c.structure) + "_" + to_string(c.size) +
+                         (c.expanded ? "_expanded" : "_gathered") + (c.at_start ? "_start" : "");
+      for (char& ch : name) {
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+      }
+      return name;
+    });
 
 // Reference (op-by-op) networks have no hand-written step: the trainer then runs autograd.
 TEST(ManualStepTest, ReferenceNetworksHaveNone) {
-  const auto x = torch::zeros({2, 3, 2}, torch::kFloat64), u = torch::zeros({2, 3, 1}, torch::kFloat64);
+  const auto x = torch::zeros({2, 3, 2}, torch::kFloat64),
+             u = torch::zeros({2, 3, 1}, torch::kFloat64);
   for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
     ModelOptions reference{kind, ModelSize::kSmall, SystemKind::kDuffing};
     reference.fused_networks = false;

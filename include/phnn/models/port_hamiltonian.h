@@ -93,7 +93,8 @@ class PhnnS : public PortHamiltonianModel {
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                  const torch::Tensor& u, double h) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                const torch::Tensor& u, double h, double min_dx_norm) const override;
+                                const torch::Tensor& u, double h,
+                                double min_dx_norm) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -113,7 +114,8 @@ class PhnnJr : public PortHamiltonianModel {
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                  const torch::Tensor& u, double h) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                const torch::Tensor& u, double h, double min_dx_norm) const override;
+                                const torch::Tensor& u, double h,
+                                double min_dx_norm) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
