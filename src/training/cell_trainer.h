@@ -63,6 +63,8 @@ class CellTrainer {
   torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u,
                           const torch::Tensor& f_at_x = {}) const;
   void step(int step, BatchSampler& sampler);
+  torch::Tensor loss_and_gradients(const torch::Tensor& x, const torch::Tensor& xn,
+                                   const torch::Tensor& u);
   void freeze_non_finite(const torch::Tensor& loss, int step, std::vector<int64_t>* dead);
   void validate(int step);
   void report_progress(int step, std::vector<double> live_best) const;

@@ -140,27 +140,8 @@ void CellTrainer::step(int step, BatchSampler& sampler) {
   const auto x = full_batch ? t_.x_all : t_.x.index({idx});
   const auto xn = full_batch ? t_.x_next_all : t_.x_next.index({idx});
   const auto u = full_batch ? t_.u_all : t_.u.index({idx});
-  // A regularizer needs df/dx at the batch; the same evaluation's f is an
-  // explicit step's first stage, so RK2/RK4 do not evaluate f(x) twice.
-  const bool regularized = cell_.regularizer != Regularizer::kNone;
   adam_->zero_grad();
-  // The model's hand-written step where it has one (the same bits, no graph).
-  torch::Tensor loss;
-  if (!regularized && opt_.loss_norm == LossNorm::kMeanL1) {
-    if (cell_.integrator == IntegratorKind::kRk2) loss = model_->rk2_mean_l1_step(x, xn, u, h_);
-    if (cell_.integrator == IntegratorKind::kDg) {
-      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm);
-    }
-  }
-  if (!loss.defined()) {
-    const FieldEval at_x = regularized ? model_->field(x, u, true) : FieldEval{};
-    loss = data_loss(x, xn, u, at_x.f);
-    if (regularized) {
-      const auto stats = jacobian_stats(at_x.dfdx, opt_.jacobian_eps);
-      loss = loss + regularizer_penalty(cell_.regularizer, stats, opt_);
-    }
-    loss.sum().backward();
-  }
+  const auto loss = loss_and_gradients(x, xn, u);
   std::vector<int64_t> dead;
   freeze_non_finite(loss, step, &dead);
   const auto dead_idx = torch::tensor(dead, torch::kLong);
@@ -174,6 +155,32 @@ void CellTrainer::step(int step, BatchSampler& sampler) {
       params_[k].index_copy_(0, dead_idx, frozen_[k].index_select(0, dead_idx));
     }
   }
+}
+
+// L_d per member (+ the regularizer's penalty) on a minibatch, its parameter
+// gradients added into the flat gradient buffer: by the model's hand-written
+// step where it has one (the same bits, no graph), else by autograd.
+torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torch::Tensor& xn,
+                                              const torch::Tensor& u) {
+  const bool regularized = cell_.regularizer != Regularizer::kNone;
+  if (!regularized && opt_.loss_norm == LossNorm::kMeanL1) {
+    torch::Tensor loss;
+    if (cell_.integrator == IntegratorKind::kRk2) loss = model_->rk2_mean_l1_step(x, xn, u, h_);
+    if (cell_.integrator == IntegratorKind::kDg) {
+      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm);
+    }
+    if (loss.defined()) return loss;
+  }
+  // A regularizer needs df/dx at the batch; the same evaluation's f is an
+  // explicit step's first stage, so RK2/RK4 do not evaluate f(x) twice.
+  const FieldEval at_x = regularized ? model_->field(x, u, true) : FieldEval{};
+  auto loss = data_loss(x, xn, u, at_x.f);
+  if (regularized) {
+    const auto stats = jacobian_stats(at_x.dfdx, opt_.jacobian_eps);
+    loss = loss + regularizer_penalty(cell_.regularizer, stats, opt_);
+  }
+  loss.sum().backward();
+  return loss;
 }
 
 // A member whose loss is non-finite is frozen at its last finite weights;
