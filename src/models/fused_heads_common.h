@@ -1,7 +1,7 @@
 // src/models/fused_heads_common.h — shared by the fused heads of src/models
-// only (fused_heads*.cpp, general*_heads.cpp): softplus/sigmoid from one exp,
-// the structure matrices a head saves for its backward, and the row and
-// lower-triangle indexing of the n-state heads.
+// only (fused_heads*.cpp, general*_heads.cpp; manual_step.cpp for rows_like):
+// softplus/sigmoid from one exp, the structure matrices a head saves for its
+// backward, and the row and lower-triangle indexing of the n-state heads.
 #pragma once
 
 #include <array>

@@ -26,6 +26,7 @@
 #include <memory>
 
 #include "models/fused_heads.h"
+#include "models/fused_heads_common.h"
 #include "models/fused_mlp.h"
 #include "models/general_heads.h"
 #include "phnn/models/port_hamiltonian.h"
@@ -33,6 +34,7 @@
 namespace phnn {
 namespace {
 
+using internal::heads::rows_like;
 using torch::Tensor;
 
 // One field evaluation f(y) and its backward: adds the parameter gradients of
@@ -229,18 +231,13 @@ EffortFieldRecorder s_effort_field(const StackedMlp& l_z, const Tensor& u,
   };
 }
 
-// u as the rows of x: [E, B, 1], dense.
-Tensor rows_of_u(const Tensor& u, const Tensor& x) {
-  return u.expand({x.size(0), x.size(1), 1}).contiguous();
-}
-
 }  // namespace
 
 torch::Tensor PhnnJr::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                        const torch::Tensor& u, double h) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, jr_effort_field(*nets_[1], rows_of_u(u, x), J_));
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, jr_effort_field(*nets_[1], rows_like(u, x), J_));
 }
 
 torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
@@ -248,14 +245,14 @@ torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tenso
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, dissipation_at_start(),
-                       jr_effort_field(*nets_[1], rows_of_u(u, x), J_));
+                       jr_effort_field(*nets_[1], rows_like(u, x), J_));
 }
 
 torch::Tensor PhnnS::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                       const torch::Tensor& u, double h) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_of_u(u, x), S_));
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_like(u, x), S_));
 }
 
 torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
@@ -263,7 +260,7 @@ torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, false,
-                       s_effort_field(*nets_[1], rows_of_u(u, x), S_));
+                       s_effort_field(*nets_[1], rows_like(u, x), S_));
 }
 
 // NODE: f = MLP(y, u); y~ = the first two columns of the input adjoint.
@@ -271,7 +268,7 @@ torch::Tensor Node::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor
                                      const torch::Tensor& u_in, double h) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  const Tensor u = rows_of_u(u_in, x);
+  const Tensor u = rows_like(u_in, x);
   const StackedMlp& mlp = *nets_[0];
   return rk2_mean_l1(x, x_next, h, [&](const Tensor& y) {
     auto net = std::make_shared<TapedNet>(TapedNet{mlp, nullptr});
