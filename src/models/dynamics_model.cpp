@@ -33,12 +33,14 @@ FieldEval DynamicsModel::discrete_gradient4_field(const torch::Tensor&, const to
 }
 
 torch::Tensor DynamicsModel::rk2_mean_l1_step(const torch::Tensor&, const torch::Tensor&,
-                                              const torch::Tensor&, double) const {
+                                              const torch::Tensor&, double,
+                                              const JacobianPenalty&) const {
   return {};
 }
 
 torch::Tensor DynamicsModel::dg_mean_l1_step(const torch::Tensor&, const torch::Tensor&,
-                                             const torch::Tensor&, double, double) const {
+                                             const torch::Tensor&, double, double,
+                                             const JacobianPenalty&) const {
   return {};
 }
 

@@ -101,6 +101,8 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
   }
 };
 
+}  // namespace
+
 // ------------------------------------------------- PHNN-JR, first-order jet
 // The field and its x-tangents (direction i): eps = (e, u), eps_i = (K_i, 0)
 // with K_i = d e / d x_i, L_i = the lower triangle of o_g[i]:
@@ -112,103 +114,125 @@ class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
 //   L~_i = v r~_i^T + v~_i eps^T,
 //   eps~ = J^T f~ + L^T v~ + sum_i L_i^T v~_i,  eps~_i = J^T f~_i + L^T v~_i,
 // keeping the lower-triangle entries of L~ and L~_i.
+
+JrFieldJet jr_field_jet_forward(const Tensor& e_in, const Tensor& k_in, const Tensor& o_in,
+                                const Tensor& og_in, const Tensor& u_in,
+                                const std::array<std::array<double, 3>, 3>& J) {
+  const Tensor e = dense(e_in), K = dense(k_in), o = dense(o_in), og = dense(og_in),
+               u = dense(u_in);
+  const int64_t E = e.size(0), B = e.size(1), rows = E * B;
+  Tensor f = torch::empty({E, B, 2}, e.options()), fg = torch::empty({E, B, 2, 2}, e.options());
+  const double *pe = e.data_ptr<double>(), *pk = K.data_ptr<double>(), *po = o.data_ptr<double>();
+  const double *pog = og.data_ptr<double>(), *pu = u.data_ptr<double>();
+  double *pf = f.data_ptr<double>(), *pfg = fg.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+    const double* L = po + 6 * r;
+    double v[3], rv[3];
+    lower_times(L, eps, v);
+    lower_transpose_times(L, v, rv);
+    for (int c = 0; c < 2; ++c)
+      pf[2 * r + c] = J[c][0] * eps[0] + J[c][1] * eps[1] + J[c][2] * eps[2] - rv[c];
+    for (int i = 0; i < 2; ++i) {
+      const double eps_i[3] = {pk[4 * r + 2 * i], pk[4 * r + 2 * i + 1], 0.0};
+      const double* Li = pog + 12 * r + 6 * i;
+      double vi[3], a[3], b[3], ri[3];
+      lower_times(Li, eps, vi);
+      lower_times(L, eps_i, a);
+      for (int k = 0; k < 3; ++k) vi[k] += a[k];
+      lower_transpose_times(Li, v, ri);
+      lower_transpose_times(L, vi, b);
+      for (int c = 0; c < 2; ++c) {
+        pfg[4 * r + 2 * i + c] = J[c][0] * eps_i[0] + J[c][1] * eps_i[1] - (ri[c] + b[c]);
+      }
+    }
+  }
+  return {f, fg};
+}
+
+JrFieldJetAdjoints jr_field_jet_backward(const Tensor& e, const Tensor& K, const Tensor& o,
+                                         const Tensor& og, const Tensor& u,
+                                         const std::array<std::array<double, 3>, 3>& J,
+                                         const Tensor& f_bar, const Tensor& g_bar) {
+  const int64_t E = e.size(0), B = e.size(1), rows = E * B;
+  const Tensor fb = f_bar.defined() ? dense(f_bar) : torch::zeros_like(e);
+  const Tensor fgb = g_bar.defined() ? dense(g_bar) : torch::zeros({E, B, 2, 2}, e.options());
+  Tensor e_bar = torch::empty_like(e), k_bar = torch::empty_like(K), o_bar = torch::empty_like(o);
+  Tensor og_bar = torch::empty_like(og), u_bar = torch::empty_like(u);
+  const double *pe = e.data_ptr<double>(), *pk = K.data_ptr<double>(), *po = o.data_ptr<double>();
+  const double *pog = og.data_ptr<double>(), *pu = u.data_ptr<double>();
+  const double *pfb = fb.data_ptr<double>(), *pfgb = fgb.data_ptr<double>();
+  double *peb = e_bar.data_ptr<double>(), *pkb = k_bar.data_ptr<double>();
+  double *pob = o_bar.data_ptr<double>(), *pogb = og_bar.data_ptr<double>(),
+         *pub = u_bar.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
+    const double* L = po + 6 * r;
+    const double* Li[2] = {pog + 12 * r, pog + 12 * r + 6};
+    double eps_i[2][3], v[3], vi[2][3];
+    lower_times(L, eps, v);
+    for (int i = 0; i < 2; ++i) {
+      eps_i[i][0] = pk[4 * r + 2 * i], eps_i[i][1] = pk[4 * r + 2 * i + 1], eps_i[i][2] = 0.0;
+      double a[3];
+      lower_times(Li[i], eps, vi[i]);
+      lower_times(L, eps_i[i], a);
+      for (int k = 0; k < 3; ++k) vi[i][k] += a[k];
+    }
+    const double rb[3] = {-pfb[2 * r], -pfb[2 * r + 1], 0.0};
+    double rib[2][3], vb[3], vib[2][3], tmp[3];
+    lower_times(L, rb, vb);
+    for (int i = 0; i < 2; ++i) {
+      rib[i][0] = -pfgb[4 * r + 2 * i], rib[i][1] = -pfgb[4 * r + 2 * i + 1], rib[i][2] = 0.0;
+      lower_times(Li[i], rib[i], tmp);
+      for (int k = 0; k < 3; ++k) vb[k] += tmp[k];
+      lower_times(L, rib[i], vib[i]);
+    }
+    double* ob = pob + 6 * r;
+    for (int k = 0; k < 6; ++k) {
+      const int a = kRow[k], b = kCol[k];
+      double s = v[a] * rb[b] + vb[a] * eps[b];
+      for (int i = 0; i < 2; ++i) s += vi[i][a] * rib[i][b] + vib[i][a] * eps_i[i][b];
+      ob[k] = s;
+      for (int i = 0; i < 2; ++i) pogb[12 * r + 6 * i + k] = v[a] * rib[i][b] + vib[i][a] * eps[b];
+    }
+    double eb[3];
+    lower_transpose_times(L, vb, eb);
+    for (int i = 0; i < 2; ++i) {
+      lower_transpose_times(Li[i], vib[i], tmp);
+      for (int k = 0; k < 3; ++k) eb[k] += tmp[k];
+    }
+    for (int j = 0; j < 3; ++j) eb[j] += J[0][j] * pfb[2 * r] + J[1][j] * pfb[2 * r + 1];
+    peb[2 * r] = eb[0], peb[2 * r + 1] = eb[1], pub[r] = eb[2];
+    for (int i = 0; i < 2; ++i) {
+      lower_transpose_times(L, vib[i], tmp);
+      for (int a = 0; a < 2; ++a) {
+        pkb[4 * r + 2 * i + a] =
+            tmp[a] + J[0][a] * pfgb[4 * r + 2 * i] + J[1][a] * pfgb[4 * r + 2 * i + 1];
+      }
+    }
+  }
+  return {e_bar, k_bar, o_bar, og_bar, u_bar};
+}
+
+namespace {
+
 class JrJetFunction : public torch::autograd::Function<JrJetFunction> {
  public:
   static variable_list forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& k_in,
                                const Tensor& o_in, const Tensor& og_in, const Tensor& u_in,
                                std::array<std::array<double, 3>, 3> J) {
     const Tensor e = dense(e_in), K = dense(k_in), o = dense(o_in), og = dense(og_in), u = dense(u_in);
-    const int64_t E = e.size(0), B = e.size(1), rows = E * B;
-    Tensor f = torch::empty({E, B, 2}, e.options()), fg = torch::empty({E, B, 2, 2}, e.options());
-    const double *pe = e.data_ptr<double>(), *pk = K.data_ptr<double>(), *po = o.data_ptr<double>();
-    const double *pog = og.data_ptr<double>(), *pu = u.data_ptr<double>();
-    double *pf = f.data_ptr<double>(), *pfg = fg.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
-      const double* L = po + 6 * r;
-      double v[3], rv[3];
-      lower_times(L, eps, v);
-      lower_transpose_times(L, v, rv);
-      for (int c = 0; c < 2; ++c) pf[2 * r + c] = J[c][0] * eps[0] + J[c][1] * eps[1] + J[c][2] * eps[2] - rv[c];
-      for (int i = 0; i < 2; ++i) {
-        const double eps_i[3] = {pk[4 * r + 2 * i], pk[4 * r + 2 * i + 1], 0.0};
-        const double* Li = pog + 12 * r + 6 * i;
-        double vi[3], a[3], b[3], ri[3];
-        lower_times(Li, eps, vi);
-        lower_times(L, eps_i, a);
-        for (int k = 0; k < 3; ++k) vi[k] += a[k];
-        lower_transpose_times(Li, v, ri);
-        lower_transpose_times(L, vi, b);
-        for (int c = 0; c < 2; ++c) {
-          pfg[4 * r + 2 * i + c] = J[c][0] * eps_i[0] + J[c][1] * eps_i[1] - (ri[c] + b[c]);
-        }
-      }
-    }
+    const JrFieldJet out = jr_field_jet_forward(e, K, o, og, u, J);
     ctx->save_for_backward({e, K, o, og, u});
     save_matrix(ctx, J);
-    return {f, fg};
+    return {out.f, out.g};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &e = saved[0], &K = saved[1], &o = saved[2], &og = saved[3], &u = saved[4];
-    const auto J = load_matrix<3, 3>(ctx);
-    const int64_t E = e.size(0), B = e.size(1), rows = E * B;
-    const Tensor fb = grads[0].defined() ? dense(grads[0]) : torch::zeros_like(e);
-    const Tensor fgb = grads[1].defined() ? dense(grads[1]) : torch::zeros({E, B, 2, 2}, e.options());
-    Tensor e_bar = torch::empty_like(e), k_bar = torch::empty_like(K), o_bar = torch::empty_like(o);
-    Tensor og_bar = torch::empty_like(og), u_bar = torch::empty_like(u);
-    const double *pe = e.data_ptr<double>(), *pk = K.data_ptr<double>(), *po = o.data_ptr<double>();
-    const double *pog = og.data_ptr<double>(), *pu = u.data_ptr<double>();
-    const double *pfb = fb.data_ptr<double>(), *pfgb = fgb.data_ptr<double>();
-    double *peb = e_bar.data_ptr<double>(), *pkb = k_bar.data_ptr<double>();
-    double *pob = o_bar.data_ptr<double>(), *pogb = og_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      const double eps[3] = {pe[2 * r], pe[2 * r + 1], pu[r]};
-      const double* L = po + 6 * r;
-      const double* Li[2] = {pog + 12 * r, pog + 12 * r + 6};
-      double eps_i[2][3], v[3], vi[2][3];
-      lower_times(L, eps, v);
-      for (int i = 0; i < 2; ++i) {
-        eps_i[i][0] = pk[4 * r + 2 * i], eps_i[i][1] = pk[4 * r + 2 * i + 1], eps_i[i][2] = 0.0;
-        double a[3];
-        lower_times(Li[i], eps, vi[i]);
-        lower_times(L, eps_i[i], a);
-        for (int k = 0; k < 3; ++k) vi[i][k] += a[k];
-      }
-      const double rb[3] = {-pfb[2 * r], -pfb[2 * r + 1], 0.0};
-      double rib[2][3], vb[3], vib[2][3], tmp[3];
-      lower_times(L, rb, vb);
-      for (int i = 0; i < 2; ++i) {
-        rib[i][0] = -pfgb[4 * r + 2 * i], rib[i][1] = -pfgb[4 * r + 2 * i + 1], rib[i][2] = 0.0;
-        lower_times(Li[i], rib[i], tmp);
-        for (int k = 0; k < 3; ++k) vb[k] += tmp[k];
-        lower_times(L, rib[i], vib[i]);
-      }
-      double* ob = pob + 6 * r;
-      for (int k = 0; k < 6; ++k) {
-        const int a = kRow[k], b = kCol[k];
-        double s = v[a] * rb[b] + vb[a] * eps[b];
-        for (int i = 0; i < 2; ++i) s += vi[i][a] * rib[i][b] + vib[i][a] * eps_i[i][b];
-        ob[k] = s;
-        for (int i = 0; i < 2; ++i) pogb[12 * r + 6 * i + k] = v[a] * rib[i][b] + vib[i][a] * eps[b];
-      }
-      double eb[3];
-      lower_transpose_times(L, vb, eb);
-      for (int i = 0; i < 2; ++i) {
-        lower_transpose_times(Li[i], vib[i], tmp);
-        for (int k = 0; k < 3; ++k) eb[k] += tmp[k];
-      }
-      for (int j = 0; j < 3; ++j) eb[j] += J[0][j] * pfb[2 * r] + J[1][j] * pfb[2 * r + 1];
-      peb[2 * r] = eb[0], peb[2 * r + 1] = eb[1], pub[r] = eb[2];
-      for (int i = 0; i < 2; ++i) {
-        lower_transpose_times(L, vib[i], tmp);
-        for (int a = 0; a < 2; ++a) {
-          pkb[4 * r + 2 * i + a] = tmp[a] + J[0][a] * pfgb[4 * r + 2 * i] + J[1][a] * pfgb[4 * r + 2 * i + 1];
-        }
-      }
-    }
-    return {e_bar, k_bar, o_bar, og_bar, u_bar, Tensor()};
+    const auto adj = jr_field_jet_backward(saved[0], saved[1], saved[2], saved[3], saved[4],
+                                           load_matrix<3, 3>(ctx), grads[0], grads[1]);
+    return {adj.effort, adj.effort_g, adj.o, adj.o_g, adj.u, Tensor()};
   }
 };
 

@@ -47,6 +47,21 @@ struct HamiltonianCurvature {
 HamiltonianCurvature hamiltonian_curvature_head(const torch::Tensor& o, const torch::Tensor& o_g,
                                                 const torch::Tensor& o_h, const torch::Tensor& x);
 
+/// hamiltonian_curvature_head without an autograd node (x already [E, B, 2]),
+/// and its backward from (gradH~, Hessian~; undefined = 0).
+struct CurvatureTape {
+  torch::Tensor o, o_g, o_h, x, aux;
+};
+HamiltonianCurvature hamiltonian_curvature_taped(const torch::Tensor& o, const torch::Tensor& o_g,
+                                                 const torch::Tensor& o_h, const torch::Tensor& x,
+                                                 CurvatureTape* tape);
+struct CurvatureAdjoints {
+  torch::Tensor o, o_g, o_h, x;
+};
+CurvatureAdjoints hamiltonian_curvature_backward(const CurvatureTape& tape,
+                                                 const torch::Tensor& grad_bar,
+                                                 const torch::Tensor& hessian_bar);
+
 /// PHNN-JR field (eq:f_theta-PHS-JR) from the effort e [E, B, 2] (gradH or
 /// the discrete gradient), the L_R outputs o [E, B, 6] (row-major lower
 /// triangle of L_R) and u [E, B, 1]:  f = [(J - L_R^T L_R) (e, u)]_{1:2}.
@@ -76,6 +91,21 @@ struct JrFieldJet {
 JrFieldJet jr_field_jet_head(const torch::Tensor& effort, const torch::Tensor& effort_g,
                              const torch::Tensor& o, const torch::Tensor& o_g, const torch::Tensor& u,
                              const std::array<std::array<double, 3>, 3>& J);
+
+/// jr_field_jet_head without an autograd node (u already [E, B, 1]), and its
+/// backward from (f~, g~; undefined = 0) given the forward's inputs, dense.
+JrFieldJet jr_field_jet_forward(const torch::Tensor& effort, const torch::Tensor& effort_g,
+                                const torch::Tensor& o, const torch::Tensor& o_g,
+                                const torch::Tensor& u,
+                                const std::array<std::array<double, 3>, 3>& J);
+struct JrFieldJetAdjoints {
+  torch::Tensor effort, effort_g, o, o_g, u;
+};
+JrFieldJetAdjoints jr_field_jet_backward(const torch::Tensor& effort, const torch::Tensor& effort_g,
+                                         const torch::Tensor& o, const torch::Tensor& o_g,
+                                         const torch::Tensor& u,
+                                         const std::array<std::array<double, 3>, 3>& J,
+                                         const torch::Tensor& f_bar, const torch::Tensor& g_bar);
 
 /// PHNN-S (eq:f_theta-PHS-DAF), in two heads around the L_z network:
 ///   w = S_wx e + S_wu u  (s_w = (S_w0, S_w1, S_w3); S_ww = 0),

@@ -247,50 +247,71 @@ struct CurvatureRow {
   }
 };
 
+}  // namespace
+
+HamiltonianCurvature hamiltonian_curvature_taped(const Tensor& o_in, const Tensor& og_in,
+                                                 const Tensor& oh_in, const Tensor& x_in,
+                                                 CurvatureTape* tape) {
+  const Tensor o = dense(o_in), og = dense(og_in), oh = dense(oh_in), x = dense(x_in);
+  const int64_t E = o.size(0), B = o.size(1), rows = E * B;
+  Tensor grad = torch::empty({E, B, 2}, o.options()),
+         hess = torch::empty({E, B, 2, 2}, o.options());
+  const double *po = o.data_ptr<double>(), *pg = og.data_ptr<double>();
+  const double *ph = oh.data_ptr<double>(), *px = x.data_ptr<double>();
+  double *pgr = grad.data_ptr<double>(), *phs = hess.data_ptr<double>();
+  Tensor aux = torch::empty({SoftplusColumns::size(2, rows)}, o.options());
+  const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data_ptr<double>());
+  for (int64_t r = 0; r < rows; ++r) {
+    const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
+    for (int i = 0; i < 2; ++i) {
+      pgr[2 * r + i] = row.grad(i);
+      for (int j = 0; j < 2; ++j) phs[4 * r + 2 * i + j] = row.hessian(i, j);
+    }
+  }
+  *tape = CurvatureTape{o, og, oh, x, aux};
+  return {grad, hess};
+}
+
+CurvatureAdjoints hamiltonian_curvature_backward(const CurvatureTape& tape, const Tensor& grad_bar,
+                                                 const Tensor& hessian_bar) {
+  const Tensor &o = tape.o, &og = tape.o_g, &oh = tape.o_h, &x = tape.x;
+  const int64_t rows = o.size(0) * o.size(1);
+  const Tensor gb = grad_bar.defined() ? dense(grad_bar) : torch::zeros_like(x);
+  const Tensor kb = hessian_bar.defined() ? dense(hessian_bar)
+                                          : torch::zeros({o.size(0), o.size(1), 2, 2}, o.options());
+  CurvatureAdjoints out{torch::empty_like(o), torch::empty_like(og), torch::empty_like(oh),
+                        torch::empty_like(x)};
+  const double *po = o.data_ptr<double>(), *pg = og.data_ptr<double>();
+  const double *ph = oh.data_ptr<double>(), *px = x.data_ptr<double>();
+  const double *pgb = gb.data_ptr<double>(), *pkb = kb.data_ptr<double>();
+  double *pob = out.o.data_ptr<double>(), *pogb = out.o_g.data_ptr<double>();
+  double *pohb = out.o_h.data_ptr<double>(), *pxb = out.x.data_ptr<double>();
+  const SoftplusColumns f = SoftplusColumns::saved(2, rows, tape.aux.data_ptr<double>());
+  for (int64_t r = 0; r < rows; ++r) {
+    const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
+    row.backward(pg + 6 * r, ph + 12 * r, pgb + 2 * r, pkb + 4 * r, pob + 3 * r, pogb + 6 * r,
+                 pohb + 12 * r, pxb + 2 * r);
+  }
+  return out;
+}
+
+namespace {
+
 class CurvatureFunction : public torch::autograd::Function<CurvatureFunction> {
  public:
   static variable_list forward(AutogradContext* ctx, const Tensor& o_in, const Tensor& og_in,
                                const Tensor& oh_in, const Tensor& x_in) {
-    const Tensor o = dense(o_in), og = dense(og_in), oh = dense(oh_in), x = dense(x_in);
-    const int64_t E = o.size(0), B = o.size(1), rows = E * B;
-    Tensor grad = torch::empty({E, B, 2}, o.options()), hess = torch::empty({E, B, 2, 2}, o.options());
-    const double *po = o.data_ptr<double>(), *pg = og.data_ptr<double>();
-    const double *ph = oh.data_ptr<double>(), *px = x.data_ptr<double>();
-    double *pgr = grad.data_ptr<double>(), *phs = hess.data_ptr<double>();
-    Tensor aux = torch::empty({SoftplusColumns::size(2, rows)}, o.options());
-    const SoftplusColumns f = SoftplusColumns::compute(po, 3, {0, 2}, rows, aux.data_ptr<double>());
-    for (int64_t r = 0; r < rows; ++r) {
-      const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
-      for (int i = 0; i < 2; ++i) {
-        pgr[2 * r + i] = row.grad(i);
-        for (int j = 0; j < 2; ++j) phs[4 * r + 2 * i + j] = row.hessian(i, j);
-      }
-    }
-    ctx->save_for_backward({o, og, oh, x, aux});
-    return {grad, hess};
+    CurvatureTape tape;
+    const HamiltonianCurvature out = hamiltonian_curvature_taped(o_in, og_in, oh_in, x_in, &tape);
+    ctx->save_for_backward({tape.o, tape.o_g, tape.o_h, tape.x, tape.aux});
+    return {out.grad, out.hessian};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &o = saved[0], &og = saved[1], &oh = saved[2], &x = saved[3];
-    const int64_t rows = o.size(0) * o.size(1);
-    const Tensor gb = grads[0].defined() ? dense(grads[0]) : torch::zeros_like(x);
-    const Tensor kb = grads[1].defined() ? dense(grads[1])
-                                         : torch::zeros({o.size(0), o.size(1), 2, 2}, o.options());
-    Tensor o_bar = torch::empty_like(o), og_bar = torch::empty_like(og);
-    Tensor oh_bar = torch::empty_like(oh), x_bar = torch::empty_like(x);
-    const double *po = o.data_ptr<double>(), *pg = og.data_ptr<double>();
-    const double *ph = oh.data_ptr<double>(), *px = x.data_ptr<double>();
-    const double *pgb = gb.data_ptr<double>(), *pkb = kb.data_ptr<double>();
-    double *pob = o_bar.data_ptr<double>(), *pogb = og_bar.data_ptr<double>();
-    double *pohb = oh_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
-    const SoftplusColumns f = SoftplusColumns::saved(2, rows, saved[4].data_ptr<double>());
-    for (int64_t r = 0; r < rows; ++r) {
-      const CurvatureRow row(po + 3 * r, pg + 6 * r, ph + 12 * r, px + 2 * r, f, r);
-      row.backward(pg + 6 * r, ph + 12 * r, pgb + 2 * r, pkb + 4 * r, pob + 3 * r, pogb + 6 * r,
-                   pohb + 12 * r, pxb + 2 * r);
-    }
-    return {o_bar, og_bar, oh_bar, x_bar};
+    const CurvatureTape tape{saved[0], saved[1], saved[2], saved[3], saved[4]};
+    const CurvatureAdjoints adj = hamiltonian_curvature_backward(tape, grads[0], grads[1]);
+    return {adj.o, adj.o_g, adj.o_h, adj.x};
   }
 };
 

@@ -21,6 +21,11 @@
 // dg from H at the ends x, x + dx (one order-0 L_H call on both) and gradH(m)
 // (general_gonzalez_head); backward F~ -> dg~ -> gradH(m)'s networks first,
 // then the ends' (the same order autograd takes); no input adjoints.
+// With a Jacobian regularizer (NODE and PHNN-JR): L += P(df/dx at x), P and
+// its adjoint from the trainer (JacobianPenalty); stage 1 of RK2 is then the
+// order-1 jet of the field at x (PHNN-JR: L_H's order-2 jet, the curvature
+// and JR jet heads), whose backward takes f~ and dfdx~ at once; in DG the
+// field at x is created first, so its backward runs last.
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -37,13 +42,14 @@ namespace {
 using internal::heads::rows_like;
 using torch::Tensor;
 
-// One field evaluation f(y) and its backward: adds the parameter gradients of
-// f~ . f into the sinks and returns y~ if `input` (else undefined).
+// One field evaluation f(y) (with df/dx if asked for) and its backward: adds
+// the parameter gradients of f~ . f + dfdx~ . df/dx into the sinks and returns
+// y~ if `input` (else undefined; dfdx~ undefined = 0).
 struct TapedField {
-  Tensor f;
-  std::function<Tensor(const Tensor& f_bar, bool input)> backward;
+  Tensor f, dfdx;
+  std::function<Tensor(const Tensor& f_bar, const Tensor& dfdx_bar, bool input)> backward;
 };
-using FieldRecorder = std::function<TapedField(const Tensor& y)>;
+using FieldRecorder = std::function<TapedField(const Tensor& y, bool jacobian)>;
 
 // [x, u] along the last dimension (x [E, B, 2], u [E, B, 1], both dense).
 Tensor cat_rows(const Tensor& x, const Tensor& u) {
@@ -88,16 +94,23 @@ Tensor mean_l1_loss(const Tensor& x_next, const Tensor& x_hat, double h, Tensor*
   return loss;
 }
 
-// The RK2 step, its loss and backward (file comment).
+// L + the penalty of df/dx (if any), with dfdx~ in *dfdx_bar.
+Tensor add_penalty(const Tensor& loss, const JacobianPenalty& penalty, const Tensor& dfdx,
+                   Tensor* dfdx_bar) {
+  return penalty ? loss + penalty(dfdx, dfdx_bar) : loss;
+}
+
+// The RK2 step, its loss (+ the penalty of df/dx at x) and backward (file comment).
 Tensor rk2_mean_l1(const Tensor& x_in, const Tensor& x_next_in, double h,
-                   const FieldRecorder& field) {
+                   const FieldRecorder& field, const JacobianPenalty& penalty) {
   const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
-  const TapedField s1 = field(x);
-  const TapedField s2 = field(add_scaled(x, 0.5 * h, s1.f));
-  Tensor k2_bar;
-  const Tensor loss = mean_l1_loss(x_next, add_scaled(x, h, s2.f), h, &k2_bar);
-  const Tensor x2_bar = s2.backward(k2_bar, true);
-  s1.backward(x2_bar * (0.5 * h), false);
+  const TapedField s1 = field(x, static_cast<bool>(penalty));
+  const TapedField s2 = field(add_scaled(x, 0.5 * h, s1.f), false);
+  Tensor k2_bar, dfdx_bar;
+  const Tensor loss = add_penalty(mean_l1_loss(x_next, add_scaled(x, h, s2.f), h, &k2_bar), penalty,
+                                  s1.dfdx, &dfdx_bar);
+  const Tensor x2_bar = s2.backward(k2_bar, Tensor(), true);
+  s1.backward(x2_bar * (0.5 * h), dfdx_bar, false);
   return loss;
 }
 
@@ -150,26 +163,36 @@ struct TapedEffortField {
 };
 using EffortFieldRecorder = std::function<TapedEffortField(const Tensor& effort, const Tensor& y)>;
 
+// A PH model's field with df/dx at a data point (no input adjoint), for a
+// Jacobian penalty; empty where the model has none hand-written.
+using JacobianFieldRecorder = std::function<TapedField(const Tensor& x)>;
+
 // RK2 of a PH model: f(y) = F(gradH(y), y).
 Tensor ph_rk2_mean_l1(const StackedMlp& l_h, const Tensor& x, const Tensor& x_next, double h,
-                      const EffortFieldRecorder& effort_field) {
-  return rk2_mean_l1(x, x_next, h, [&](const Tensor& y) {
+                      const EffortFieldRecorder& effort_field,
+                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty) {
+  const FieldRecorder field = [&](const Tensor& y, bool jacobian) {
+    if (jacobian) return jacobian_field(y);
     auto gradient = std::make_shared<TapedGradient>(l_h, y);
-    const TapedEffortField field = effort_field(gradient->grad, y);
-    TapedField t{field.f, {}};
-    t.backward = [=](const Tensor& f_bar, bool input) {
-      const auto [effort_bar, y_bar] = field.backward(f_bar, input);
+    const TapedEffortField effort = effort_field(gradient->grad, y);
+    TapedField t{effort.f, Tensor(), {}};
+    t.backward = [=](const Tensor& f_bar, const Tensor&, bool input) {
+      const auto [effort_bar, y_bar] = effort.backward(f_bar, input);
       return gradient->backward(effort_bar, input, y_bar);
     };
     return t;
-  });
+  };
+  return rk2_mean_l1(x, x_next, h, field, penalty);
 }
 
-// The DG step of a PH model, its loss and backward (file comment).
+// The DG step of a PH model, its loss (+ the penalty of df/dx at x) and
+// backward (file comment); the field at x, created first, goes back last.
 Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x_in, const Tensor& x_next_in, double h,
                      double min_dx_norm, bool dissipation_at_start,
-                     const EffortFieldRecorder& effort_field) {
+                     const EffortFieldRecorder& effort_field,
+                     const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty) {
   const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
+  const TapedField at_x = penalty ? jacobian_field(x) : TapedField{};
   const int64_t B = x.size(1);
   const Tensor dx = x_next - x, m = add_scaled(x, 0.5, dx);
   const Tensor ends = torch::cat({x, add_scaled(x, 1.0, dx)}, /*dim=*/1);
@@ -182,8 +205,9 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x_in, const Tensor& x_
   const Tensor h0 = h_ends.narrow(1, 0, B), h1 = h_ends.narrow(1, B, B);
   const Tensor effort = internal::gonzalez_forward(h0, h1, mid.grad, dx, min_dx_norm);
   const TapedEffortField field = effort_field(effort, dissipation_at_start ? x : m);
-  Tensor f_bar;
-  const Tensor loss = mean_l1_loss(x_next, add_scaled(x, h, field.f), h, &f_bar);
+  Tensor f_bar, dfdx_bar;
+  const Tensor loss = add_penalty(mean_l1_loss(x_next, add_scaled(x, h, field.f), h, &f_bar),
+                                  penalty, at_x.dfdx, &dfdx_bar);
   const auto g = internal::gonzalez_backward(h0, h1, mid.grad, dx, min_dx_norm,
                                              field.backward(f_bar, false).first);
   mid.backward(g.grad, false);
@@ -191,6 +215,7 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x_in, const Tensor& x_
   const Tensor h_ends_bar = torch::cat({g.h0, g.h1}, /*dim=*/1) + 0.0;
   const auto ends_adj = internal::hamiltonian_head_backward(ends_head, h_ends_bar, Tensor());
   ends_net.backward({ends_adj.o}, false);
+  if (penalty) at_x.backward(Tensor(), dfdx_bar, false);
   return loss;
 }
 
@@ -206,6 +231,35 @@ EffortFieldRecorder jr_effort_field(const StackedMlp& l_r, const Tensor& u,
       const auto jr = internal::jr_field_backward(effort, o_r, u, J, f_bar);
       const Tensor c = net_r->backward({jr.o}, input);
       return std::make_pair(jr.effort, input ? c.narrow(-1, 0, 2) : Tensor());
+    };
+    return t;
+  };
+}
+
+// PHNN-JR's field and df/dx at x: gradH and its Hessian from L_H's order-2
+// jet (the curvature head), L_R's order-1 jet, the JR jet head. Backward, in
+// autograd's order: the JR jet head, L_R, the curvature head, L_H.
+JacobianFieldRecorder jr_jacobian_field(const StackedMlp& l_h, const StackedMlp& l_r,
+                                        const Tensor& u,
+                                        const std::array<std::array<double, 3>, 3>& J) {
+  return [&l_h, &l_r, u, J](const Tensor& x) {
+    auto net_h = std::make_shared<TapedNet>(TapedNet{l_h, nullptr});
+    auto net_r = std::make_shared<TapedNet>(TapedNet{l_r, nullptr});
+    auto curvature = std::make_shared<internal::CurvatureTape>();
+    const auto o_h = net_h->forward(x, 2, 2);
+    const auto effort =
+        internal::hamiltonian_curvature_taped(o_h.v, o_h.g, o_h.h, x, curvature.get());
+    const auto jet_r = net_r->forward(cat_rows(x, u), 2, 1);
+    const Tensor o = jet_r.v.contiguous(), o_g = jet_r.g.contiguous();
+    const auto jet = internal::jr_field_jet_forward(effort.grad, effort.hessian, o, o_g, u, J);
+    TapedField t{jet.f, jet.g.transpose(-1, -2), {}};
+    t.backward = [=](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
+      const auto jr = internal::jr_field_jet_backward(effort.grad, effort.hessian, o, o_g, u, J,
+                                                      f_bar, dfdx_bar.transpose(-1, -2));
+      net_r->backward({jr.o, jr.o_g}, false);
+      const auto c = internal::hamiltonian_curvature_backward(*curvature, jr.effort, jr.effort_g);
+      net_h->backward({c.o, c.o_g, c.o_h}, false);
+      return Tensor();
     };
     return t;
   };
@@ -234,51 +288,67 @@ EffortFieldRecorder s_effort_field(const StackedMlp& l_z, const Tensor& u,
 }  // namespace
 
 torch::Tensor PhnnJr::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                       const torch::Tensor& u, double h) const {
+                                       const torch::Tensor& u_in, double h,
+                                       const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, jr_effort_field(*nets_[1], rows_like(u, x), J_));
+  const Tensor u = rows_like(u_in, x);
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, jr_effort_field(*nets_[1], u, J_),
+                        jr_jacobian_field(*nets_[0], *nets_[1], u, J_), penalty);
 }
 
 torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                      const torch::Tensor& u, double h, double min_dx_norm) const {
+                                      const torch::Tensor& u_in, double h, double min_dx_norm,
+                                      const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
+  const Tensor u = rows_like(u_in, x);
   return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, dissipation_at_start(),
-                       jr_effort_field(*nets_[1], rows_like(u, x), J_));
+                       jr_effort_field(*nets_[1], u, J_),
+                       jr_jacobian_field(*nets_[0], *nets_[1], u, J_), penalty);
 }
 
+// PHNN-S's field jet is op by op (field_from_effort): a penalized step runs autograd.
 torch::Tensor PhnnS::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                      const torch::Tensor& u, double h) const {
-  if (!has_manual_step(nets_, options().dtype)) return {};
+                                      const torch::Tensor& u, double h,
+                                      const JacobianPenalty& penalty) const {
+  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_like(u, x), S_));
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_like(u, x), S_), {},
+                        {});
 }
 
 torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                     const torch::Tensor& u, double h, double min_dx_norm) const {
-  if (!has_manual_step(nets_, options().dtype)) return {};
+                                     const torch::Tensor& u, double h, double min_dx_norm,
+                                     const JacobianPenalty& penalty) const {
+  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, false,
-                       s_effort_field(*nets_[1], rows_like(u, x), S_));
+                       s_effort_field(*nets_[1], rows_like(u, x), S_), {}, {});
 }
 
-// NODE: f = MLP(y, u); y~ = the first two columns of the input adjoint.
+// NODE: f = MLP(y, u) (with its order-1 jet in y for df/dx); y~ = the first
+// two columns of the input adjoint.
 torch::Tensor Node::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                     const torch::Tensor& u_in, double h) const {
+                                     const torch::Tensor& u_in, double h,
+                                     const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
   const StackedMlp& mlp = *nets_[0];
-  return rk2_mean_l1(x, x_next, h, [&](const Tensor& y) {
+  const FieldRecorder field = [&](const Tensor& y, bool jacobian) {
     auto net = std::make_shared<TapedNet>(TapedNet{mlp, nullptr});
-    TapedField t{net->forward(cat_rows(y, u), 0, 0).v, {}};
-    t.backward = [=](const Tensor& f_bar, bool input) {
-      const Tensor c = net->backward({f_bar}, input);
+    const auto out = net->forward(cat_rows(y, u), jacobian ? 2 : 0, jacobian ? 1 : 0);
+    TapedField t{out.v, jacobian ? out.g.transpose(-1, -2) : Tensor(), {}};
+    t.backward = [=](const Tensor& f_bar, const Tensor& dfdx_bar, bool input) {
+      std::vector<Tensor> grads{f_bar};
+      if (dfdx_bar.defined()) grads.push_back(dfdx_bar.transpose(-1, -2).contiguous());
+      const Tensor c = net->backward(grads, input);
       return input ? c.narrow(-1, 0, 2) : Tensor();
     };
     return t;
-  });
+  };
+  return rk2_mean_l1(x, x_next, h, field, penalty);
 }
 
 }  // namespace phnn

@@ -64,4 +64,16 @@ torch::Tensor regularizer_penalty(Regularizer reg, const JacobianStats& stats,
   return torch::zeros({stats.kappa.size(0)}, stats.kappa.options());
 }
 
+JacobianPenalty jacobian_penalty(Regularizer reg, const TrainerOptions& options) {
+  if (reg == Regularizer::kNone) return {};
+  return [reg, options](const torch::Tensor& dfdx, torch::Tensor* dfdx_bar) {
+    torch::AutoGradMode enable(true);
+    const auto leaf = dfdx.detach().requires_grad_(true);
+    const auto penalty =
+        regularizer_penalty(reg, jacobian_stats(leaf, options.jacobian_eps), options);
+    *dfdx_bar = torch::autograd::grad({penalty.sum()}, {leaf})[0];
+    return penalty.detach();
+  };
+}
+
 }  // namespace phnn

@@ -163,11 +163,14 @@ void CellTrainer::step(int step, BatchSampler& sampler) {
 torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torch::Tensor& xn,
                                               const torch::Tensor& u) {
   const bool regularized = cell_.regularizer != Regularizer::kNone;
-  if (!regularized && opt_.loss_norm == LossNorm::kMeanL1) {
+  if (opt_.loss_norm == LossNorm::kMeanL1) {
+    const JacobianPenalty penalty = jacobian_penalty(cell_.regularizer, opt_);
     torch::Tensor loss;
-    if (cell_.integrator == IntegratorKind::kRk2) loss = model_->rk2_mean_l1_step(x, xn, u, h_);
+    if (cell_.integrator == IntegratorKind::kRk2) {
+      loss = model_->rk2_mean_l1_step(x, xn, u, h_, penalty);
+    }
     if (cell_.integrator == IntegratorKind::kDg) {
-      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm);
+      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty);
     }
     if (loss.defined()) return loss;
   }

@@ -4,7 +4,9 @@
 // the same order), for NODE, PHNN-S and PHNN-JR with RK2 and the PH models with
 // DG (R at the midpoint and at the start; rows below the Gonzalez threshold
 // included), each built-in structure, two sizes, data expanded over the
-// members (the full-batch view) and gathered per member.
+// members (the full-batch view) and gathered per member; with a Jacobian
+// regularizer (CN, SN, SR) the reference is the trainer's regularized loss,
+// L_d + the penalty of df/dx at x with the RK2 step's first stage reused.
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
@@ -15,6 +17,7 @@
 
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/discrete_step.h"
+#include "phnn/training/regularizers.h"
 
 namespace phnn {
 namespace {
@@ -32,7 +35,23 @@ struct Case {
   ModelSize size;
   bool expanded;          // x, x_next, u one [1, B, .] array viewed by every member
   bool at_start = false;  // DG: R at x_n
+  Regularizer regularizer = Regularizer::kNone;
 };
+
+// The trainer's loss without a hand-written step (CellTrainer::loss_and_gradients).
+torch::Tensor autograd_loss_of(const DynamicsModel& model, const Case& c, const torch::Tensor& x,
+                               const torch::Tensor& x_next, const torch::Tensor& u, double h,
+                               double min_dx_norm, const TrainerOptions& options) {
+  const bool regularized = c.regularizer != Regularizer::kNone;
+  const FieldEval at_x = regularized ? model.field(x, u, true) : FieldEval{};
+  const auto x_hat = c.integrator == IntegratorKind::kDg
+                         ? dg_training_step(model, x, x_next, u, h, min_dx_norm)
+                         : rk2_step(model, x, u, h, at_x.f);
+  const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
+  if (!regularized) return loss;
+  return loss + regularizer_penalty(c.regularizer, jacobian_stats(at_x.dfdx, options.jacobian_eps),
+                                    options);
+}
 
 class ManualStepTest : public ::testing::TestWithParam<Case> {};
 
@@ -61,17 +80,17 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
   const double h = 0.05, min_dx_norm = 1e-10;
   const bool dg = c.integrator == IntegratorKind::kDg;
 
+  const TrainerOptions trainer;
   flat.gradients.zero_();
-  const auto x_hat =
-      dg ? dg_training_step(*model, x, x_next, u, h, min_dx_norm) : rk2_step(*model, x, u, h);
-  const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
+  const auto loss = autograd_loss_of(*model, c, x, x_next, u, h, min_dx_norm, trainer);
   loss.sum().backward();
   const auto autograd_loss = loss.detach().clone(), autograd_grad = flat.gradients.clone();
   ASSERT_GT(autograd_grad.abs().sum().item<double>(), 0.0);
 
   flat.gradients.zero_();
-  const auto manual = dg ? model->dg_mean_l1_step(x, x_next, u, h, min_dx_norm)
-                         : model->rk2_mean_l1_step(x, x_next, u, h);
+  const JacobianPenalty penalty = jacobian_penalty(c.regularizer, trainer);
+  const auto manual = dg ? model->dg_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty)
+                         : model->rk2_mean_l1_step(x, x_next, u, h, penalty);
   ASSERT_TRUE(manual.defined());
   EXPECT_TRUE(same_bits(manual, autograd_loss)) << manual << autograd_loss;
   EXPECT_TRUE(same_bits(flat.gradients, autograd_grad))
@@ -107,13 +126,29 @@ INSTANTIATE_TEST_SUITE_P(
              false, true},
         Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kDuffing, ModelSize::kSmall, true},
         Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kSelfSustained, ModelSize::kMedium,
-             false}),
+             false},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall,
+             false, false, Regularizer::kCn},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk2, SystemKind::kSelfSustained,
+             ModelSize::kMedium, true, false, Regularizer::kSr},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kHarmonic, ModelSize::kSmall,
+             false, false, Regularizer::kCn},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kDg, SystemKind::kDuffing, ModelSize::kSmall, true,
+             true, Regularizer::kSn},
+        Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall, false,
+             false, Regularizer::kCn},
+        Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kHarmonic, ModelSize::kMedium,
+             true, false, Regularizer::kSn},
+        Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kSelfSustained, ModelSize::kSmall,
+             false, false, Regularizer::kSr}),
     // A readable, deterministic name (the default prints the struct's bytes, padding included).
     [](const ::testing::TestParamInfo<Case>& case_info) {
       const Case& c = case_info.param;
-      std::string name = to_string(c.kind) + "_" + to_string(c.integrator) + "_" +
-                         to_string(c.structure) + "_" + to_string(c.size) +
-                         (c.expanded ? "_expanded" : "_gathered") + (c.at_start ? "_start" : "");
+      std::string name =
+          to_string(c.kind) + "_" + to_string(c.integrator) + "_" + to_string(c.structure) + "_" +
+          to_string(c.size) + (c.expanded ? "_expanded" : "_gathered") +
+          (c.at_start ? "_start" : "") +
+          (c.regularizer != Regularizer::kNone ? "_" + to_string(c.regularizer) : "");
       for (char& ch : name) {
         if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
       }
@@ -129,9 +164,22 @@ TEST(ManualStepTest, ReferenceNetworksHaveNone) {
     reference.fused_networks = false;
     auto model = DynamicsModel::create(reference, {0, 1});
     model->flatten_parameters();
-    EXPECT_FALSE(model->rk2_mean_l1_step(x, x, u, 0.1).defined()) << to_string(kind);
-    EXPECT_FALSE(model->dg_mean_l1_step(x, x, u, 0.1, 1e-10).defined()) << to_string(kind);
+    EXPECT_FALSE(model->rk2_mean_l1_step(x, x, u, 0.1, {}).defined()) << to_string(kind);
+    EXPECT_FALSE(model->dg_mean_l1_step(x, x, u, 0.1, 1e-10, {}).defined()) << to_string(kind);
   }
+}
+
+// PHNN-S's field jet is op by op: a regularized PHNN-S step runs autograd.
+TEST(ManualStepTest, RegularizedPhnnSHasNone) {
+  const auto x = torch::zeros({2, 3, 2}, torch::kFloat64),
+             u = torch::zeros({2, 3, 1}, torch::kFloat64);
+  auto model =
+      DynamicsModel::create({ModelKind::kPhnnS, ModelSize::kSmall, SystemKind::kDuffing}, {0, 1});
+  model->flatten_parameters();
+  const JacobianPenalty cn = jacobian_penalty(Regularizer::kCn, TrainerOptions{});
+  EXPECT_FALSE(model->rk2_mean_l1_step(x, x, u, 0.1, cn).defined());
+  EXPECT_FALSE(model->dg_mean_l1_step(x, x, u, 0.1, 1e-10, cn).defined());
+  EXPECT_TRUE(model->rk2_mean_l1_step(x, x, u, 0.1, {}).defined());
 }
 
 }  // namespace

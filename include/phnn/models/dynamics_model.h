@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -21,6 +22,12 @@ struct FieldEval {
   torch::Tensor f;
   torch::Tensor dfdx;  // undefined unless asked for
 };
+
+/// A Jacobian regularizer for a hand-written step: the penalty per member
+/// [E] of df/dx [E, B, n_x, n_x], and in *dfdx_bar the adjoint of the
+/// penalties' sum w.r.t. df/dx. Empty: no regularizer.
+using JacobianPenalty =
+    std::function<torch::Tensor(const torch::Tensor& dfdx, torch::Tensor* dfdx_bar)>;
 
 /// Options of a model stack.
 struct ModelOptions {
@@ -78,17 +85,21 @@ class DynamicsModel {
                                              double min_dx_norm) const;
   /// A hand-written training step, where the model has one: the loss L_d
   /// of the explicit midpoint (RK2) step in the mean-L1 norm per member [E]
-  /// (discrete_loss with LossNorm::kMeanL1), with its parameter gradients
-  /// added into the flat gradient buffer (after flatten_parameters), in the
-  /// same operations and order as autograd's backward of that loss: the
-  /// same bits, without the graph. Undefined where there is none (the
-  /// caller runs autograd); today: the 2-state NODE, PHNN-S and PHNN-JR on
-  /// fused float64 networks (models/manual_step.cpp).
+  /// (discrete_loss with LossNorm::kMeanL1), plus `penalty` of df/dx at x if
+  /// one is given (the trainer's regularized loss), with its parameter
+  /// gradients added into the flat gradient buffer (after
+  /// flatten_parameters), in the same operations and order as autograd's
+  /// backward of that loss: the same bits, without the graph. Undefined
+  /// where there is none (the caller runs autograd); today: the 2-state
+  /// NODE, PHNN-S and PHNN-JR on fused float64 networks, PHNN-S without a
+  /// penalty (models/manual_step.cpp).
   virtual torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                         const torch::Tensor& u, double h) const;
+                                         const torch::Tensor& u, double h,
+                                         const JacobianPenalty& penalty) const;
   /// The same for the DG training step (dg_training_step): PHNN-S and PHNN-JR.
   virtual torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                        const torch::Tensor& u, double h, double min_dx_norm) const;
+                                        const torch::Tensor& u, double h, double min_dx_norm,
+                                        const JacobianPenalty& penalty) const;
   /// H_theta(x) [E, B] and gradH_theta(x) [E, B, 2] (PH models only).
   virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;

@@ -91,10 +91,11 @@ class PhnnS : public PortHamiltonianModel {
  public:
   PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h) const override;
+                                 const torch::Tensor& u, double h,
+                                 const JacobianPenalty& penalty) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                const torch::Tensor& u, double h,
-                                double min_dx_norm) const override;
+                                const torch::Tensor& u, double h, double min_dx_norm,
+                                const JacobianPenalty& penalty) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -112,10 +113,11 @@ class PhnnJr : public PortHamiltonianModel {
   /// R_theta(x, u) [E, B, 3, 3] (for tests: symmetric PSD).
   torch::Tensor dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const;
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h) const override;
+                                 const torch::Tensor& u, double h,
+                                 const JacobianPenalty& penalty) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                const torch::Tensor& u, double h,
-                                double min_dx_norm) const override;
+                                const torch::Tensor& u, double h, double min_dx_norm,
+                                const JacobianPenalty& penalty) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -134,7 +136,8 @@ class Node : public DynamicsModel {
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h) const override;
+                                 const torch::Tensor& u, double h,
+                                 const JacobianPenalty& penalty) const override;
 };
 
 }  // namespace phnn

@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include "phnn/config/trainer_options.h"
+#include "phnn/models/dynamics_model.h"
 
 namespace phnn {
 
@@ -32,5 +33,11 @@ JacobianStats jacobian_stats_general(const torch::Tensor& jacobian, double eps);
 /// mean(sigma_max), SR lambda_SR mean((rho - 1)^2); zeros for kNone.
 torch::Tensor regularizer_penalty(Regularizer reg, const JacobianStats& stats,
                                   const TrainerOptions& options);
+
+/// The penalty of `reg` for a model's hand-written training step:
+/// regularizer_penalty(jacobian_stats(df/dx)), its adjoint by autograd on the
+/// small graph from df/dx alone (the same operations as the whole graph's,
+/// so the same bits). Empty for kNone.
+JacobianPenalty jacobian_penalty(Regularizer reg, const TrainerOptions& options);
 
 }  // namespace phnn
