@@ -35,9 +35,12 @@ torch::Tensor regularizer_penalty(Regularizer reg, const JacobianStats& stats,
                                   const TrainerOptions& options);
 
 /// The penalty of `reg` for a model's hand-written training step:
-/// regularizer_penalty(jacobian_stats(df/dx)), its adjoint by autograd on the
-/// small graph from df/dx alone (the same operations as the whole graph's,
-/// so the same bits). Empty for kNone.
+/// regularizer_penalty(jacobian_stats(df/dx)) per member and its adjoint,
+/// the same bits as autograd's through the whole graph. For 2 x 2 float64
+/// Jacobians in closed form, row by row (no graph); otherwise by autograd
+/// on the small graph from df/dx alone (jacobian_penalty_by_autograd, also
+/// the tests' reference). Empty for kNone.
 JacobianPenalty jacobian_penalty(Regularizer reg, const TrainerOptions& options);
+JacobianPenalty jacobian_penalty_by_autograd(Regularizer reg, const TrainerOptions& options);
 
 }  // namespace phnn
