@@ -236,19 +236,32 @@ EffortFieldRecorder jr_effort_field(const StackedMlp& l_r, const Tensor& u,
   };
 }
 
-// PHNN-JR's field and df/dx at x: gradH and its Hessian from L_H's order-2
-// jet (the curvature head), L_R's order-1 jet, the JR jet head. Backward, in
-// autograd's order: the JR jet head, L_R, the curvature head, L_H.
+// gradH(x) and its Hessian from L_H's order-2 jet (the curvature head), kept
+// for the backward from (gradH~, Hessian~): the head, then L_H.
+struct TapedCurvature {
+  TapedNet l_h;
+  internal::CurvatureTape head;
+  internal::HamiltonianCurvature effort;
+  TapedCurvature(const StackedMlp& net, const Tensor& x) : l_h{net, nullptr} {
+    const auto o = l_h.forward(x, 2, 2);
+    effort = internal::hamiltonian_curvature_taped(o.v, o.g, o.h, x, &head);
+  }
+  void backward(const Tensor& grad_bar, const Tensor& hessian_bar) const {
+    const auto c = internal::hamiltonian_curvature_backward(head, grad_bar, hessian_bar);
+    l_h.backward({c.o, c.o_g, c.o_h}, false);
+  }
+};
+
+// PHNN-JR's field and df/dx at x: the curvature (above), L_R's order-1 jet,
+// the JR jet head. Backward, in autograd's order: the JR jet head, L_R, the
+// curvature head, L_H.
 JacobianFieldRecorder jr_jacobian_field(const StackedMlp& l_h, const StackedMlp& l_r,
                                         const Tensor& u,
                                         const std::array<std::array<double, 3>, 3>& J) {
   return [&l_h, &l_r, u, J](const Tensor& x) {
-    auto net_h = std::make_shared<TapedNet>(TapedNet{l_h, nullptr});
+    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
+    const auto& effort = curvature->effort;
     auto net_r = std::make_shared<TapedNet>(TapedNet{l_r, nullptr});
-    auto curvature = std::make_shared<internal::CurvatureTape>();
-    const auto o_h = net_h->forward(x, 2, 2);
-    const auto effort =
-        internal::hamiltonian_curvature_taped(o_h.v, o_h.g, o_h.h, x, curvature.get());
     const auto jet_r = net_r->forward(cat_rows(x, u), 2, 1);
     const Tensor o = jet_r.v.contiguous(), o_g = jet_r.g.contiguous();
     const auto jet = internal::jr_field_jet_forward(effort.grad, effort.hessian, o, o_g, u, J);
@@ -257,8 +270,41 @@ JacobianFieldRecorder jr_jacobian_field(const StackedMlp& l_h, const StackedMlp&
       const auto jr = internal::jr_field_jet_backward(effort.grad, effort.hessian, o, o_g, u, J,
                                                       f_bar, dfdx_bar.transpose(-1, -2));
       net_r->backward({jr.o, jr.o_g}, false);
-      const auto c = internal::hamiltonian_curvature_backward(*curvature, jr.effort, jr.effort_g);
-      net_h->backward({c.o, c.o_g, c.o_h}, false);
+      curvature->backward(jr.effort, jr.effort_g);
+      return Tensor();
+    };
+    return t;
+  };
+}
+
+// A PH model's field and df/dx at x from an effort jet op by op (its
+// field_from_effort at order 1: Jet arithmetic around the dissipation
+// network's input-jet call): the curvature (taped), then that jet on
+// autograd's small graph from the effort jet, whose nodes run in the whole
+// graph's order; its backward adds the dissipation network's gradients (its
+// fused node) and gives the effort jet's adjoint, then the curvature's.
+using EffortJetField = std::function<Jet(const Jet& effort, const Tensor& x)>;
+JacobianFieldRecorder op_by_op_jacobian_field(const StackedMlp& l_h, EffortJetField field_jet) {
+  return [&l_h, field_jet](const Tensor& x) {
+    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
+    Jet effort, f;
+    {
+      torch::AutoGradMode enable(true);
+      effort.v = curvature->effort.grad.requires_grad_(true);
+      effort.g = curvature->effort.hessian.requires_grad_(true);
+      f = field_jet(effort, x);
+    }
+    TapedField t{f.v.detach(), f.g.detach().transpose(-1, -2), {}};
+    t.backward = [=](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
+      std::vector<Tensor> outputs{f.g}, grads{dfdx_bar.transpose(-1, -2)};
+      if (f_bar.defined()) {
+        outputs.insert(outputs.begin(), f.v);
+        grads.insert(grads.begin(), f_bar);
+      }
+      const auto adj = torch::autograd::grad(outputs, {effort.v, effort.g}, grads,
+                                             /*retain_graph=*/false, /*create_graph=*/false,
+                                             /*allow_unused=*/true);
+      curvature->backward(adj[0], adj[1]);
       return Tensor();
     };
     return t;
@@ -308,23 +354,31 @@ torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tenso
                        jr_jacobian_field(*nets_[0], *nets_[1], u, J_), penalty);
 }
 
-// PHNN-S's field jet is op by op (field_from_effort): a penalized step runs autograd.
+// PHNN-S's field jet is op by op (field_from_effort): with a penalty its
+// first stage (RK2) or field at x (DG) is op_by_op_jacobian_field.
 torch::Tensor PhnnS::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                       const torch::Tensor& u, double h,
                                       const JacobianPenalty& penalty) const {
-  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
+  if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_like(u, x), S_), {},
-                        {});
+  const EffortJetField field_jet = [this, &u](const Jet& effort, const Tensor& y) {
+    return field_from_effort(effort, y, u, /*order=*/1, /*dissipation_fixed=*/false);
+  };
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_like(u, x), S_),
+                        op_by_op_jacobian_field(*nets_[0], field_jet), penalty);
 }
 
 torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                      const torch::Tensor& u, double h, double min_dx_norm,
                                      const JacobianPenalty& penalty) const {
-  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
+  if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
+  const EffortJetField field_jet = [this, &u](const Jet& effort, const Tensor& y) {
+    return field_from_effort(effort, y, u, /*order=*/1, /*dissipation_fixed=*/false);
+  };
   return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, false,
-                       s_effort_field(*nets_[1], rows_like(u, x), S_), {}, {});
+                       s_effort_field(*nets_[1], rows_like(u, x), S_),
+                       op_by_op_jacobian_field(*nets_[0], field_jet), penalty);
 }
 
 // NODE: f = MLP(y, u) (with its order-1 jet in y for df/dx); y~ = the first

@@ -140,7 +140,15 @@ INSTANTIATE_TEST_SUITE_P(
         Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kHarmonic, ModelSize::kMedium,
              true, false, Regularizer::kSn},
         Case{ModelKind::kNode, IntegratorKind::kRk2, SystemKind::kSelfSustained, ModelSize::kSmall,
-             false, false, Regularizer::kSr}),
+             false, false, Regularizer::kSr},
+        Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kDuffing, ModelSize::kSmall,
+             false, false, Regularizer::kCn},
+        Case{ModelKind::kPhnnS, IntegratorKind::kRk2, SystemKind::kSelfSustained,
+             ModelSize::kMedium, true, false, Regularizer::kSn},
+        Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kHarmonic, ModelSize::kSmall,
+             false, false, Regularizer::kSr},
+        Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kSelfSustained, ModelSize::kSmall,
+             true, false, Regularizer::kCn}),
     // A readable, deterministic name (the default prints the struct's bytes, padding included).
     [](const ::testing::TestParamInfo<Case>& case_info) {
       const Case& c = case_info.param;
@@ -167,19 +175,6 @@ TEST(ManualStepTest, ReferenceNetworksHaveNone) {
     EXPECT_FALSE(model->rk2_mean_l1_step(x, x, u, 0.1, {}).defined()) << to_string(kind);
     EXPECT_FALSE(model->dg_mean_l1_step(x, x, u, 0.1, 1e-10, {}).defined()) << to_string(kind);
   }
-}
-
-// PHNN-S's field jet is op by op: a regularized PHNN-S step runs autograd.
-TEST(ManualStepTest, RegularizedPhnnSHasNone) {
-  const auto x = torch::zeros({2, 3, 2}, torch::kFloat64),
-             u = torch::zeros({2, 3, 1}, torch::kFloat64);
-  auto model =
-      DynamicsModel::create({ModelKind::kPhnnS, ModelSize::kSmall, SystemKind::kDuffing}, {0, 1});
-  model->flatten_parameters();
-  const JacobianPenalty cn = jacobian_penalty(Regularizer::kCn, TrainerOptions{});
-  EXPECT_FALSE(model->rk2_mean_l1_step(x, x, u, 0.1, cn).defined());
-  EXPECT_FALSE(model->dg_mean_l1_step(x, x, u, 0.1, 1e-10, cn).defined());
-  EXPECT_TRUE(model->rk2_mean_l1_step(x, x, u, 0.1, {}).defined());
 }
 
 }  // namespace
