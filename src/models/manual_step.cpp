@@ -21,10 +21,11 @@
 // dg from H at the ends x, x + dx (one order-0 L_H call on both) and gradH(m)
 // (general_gonzalez_head); backward F~ -> dg~ -> gradH(m)'s networks first,
 // then the ends' (the same order autograd takes); no input adjoints.
-// With a Jacobian regularizer (NODE and PHNN-JR): L += P(df/dx at x), P and
-// its adjoint from the trainer (JacobianPenalty); stage 1 of RK2 is then the
-// order-1 jet of the field at x (PHNN-JR: L_H's order-2 jet, the curvature
-// and JR jet heads), whose backward takes f~ and dfdx~ at once; in DG the
+// With a Jacobian regularizer: L += P(df/dx at x), P and its adjoint from
+// the trainer (JacobianPenalty); stage 1 of RK2 is then the order-1 jet of
+// the field at x (PHNN-JR: L_H's order-2 jet, the curvature and JR jet
+// heads; PHNN-S: the curvature, then its op-by-op field jet on a small
+// autograd graph), whose backward takes f~ and dfdx~ at once; in DG the
 // field at x is created first, so its backward runs last.
 #include <cmath>
 #include <functional>

@@ -91,8 +91,8 @@ class DynamicsModel {
   /// flatten_parameters), in the same operations and order as autograd's
   /// backward of that loss: the same bits, without the graph. Undefined
   /// where there is none (the caller runs autograd); today: the 2-state
-  /// NODE, PHNN-S and PHNN-JR on fused float64 networks, PHNN-S without a
-  /// penalty (models/manual_step.cpp).
+  /// NODE, PHNN-S and PHNN-JR on fused float64 networks
+  /// (models/manual_step.cpp).
   virtual torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                          const torch::Tensor& u, double h,
                                          const JacobianPenalty& penalty) const;
