@@ -7,6 +7,8 @@
 // same order, so loss and gradients are bitwise those of
 // loss.sum().backward() (tests/models/manual_step_test.cpp).
 // Touches only the models' gradient sinks (their flat gradient buffer).
+// Size: one file, as every step composes the same tapes in autograd's order (the
+// bitwise contract the tests pin); splitting it would put the tapes in a header.
 //
 // Forward (per member, batch rows b, h the step):
 //   k1 = f(x),  x2 = x + (h/2) k1,  k2 = f(x2),  x^ = x + h k2,
