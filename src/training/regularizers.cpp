@@ -75,7 +75,7 @@ namespace {
 // (tests/training/regularizers_test.cpp). Each returns the row's term of
 // the mean and writes J~ for the term's adjoint g; autograd's J~ is a sum of
 // four select adjoints over zeros, hence "+ 0.0" (-0 becomes +0).
-// Backward rules: x*x -> 2 (g x) (two equal terms), sqrt -> g / (2 sqrt),
+// Backward rules: x*x -> g x + g x (exactly 2 g x), sqrt -> g / (2 sqrt),
 // clamp_min -> g where x >= floor else 0, |x| -> g sgn(x), p / q ->
 // (g / q, -g ((p / q) / q)), maximum/minimum -> g (g / 2 on ties) to the
 // larger/smaller operand.
@@ -143,8 +143,10 @@ double sr_row(const double* j, double g, double eps, double* jb) {
   const double den = mn + eps, r = mx / den - 1.0;
   const double rb = g * r + g * r;
   const double mxb = rb / den, mnb = -rb * ((mx / den) / den);
-  const double re1b = extremum_adjoint(mnb, re1, re2, false) + extremum_adjoint(mxb, re1, re2, true);
-  const double re2b = extremum_adjoint(mnb, re2, re1, false) + extremum_adjoint(mxb, re2, re1, true);
+  const double re1b =
+      extremum_adjoint(mnb, re1, re2, false) + extremum_adjoint(mxb, re1, re2, true);
+  const double re2b =
+      extremum_adjoint(mnb, re2, re1, false) + extremum_adjoint(mxb, re2, re1, true);
   const double m1b = re2b * sgn(m1), p1b = re1b * sgn(p1);
   const double rootb = -m1b + p1b, s3b = disc > 0 ? rootb : 0.0;
   const double discb = disc >= kFloor ? s3b / (2.0 * s3) : 0.0;
