@@ -90,6 +90,8 @@ class CellTrainer {
   Clock::time_point start_ = Clock::now();
   const int64_t E_;
   const double h_;
+  // The regularizer's penalty for the hand-written steps (empty: none).
+  const JacobianPenalty penalty_;
   std::unique_ptr<DynamicsModel> model_;
   // float32 training only: the float64 stack the rollouts use.
   std::unique_ptr<DynamicsModel> inference_model_;

@@ -9,12 +9,14 @@
 
 namespace phnn {
 namespace {
+constexpr double kFloor = 1e-300;  // safe_sqrt's float64 floor
+
 // sqrt with a finite derivative at 0 (the clamped branch has zero slope).
 // The floor is a positive normal number of the dtype: 1e-300 would round to 0
 // in float32 (float32 training), where sqrt has an infinite slope.
 torch::Tensor safe_sqrt(const torch::Tensor& s) {
   const double floor =
-      s.scalar_type() == torch::kFloat32 ? std::numeric_limits<float>::min() : 1e-300;
+      s.scalar_type() == torch::kFloat32 ? std::numeric_limits<float>::min() : kFloor;
   return torch::sqrt(s.clamp_min(floor));
 }
 }  // namespace
@@ -79,7 +81,6 @@ namespace {
 // clamp_min -> g where x >= floor else 0, |x| -> g sgn(x), p / q ->
 // (g / q, -g ((p / q) / q)), maximum/minimum -> g (g / 2 on ties) to the
 // larger/smaller operand.
-constexpr double kFloor = 1e-300;  // safe_sqrt's float64 floor
 inline double clamp_floor(double q) { return q < kFloor ? kFloor : q; }
 inline double sgn(double x) { return static_cast<double>((0.0 < x) - (x < 0.0)); }
 inline void put(double* jb, double ab, double bb, double cb, double db) {

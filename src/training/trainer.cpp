@@ -63,7 +63,8 @@ ModelOptions training_model_options(const CellSpec& cell, const CellData& data) 
 CellTrainer::CellTrainer(const CellSpec& cell, const CellData& data,
                          const ProgressCallback& progress, const CellCheckpointing* checkpointing)
     : cell_(cell), data_(data), opt_(cell.training), progress_(progress),
-      E_(static_cast<int64_t>(cell.seeds.size())), h_(data.step), checkpointing_(checkpointing) {
+      E_(static_cast<int64_t>(cell.seeds.size())), h_(data.step),
+      penalty_(jacobian_penalty(cell.regularizer, opt_)), checkpointing_(checkpointing) {
   std::vector<std::uint64_t> seeds(cell.seeds.begin(), cell.seeds.end());
   model_ = DynamicsModel::create(training_model_options(cell, data), seeds);
   if (model_->options().dtype != torch::kFloat64) {
@@ -164,13 +165,12 @@ torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torc
                                               const torch::Tensor& u) {
   const bool regularized = cell_.regularizer != Regularizer::kNone;
   if (opt_.loss_norm == LossNorm::kMeanL1) {
-    const JacobianPenalty penalty = jacobian_penalty(cell_.regularizer, opt_);
     torch::Tensor loss;
     if (cell_.integrator == IntegratorKind::kRk2) {
-      loss = model_->rk2_mean_l1_step(x, xn, u, h_, penalty);
+      loss = model_->rk2_mean_l1_step(x, xn, u, h_, penalty_);
     }
     if (cell_.integrator == IntegratorKind::kDg) {
-      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty);
+      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
     }
     if (loss.defined()) return loss;
   }
