@@ -134,5 +134,40 @@ PhnnSFieldAdjoints phnn_s_field_backward(const torch::Tensor& l, const torch::Te
                                          const std::array<std::array<double, 4>, 4>& S,
                                          const torch::Tensor& f_bar);
 
+/// PHNN-S's order-1 field jet without autograd (phnn_s_jet_head.cpp), for
+/// the structures of the paper's oscillators (any other: kOther, and the
+/// caller keeps the op-by-op path). From the effort e [E, B, 2], its
+/// tangents G [E, B, 2 (direction), 2] and u [E, B, 1]: w's jet; with L_z's
+/// jet (l [E, B, 1], l_g [E, B, 2, 1]) the field jet (f, g as JrFieldJet).
+/// Backward from (f~ or undefined, g~): L_z's output adjoints and the part
+/// of w's adjoint before L_z's input adjoint, then (e~, G~).
+enum class PhnnSJetStructure { kOther, kMechanical, kSelfSustained };
+PhnnSJetStructure phnn_s_jet_structure(const std::array<std::array<double, 4>, 4>& S);
+struct PhnnSWJet {
+  torch::Tensor w, w_g;
+};
+PhnnSWJet phnn_s_w_jet_forward(const torch::Tensor& effort, const torch::Tensor& effort_g,
+                               const torch::Tensor& u, PhnnSJetStructure structure);
+JrFieldJet phnn_s_field_jet_forward(const torch::Tensor& effort, const torch::Tensor& effort_g,
+                                    const torch::Tensor& u, const torch::Tensor& l,
+                                    const torch::Tensor& l_g, const PhnnSWJet& w,
+                                    PhnnSJetStructure structure);
+struct PhnnSJetNetAdjoints {
+  torch::Tensor l, l_g, w, w_g;  // w, w_g: the part before L_z's input adjoint
+};
+PhnnSJetNetAdjoints phnn_s_field_jet_backward_net(const torch::Tensor& f_bar,
+                                                  const torch::Tensor& g_bar,
+                                                  const torch::Tensor& l, const torch::Tensor& l_g,
+                                                  const PhnnSWJet& w, PhnnSJetStructure structure);
+struct PhnnSJetEffortAdjoints {
+  torch::Tensor effort, effort_g;
+};
+PhnnSJetEffortAdjoints phnn_s_field_jet_backward_effort(const torch::Tensor& f_bar,
+                                                        const torch::Tensor& g_bar,
+                                                        const PhnnSJetNetAdjoints& first,
+                                                        const torch::Tensor& x_bar,
+                                                        const torch::Tensor& xg_bar,
+                                                        PhnnSJetStructure structure);
+
 }  // namespace internal
 }  // namespace phnn

@@ -438,8 +438,9 @@ struct FusedMlpTape {
 
 FusedMlpJet fused_mlp_taped(const std::vector<torch::Tensor>& weights,
                             const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
-                            const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape) {
-  ForwardPass pass = forward_pass(weights, biases, x_v, {}, {}, options);
+                            const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape,
+                            const torch::Tensor& x_g) {
+  ForwardPass pass = forward_pass(weights, biases, x_v, x_g, {}, options);
   *tape = std::make_shared<FusedMlpTape>(
       FusedMlpTape{std::move(pass.plan), std::move(pass.workspace)});
   return pass.jet;
@@ -454,6 +455,17 @@ torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
   std::vector<bool> need(static_cast<std::size_t>(3 + 2 * tape.plan.layers()), false);
   need[0] = input_adjoint;
   return backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need)[0];
+}
+
+std::pair<torch::Tensor, torch::Tensor> fused_mlp_taped_jet_backward(
+    const FusedMlpTape& tape, const std::vector<torch::Tensor>& weights,
+    const std::vector<torch::Tensor>& gradient_sinks, const std::vector<torch::Tensor>& grads) {
+  TORCH_CHECK(gradient_sinks.size() == 2 * weights.size(),
+              "fused_mlp_taped_jet_backward: expected one gradient sink per weight and bias");
+  std::vector<bool> need(static_cast<std::size_t>(3 + 2 * tape.plan.layers()), false);
+  need[0] = need[1] = true;
+  auto out = backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need);
+  return {out[0], out[1]};
 }
 
 }  // namespace internal

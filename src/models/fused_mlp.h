@@ -54,11 +54,13 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
 /// The same forward without an autograd node, for a hand-written step
 /// (models/manual_step.cpp): the outputs, and in *tape the workspace its
 /// backward reads (held until the tape is dropped). The input jet is the
-/// input coordinates' (x_g, x_h undefined in fused_mlp's terms).
+/// input coordinates' (x_g, x_h undefined in fused_mlp's terms), or with x_g
+/// an order-1 input jet as fused_mlp's.
 struct FusedMlpTape;
 FusedMlpJet fused_mlp_taped(const std::vector<torch::Tensor>& weights,
                             const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
-                            const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape);
+                            const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape,
+                            const torch::Tensor& x_g = {});
 
 /// The backward of a taped call, the same arithmetic as fused_mlp's node:
 /// from the output adjoints `grads` (v~, g~, h~; undefined = 0) the
@@ -68,6 +70,11 @@ torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
                                        const std::vector<torch::Tensor>& weights,
                                        const std::vector<torch::Tensor>& gradient_sinks,
                                        const std::vector<torch::Tensor>& grads, bool input_adjoint);
+
+/// The same backward for a call with an input jet x_g: returns (x_v~, x_g~).
+std::pair<torch::Tensor, torch::Tensor> fused_mlp_taped_jet_backward(
+    const FusedMlpTape& tape, const std::vector<torch::Tensor>& weights,
+    const std::vector<torch::Tensor>& gradient_sinks, const std::vector<torch::Tensor>& grads);
 
 }  // namespace internal
 }  // namespace phnn

@@ -26,7 +26,8 @@
 // With a Jacobian regularizer: L += P(df/dx at x), P and its adjoint from
 // the trainer (JacobianPenalty); stage 1 of RK2 is then the order-1 jet of
 // the field at x (PHNN-JR: L_H's order-2 jet, the curvature and JR jet
-// heads; PHNN-S: the curvature, then its op-by-op field jet on a small
+// heads; PHNN-S: the curvature, L_z's jet and the PHNN-S jet head, or for
+// a structure other than the paper's its op-by-op field jet on a small
 // autograd graph), whose backward takes f~ and dfdx~ at once; in DG the
 // field at x is created first, so its backward runs last.
 #include <cmath>
@@ -314,6 +315,44 @@ JacobianFieldRecorder op_by_op_jacobian_field(const StackedMlp& l_h, EffortJetFi
   };
 }
 
+// PHNN-S's field and df/dx at x: the curvature, w's jet, L_z's order-1 jet
+// from it and the field jet head (phnn_s_jet_head.cpp) for the paper's
+// two structures; backward, in autograd's order: the head's first half,
+// L_z, its second half, the curvature. Any other structure: the op-by-op
+// jet of `field_jet`.
+JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp& l_z,
+                                       const Tensor& u,
+                                       const std::array<std::array<double, 4>, 4>& S,
+                                       EffortJetField field_jet) {
+  const auto structure = internal::phnn_s_jet_structure(S);
+  if (structure == internal::PhnnSJetStructure::kOther) {
+    return op_by_op_jacobian_field(l_h, std::move(field_jet));
+  }
+  return [&l_h, &l_z, u, structure](const Tensor& x) {
+    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
+    const auto& e = curvature->effort;
+    const auto w = internal::phnn_s_w_jet_forward(e.grad, e.hessian, u, structure);
+    auto net_z = std::make_shared<TapedNet>(TapedNet{l_z, nullptr});
+    const auto l = internal::fused_mlp_taped(l_z.weights(), l_z.biases(), w.w, {2, 1},
+                                             &net_z->tape, w.w_g);
+    const auto jet =
+        internal::phnn_s_field_jet_forward(e.grad, e.hessian, u, l.v, l.g, w, structure);
+    TapedField t{jet.f, jet.g.transpose(-1, -2), {}};
+    t.backward = [=, &l_z](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
+      const Tensor g_bar = dfdx_bar.transpose(-1, -2);
+      const auto first =
+          internal::phnn_s_field_jet_backward_net(f_bar, g_bar, l.v, l.g, w, structure);
+      const auto [x_bar, xg_bar] = internal::fused_mlp_taped_jet_backward(
+          *net_z->tape, l_z.weights(), l_z.gradient_sinks(), {first.l, first.l_g});
+      const auto adj = internal::phnn_s_field_jet_backward_effort(f_bar, g_bar, first, x_bar,
+                                                                  xg_bar, structure);
+      curvature->backward(adj.effort, adj.effort_g);
+      return Tensor();
+    };
+    return t;
+  };
+}
+
 // PHNN-S: w = S_w (e, u), F = S-field(e, u, L_z(w), w). Backward: F~ ->
 // (e~ A, l~, w~ B);  L_z (w~ C);  w~ = B + C -> the w head (e~ D);  e~ = A + D.
 EffortFieldRecorder s_effort_field(const StackedMlp& l_z, const Tensor& u,
@@ -357,8 +396,8 @@ torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tenso
                        jr_jacobian_field(*nets_[0], *nets_[1], u, J_), penalty);
 }
 
-// PHNN-S's field jet is op by op (field_from_effort): with a penalty its
-// first stage (RK2) or field at x (DG) is op_by_op_jacobian_field.
+// PHNN-S: with a penalty its first stage (RK2) or field at x (DG) is
+// s_jacobian_field (field_from_effort's op-by-op jet for other structures).
 torch::Tensor PhnnS::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                       const torch::Tensor& u, double h,
                                       const JacobianPenalty& penalty) const {
@@ -367,8 +406,9 @@ torch::Tensor PhnnS::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tenso
   const EffortJetField field_jet = [this, &u](const Jet& effort, const Tensor& y) {
     return field_from_effort(effort, y, u, /*order=*/1, /*dissipation_fixed=*/false);
   };
-  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], rows_like(u, x), S_),
-                        op_by_op_jacobian_field(*nets_[0], field_jet), penalty);
+  const Tensor u_rows = rows_like(u, x);
+  return ph_rk2_mean_l1(*nets_[0], x, x_next, h, s_effort_field(*nets_[1], u_rows, S_),
+                        s_jacobian_field(*nets_[0], *nets_[1], u_rows, S_, field_jet), penalty);
 }
 
 torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
@@ -379,9 +419,10 @@ torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor
   const EffortJetField field_jet = [this, &u](const Jet& effort, const Tensor& y) {
     return field_from_effort(effort, y, u, /*order=*/1, /*dissipation_fixed=*/false);
   };
+  const Tensor u_rows = rows_like(u, x);
   return ph_dg_mean_l1(*nets_[0], x, x_next, h, min_dx_norm, false,
-                       s_effort_field(*nets_[1], rows_like(u, x), S_),
-                       op_by_op_jacobian_field(*nets_[0], field_jet), penalty);
+                       s_effort_field(*nets_[1], u_rows, S_),
+                       s_jacobian_field(*nets_[0], *nets_[1], u_rows, S_, field_jet), penalty);
 }
 
 // NODE: f = MLP(y, u) (with its order-1 jet in y for df/dx); y~ = the first
