@@ -138,6 +138,15 @@ struct TapedNet {
     return internal::fused_mlp_taped_backward(*tape, net.weights(), net.gradient_sinks(), grads,
                                               input);
   }
+  // With an order-1 input jet (v, g [E, B, d, n]); backward -> (v~, g~).
+  internal::FusedMlpJet forward_jet(const Tensor& v, const Tensor& g) {
+    const int directions = static_cast<int>(g.size(-2));
+    return internal::fused_mlp_taped(net.weights(), net.biases(), v, {directions, 1}, &tape, g);
+  }
+  std::pair<Tensor, Tensor> backward_jet(const std::vector<Tensor>& grads) const {
+    return internal::fused_mlp_taped_jet_backward(*tape, net.weights(), net.gradient_sinks(),
+                                                  grads);
+  }
 };
 
 // gradH(y) from L_H's first-order jet, kept for its backward.
@@ -333,17 +342,15 @@ JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp& 
     const auto& e = curvature->effort;
     const auto w = internal::phnn_s_w_jet_forward(e.grad, e.hessian, u, structure);
     auto net_z = std::make_shared<TapedNet>(TapedNet{l_z, nullptr});
-    const auto l = internal::fused_mlp_taped(l_z.weights(), l_z.biases(), w.w, {2, 1},
-                                             &net_z->tape, w.w_g);
+    const auto l = net_z->forward_jet(w.w, w.w_g);
     const auto jet =
         internal::phnn_s_field_jet_forward(e.grad, e.hessian, u, l.v, l.g, w, structure);
     TapedField t{jet.f, jet.g.transpose(-1, -2), {}};
-    t.backward = [=, &l_z](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
+    t.backward = [=](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
       const Tensor g_bar = dfdx_bar.transpose(-1, -2);
       const auto first =
           internal::phnn_s_field_jet_backward_net(f_bar, g_bar, l.v, l.g, w, structure);
-      const auto [x_bar, xg_bar] = internal::fused_mlp_taped_jet_backward(
-          *net_z->tape, l_z.weights(), l_z.gradient_sinks(), {first.l, first.l_g});
+      const auto [x_bar, xg_bar] = net_z->backward_jet({first.l, first.l_g});
       const auto adj = internal::phnn_s_field_jet_backward_effort(f_bar, g_bar, first, x_bar,
                                                                   xg_bar, structure);
       curvature->backward(adj.effort, adj.effort_g);

@@ -46,6 +46,8 @@ PhnnSJetStructure phnn_s_jet_structure(const std::array<std::array<double, 4>, 4
 
 PhnnSWJet phnn_s_w_jet_forward(const Tensor& e_in, const Tensor& g_in, const Tensor& u_in,
                                PhnnSJetStructure structure) {
+  TORCH_CHECK(structure != PhnnSJetStructure::kOther,
+              "phnn_s_w_jet_forward: not a structure of the paper's oscillators");
   const Tensor e = dense(e_in), G = dense(g_in), u = dense(u_in);
   const int64_t E = e.size(0), B = e.size(1), rows = E * B;
   PhnnSWJet out{torch::empty({E, B, 1}, e.options()), torch::empty({E, B, 2, 1}, e.options())};
@@ -65,6 +67,8 @@ PhnnSWJet phnn_s_w_jet_forward(const Tensor& e_in, const Tensor& g_in, const Ten
 JrFieldJet phnn_s_field_jet_forward(const Tensor& e_in, const Tensor& g_in, const Tensor& u_in,
                                     const Tensor& l_in, const Tensor& lg_in, const PhnnSWJet& w_in,
                                     PhnnSJetStructure structure) {
+  TORCH_CHECK(structure != PhnnSJetStructure::kOther,
+              "phnn_s_field_jet_forward: not a structure of the paper's oscillators");
   const Tensor e = dense(e_in), G = dense(g_in), u = dense(u_in), l = dense(l_in),
                lg = dense(lg_in), w = dense(w_in.w), wg = dense(w_in.w_g);
   const int64_t E = e.size(0), B = e.size(1), rows = E * B;
