@@ -446,25 +446,32 @@ FusedMlpJet fused_mlp_taped(const std::vector<torch::Tensor>& weights,
   return pass.jet;
 }
 
+namespace {
+// A taped call's backward into the sinks, with the input adjoints x_v~
+// (need_v) and x_g~ (need_g) where asked for.
+variable_list taped_backward(const FusedMlpTape& tape, const std::vector<torch::Tensor>& weights,
+                             const std::vector<torch::Tensor>& gradient_sinks,
+                             const std::vector<torch::Tensor>& grads, bool need_v, bool need_g) {
+  TORCH_CHECK(gradient_sinks.size() == 2 * weights.size(),
+              "fused_mlp_taped_backward: expected one gradient sink per weight and bias");
+  std::vector<bool> need(static_cast<std::size_t>(3 + 2 * tape.plan.layers()), false);
+  need[0] = need_v;
+  need[1] = need_g;
+  return backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need);
+}
+}  // namespace
+
 torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
                                        const std::vector<torch::Tensor>& weights,
                                        const std::vector<torch::Tensor>& gradient_sinks,
                                        const std::vector<torch::Tensor>& grads, bool input_adjoint) {
-  TORCH_CHECK(gradient_sinks.size() == 2 * weights.size(),
-              "fused_mlp_taped_backward: expected one gradient sink per weight and bias");
-  std::vector<bool> need(static_cast<std::size_t>(3 + 2 * tape.plan.layers()), false);
-  need[0] = input_adjoint;
-  return backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need)[0];
+  return taped_backward(tape, weights, gradient_sinks, grads, input_adjoint, false)[0];
 }
 
 std::pair<torch::Tensor, torch::Tensor> fused_mlp_taped_jet_backward(
     const FusedMlpTape& tape, const std::vector<torch::Tensor>& weights,
     const std::vector<torch::Tensor>& gradient_sinks, const std::vector<torch::Tensor>& grads) {
-  TORCH_CHECK(gradient_sinks.size() == 2 * weights.size(),
-              "fused_mlp_taped_jet_backward: expected one gradient sink per weight and bias");
-  std::vector<bool> need(static_cast<std::size_t>(3 + 2 * tape.plan.layers()), false);
-  need[0] = need[1] = true;
-  auto out = backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need);
+  auto out = taped_backward(tape, weights, gradient_sinks, grads, true, true);
   return {out[0], out[1]};
 }
 
