@@ -2,6 +2,11 @@
 """Where an adaptive sweep spent its seeds, and what it cost against every cell at max_seeds.
 
     /usr/bin/python3 analysis/adaptive_cost.py results/paper-adaptive.h5 sweeps/paper-adaptive.toml
+    /usr/bin/python3 analysis/adaptive_cost.py results/paper-adaptive.h5 OTHER.toml --rule
+
+With --rule, OTHER's [adaptive] table is replayed on the file's runs (`phnn reduce --rule`): the
+cost that rule would have had, from the wall times of the runs it asks for; runs it asks for that
+the file lacks are counted and named as missing (their cost is unknown).
 
 Seeds per cell come from `phnn reduce --per-run` (exactly the runs the rounds asked for), measured
 core-seconds from the runs' `wall_time_s` (an item's wall time shared by its members; one thread
@@ -64,13 +69,21 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("results", help="results file of an adaptive sweep")
     parser.add_argument("sweep", help="its sweep file (for the cost model's per-cell seconds)")
+    parser.add_argument("--rule", action="store_true",
+                        help="replay SWEEP's [adaptive] table on the file's runs instead of the "
+                        "file's own (same grid, another rule)")
     args = parser.parse_args(argv)
     import tomllib
     with open(args.sweep, "rb") as f:
         adaptive = tomllib.load(f).get("adaptive")
     if not adaptive:
         parser.error(f"{args.sweep}: no [adaptive] table")
-    runs = run_csv("reduce", args.results, "--per-run")
+    runs = run_csv("reduce", args.results, "--per-run", *(("--rule", args.sweep) if args.rule else ()))
+    missing = [r for r in runs if r["status"] == "pending"]
+    if missing:
+        print(f"adaptive_cost.py: warning: {len(missing)} runs asked for are not finished in "
+              f"{args.results} (their cost is left out), e.g. {missing[0]['run_id']}",
+              file=sys.stderr)
     costs = run_csv("sweep", args.sweep, "--dry-run", "--cell-costs")
     # Round 0's seeds: the fewest any cell has (every cell trains them).
     seeds_by_cell = Counter(cell_key(r, "model_label") for r in runs)

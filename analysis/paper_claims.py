@@ -651,6 +651,9 @@ def main(argv=None):
     parser.add_argument("--round", type=int, default=None, metavar="K",
                         help="adaptive sweeps: the verdicts as they stood after round K (0: "
                         "every cell at its first seeds, e.g. the 10-seed verdicts)")
+    parser.add_argument("--rule", metavar="SWEEP",
+                        help="adaptive sweeps: replay the [adaptive] table of sweep file SWEEP "
+                        "on the file's runs (`phnn reduce --rule`): the verdicts that rule gives")
     args = parser.parse_args(argv)
     if not os.path.exists(args.results):
         parser.error(f"{args.results}: no such file")
@@ -660,6 +663,7 @@ def main(argv=None):
     if args.round is not None and args.round < 0:
         parser.error("--round K needs K >= 0")
     extra = ("--round", str(args.round)) if args.round is not None else ()
+    extra += ("--rule", args.rule) if args.rule else ()
     run_rows = reduce_csv(args.results, "--per-run", *extra)
     problems = setting_problems(run_rows)
     for p in problems:
@@ -672,7 +676,8 @@ def main(argv=None):
     stat_rows = reduce_csv(args.results, *extra)
     results = Results(stat_rows, run_rows)
     stable = stability(stat_rows, run_rows, args.stability) if args.stability else None
-    title = args.results + (f" after round {args.round}" if args.round is not None else "")
+    title = args.results + (f" replaying {args.rule}" if args.rule else "") + (
+        f" after round {args.round}" if args.round is not None else "")
     print(report(results, title, problems, stable))
     return 0
 

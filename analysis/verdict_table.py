@@ -6,7 +6,8 @@ one adaptive sweep after different rounds: one row per statement, one column per
         results/s1-haswell.h5@0 results/s1-haswell.h5 [--stability 200]
 
 FILE@K reads an adaptive sweep as it stood after round K (`phnn reduce --round K`; @0: every cell
-at its first seeds). A row whose verdicts differ is marked; --stability N adds, per column, the
+at its first seeds); FILE@SWEEP (a path, not a number) replays the [adaptive] table of sweep file
+SWEEP on FILE's runs (`phnn reduce --rule SWEEP`: what that rule would have concluded). A row whose verdicts differ is marked; --stability N adds, per column, the
 share of N bootstrap resamples of the seeds that give that column's verdict. --decided prints
 what the resolved comparisons alone decide instead (paper_claims.decided: holds, for in part,
 undecided, against, split, by direction only), blind to the directions of tied medians.
@@ -18,9 +19,9 @@ import paper_claims as pc
 
 
 def verdicts(spec, resamples=0, judge=pc.verdict_name):
-    """{tag: (verdict, share or None)} of one FILE[@K]."""
-    path, _, round_ = spec.partition("@")
-    extra = ("--round", round_) if round_ else ()
+    """{tag: (verdict, share or None)} of one FILE[@K] or FILE[@SWEEP]."""
+    path, _, at = spec.partition("@")
+    extra = () if not at else ("--round", at) if at.isdigit() else ("--rule", at)
     run_rows = pc.reduce_csv(path, "--per-run", *extra)
     stat_rows = pc.reduce_csv(path, *extra)
     claims = pc.all_claims(pc.Results(stat_rows, run_rows))
@@ -47,8 +48,9 @@ def table(columns, labels):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("files", nargs="+", metavar="FILE[@K]",
-                        help="results files; @K: an adaptive sweep after round K")
+    parser.add_argument("files", nargs="+", metavar="FILE[@K|@SWEEP]",
+                        help="results files; @K: an adaptive sweep after round K; @SWEEP: "
+                        "sweep file SWEEP's [adaptive] rule replayed on the file's runs")
     parser.add_argument("--stability", type=int, default=0, metavar="N",
                         help="add each verdict's share of N bootstrap resamples (! below 90 %%)")
     parser.add_argument("--decided", action="store_true",

@@ -9,6 +9,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/reduce_rule.h"
 #include "phnn/report/per_run.h"
 #include "phnn/report/tables.h"
 #include "phnn/store/results_file.h"
@@ -185,13 +186,93 @@ std::optional<AdaptiveState> adaptive_rounds(const SweepSpec& spec, const Grid& 
 }
 
 // Where an adaptive sweep stands, under the preamble.
-void print_adaptive_preamble(const SweepSpec& spec, const AdaptiveState& state) {
+// `replayed`: the --rule sweep file whose [adaptive] table was replayed, or "".
+void print_adaptive_preamble(const SweepSpec& spec, const AdaptiveState& state,
+                             const std::string& replayed) {
+  if (!replayed.empty()) {
+    std::cout << "Replayed: the [adaptive] table of " << replayed << " on this file's runs "
+              << "(the runs that sweep would have trained, where the file holds them).\n\n";
+  }
   std::cout << "Adaptive seeds (rule " << to_string(spec.adaptive.rule) << ", "
             << spec.adaptive.initial_seeds.size() << " seeds per cell, then " << spec.adaptive.batch
             << " more per round where the rule asks, at most " << spec.adaptive.max_seeds << "): "
             << (state.complete ? "complete after round " : "up to round ") << state.round
             << "; " << state.active_runs() << " runs asked for; the other pending runs are seeds "
             << "no round asked for, left out of the tables.\n\n";
+}
+
+// The runs the tables cover: the file's sweep, or with --rule another sweep
+// file's grid, each run read from the file's row that holds it (view.row).
+struct Inputs {
+  Grid own_grid;  // of the file's sweep text
+  RuleView view;
+  std::vector<int> damaged;
+  std::vector<RunStatus> statuses;
+  std::vector<double> mse;
+};
+
+Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
+  const std::string& path = file.path();
+  Inputs in;
+  in.damaged = damaged_rows_named(file);
+  auto statuses = file.read_statuses();
+  for (int row : in.damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
+  auto mse = file.read_double_column("mse");
+  const SweepSpec own =
+      parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
+  in.own_grid = checked_grid(file, own);
+  if (!parser.has("rule")) {
+    in.view.spec = own;
+    in.view.grid = in.own_grid;
+    in.view.row.resize(statuses.size());
+    for (std::size_t i = 0; i < statuses.size(); ++i) in.view.row[i] = static_cast<int>(i);
+    in.statuses = std::move(statuses);
+    in.mse = std::move(mse);
+    return in;
+  }
+  in.view = rule_view(file, parser.get("rule"));
+  in.statuses = through_view(in.view, statuses, RunStatus::kPending);
+  in.mse = through_view(in.view, mse, std::numeric_limits<double>::quiet_NaN());
+  return in;
+}
+
+// --rule: a replay that stops at a round the file cannot finish says so.
+void warn_unfinished_replay(const Inputs& in, const AdaptiveState& state,
+                            const cli::Parser& parser, const std::string& path) {
+  if (!parser.has("rule") || state.complete || state.pending == 0) return;
+  int lacking = 0;
+  for (std::size_t i = 0; i < state.active.size(); ++i) {
+    lacking += state.active[i] && in.view.row[i] < 0 ? 1 : 0;
+  }
+  std::cerr << "phnn reduce: warning: --rule " << parser.get("rule") << ": its round "
+            << state.round << " asks for " << state.pending << " runs " << path
+            << " has not finished (" << lacking << " of them not in it at all); the tables "
+            << "show the replay up to there. To finish it, train them: `phnn sweep "
+            << parser.get("rule") << " --out COPY`, COPY a copy of " << path << "\n";
+}
+
+// One record per run of the view (a run the file lacks: pending, its
+// configuration from the grid).
+std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
+  std::vector<RunRecord> rows = read_run_records(file, in.own_grid);
+  for (int row : in.damaged) rows[static_cast<std::size_t>(row)].status = RunStatus::kPending;
+  std::vector<RunRecord> records(in.view.row.size());
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    if (in.view.row[i] >= 0) {
+      records[i] = rows[static_cast<std::size_t>(in.view.row[i])];
+      continue;
+    }
+    const RunConfig& run = in.view.grid.runs[i];
+    RunRecord& r = records[i];
+    r.id = run.id();
+    r.canonical = run.canonical();
+    r.model_label = model_label(run.model, run.integrator);
+    for (const std::string& s : in.view.grid.run_studies[i]) {
+      r.studies += (r.studies.empty() ? "" : ",") + s;
+    }
+    r.mse = r.best_validation_loss = r.wall_time_s = std::numeric_limits<double>::quiet_NaN();
+  }
+  return records;
 }
 
 }  // namespace
@@ -217,6 +298,10 @@ int run_reduce(int argc, char** argv, int first) {
   parser.option("round",
                  "adaptive sweeps: the tables as they stood after round K (0: every cell at its "
                  "first seeds)");
+  parser.option("rule",
+                "adaptive sweeps: replay the [adaptive] table of sweep file SWEEP (same grid, "
+                "another rule, batch or max_seeds) on FILE's runs instead of FILE's own; the "
+                "runs it asks for that FILE lacks count as pending");
   if (!parser.parse(argc, argv, first)) return 0;
   const bool per_run = parser.flag_set("per-run"), seeds_summary = parser.flag_set("seeds-summary");
   // --per-run writes CSV: it needs no --format csv, only refuses another one.
@@ -233,18 +318,15 @@ int run_reduce(int argc, char** argv, int first) {
   }
   const std::string path = parser.get("FILE");
   const ResultsFile file = ResultsFile::open_read_only(path);
-  const SweepSpec spec =
-      parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
-  const Grid grid = checked_grid(file, spec);
-  const std::vector<int> damaged = damaged_rows_named(file);
-  auto statuses = file.read_statuses();
-  for (int row : damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
-  const auto mse = file.read_double_column("mse");
+  const Inputs in = read_inputs(file, parser);
+  const SweepSpec& spec = in.view.spec;
+  const Grid& grid = in.view.grid;
+  const std::vector<RunStatus>& statuses = in.statuses;
   const std::optional<AdaptiveState> adaptive =
-      adaptive_rounds(spec, grid, statuses, mse, parser, path);
+      adaptive_rounds(spec, grid, statuses, in.mse, parser, path);
+  if (adaptive) warn_unfinished_replay(in, *adaptive, parser, path);
   if (per_run) {
-    std::vector<RunRecord> records = read_run_records(file, grid);
-    for (int row : damaged) records[static_cast<std::size_t>(row)].status = RunStatus::kPending;
+    std::vector<RunRecord> records = view_records(file, in);
     if (adaptive) {  // only the runs the rounds asked for
       std::vector<RunRecord> asked;
       for (std::size_t i = 0; i < records.size(); ++i) {
@@ -255,7 +337,7 @@ int run_reduce(int argc, char** argv, int first) {
     std::cout << render_per_run_csv(records);
     return 0;
   }
-  const auto entries = make_table_entries(grid, statuses, mse, adaptive ? &adaptive->active : nullptr);
+  const auto entries = make_table_entries(grid, statuses, in.mse, adaptive ? &adaptive->active : nullptr);
   std::size_t expected_seeds = 0;
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());
   if (adaptive) expected_seeds = 0;
@@ -265,7 +347,9 @@ int run_reduce(int argc, char** argv, int first) {
       if (!adaptive || adaptive->active[i]) covered.push_back(statuses[i]);
     }
     print_markdown_preamble(file, spec, covered, seeds_summary);
-    if (adaptive) print_adaptive_preamble(spec, *adaptive);
+    if (adaptive) {
+      print_adaptive_preamble(spec, *adaptive, parser.has("rule") ? parser.get("rule") : "");
+    }
   }
   const int expected = static_cast<int>(expected_seeds);
   std::cout << (seeds_summary ? render_seeds_summary(grid.studies, entries, format, expected)

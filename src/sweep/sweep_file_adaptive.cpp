@@ -187,6 +187,14 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
         values.fail(k.line, "futility expects true or false; got " + values.describe(*k.value));
       }
       a.futility = *k.value->value<bool>();
+    } else if (k.key == "grow") {
+      const std::string grow = values.string(k);
+      if (grow != "both" && grow != "one") {
+        values.fail(k.line, "grow expects \"both\" (both cells of an unresolved comparison get "
+                            "seeds) or \"one\" (the cheaper way to close its gap); got " +
+                                values.describe(*k.value));
+      }
+      a.grow_one = grow == "one";
     } else if (k.key == "stop_confidence") {
       a.stop_confidence = values.number(k, *k.value);
       if (!(a.stop_confidence >= 0.5 && a.stop_confidence <= 0.999)) {
@@ -195,7 +203,7 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
       }
     } else {
       const std::vector<std::string> keys = {"max_seeds", "batch", "rule", "comparisons",
-                                             "futility", "stop_confidence"};
+                                             "futility", "grow", "stop_confidence"};
       values.fail(k.line, "unknown key " + quoted(k.key) + " in [adaptive]" +
                               did_you_mean(k.key, keys) + "; expected one of: " + join(keys));
     }
@@ -212,6 +220,10 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
   if (a.rule != AdaptiveRule::kComparisons && a.futility) {
     values.fail(e.line, "futility applies to rule = \"comparisons\" only; set that rule or "
                         "remove futility");
+  }
+  if (a.rule != AdaptiveRule::kComparisons && a.grow_one) {
+    values.fail(e.line, "grow = \"one\" applies to rule = \"comparisons\" only; set that rule "
+                        "or remove grow");
   }
   if (a.rule != AdaptiveRule::kComparisons && !a.comparisons.empty()) {
     values.fail(e.line, "comparisons are read by rule = \"comparisons\" only; set that rule or "

@@ -53,6 +53,30 @@ rows() { "$phnn" reduce "$dir/np1.h5" --per-run --round "$1" | tail -n +2 | wc -
 [[ $(rows 0) -eq 15 && $(rows 1) -eq 21 && $(rows 3) -eq 29 ]] ||
   fail "reduce --per-run --round 0/1/3 gave $(rows 0)/$(rows 1)/$(rows 3) runs, expected 15/21/29"
 "$phnn" reduce "$dir/np1.h5" --round 0 | grep -q "up to round 0" || fail "reduce --round 0"
+# --rule: another [adaptive] table replayed on the file's runs gives what a
+# sweep with that table trains, bitwise. max_seeds 8 asks for a subset of
+# np1.h5's runs (5 + 3 per tied cell: 21); max_seeds 15 asks in round 3 for
+# seeds 11-13 of both tied cells, of which the file lacks 12 and 13: named
+# and counted as pending.
+sed 's/^max_seeds = 12/max_seeds = 8/; s/^name = .*/name = "adaptive-test-8"/' "$dir/a.toml" > "$dir/b.toml"
+"$phnn" reduce "$dir/np1.h5" --per-run --rule "$dir/b.toml" > "$dir/replay8.csv" ||
+  fail "reduce --rule b.toml"
+timeout -k 5 400 "$mpiexec" "$np_flag" 1 "${preflags[@]}" "$phnn" sweep "$dir/b.toml" \
+  --out "$dir/b8.h5" --max-group-size 2 > "$dir/log" 2>&1 || fail "the max_seeds 8 sweep failed"
+per_run "$dir/b8.h5" "$dir/b8.csv"
+[[ $(tail -n +2 "$dir/b8.csv" | wc -l) -eq 21 ]] || fail "the max_seeds 8 sweep did not train 21 runs"
+python3 "$here/compare_runs.py" "$dir/b8.csv" "$dir/replay8.csv" ||
+  fail "reduce --rule differs from the sweep it replays"
+sed 's/^max_seeds = 12/max_seeds = 15/' "$dir/a.toml" > "$dir/c.toml"
+"$phnn" reduce "$dir/np1.h5" --per-run --rule "$dir/c.toml" > "$dir/replay15.csv" 2> "$dir/err" ||
+  fail "reduce --rule c.toml"
+grep -q "its round 3 asks for 4 runs .* has not finished (4 of them not in it at all)" "$dir/err" ||
+  fail "reduce --rule does not name the runs the file lacks: $(cat "$dir/err")"
+[[ $(grep -c ",pending," "$dir/replay15.csv") -eq 4 ]] || fail "the lacking runs are not pending rows"
+"$phnn" reduce "$dir/np1.h5" --rule "$here/../../sweeps/paper.toml" > /dev/null 2> "$dir/err" &&
+  fail "reduce --rule accepted a sweep without [adaptive]"
+grep -q "no \[adaptive\] table" "$dir/err" || fail "no clear error for a rule without [adaptive]"
+
 for np in 2 3; do
   sweep "$np" "$dir/np$np.h5" || fail "the $np-rank sweep failed"
   per_run "$dir/np$np.h5" "$dir/np$np.csv"

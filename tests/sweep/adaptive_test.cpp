@@ -359,6 +359,57 @@ TEST(AdaptiveRoundsTest, StopConfidenceKeepsMarginalResolutionsGrowing) {
   }
 }
 
+// grow = "one": of an unresolved pair, only the cell whose next batch
+// closes more of the gap between the intervals per estimated core-second.
+// Facing half-widths w (RK2's upper, RK4's lower: RK2's median is smaller)
+// set the gain; the cost model's member seconds (RK4 > RK2) the price.
+TEST(AdaptiveRoundsTest, GrowOneNamesTheCheaperWayToCloseTheGap) {
+  const std::string adaptive =
+      "max_seeds = 40\nbatch = 10\nrule = \"comparisons\"\n"
+      "comparisons = [[\"harmonic/phnn-jr-rk2/25/small/none\", \"harmonic/phnn-jr-rk4/25/small/none\"]]\n";
+  const SweepSpec both = parse_sweep_text(sweep_text(kTwoModels, adaptive), "x.toml");
+  const SweepSpec one =
+      parse_sweep_text(sweep_text(kTwoModels, adaptive + "grow = \"one\"\n"), "x.toml");
+  ASSERT_TRUE(one.adaptive.grow_one);
+  ASSERT_FALSE(both.adaptive.grow_one);
+  const Grid grid = expand_grid(both);
+  const auto cost_of = [&](IntegratorKind integrator) {
+    for (const Cell& c : grid.cells) {
+      if (grid.runs[static_cast<std::size_t>(c.runs[0])].integrator == integrator) return c.member_cost_s;
+    }
+    return -1.0;
+  };
+  const double c2 = cost_of(IntegratorKind::kRk2), c4 = cost_of(IntegratorKind::kRk4);
+  ASSERT_GT(c4, 1.5 * c2);  // RK4 costs more per seed (the cost model: 2.3x)
+  std::vector<char> active(grid.runs.size(), 0);
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) active[i] = grid.runs[i].seed < 5;
+  const auto named = [&](const SweepSpec& spec, double spread2, double base4, double spread4) {
+    const Results r = results_of(grid, [&](const RunConfig& run) {
+      const int k = run.seed % 5;
+      return run.integrator == IntegratorKind::kRk4 ? base4 + spread4 * k : 1.0 + spread2 * k;
+    });
+    std::vector<IntegratorKind> out;
+    for (int c : adaptive_rule_cells(spec, grid, active, r.status, r.mse)) {
+      out.push_back(grid.runs[static_cast<std::size_t>(grid.cells[c].runs[0])].integrator);
+    }
+    return out;
+  };
+  // RK2 wide (median 1.6, w ~ 0.3), RK4 narrow (median 1.82, w ~ 0.01):
+  // RK2 closes 30x more of the gap at under half the price.
+  EXPECT_THAT(named(one, 0.3, 1.8, 0.01), ElementsAre(IntegratorKind::kRk2));
+  EXPECT_EQ(named(both, 0.3, 1.8, 0.01).size(), 2u);
+  // Mirrored: RK2 narrow (1.00 ... 1.04), RK4 wide (0.5 ... 1.7, median 1.1,
+  // lower w ~ 0.3): RK4, though dearer.
+  EXPECT_THAT(named(one, 0.01, 0.5, 0.3), ElementsAre(IntegratorKind::kRk4));
+  // Equal spreads, medians 1.2 and 1.35: facing widths alike by symmetry,
+  // so the price decides.
+  EXPECT_THAT(named(one, 0.1, 1.15, 0.1), ElementsAre(IntegratorKind::kRk2));
+  EXPECT_THAT(error_of(sweep_text(kTwoModels, adaptive + "grow = \"all\"\n")),
+              AllOf(HasSubstr("x.toml:11:"), HasSubstr("grow expects \"both\"")));
+  EXPECT_THAT(error_of(sweep_text(kTwoModels, kColumnBest + "grow = \"one\"\n")),
+              HasSubstr("grow = \"one\" applies to rule = \"comparisons\" only"));
+}
+
 TEST(AdaptiveRoundsTest, TheRuleSeesOnlyTheRunsAskedFor) {
   const SweepSpec spec = parse_sweep_text(sweep_text(kTwoModels, kColumnBest), "x.toml");
   const Grid grid = expand_grid(spec);

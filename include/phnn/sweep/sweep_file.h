@@ -134,6 +134,11 @@ struct AdaptiveSpec {
   /// interval narrowed about its median by sqrt(finished / max_seeds)
   /// (docs/METHOD.md, "Adaptive seeds").
   bool futility = false;
+  /// rule comparisons only: false (grow = "both"): both cells of an
+  /// unresolved comparison get seeds; true (grow = "one"): only the one
+  /// whose next batch is expected to close more of the gap between the two
+  /// intervals per estimated core-second (docs/METHOD.md, "Adaptive seeds").
+  bool grow_one = false;
   /// `stop_confidence`: a comparison (column-best: a cell against its
   /// column's best) stops getting seeds before max_seeds only when its
   /// intervals at this confidence are disjoint; the tables, the verdicts and
