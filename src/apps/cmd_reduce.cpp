@@ -198,7 +198,15 @@ void print_adaptive_preamble(const SweepSpec& spec, const AdaptiveState& state,
             << " more per round where the rule asks, at most " << spec.adaptive.max_seeds << "): "
             << (state.complete ? "complete after round " : "up to round ") << state.round
             << "; " << state.active_runs() << " runs asked for; the other pending runs are seeds "
-            << "no round asked for, left out of the tables.\n\n";
+            << "no round asked for, left out of the tables.";
+  if (!state.cells_grown.empty()) {
+    std::cout << " Cells given more seeds after round 0, 1, ...:";
+    for (std::size_t k = 0; k < state.cells_grown.size(); ++k) {
+      std::cout << (k == 0 ? " " : ", ") << state.cells_grown[k];
+    }
+    std::cout << ".";
+  }
+  std::cout << "\n\n";
 }
 
 // The runs the tables cover: the file's sweep, or with --rule another sweep

@@ -47,7 +47,8 @@ grep -q "adaptive sweep complete after round 3: 29 runs of at most 36" "$dir/log
   fail "expected 3 rounds after round 0 and 29 runs"
 per_run "$dir/np1.h5" "$dir/np1.csv"
 "$phnn" reduce "$dir/np1.h5" > "$dir/table.md" || fail "reduce of the adaptive file"
-grep -q "complete after round 3" "$dir/table.md" || fail "reduce does not say where the sweep stands"
+grep -q "complete after round 3; 29 runs asked for.*after round 0, 1, ...: 2, 2, 2\." "$dir/table.md" ||
+  fail "reduce does not say where the sweep stands and how it grew"
 # --round K: the sweep as it stood after round K (round 0: 3 cells x 5 seeds).
 rows() { "$phnn" reduce "$dir/np1.h5" --per-run --round "$1" | tail -n +2 | wc -l; }
 [[ $(rows 0) -eq 15 && $(rows 1) -eq 21 && $(rows 3) -eq 29 ]] ||
