@@ -82,7 +82,8 @@ def main(argv=None):
     missing = [r for r in runs if r["status"] == "pending"]
     if missing:
         print(f"adaptive_cost.py: warning: {len(missing)} runs asked for are not finished in "
-              f"{args.results} (their cost is left out), e.g. {missing[0]['run_id']}",
+              f"{args.results}: they count as trained runs (and in the cost model's figures) but "
+              f"their seconds are unknown, left out of 'measured', e.g. {missing[0]['run_id']}",
               file=sys.stderr)
     costs = run_csv("sweep", args.sweep, "--dry-run", "--cell-costs")
     # Round 0's seeds: the fewest any cell has (every cell trains them).

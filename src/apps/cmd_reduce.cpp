@@ -1,7 +1,8 @@
 // src/apps/cmd_reduce.cpp — `phnn reduce results.h5`: the paper's Appendix-F
 // tables (median [IQR] and bootstrap interval of the inference MSE over
 // seeds), the seeds-per-mode view, or one CSV row per run, from a results
-// file, complete or partial.
+// file, complete or partial; --round K and --rule SWEEP show an adaptive
+// sweep after round K or under another rule (apps/reduce_rule.h).
 #include <algorithm>
 #include <iostream>
 #include <limits>
@@ -248,15 +249,20 @@ Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
 void warn_unfinished_replay(const Inputs& in, const AdaptiveState& state,
                             const cli::Parser& parser, const std::string& path) {
   if (!parser.has("rule") || state.complete || state.pending == 0) return;
-  int lacking = 0;
+  std::vector<std::string> lacking;
   for (std::size_t i = 0; i < state.active.size(); ++i) {
-    lacking += state.active[i] && in.view.row[i] < 0 ? 1 : 0;
+    if (state.active[i] && in.view.row[i] < 0) lacking.push_back(in.view.grid.runs[i].id());
   }
   std::cerr << "phnn reduce: warning: --rule " << parser.get("rule") << ": its round "
-            << state.round << " asks for " << state.pending << " runs " << path
-            << " has not finished (" << lacking << " of them not in it at all); the tables "
-            << "show the replay up to there. To finish it, train them: `phnn sweep "
-            << parser.get("rule") << " --out COPY`, COPY a copy of " << path << "\n";
+            << state.round << " needs " << state.pending << " runs that " << path
+            << " has not finished (" << lacking.size() << " of them not in it at all";
+  for (std::size_t k = 0; k < std::min<std::size_t>(lacking.size(), 3); ++k) {
+    std::cerr << (k == 0 ? ": " : ", ") << lacking[k];
+  }
+  std::cerr << (lacking.size() > 3 ? ", ..." : "") << "); the tables show the replay up to "
+            << "there. To go on, train them on a copy: `cp " << path << " F.h5 && phnn sweep "
+            << parser.get("rule") << " --out F.h5` (refused if the rule's grid lacks runs "
+            << path << " finished)\n";
 }
 
 // One record per run of the view (a run the file lacks: pending, its
@@ -278,7 +284,11 @@ std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
     for (const std::string& s : in.view.grid.run_studies[i]) {
       r.studies += (r.studies.empty() ? "" : ",") + s;
     }
-    r.mse = r.best_validation_loss = r.wall_time_s = std::numeric_limits<double>::quiet_NaN();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    r.mse = r.best_validation_loss = r.wall_time_s = r.initial_validation_loss = nan;
+    r.final_train_loss = r.final_validation_loss = r.final_kappa = r.final_sigma_max = nan;
+    r.final_rho = nan;
+    r.message = "not in " + file.path();
   }
   return records;
 }

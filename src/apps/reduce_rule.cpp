@@ -28,8 +28,8 @@ RuleView rule_view(const ResultsFile& file, const std::string& rule_path) {
     const auto it = row_of.find(view.grid.runs[i].id());
     if (it != row_of.end()) view.row[i] = it->second;
   }
-  view.missing = static_cast<int>(std::count(view.row.begin(), view.row.end(), -1));
-  if (view.missing == static_cast<int>(view.row.size())) {
+  const auto lacking = std::count(view.row.begin(), view.row.end(), -1);
+  if (lacking == static_cast<std::ptrdiff_t>(view.row.size())) {
     throw cli::UsageError{"phnn reduce: --rule " + rule_path + ": none of its " +
                           std::to_string(view.row.size()) + " runs is in " + file.path() +
                           "; the rule must expand to the grid (or part of it) that wrote the "

@@ -21,12 +21,12 @@ struct RuleView {
   SweepSpec spec;
   Grid grid;
   std::vector<int> row;
-  int missing = 0;  // runs of the grid FILE lacks
 };
 
-/// Parses `rule_path` (a sweep file with an [adaptive] table) and maps its
-/// runs onto `file`'s rows. Throws cli::UsageError when the file has no
-/// [adaptive] table or shares no run with `file` (another grid: a typo).
+/// Parses `rule_path` (a sweep file with an [adaptive] table; its system
+/// files read from disk, relative to it) and maps its runs onto `file`'s
+/// rows. Throws cli::UsageError when the file has no [adaptive] table or
+/// shares no run with `file` (another grid: a typo, or edited system files).
 RuleView rule_view(const ResultsFile& file, const std::string& rule_path);
 
 /// values[row[i]] per run of the view; `missing` where row[i] < 0.

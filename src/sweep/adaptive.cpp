@@ -1,8 +1,9 @@
 // src/sweep/adaptive.cpp — adaptive seeds: the rounds replayed from finished
 // results, and the two rules that name the cells of the next round
 // (column-best: the reducer's (tie) cells; comparisons: both sides of every
-// comparison whose intervals overlap). Reads the report's statistics
-// (phnn/report/tables.h); writes nothing.
+// comparison whose intervals overlap, or with grow = "one" the side that
+// closes the gap more cheaply). Reads the report's statistics
+// (phnn/report/tables.h) and the grid's cost model; writes nothing.
 #include "phnn/sweep/adaptive.h"
 
 #include <algorithm>
@@ -67,8 +68,9 @@ class ComparisonRule {
     }
   }
 
-  // Named cells of one comparison (none, or both sides' picks): resolved
-  // at the stop confidence, or futile at the tables' confidence, stops it.
+  // Named cells of one comparison (none, one or both sides' picks): resolved
+  // at the stop confidence, or futile at the tables' confidence, stops it;
+  // grow = "one" names one side when both have intervals and unequal medians.
   void name_cells(const SeedComparison& c, std::vector<int>* cells) {
     const int a = pick(c.a), b = pick(c.b);
     if (a < 0 || b < 0) return;
@@ -78,7 +80,7 @@ class ComparisonRule {
     if (adaptive_.futility && sa.has_interval() && sb.has_interval() && futile(sa, sb)) {
       return;  // max_seeds is not expected to resolve it
     }
-    if (adaptive_.grow_one && sa.has_interval() && sb.has_interval()) {
+    if (adaptive_.grow_one && sa.has_interval() && sb.has_interval() && sa.median != sb.median) {
       const double ga = gain_per_second(a, sa, sb), gb = gain_per_second(b, sb, sa);
       if (ga > gb) return cells->push_back(a);
       if (gb > ga) return cells->push_back(b);
@@ -127,15 +129,16 @@ class ComparisonRule {
 
   // grow = "one": the two intervals separate when the half-widths that face
   // each other, (hi - m) of the smaller median's cell and (m - lo) of the
-  // other's, sum to less than the distance of the medians. `batch` more
-  // seeds shrink a cell's facing half-width w by the factor sqrt(n / (n +
-  // batch)) (n its seeds asked for; the futility projection's 1 / sqrt(n)
-  // law), so they close
-  //   gain = w (1 - sqrt(n / (n + batch)))   of the gap, at a cost of
-  //   batch * member_cost_s                  (the cost model's, not a timing:
-  // the decision stays a function of the results alone). Returns gain per
-  // core-second; 0 for a cell at max_seeds, +inf for an infinite w (diverged
-  // seeds: the cheapest way to learn anything). Equal gains name both cells.
+  // other's, sum to less than the distance of the medians. k = min(batch,
+  // max_seeds - n) more seeds shrink a cell's facing half-width w by the
+  // factor sqrt(n / (n + k)) (n its seeds asked for; the futility
+  // projection's 1 / sqrt(n) law), so they close
+  //   gain = w (1 - sqrt(n / (n + k)))   of the gap, at a cost of
+  //   k * member_cost_s                  (the cost model's per-seed seconds,
+  // not a timing: the decision is a function of the results, the sweep and
+  // the binary's cost model, pinned by a test; the per-round fixed cost is
+  // left out). Returns gain per core-second; 0 for a cell at max_seeds, +inf
+  // for an infinite w (diverged seeds). Equal gains name both cells.
   double gain_per_second(int cell, const CellSummary& s, const CellSummary& other) const {
     const auto& runs = grid_.cells[static_cast<std::size_t>(cell)].runs;
     int n = 0;
@@ -144,9 +147,9 @@ class ComparisonRule {
     const double w = s.median < other.median ? s.median_interval.high - s.median
                                              : s.median - s.median_interval.low;
     if (!(w < std::numeric_limits<double>::infinity())) return w == w ? w : 0.0;
-    const double shrink =
-        1.0 - std::sqrt(static_cast<double>(n) / static_cast<double>(n + adaptive_.batch));
-    const double cost = adaptive_.batch * grid_.cells[static_cast<std::size_t>(cell)].member_cost_s;
+    const int k = std::min(adaptive_.batch, adaptive_.max_seeds - n);
+    const double shrink = 1.0 - std::sqrt(static_cast<double>(n) / static_cast<double>(n + k));
+    const double cost = k * grid_.cells[static_cast<std::size_t>(cell)].member_cost_s;
     return w * shrink / cost;
   }
 

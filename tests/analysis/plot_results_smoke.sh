@@ -65,7 +65,7 @@ if [ $# -ge 2 ]; then
         || { echo "schedule_replay.py: unexpected output" >&2; cat "$out/replay.md" >&2; exit 1; }
     # The comparisons of the shipped adaptive sweeps are what paper_claims.py writes for their
     # grids (a sweep stopped at once: every run pending, every cell listed).
-    for f in paper-adaptive paper-adaptive-both paper-adaptive-study1; do
+    for f in paper-adaptive paper-adaptive-both paper-adaptive-study1 paper-adaptive-study1-lean; do
         timeout -s TERM 2 "$2" sweep "$root/sweeps/$f.toml" --out "$out/$f.h5" > /dev/null 2>&1 || true
         PHNN="$2" "$py" "$root/analysis/paper_claims.py" "$out/$f.h5" --write-comparisons > "$out/$f.cmp"
         grep -q '^  \["' "$out/$f.cmp" || { echo "$f: no comparison written" >&2; exit 1; }

@@ -9,7 +9,7 @@ shift 3
 preflags=("$@")
 here=$(cd "$(dirname "$0")" && pwd)
 dir=$(mktemp -d)
-trap 'pkill -KILL -f "$dir/a.toml" 2>/dev/null; rm -rf "$dir"' EXIT
+trap 'pkill -KILL -f "$dir/" 2>/dev/null; rm -rf "$dir"' EXIT
 fail() { echo "FAILED: $*"; tail -30 "$dir/log" 2>/dev/null; exit 1; }
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 
@@ -71,9 +71,34 @@ python3 "$here/compare_runs.py" "$dir/b8.csv" "$dir/replay8.csv" ||
 sed 's/^max_seeds = 12/max_seeds = 15/' "$dir/a.toml" > "$dir/c.toml"
 "$phnn" reduce "$dir/np1.h5" --per-run --rule "$dir/c.toml" > "$dir/replay15.csv" 2> "$dir/err" ||
   fail "reduce --rule c.toml"
-grep -q "its round 3 asks for 4 runs .* has not finished (4 of them not in it at all)" "$dir/err" ||
+grep -q "its round 3 needs 4 runs that .* has not finished (4 of them not in it at all: [0-9a-f]\{16\}, " "$dir/err" ||
   fail "reduce --rule does not name the runs the file lacks: $(cat "$dir/err")"
-[[ $(grep -c ",pending," "$dir/replay15.csv") -eq 4 ]] || fail "the lacking runs are not pending rows"
+[[ $(grep -c ",pending,.*,not in $dir/np1.h5\$" "$dir/replay15.csv") -eq 4 ]] ||
+  fail "the lacking runs are not pending rows saying so"
+# grow = "one" end to end: a sweep of the comparisons rule on a copy of
+# np1.h5 trains only the runs it lacks and ends with the runs of the same
+# sweep from scratch, bitwise. RK2 and RK4 tie and NODE is resolved, so each
+# round names one cell (the cheaper RK2 first, RK4 once RK2 is at the cap).
+cat "$dir/a.toml" | sed '/^\[adaptive\]/,$d' > "$dir/d.toml"
+cat >> "$dir/d.toml" <<'TOML'
+[adaptive]
+max_seeds = 12
+batch = 3
+rule = "comparisons"
+grow = "one"
+comparisons = [["harmonic/phnn-jr-rk2/25/small/none", "harmonic/phnn-jr-rk4/25/small/none"],
+               ["harmonic/phnn-jr-rk2+phnn-jr-rk4/25/small/none", "harmonic/node-rk2/25/small/none"]]
+TOML
+cp "$dir/np1.h5" "$dir/dcopy.h5"
+timeout -k 5 400 "$mpiexec" "$np_flag" 1 "${preflags[@]}" "$phnn" sweep "$dir/d.toml" \
+  --out "$dir/dcopy.h5" --max-group-size 2 > "$dir/log" 2>&1 || fail "the grow-one sweep on a copy failed"
+per_run "$dir/dcopy.h5" "$dir/dcopy.csv"
+timeout -k 5 400 "$mpiexec" "$np_flag" 1 "${preflags[@]}" "$phnn" sweep "$dir/d.toml" \
+  --out "$dir/d.h5" --max-group-size 2 > "$dir/log" 2>&1 || fail "the grow-one sweep failed"
+grep -q "adaptive round 1: .*(1 cell" "$dir/log" || fail "grow = one named more than one cell in round 0"
+per_run "$dir/d.h5" "$dir/d.csv"
+python3 "$here/compare_runs.py" "$dir/d.csv" "$dir/dcopy.csv" ||
+  fail "the grow-one sweep continued on a copy differs from the same sweep from scratch"
 "$phnn" reduce "$dir/np1.h5" --rule "$here/../../sweeps/paper.toml" > /dev/null 2> "$dir/err" &&
   fail "reduce --rule accepted a sweep without [adaptive]"
 grep -q "no \[adaptive\] table" "$dir/err" || fail "no clear error for a rule without [adaptive]"

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -175,10 +177,70 @@ TEST(AdaptiveRoundsTest, GrowOneNamesTheCheaperWayToCloseTheGap) {
   // Equal spreads, medians 1.2 and 1.35: facing widths alike by symmetry,
   // so the price decides.
   EXPECT_THAT(named(one, 0.1, 1.15, 0.1), ElementsAre(IntegratorKind::kRk2));
+  // Diverged seeds give RK2 (median 1.2) an infinite facing half-width:
+  // named, though RK4 (1.3 ... 5.3, median 3.3) has a wide finite one.
+  {
+    const Results r = results_of(grid, [](const RunConfig& run) {
+      const int k = run.seed % 5;
+      if (run.integrator == IntegratorKind::kRk4) return 1.3 + 1.0 * k;
+      return k >= 3 ? std::numeric_limits<double>::infinity() : 1.0 + 0.1 * k;
+    });
+    std::vector<int> cells = adaptive_rule_cells(one, grid, active, r.status, r.mse);
+    ASSERT_EQ(cells.size(), 1u);
+    EXPECT_EQ(grid.runs[static_cast<std::size_t>(grid.cells[cells[0]].runs[0])].integrator,
+              IntegratorKind::kRk2);
+  }
+  // The wide RK2 of the first case but already at max_seeds (10 seeds, cap
+  // 10): it cannot grow, so RK4 is named; and a side without an interval
+  // (RK4 at 4 seeds) names both, as grow = "both" does.
+  {
+    std::string text = sweep_text(kTwoModels, adaptive + "grow = \"one\"\n");
+    text.replace(text.find("max_seeds = 40"), 14, "max_seeds = 10");
+    const SweepSpec capped = parse_sweep_text(text, "x.toml");
+    const Grid g = expand_grid(capped);
+    const Results r = results_of(g, [](const RunConfig& run) {
+      const int k = run.seed % 5;
+      return run.integrator == IntegratorKind::kRk4 ? 1.8 + 0.01 * k : 1.0 + 0.3 * k;
+    });
+    const auto named_with = [&](int rk4_seeds) {
+      std::vector<char> on(g.runs.size(), 0);
+      for (std::size_t i = 0; i < g.runs.size(); ++i) {
+        on[i] = g.runs[i].integrator == IntegratorKind::kRk2 || g.runs[i].seed < rk4_seeds;
+      }
+      std::vector<IntegratorKind> out;
+      for (int c : adaptive_rule_cells(capped, g, on, r.status, r.mse)) {
+        out.push_back(g.runs[static_cast<std::size_t>(g.cells[c].runs[0])].integrator);
+      }
+      return out;
+    };
+    EXPECT_THAT(named_with(5), ElementsAre(IntegratorKind::kRk4));
+    EXPECT_EQ(named_with(4).size(), 2u);
+  }
   EXPECT_THAT(error_of(sweep_text(kTwoModels, adaptive + "grow = \"all\"\n")),
               AllOf(HasSubstr("x.toml:11:"), HasSubstr("grow expects \"both\"")));
   EXPECT_THAT(error_of(sweep_text(kTwoModels, kColumnBest + "grow = \"one\"\n")),
               HasSubstr("grow = \"one\" applies to rule = \"comparisons\" only"));
 }
+// grow = "one" reads the cost model's per-seed seconds, so a refit of the
+// model (include/phnn/sweep/grid.h) changes which cell of a pair grows, and
+// with it the runs sweeps/paper-adaptive.toml asks for on results already
+// trained: replays of existing files would no longer match their sweeps.
+// This pins the model's per-seed seconds of every cell of that grid. If a
+// refit is intended, freeze the old values for grow = "one" (or make the
+// change a new rule) rather than updating the fingerprint.
+TEST(AdaptiveRoundsTest, GrowOneCostsOfThePaperGridArePinned) {
+  const SweepSpec spec =
+      parse_sweep_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/paper-adaptive.toml");
+  ASSERT_TRUE(spec.adaptive.grow_one);
+  const Grid grid = expand_grid(spec);
+  std::string all;
+  for (const Cell& c : grid.cells) {
+    char v[32];
+    std::snprintf(v, sizeof v, "%.17g", c.member_cost_s);
+    all += grid.runs[static_cast<std::size_t>(c.runs[0])].cell_key() + "=" + v + ";";
+  }
+  EXPECT_EQ(hex64(fnv1a64(all)), "1577893f59b2b1a4") << "the cost model's per-seed seconds changed";
+}
+
 }  // namespace
 }  // namespace phnn

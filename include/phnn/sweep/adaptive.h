@@ -64,7 +64,12 @@ AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
 ///                 (among cells with a finished run; a side without one skips
 ///                 the comparison); both are named unless the two bootstrap
 ///                 intervals of the medians are disjoint (a side with fewer
-///                 than kMinSeedsForInterval finished runs has none: named).
+///                 than kMinSeedsForInterval finished runs has none: named);
+///                 with futility, a futile comparison names none; with
+///                 grow = "one" (AdaptiveSpec::grow_one), a comparison whose
+///                 sides both have intervals and unequal medians names one:
+///                 the side whose next seeds close more of the gap per
+///                 core-second of the grid's cost model (docs/METHOD.md).
 std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
                                      const std::vector<char>& active,
                                      const std::vector<RunStatus>& status,
