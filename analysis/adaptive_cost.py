@@ -78,7 +78,8 @@ def main(argv=None):
         adaptive = tomllib.load(f).get("adaptive")
     if not adaptive:
         parser.error(f"{args.sweep}: no [adaptive] table")
-    runs = run_csv("reduce", args.results, "--per-run", *(("--rule", args.sweep) if args.rule else ()))
+    replay = ("--rule", args.sweep) if args.rule else ()
+    runs = run_csv("reduce", args.results, "--per-run", *replay)
     missing = [r for r in runs if r["status"] == "pending"]
     if missing:
         print(f"adaptive_cost.py: warning: {len(missing)} runs asked for are not finished in "

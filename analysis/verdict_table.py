@@ -7,10 +7,11 @@ one adaptive sweep after different rounds: one row per statement, one column per
 
 FILE@K reads an adaptive sweep as it stood after round K (`phnn reduce --round K`; @0: every cell
 at its first seeds); FILE@SWEEP (a path, not a number) replays the [adaptive] table of sweep file
-SWEEP on FILE's runs (`phnn reduce --rule SWEEP`: what that rule would have concluded). A row whose verdicts differ is marked; --stability N adds, per column, the
-share of N bootstrap resamples of the seeds that give that column's verdict. --decided prints
-what the resolved comparisons alone decide instead (paper_claims.decided: holds, for in part,
-undecided, against, split, by direction only), blind to the directions of tied medians.
+SWEEP on FILE's runs (`phnn reduce --rule SWEEP`: what that rule would have concluded). A row
+whose verdicts differ is marked; --stability N adds, per column, the share of N bootstrap
+resamples of the seeds that give that column's verdict. --decided prints what the resolved
+comparisons alone decide instead (paper_claims.decided: holds, for in part, undecided, against,
+split, by direction only), blind to the directions of tied medians.
 """
 import argparse
 import sys

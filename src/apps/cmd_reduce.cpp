@@ -355,7 +355,8 @@ int run_reduce(int argc, char** argv, int first) {
     std::cout << render_per_run_csv(records);
     return 0;
   }
-  const auto entries = make_table_entries(grid, statuses, in.mse, adaptive ? &adaptive->active : nullptr);
+  const auto entries =
+      make_table_entries(grid, statuses, in.mse, adaptive ? &adaptive->active : nullptr);
   std::size_t expected_seeds = 0;
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());
   if (adaptive) expected_seeds = 0;

@@ -188,13 +188,7 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
       }
       a.futility = *k.value->value<bool>();
     } else if (k.key == "grow") {
-      const std::string grow = values.string(k);
-      if (grow != "both" && grow != "one") {
-        values.fail(k.line, "grow expects \"both\" (both cells of an unresolved comparison get "
-                            "seeds) or \"one\" (the cheaper way to close its gap); got " +
-                                values.describe(*k.value));
-      }
-      a.grow_one = grow == "one";
+      a.grow_one = values.choice_index(k, {"both", "one"}) == 1;
     } else if (k.key == "stop_confidence") {
       a.stop_confidence = values.number(k, *k.value);
       if (!(a.stop_confidence >= 0.5 && a.stop_confidence <= 0.999)) {

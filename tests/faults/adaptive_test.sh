@@ -79,7 +79,7 @@ grep -q "its round 3 needs 4 runs that .* has not finished (4 of them not in it 
 # np1.h5 trains only the runs it lacks and ends with the runs of the same
 # sweep from scratch, bitwise. RK2 and RK4 tie and NODE is resolved, so each
 # round names one cell (the cheaper RK2 first, RK4 once RK2 is at the cap).
-cat "$dir/a.toml" | sed '/^\[adaptive\]/,$d' > "$dir/d.toml"
+sed '/^\[adaptive\]/,$d' "$dir/a.toml" > "$dir/d.toml"
 cat >> "$dir/d.toml" <<'TOML'
 [adaptive]
 max_seeds = 12

@@ -148,7 +148,8 @@ TEST(AdaptiveRoundsTest, GrowOneNamesTheCheaperWayToCloseTheGap) {
   const Grid grid = expand_grid(both);
   const auto cost_of = [&](IntegratorKind integrator) {
     for (const Cell& c : grid.cells) {
-      if (grid.runs[static_cast<std::size_t>(c.runs[0])].integrator == integrator) return c.member_cost_s;
+      const RunConfig& run = grid.runs[static_cast<std::size_t>(c.runs[0])];
+      if (run.integrator == integrator) return c.member_cost_s;
     }
     return -1.0;
   };
@@ -217,7 +218,8 @@ TEST(AdaptiveRoundsTest, GrowOneNamesTheCheaperWayToCloseTheGap) {
     EXPECT_EQ(named_with(4).size(), 2u);
   }
   EXPECT_THAT(error_of(sweep_text(kTwoModels, adaptive + "grow = \"all\"\n")),
-              AllOf(HasSubstr("x.toml:11:"), HasSubstr("grow expects \"both\"")));
+              AllOf(HasSubstr("x.toml:11: unknown grow \"all\""),
+                    HasSubstr("expected one of: both, one")));
   EXPECT_THAT(error_of(sweep_text(kTwoModels, kColumnBest + "grow = \"one\"\n")),
               HasSubstr("grow = \"one\" applies to rule = \"comparisons\" only"));
 }
