@@ -19,6 +19,9 @@
 //                                      member-step; at n_x = 2 the built-in
 //                                      harmonic oscillator's fused path beside
 //                                      the general path on the same system
+//   bench_training general-run K MODEL INTEGRATOR REG STEPS   one cell of the
+//                                      n-dimensional models on a chain of K
+//                                      masses, E = 10 (for perf)
 //   bench_training cell                one full cell: small PHNN-JR-RK2,
 //                                      E = 10, 50 000 steps (+ inference)
 //
@@ -406,6 +409,22 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (mode == "stacked") return stacked(repeats);
+  if (mode == "general-run" && argc > 6) {  // for perf: general-run K MODEL INTEGRATOR REG STEPS
+    const auto system = phnn::compile_system(chain_text(std::atoi(argv[2])), "chain.toml");
+    phnn::DatasetOptions options;
+    options.num_validation = 64;
+    options.num_inference = 1;
+    options.beta = 0.4;
+    const phnn::PhSystemData data = phnn::make_ph_system_data(*system, options, 100);
+    CellSpec cell;
+    cell.model = phnn::parse_model(argv[3]);
+    cell.integrator = phnn::parse_integrator(argv[4]);
+    cell.regularizer = phnn::parse_regularizer(argv[5]);
+    cell.n_train = 64;
+    cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+    std::printf("%.3f s\n", time_general_cell(cell, data, *system, std::atoi(argv[6])));
+    return 0;
+  }
   if (mode == "run" && argc > 5) {  // for perf: run MODEL INTEGRATOR REG STEPS [SIZE] [N_TRAIN] [E]
     CellSpec cell;
     cell.model = phnn::parse_model(argv[2]);

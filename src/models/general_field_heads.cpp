@@ -45,84 +45,101 @@ struct PortRow {
   }
 };
 
+}  // namespace
+
+Tensor general_s_field_forward(const Tensor& e_in, const Tensor& u_in, const Tensor& o_in,
+                               const Tensor& w_in, const std::vector<double>& S, int nw) {
+  const Tensor e = dense(e_in), u = rows_like(u_in, e_in), o = dense(o_in), w = dense(w_in);
+  const int nx = static_cast<int>(e.size(-1)), nu = static_cast<int>(u.size(-1));
+  const int n = nw, T = static_cast<int>(o.size(-1)), W = nx + n + nu;
+  PHNN_CHECK(static_cast<int>(S.size()) >= nx * W && T == n * n,
+             "general_s_field_head: structure or output sizes");
+  const int64_t rows = rows_of(e);
+  Tensor f = torch::empty_like(e);
+  const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
+  const double *po = o.data_ptr<double>(), *pw = w.data_ptr<double>();
+  double* pf = f.data_ptr<double>();
+  std::vector<double> y(n), z(n);
+  for (int64_t r = 0; r < rows; ++r) {
+    const PortRow port{po + T * r, n};
+    const double* wr = pw + n * r;
+    lower_times(port.o, wr, n, y.data());
+    lower_transpose_times(port.o, y.data(), n, z.data());
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) z[a] += port.a(a, b) * wr[b];
+    for (int i = 0; i < nx; ++i) {
+      const double* s = S.data() + i * W;
+      double acc = 0.0;
+      for (int j = 0; j < nx; ++j) acc += s[j] * pe[nx * r + j];
+      for (int a = 0; a < n; ++a) acc += s[nx + a] * z[a];
+      for (int b = 0; b < nu; ++b) acc += s[nx + n + b] * pu[nu * r + b];
+      pf[nx * r + i] = acc;
+    }
+  }
+  return f;
+}
+
+SFieldAdjoints general_s_field_backward(const Tensor& o_in, const Tensor& w_in,
+                                        const std::vector<double>& S, int nx, int n, int nu,
+                                        const Tensor& f_bar) {
+  const Tensor o = dense(o_in), w = dense(w_in);
+  const int T = static_cast<int>(o.size(-1)), W = nx + n + nu;
+  const Tensor fb = dense(f_bar);
+  const int64_t E = o.size(0), B = o.size(1), rows = rows_of(o);
+  SFieldAdjoints out{torch::empty({E, B, nx}, o.options()), torch::empty({E, B, nu}, o.options()),
+                     torch::empty_like(o), torch::empty_like(w)};
+  const double *po = o.data_ptr<double>(), *pw = w.data_ptr<double>(), *pfb = fb.data_ptr<double>();
+  double *peb = out.e.data_ptr<double>(), *pub = out.u.data_ptr<double>();
+  double *pob = out.o.data_ptr<double>(), *pwb = out.w.data_ptr<double>();
+  std::vector<double> adj(W), y(n), yb(n);
+  for (int64_t r = 0; r < rows; ++r) {
+    const double* f = pfb + nx * r;
+    for (int j = 0; j < W; ++j) {
+      double s = 0.0;
+      for (int i = 0; i < nx; ++i) s += f[i] * S[static_cast<std::size_t>(i * W + j)];
+      adj[j] = s;
+    }
+    for (int j = 0; j < nx; ++j) peb[nx * r + j] = adj[j];
+    for (int b = 0; b < nu; ++b) pub[nu * r + b] = adj[nx + n + b];
+    const double* zb = adj.data() + nx;
+    const PortRow port{po + T * r, n};
+    const double* wr = pw + n * r;
+    lower_times(port.o, wr, n, y.data());
+    lower_times(port.o, zb, n, yb.data());
+    double* ob = pob + T * r;
+    for (int i = 0; i < n; ++i)
+      for (int a = 0; a <= i; ++a) ob[tri(i, a)] = y[i] * zb[a] + yb[i] * wr[a];
+    for (int a = 1; a < n; ++a)
+      for (int b = 0; b < a; ++b)
+        ob[n * (n + 1) / 2 + a * (a - 1) / 2 + b] = zb[a] * wr[b] - zb[b] * wr[a];
+    double* wb = pwb + n * r;
+    lower_transpose_times(port.o, yb.data(), n, wb);
+    for (int c = 0; c < n; ++c)
+      for (int a = 0; a < n; ++a) wb[c] += port.a(a, c) * zb[a];
+  }
+  return out;
+}
+
+namespace {
+
 class SFieldFunction : public torch::autograd::Function<SFieldFunction> {
  public:
-  static Tensor forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& u_in,
-                        const Tensor& o_in, const Tensor& w_in, std::vector<double> S,
-                        int64_t nw) {
-    const Tensor e = dense(e_in), u = rows_like(u_in, e_in), o = dense(o_in), w = dense(w_in);
-    const int nx = static_cast<int>(e.size(-1)), nu = static_cast<int>(u.size(-1));
-    const int n = static_cast<int>(nw), T = static_cast<int>(o.size(-1)), W = nx + n + nu;
-    PHNN_CHECK(static_cast<int>(S.size()) >= nx * W && T == n * n,
-               "general_s_field_head: structure or output sizes");
-    const int64_t rows = rows_of(e);
-    Tensor f = torch::empty_like(e);
-    const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>();
-    const double *po = o.data_ptr<double>(), *pw = w.data_ptr<double>();
-    double* pf = f.data_ptr<double>();
-    std::vector<double> y(n), z(n);
-    for (int64_t r = 0; r < rows; ++r) {
-      const PortRow port{po + T * r, n};
-      const double* wr = pw + n * r;
-      lower_times(port.o, wr, n, y.data());
-      lower_transpose_times(port.o, y.data(), n, z.data());
-      for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b) z[a] += port.a(a, b) * wr[b];
-      for (int i = 0; i < nx; ++i) {
-        const double* s = S.data() + i * W;
-        double acc = 0.0;
-        for (int j = 0; j < nx; ++j) acc += s[j] * pe[nx * r + j];
-        for (int a = 0; a < n; ++a) acc += s[nx + a] * z[a];
-        for (int b = 0; b < nu; ++b) acc += s[nx + n + b] * pu[nu * r + b];
-        pf[nx * r + i] = acc;
-      }
-    }
-    ctx->save_for_backward({o, w});
+  static Tensor forward(AutogradContext* ctx, const Tensor& e, const Tensor& u, const Tensor& o,
+                        const Tensor& w, std::vector<double> S, int64_t nw) {
+    const Tensor f = general_s_field_forward(e, u, o, w, S, static_cast<int>(nw));
+    ctx->save_for_backward({dense(o), dense(w)});
     ctx->saved_data["S"] = S;
-    ctx->saved_data["dims"] = std::vector<int64_t>{nx, n, nu};
+    ctx->saved_data["dims"] = std::vector<int64_t>{e.size(-1), nw, u.size(-1)};
     return f;
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &o = saved[0], &w = saved[1];
-    const std::vector<double> S = ctx->saved_data["S"].toDoubleVector();
     const auto dims = ctx->saved_data["dims"].toIntVector();
-    const int nx = static_cast<int>(dims[0]), n = static_cast<int>(dims[1]);
-    const int nu = static_cast<int>(dims[2]), T = static_cast<int>(o.size(-1)), W = nx + n + nu;
-    const Tensor fb = dense(grads[0]);
-    const int64_t E = o.size(0), B = o.size(1), rows = rows_of(o);
-    Tensor e_bar = torch::empty({E, B, nx}, o.options()), u_bar = torch::empty({E, B, nu}, o.options());
-    Tensor o_bar = torch::empty_like(o), w_bar = torch::empty_like(w);
-    const double *po = o.data_ptr<double>(), *pw = w.data_ptr<double>(), *pfb = fb.data_ptr<double>();
-    double *peb = e_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>();
-    double *pob = o_bar.data_ptr<double>(), *pwb = w_bar.data_ptr<double>();
-    std::vector<double> adj(W), y(n), yb(n);
-    for (int64_t r = 0; r < rows; ++r) {
-      const double* f = pfb + nx * r;
-      for (int j = 0; j < W; ++j) {
-        double s = 0.0;
-        for (int i = 0; i < nx; ++i) s += f[i] * S[static_cast<std::size_t>(i * W + j)];
-        adj[j] = s;
-      }
-      for (int j = 0; j < nx; ++j) peb[nx * r + j] = adj[j];
-      for (int b = 0; b < nu; ++b) pub[nu * r + b] = adj[nx + n + b];
-      const double* zb = adj.data() + nx;
-      const PortRow port{po + T * r, n};
-      const double* wr = pw + n * r;
-      lower_times(port.o, wr, n, y.data());
-      lower_times(port.o, zb, n, yb.data());
-      double* ob = pob + T * r;
-      for (int i = 0; i < n; ++i)
-        for (int a = 0; a <= i; ++a) ob[tri(i, a)] = y[i] * zb[a] + yb[i] * wr[a];
-      for (int a = 1; a < n; ++a)
-        for (int b = 0; b < a; ++b) ob[n * (n + 1) / 2 + a * (a - 1) / 2 + b] = zb[a] * wr[b] - zb[b] * wr[a];
-      double* wb = pwb + n * r;
-      lower_transpose_times(port.o, yb.data(), n, wb);
-      for (int c = 0; c < n; ++c)
-        for (int a = 0; a < n; ++a) wb[c] += port.a(a, c) * zb[a];
-    }
-    return {e_bar, u_bar, o_bar, w_bar, Tensor(), Tensor()};
+    const auto adj = general_s_field_backward(
+        saved[0], saved[1], ctx->saved_data["S"].toDoubleVector(), static_cast<int>(dims[0]),
+        static_cast<int>(dims[1]), static_cast<int>(dims[2]), grads[0]);
+    return {adj.e, adj.u, adj.o, adj.w, Tensor(), Tensor()};
   }
 };
 
@@ -131,68 +148,86 @@ class SFieldFunction : public torch::autograd::Function<SFieldFunction> {
 //   y = L p,  f_i = sum_j J_ij p_j - (L^T y)_i  (i < n_x).
 // Backward with f~ (zero beyond n_x), r~ = -f~:
 //   y~ = L r~,  L~_rc = r~_c y_r + y~_r p_c,  p~ = J^T f~ + L^T y~.
+}  // namespace
+
+Tensor general_jr_field_forward(const Tensor& e_in, const Tensor& u_in, const Tensor& o_in,
+                                const std::vector<double>& J) {
+  const Tensor e = dense(e_in), u = rows_like(u_in, e_in), o = dense(o_in);
+  const int nx = static_cast<int>(e.size(-1)), nu = static_cast<int>(u.size(-1)), m = nx + nu;
+  PHNN_CHECK(static_cast<int>(J.size()) == m * m && o.size(-1) == m * (m + 1) / 2,
+             "general_jr_field_head: structure or output sizes");
+  const int K = m * (m + 1) / 2;
+  const int64_t rows = rows_of(e);
+  Tensor f = torch::empty_like(e);
+  const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>(), *po = o.data_ptr<double>();
+  double* pf = f.data_ptr<double>();
+  std::vector<double> p(m), y(m), rr(m);
+  for (int64_t r = 0; r < rows; ++r) {
+    for (int j = 0; j < nx; ++j) p[j] = pe[nx * r + j];
+    for (int b = 0; b < nu; ++b) p[nx + b] = pu[nu * r + b];
+    lower_times(po + K * r, p.data(), m, y.data());
+    lower_transpose_times(po + K * r, y.data(), m, rr.data());
+    for (int i = 0; i < nx; ++i) {
+      double s = 0.0;
+      for (int j = 0; j < m; ++j) s += J[static_cast<std::size_t>(i * m + j)] * p[j];
+      pf[nx * r + i] = s - rr[i];
+    }
+  }
+  return f;
+}
+
+JrFieldAdjoints general_jr_field_backward(const Tensor& e_in, const Tensor& u_in,
+                                          const Tensor& o_in, const std::vector<double>& J,
+                                          const Tensor& f_bar) {
+  const Tensor e = dense(e_in), u = rows_like(u_in, e_in), o = dense(o_in);
+  const int nx = static_cast<int>(e.size(-1)), nu = static_cast<int>(u.size(-1)), m = nx + nu;
+  const int K = m * (m + 1) / 2;
+  const Tensor fb = dense(f_bar);
+  const int64_t rows = rows_of(e);
+  JrFieldAdjoints out{torch::empty_like(e), torch::empty_like(o), torch::empty_like(u)};
+  const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>(), *po = o.data_ptr<double>();
+  const double* pfb = fb.data_ptr<double>();
+  double *peb = out.effort.data_ptr<double>(), *pub = out.u.data_ptr<double>();
+  double* pob = out.o.data_ptr<double>();
+  std::vector<double> p(m), y(m), rb(m, 0.0), yb(m), pb(m);
+  for (int64_t r = 0; r < rows; ++r) {
+    for (int j = 0; j < nx; ++j) p[j] = pe[nx * r + j], rb[j] = -pfb[nx * r + j];
+    for (int b = 0; b < nu; ++b) p[nx + b] = pu[nu * r + b];
+    const double* L = po + K * r;
+    lower_times(L, p.data(), m, y.data());
+    lower_times(L, rb.data(), m, yb.data());
+    double* ob = pob + K * r;
+    for (int i = 0; i < m; ++i)
+      for (int c = 0; c <= i; ++c) ob[tri(i, c)] = rb[c] * y[i] + yb[i] * p[c];
+    lower_transpose_times(L, yb.data(), m, pb.data());
+    for (int j = 0; j < m; ++j) {
+      double s = 0.0;
+      for (int i = 0; i < nx; ++i) s += pfb[nx * r + i] * J[static_cast<std::size_t>(i * m + j)];
+      pb[j] += s;
+    }
+    for (int j = 0; j < nx; ++j) peb[nx * r + j] = pb[j];
+    for (int b = 0; b < nu; ++b) pub[nu * r + b] = pb[nx + b];
+  }
+  return out;
+}
+
+namespace {
+
 class JrFieldFunction : public torch::autograd::Function<JrFieldFunction> {
  public:
-  static Tensor forward(AutogradContext* ctx, const Tensor& e_in, const Tensor& u_in,
-                        const Tensor& o_in, std::vector<double> J) {
-    const Tensor e = dense(e_in), u = rows_like(u_in, e_in), o = dense(o_in);
-    const int nx = static_cast<int>(e.size(-1)), nu = static_cast<int>(u.size(-1)), m = nx + nu;
-    PHNN_CHECK(static_cast<int>(J.size()) == m * m && o.size(-1) == m * (m + 1) / 2,
-               "general_jr_field_head: structure or output sizes");
-    const int K = m * (m + 1) / 2;
-    const int64_t rows = rows_of(e);
-    Tensor f = torch::empty_like(e);
-    const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>(), *po = o.data_ptr<double>();
-    double* pf = f.data_ptr<double>();
-    std::vector<double> p(m), y(m), rr(m);
-    for (int64_t r = 0; r < rows; ++r) {
-      for (int j = 0; j < nx; ++j) p[j] = pe[nx * r + j];
-      for (int b = 0; b < nu; ++b) p[nx + b] = pu[nu * r + b];
-      lower_times(po + K * r, p.data(), m, y.data());
-      lower_transpose_times(po + K * r, y.data(), m, rr.data());
-      for (int i = 0; i < nx; ++i) {
-        double s = 0.0;
-        for (int j = 0; j < m; ++j) s += J[static_cast<std::size_t>(i * m + j)] * p[j];
-        pf[nx * r + i] = s - rr[i];
-      }
-    }
-    ctx->save_for_backward({e, u, o});
+  static Tensor forward(AutogradContext* ctx, const Tensor& e, const Tensor& u, const Tensor& o,
+                        std::vector<double> J) {
+    const Tensor f = general_jr_field_forward(e, u, o, J);
+    ctx->save_for_backward({dense(e), rows_like(u, e), dense(o)});
     ctx->saved_data["J"] = J;
     return f;
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &e = saved[0], &u = saved[1], &o = saved[2];
-    const std::vector<double> J = ctx->saved_data["J"].toDoubleVector();
-    const int nx = static_cast<int>(e.size(-1)), nu = static_cast<int>(u.size(-1)), m = nx + nu;
-    const int K = m * (m + 1) / 2;
-    const Tensor fb = dense(grads[0]);
-    const int64_t rows = rows_of(e);
-    Tensor e_bar = torch::empty_like(e), u_bar = torch::empty_like(u), o_bar = torch::empty_like(o);
-    const double *pe = e.data_ptr<double>(), *pu = u.data_ptr<double>(), *po = o.data_ptr<double>();
-    const double* pfb = fb.data_ptr<double>();
-    double *peb = e_bar.data_ptr<double>(), *pub = u_bar.data_ptr<double>(), *pob = o_bar.data_ptr<double>();
-    std::vector<double> p(m), y(m), rb(m, 0.0), yb(m), pb(m);
-    for (int64_t r = 0; r < rows; ++r) {
-      for (int j = 0; j < nx; ++j) p[j] = pe[nx * r + j], rb[j] = -pfb[nx * r + j];
-      for (int b = 0; b < nu; ++b) p[nx + b] = pu[nu * r + b];
-      const double* L = po + K * r;
-      lower_times(L, p.data(), m, y.data());
-      lower_times(L, rb.data(), m, yb.data());
-      double* ob = pob + K * r;
-      for (int i = 0; i < m; ++i)
-        for (int c = 0; c <= i; ++c) ob[tri(i, c)] = rb[c] * y[i] + yb[i] * p[c];
-      lower_transpose_times(L, yb.data(), m, pb.data());
-      for (int j = 0; j < m; ++j) {
-        double s = 0.0;
-        for (int i = 0; i < nx; ++i) s += pfb[nx * r + i] * J[static_cast<std::size_t>(i * m + j)];
-        pb[j] += s;
-      }
-      for (int j = 0; j < nx; ++j) peb[nx * r + j] = pb[j];
-      for (int b = 0; b < nu; ++b) pub[nu * r + b] = pb[nx + b];
-    }
-    return {e_bar, u_bar, o_bar, Tensor()};
+    const auto adj = general_jr_field_backward(saved[0], saved[1], saved[2],
+                                               ctx->saved_data["J"].toDoubleVector(), grads[0]);
+    return {adj.effort, adj.u, adj.o, Tensor()};
   }
 };
 

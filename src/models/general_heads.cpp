@@ -5,6 +5,9 @@
 // above each class.
 #include "models/general_heads.h"
 
+#include <algorithm>
+#include <vector>
+
 #include "models/fused_heads_common.h"
 #include "phnn/common/check.h"
 
@@ -41,123 +44,157 @@ void lower_times(const LowerFactor& L, const double* x, int n, double* v) {
   }
 }
 
+}  // namespace
+
+HamiltonianHead general_hamiltonian_forward(const Tensor& o_in, const Tensor& o_g_in,
+                                            const Tensor& x_in, HamiltonianTape* tape) {
+  const Tensor o = dense(o_in), x = dense(x_in);
+  const bool with_grad = o_g_in.defined();
+  const Tensor o_g = with_grad ? dense(o_g_in) : Tensor();
+  const int n = static_cast<int>(x.size(-1)), K = static_cast<int>(o.size(-1));
+  PHNN_CHECK(K == n * (n + 1) / 2,
+             "general_hamiltonian_head: " << K << " outputs for " << n << " states");
+  const int64_t rows = rows_of(o);
+  Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
+  Tensor grad = with_grad ? torch::empty_like(x) : Tensor();
+  Tensor aux = torch::empty({rows, 3 * n}, o.options());
+  const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+  const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
+  double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
+  double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
+  std::vector<double> v(n), c(K);
+  std::vector<int> diagonal(n);
+  for (int i = 0; i < n; ++i) diagonal[i] = tri(i, i);
+  thread_local std::vector<double> columns;
+  columns.resize(static_cast<std::size_t>(SoftplusColumns::size(n, rows)));
+  const SoftplusColumns f = SoftplusColumns::compute(po, K, diagonal, rows, columns.data());
+  for (int64_t r = 0; r < rows; ++r) {
+    double* a = pa + 3 * n * r;
+    for (int i = 0; i < n; ++i)
+      a[3 * i] = f.softplus(i, r), a[3 * i + 1] = f.sigmoid(i, r), a[3 * i + 2] = f.slope(i, r);
+    const LowerFactor L{po + K * r, a};
+    const double* xr = px + n * r;
+    lower_times(L, xr, n, v.data());
+    double s = 0.0;
+    for (int i = 0; i < n; ++i) s += v[i] * v[i];
+    ph[r] = 0.5 * s;
+    if (!with_grad) continue;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j <= i; ++j) c[tri(i, j)] = v[i] * L.sig(i, j) * xr[j];
+    const double* og = pog + static_cast<int64_t>(n) * K * r;
+    for (int i = 0; i < n; ++i) {
+      double g = 0.0;
+      for (int k = i; k < n; ++k) g += L.entry(k, i) * v[k];
+      for (int k = 0; k < K; ++k) g += og[i * K + k] * c[k];
+      pg[n * r + i] = g;
+    }
+  }
+  *tape = HamiltonianTape{o, o_g, x, aux};
+  return {h, grad};
+}
+
+namespace {
+
+// The backward's rows: o_g~, then v~, x~ and o~ of one row (formulas above);
+// `work` holds 3 n + K doubles.
+void hamiltonian_row_backward(const LowerFactor& L, const double* xr, const double* og,
+                              const double* gbr, double hb, int n, int K, double* ogb,
+                              double* ob, double* xb, double* work) {
+  double *v = work, *gb = work + n, *vb = work + 2 * n, *cb = work + 3 * n;
+  std::fill(gb, gb + n, 0.0);
+  std::fill(cb, cb + K, 0.0);
+  lower_times(L, xr, n, v);
+  if (gbr) {
+    for (int i = 0; i < n; ++i) gb[i] = gbr[i];
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j <= i; ++j) {
+        const int k = tri(i, j);
+        const double ck = v[i] * L.sig(i, j) * xr[j];
+        double s = 0.0;
+        for (int d = 0; d < n; ++d) {
+          s += gb[d] * og[d * K + k];
+          ogb[d * K + k] = gb[d] * ck;
+        }
+        cb[k] = s;
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    double s = hb * v[i];
+    for (int c = 0; c <= i; ++c) s += gb[c] * L.entry(i, c) + cb[tri(i, c)] * L.sig(i, c) * xr[c];
+    vb[i] = s;
+  }
+  for (int c = 0; c < n; ++c) {
+    double s = 0.0;
+    for (int i = c; i < n; ++i) s += cb[tri(i, c)] * v[i] * L.sig(i, c) + vb[i] * L.entry(i, c);
+    xb[c] = s;
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int c = 0; c <= i; ++c) {
+      const int k = tri(i, c);
+      const double l_bar = gb[c] * v[i] + vb[i] * xr[c];
+      if (c < i) {
+        ob[k] = l_bar;
+      } else {
+        const double s = L.aux[3 * i + 1];
+        ob[k] = l_bar * L.aux[3 * i + 2] + cb[k] * v[i] * xr[i] * s * (1.0 - s);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+HamiltonianAdjoints general_hamiltonian_backward(const HamiltonianTape& tape,
+                                                 const Tensor& h_bar_in, const Tensor& g_bar_in) {
+  const Tensor &o = tape.o, &x = tape.x, &aux = tape.aux;
+  const bool with_grad = tape.o_g.defined();
+  const int n = static_cast<int>(x.size(-1)), K = static_cast<int>(o.size(-1));
+  const int64_t rows = rows_of(o);
+  const Tensor h_bar = h_bar_in.defined() ? dense(h_bar_in)
+                                          : torch::zeros({o.size(0), o.size(1), 1}, o.options());
+  const Tensor g_bar = with_grad && g_bar_in.defined() ? dense(g_bar_in) : Tensor();
+  Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
+  Tensor o_g_bar = with_grad ? torch::zeros_like(tape.o_g) : Tensor();
+  const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
+  const double *phb = h_bar.data_ptr<double>(), *pa = aux.data_ptr<double>();
+  const double* pog = g_bar.defined() ? tape.o_g.data_ptr<double>() : nullptr;
+  const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
+  double* pogb = g_bar.defined() ? o_g_bar.data_ptr<double>() : nullptr;
+  double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
+  const int64_t per_row = static_cast<int64_t>(n) * K;
+  std::vector<double> work(static_cast<std::size_t>(3 * n + K));
+  for (int64_t r = 0; r < rows; ++r) {
+    hamiltonian_row_backward(LowerFactor{po + K * r, pa + 3 * n * r}, px + n * r,
+                             pog ? pog + per_row * r : nullptr, pgb ? pgb + n * r : nullptr,
+                             phb[r], n, K, pogb ? pogb + per_row * r : nullptr, pob + K * r,
+                             pxb + n * r, work.data());
+  }
+  return {o_bar, o_g_bar, x_bar};
+}
+
+namespace {
+
 class GeneralHamiltonianFunction
     : public torch::autograd::Function<GeneralHamiltonianFunction> {
  public:
-  static variable_list forward(AutogradContext* ctx, const Tensor& o_in,
-                               const c10::optional<Tensor>& o_g_in, const Tensor& x_in) {
-    const Tensor o = dense(o_in), x = dense(x_in);
-    const bool with_grad = o_g_in.has_value();
-    const Tensor o_g = with_grad ? dense(*o_g_in) : Tensor();
-    const int n = static_cast<int>(x.size(-1)), K = static_cast<int>(o.size(-1));
-    PHNN_CHECK(K == n * (n + 1) / 2, "general_hamiltonian_head: " << K << " outputs for " << n << " states");
-    const int64_t rows = rows_of(o);
-    Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
-    Tensor grad = with_grad ? torch::empty_like(x) : Tensor();
-    Tensor aux = torch::empty({rows, 3 * n}, o.options());
-    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
-    const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
-    double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
-    double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
-    std::vector<double> v(n), c(K);
-    std::vector<int> diagonal(n);
-    for (int i = 0; i < n; ++i) diagonal[i] = tri(i, i);
-    thread_local std::vector<double> columns;
-    columns.resize(static_cast<std::size_t>(SoftplusColumns::size(n, rows)));
-    const SoftplusColumns f = SoftplusColumns::compute(po, K, diagonal, rows, columns.data());
-    for (int64_t r = 0; r < rows; ++r) {
-      double* a = pa + 3 * n * r;
-      for (int i = 0; i < n; ++i)
-        a[3 * i] = f.softplus(i, r), a[3 * i + 1] = f.sigmoid(i, r), a[3 * i + 2] = f.slope(i, r);
-      const LowerFactor L{po + K * r, a};
-      const double* xr = px + n * r;
-      lower_times(L, xr, n, v.data());
-      double s = 0.0;
-      for (int i = 0; i < n; ++i) s += v[i] * v[i];
-      ph[r] = 0.5 * s;
-      if (!with_grad) continue;
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j <= i; ++j) c[tri(i, j)] = v[i] * L.sig(i, j) * xr[j];
-      const double* og = pog + static_cast<int64_t>(n) * K * r;
-      for (int i = 0; i < n; ++i) {
-        double g = 0.0;
-        for (int k = i; k < n; ++k) g += L.entry(k, i) * v[k];
-        for (int k = 0; k < K; ++k) g += og[i * K + k] * c[k];
-        pg[n * r + i] = g;
-      }
-    }
-    ctx->save_for_backward({o, with_grad ? o_g : o, x, aux});
+  static variable_list forward(AutogradContext* ctx, const Tensor& o,
+                               const c10::optional<Tensor>& o_g, const Tensor& x) {
+    HamiltonianTape tape;
+    const auto out = general_hamiltonian_forward(o, o_g.has_value() ? *o_g : Tensor(), x, &tape);
+    const bool with_grad = tape.o_g.defined();
+    ctx->save_for_backward({tape.o, with_grad ? tape.o_g : tape.o, tape.x, tape.aux});
     ctx->saved_data["with_grad"] = with_grad;
-    return with_grad ? variable_list{h, grad} : variable_list{h};
+    return with_grad ? variable_list{out.h, out.grad} : variable_list{out.h};
   }
 
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
     const auto saved = ctx->get_saved_variables();
-    const Tensor &o = saved[0], &x = saved[2], &aux = saved[3];
     const bool with_grad = ctx->saved_data["with_grad"].toBool();
-    const int n = static_cast<int>(x.size(-1)), K = static_cast<int>(o.size(-1));
-    const int64_t rows = rows_of(o);
-    const Tensor h_bar = grads[0].defined() ? dense(grads[0]) : torch::zeros({o.size(0), o.size(1), 1}, o.options());
-    const Tensor g_bar = with_grad && grads[1].defined() ? dense(grads[1]) : Tensor();
-    Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
-    Tensor o_g_bar = with_grad ? torch::zeros_like(saved[1]) : Tensor();
-    const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
-    const double *phb = h_bar.data_ptr<double>(), *pa = aux.data_ptr<double>();
-    const double* pog = g_bar.defined() ? saved[1].data_ptr<double>() : nullptr;
-    const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
-    double* pogb = g_bar.defined() ? o_g_bar.data_ptr<double>() : nullptr;
-    double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
-    std::vector<double> v(n), gb(n), cb(K), vb(n);
-    for (int64_t r = 0; r < rows; ++r) {
-      const LowerFactor L{po + K * r, pa + 3 * n * r};
-      const double* xr = px + n * r;
-      lower_times(L, xr, n, v.data());
-      std::fill(gb.begin(), gb.end(), 0.0);
-      std::fill(cb.begin(), cb.end(), 0.0);
-      if (pgb) {
-        const double* og = pog + static_cast<int64_t>(n) * K * r;
-        double* ogb = pogb + static_cast<int64_t>(n) * K * r;
-        for (int i = 0; i < n; ++i) gb[i] = pgb[n * r + i];
-        for (int i = 0; i < n; ++i) {
-          for (int j = 0; j <= i; ++j) {
-            const int k = tri(i, j);
-            const double ck = v[i] * L.sig(i, j) * xr[j];
-            double s = 0.0;
-            for (int d = 0; d < n; ++d) {
-              s += gb[d] * og[d * K + k];
-              ogb[d * K + k] = gb[d] * ck;
-            }
-            cb[k] = s;
-          }
-        }
-      }
-      for (int i = 0; i < n; ++i) {
-        double s = phb[r] * v[i];
-        for (int c = 0; c <= i; ++c) s += gb[c] * L.entry(i, c) + cb[tri(i, c)] * L.sig(i, c) * xr[c];
-        vb[i] = s;
-      }
-      double* ob = pob + K * r;
-      double* xb = pxb + n * r;
-      for (int c = 0; c < n; ++c) {
-        double s = 0.0;
-        for (int i = c; i < n; ++i) s += cb[tri(i, c)] * v[i] * L.sig(i, c) + vb[i] * L.entry(i, c);
-        xb[c] = s;
-      }
-      const double* a = pa + 3 * n * r;
-      for (int i = 0; i < n; ++i) {
-        for (int c = 0; c <= i; ++c) {
-          const int k = tri(i, c);
-          const double l_bar = gb[c] * v[i] + vb[i] * xr[c];
-          if (c < i) {
-            ob[k] = l_bar;
-          } else {
-            const double s = a[3 * i + 1];
-            ob[k] = l_bar * a[3 * i + 2] + cb[k] * v[i] * xr[i] * s * (1.0 - s);
-          }
-        }
-      }
-    }
-    return {o_bar, o_g_bar, x_bar};
+    const HamiltonianTape tape{saved[0], with_grad ? saved[1] : Tensor(), saved[2], saved[3]};
+    const auto adj = general_hamiltonian_backward(tape, grads[0],
+                                                  with_grad ? grads[1] : Tensor());
+    return {adj.o, adj.o_g, adj.x};
   }
 };
 
@@ -246,52 +283,69 @@ class GeneralGonzalezFunction : public torch::autograd::Function<GeneralGonzalez
   }
 };
 
+}  // namespace
+
 // ----------------------------------------------------------------- linear
 // y_i = sum_j M_ij a_j + sum_j M_i(n_a + j) b_j;  a~_j = sum_i y~_i M_ij, b~ likewise.
+Tensor general_linear_forward(const Tensor& a_in, const Tensor& b_in, const std::vector<double>& M,
+                              int out) {
+  const Tensor a = dense(a_in), b = rows_like(b_in, a_in);
+  const int na = static_cast<int>(a.size(-1)), nb = static_cast<int>(b.size(-1)), w = na + nb;
+  PHNN_CHECK(static_cast<int64_t>(M.size()) == static_cast<int64_t>(out) * w,
+             "general_linear_head: matrix size");
+  const int64_t rows = rows_of(a);
+  Tensor y = torch::empty({a.size(0), a.size(1), out}, a.options());
+  const double *pa = a.data_ptr<double>(), *pb = b.data_ptr<double>();
+  double* py = y.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    for (int64_t i = 0; i < out; ++i) {
+      const double* m = M.data() + i * w;
+      double s = 0.0;
+      for (int j = 0; j < na; ++j) s += m[j] * pa[na * r + j];
+      for (int j = 0; j < nb; ++j) s += m[na + j] * pb[nb * r + j];
+      py[out * r + i] = s;
+    }
+  }
+  return y;
+}
+
+LinearAdjoints general_linear_backward(const Tensor& y_bar, const std::vector<double>& M, int na,
+                                       int nb) {
+  const int w = na + nb;
+  const Tensor yb = dense(y_bar);
+  const int out = static_cast<int>(yb.size(-1));
+  const int64_t rows = rows_of(yb);
+  Tensor a_bar = torch::empty({yb.size(0), yb.size(1), na}, yb.options());
+  Tensor b_bar = torch::empty({yb.size(0), yb.size(1), nb}, yb.options());
+  const double* pyb = yb.data_ptr<double>();
+  double *pab = a_bar.data_ptr<double>(), *pbb = b_bar.data_ptr<double>();
+  for (int64_t r = 0; r < rows; ++r) {
+    for (int j = 0; j < w; ++j) {
+      double s = 0.0;
+      for (int i = 0; i < out; ++i) s += pyb[out * r + i] * M[static_cast<std::size_t>(i * w + j)];
+      if (j < na) pab[na * r + j] = s; else pbb[nb * r + j - na] = s;
+    }
+  }
+  return {a_bar, b_bar};
+}
+
+namespace {
+
 class LinearFunction : public torch::autograd::Function<LinearFunction> {
  public:
-  static Tensor forward(AutogradContext* ctx, const Tensor& a_in, const Tensor& b_in,
+  static Tensor forward(AutogradContext* ctx, const Tensor& a, const Tensor& b,
                         std::vector<double> M, int64_t out) {
-    const Tensor a = dense(a_in), b = rows_like(b_in, a_in);
-    const int na = static_cast<int>(a.size(-1)), nb = static_cast<int>(b.size(-1)), w = na + nb;
-    PHNN_CHECK(static_cast<int64_t>(M.size()) == out * w, "general_linear_head: matrix size");
-    const int64_t rows = rows_of(a);
-    Tensor y = torch::empty({a.size(0), a.size(1), out}, a.options());
-    const double *pa = a.data_ptr<double>(), *pb = b.data_ptr<double>();
-    double* py = y.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      for (int64_t i = 0; i < out; ++i) {
-        const double* m = M.data() + i * w;
-        double s = 0.0;
-        for (int j = 0; j < na; ++j) s += m[j] * pa[na * r + j];
-        for (int j = 0; j < nb; ++j) s += m[na + j] * pb[nb * r + j];
-        py[out * r + i] = s;
-      }
-    }
     ctx->saved_data["M"] = M;
-    ctx->saved_data["na"] = static_cast<int64_t>(na);
-    ctx->saved_data["nb"] = static_cast<int64_t>(nb);
-    return y;
+    ctx->saved_data["na"] = a.size(-1);
+    ctx->saved_data["nb"] = b.size(-1);
+    return general_linear_forward(a, b, M, static_cast<int>(out));
   }
   static variable_list backward(AutogradContext* ctx, variable_list grads) {
-    const std::vector<double> M = ctx->saved_data["M"].toDoubleVector();
-    const int na = static_cast<int>(ctx->saved_data["na"].toInt());
-    const int nb = static_cast<int>(ctx->saved_data["nb"].toInt()), w = na + nb;
-    const Tensor yb = dense(grads[0]);
-    const int out = static_cast<int>(yb.size(-1));
-    const int64_t rows = rows_of(yb);
-    Tensor a_bar = torch::empty({yb.size(0), yb.size(1), na}, yb.options());
-    Tensor b_bar = torch::empty({yb.size(0), yb.size(1), nb}, yb.options());
-    const double* pyb = yb.data_ptr<double>();
-    double *pab = a_bar.data_ptr<double>(), *pbb = b_bar.data_ptr<double>();
-    for (int64_t r = 0; r < rows; ++r) {
-      for (int j = 0; j < w; ++j) {
-        double s = 0.0;
-        for (int i = 0; i < out; ++i) s += pyb[out * r + i] * M[static_cast<std::size_t>(i * w + j)];
-        if (j < na) pab[na * r + j] = s; else pbb[nb * r + j - na] = s;
-      }
-    }
-    return {a_bar, b_bar, Tensor(), Tensor()};
+    const auto adj = general_linear_backward(
+        grads[0], ctx->saved_data["M"].toDoubleVector(),
+        static_cast<int>(ctx->saved_data["na"].toInt()),
+        static_cast<int>(ctx->saved_data["nb"].toInt()));
+    return {adj.a, adj.b, Tensor(), Tensor()};
   }
 };
 

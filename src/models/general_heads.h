@@ -5,12 +5,17 @@
 // depend on its stackmates). Order 0 and 1 in the state (training, RK and DG
 // fields); the jets of order 2 (regularizers, DG4, Newton Jacobians) stay on
 // the op-by-op path of general_ph.cpp, which is also the reference the tests
-// compare these heads with. Private to src/models.
+// compare these heads with. Each head's arithmetic is a pair of plain
+// functions (forward, backward) that its autograd node calls and that the
+// hand-written steps (general_manual_step.cpp) call without a node, so both
+// paths compute the same bits. Private to src/models.
 #pragma once
 
 #include <vector>
 
 #include <torch/torch.h>
+
+#include "models/fused_heads.h"
 
 namespace phnn {
 namespace internal {
@@ -25,6 +30,15 @@ struct GeneralHamiltonian {
 };
 GeneralHamiltonian general_hamiltonian_head(const torch::Tensor& o, const torch::Tensor& o_g,
                                             const torch::Tensor& x);
+
+/// general_hamiltonian_head without an autograd node: the same forward,
+/// with what its backward reads in *tape (o_g undefined: H only), and the
+/// same backward from (H~, gradH~; undefined = 0): the adjoints of o, o_g, x.
+HamiltonianHead general_hamiltonian_forward(const torch::Tensor& o, const torch::Tensor& o_g,
+                                            const torch::Tensor& x, HamiltonianTape* tape);
+HamiltonianAdjoints general_hamiltonian_backward(const HamiltonianTape& tape,
+                                                 const torch::Tensor& h_bar,
+                                                 const torch::Tensor& g_bar);
 
 /// Gonzalez discrete gradient for n states (eq: gonzalez-discrete-gradient):
 ///   dg = g + (H1 - H0 - g.dx) / |dx|^2 dx,  = g where |dx| < min_dx_norm.
@@ -48,6 +62,14 @@ GonzalezAdjoints gonzalez_backward(const torch::Tensor& h0, const torch::Tensor&
 /// (a structure block): the PHNN-S port variables w = [S_wx S_wu] [e; u].
 torch::Tensor general_linear_head(const torch::Tensor& a, const torch::Tensor& b,
                                   const std::vector<double>& M, int rows);
+/// Its forward without a node, and its backward from y~ (n_a, n_b the widths of a, b).
+torch::Tensor general_linear_forward(const torch::Tensor& a, const torch::Tensor& b,
+                                     const std::vector<double>& M, int rows);
+struct LinearAdjoints {
+  torch::Tensor a, b;
+};
+LinearAdjoints general_linear_backward(const torch::Tensor& y_bar, const std::vector<double>& M,
+                                       int n_a, int n_b);
 
 /// PHNN-S field for n_w ports from the effort e [E, B, n_x], u [E, B, n_u],
 /// the L_z outputs o [E, B, n_w (n_w + 1) / 2 + n_w (n_w - 1) / 2] (L_z lower
@@ -57,12 +79,29 @@ torch::Tensor general_linear_head(const torch::Tensor& a, const torch::Tensor& b
 torch::Tensor general_s_field_head(const torch::Tensor& e, const torch::Tensor& u,
                                    const torch::Tensor& o, const torch::Tensor& w,
                                    const std::vector<double>& S, int n_w);
+/// Its forward without a node, and its backward from f~ given o and w.
+torch::Tensor general_s_field_forward(const torch::Tensor& e, const torch::Tensor& u,
+                                      const torch::Tensor& o, const torch::Tensor& w,
+                                      const std::vector<double>& S, int n_w);
+struct SFieldAdjoints {
+  torch::Tensor e, u, o, w;
+};
+SFieldAdjoints general_s_field_backward(const torch::Tensor& o, const torch::Tensor& w,
+                                        const std::vector<double>& S, int n_x, int n_w, int n_u,
+                                        const torch::Tensor& f_bar);
 
 /// PHNN-JR field: f = [(J - L^T L) [e; u]]_{1:n_x} with L lower triangular
 /// m x m (m = n_x + n_u) from the L_R outputs o [E, B, m (m + 1) / 2] and J
 /// row-major m x m.
 torch::Tensor general_jr_field_head(const torch::Tensor& e, const torch::Tensor& u,
                                     const torch::Tensor& o, const std::vector<double>& J);
+/// Its forward without a node, and its backward from f~: the adjoints of
+/// the effort, of o and of u.
+torch::Tensor general_jr_field_forward(const torch::Tensor& e, const torch::Tensor& u,
+                                       const torch::Tensor& o, const std::vector<double>& J);
+JrFieldAdjoints general_jr_field_backward(const torch::Tensor& e, const torch::Tensor& u,
+                                          const torch::Tensor& o, const std::vector<double>& J,
+                                          const torch::Tensor& f_bar);
 
 }  // namespace internal
 }  // namespace phnn

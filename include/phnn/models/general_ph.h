@@ -58,6 +58,14 @@ class GeneralPortHamiltonianModel : public PortHamiltonianModel {
 class GeneralPhnnS : public GeneralPortHamiltonianModel {
  public:
   GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  /// Hand-written steps (src/models/general_manual_step.cpp) without a
+  /// penalty; with one, undefined (the trainer takes autograd).
+  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                 const torch::Tensor& u, double h,
+                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                const torch::Tensor& u, double h, double min_dx_norm,
+                                const JacobianPenalty& penalty) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -76,6 +84,13 @@ class GeneralPhnnS : public GeneralPortHamiltonianModel {
 class GeneralPhnnJr : public GeneralPortHamiltonianModel {
  public:
   GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  /// Hand-written steps without a penalty, as GeneralPhnnS's.
+  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                 const torch::Tensor& u, double h,
+                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                const torch::Tensor& u, double h, double min_dx_norm,
+                                const JacobianPenalty& penalty) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -92,6 +107,10 @@ class GeneralNode : public DynamicsModel {
   GeneralNode(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
+  /// Hand-written RK2 step, with or without a penalty.
+  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                 const torch::Tensor& u, double h,
+                                 const JacobianPenalty& penalty) const override;
 };
 
 }  // namespace phnn

@@ -1,0 +1,108 @@
+// src/models/manual_step.h — the parts of the hand-written training steps
+// that do not depend on a model's structure or size: taped networks, the
+// mean-L1 loss and its adjoint, the RK2 and DG steps of a field recorder,
+// and the PH models' steps around a Hamiltonian head. Private to src/models
+// (manual_step.cpp: the 2-state models; general_manual_step.cpp: any n_x).
+// Every function computes the operations of the autograd path in its order,
+// so the loss and the gradients are bitwise those of loss.sum().backward()
+// (tests/models/manual_step_test.cpp, general_manual_step_test.cpp).
+#pragma once
+
+#include <torch/torch.h>
+
+#include <functional>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "models/fused_heads.h"
+#include "models/fused_mlp.h"
+#include "phnn/models/dynamics_model.h"
+#include "phnn/models/stacked_mlp.h"
+
+namespace phnn {
+namespace internal {
+namespace manual {
+
+using torch::Tensor;
+
+/// One field evaluation f(y) (with df/dx if asked for) and its backward:
+/// adds the parameter gradients of f~ . f + dfdx~ . df/dx into the sinks and
+/// returns y~ if `input` (else undefined; dfdx~ undefined = 0).
+struct TapedField {
+  Tensor f, dfdx;
+  std::function<Tensor(const Tensor& f_bar, const Tensor& dfdx_bar, bool input)> backward;
+};
+using FieldRecorder = std::function<TapedField(const Tensor& y, bool jacobian)>;
+
+/// A PH model's field from an effort e, with y the dissipation's point
+/// (PHNN-S ignores it): f, and the backward f~ -> (e~, y~ or undefined).
+struct TapedEffortField {
+  Tensor f;
+  std::function<std::pair<Tensor, Tensor>(const Tensor& f_bar, bool input)> backward;
+};
+using EffortFieldRecorder = std::function<TapedEffortField(const Tensor& effort, const Tensor& y)>;
+
+/// A PH model's field with df/dx at a data point (no input adjoint), for a
+/// Jacobian penalty; empty where the model has none hand-written.
+using JacobianFieldRecorder = std::function<TapedField(const Tensor& x)>;
+
+/// [x, u] along the last dimension (x [E, B, n], u [E, B, k], both dense).
+Tensor cat_rows(const Tensor& x, const Tensor& u);
+
+/// out = a + c b, elementwise (two roundings: the build does not contract).
+Tensor add_scaled(const Tensor& a, double c, const Tensor& b);
+
+/// The networks a hand-written step can use: fused float64, bound to the
+/// flat buffers.
+bool has_manual_step(const std::vector<std::unique_ptr<StackedMlp>>& nets, torch::ScalarType dtype);
+
+/// A network's taped forward and its backward (parameter gradients into its sinks).
+struct TapedNet {
+  const StackedMlp& net;
+  std::shared_ptr<FusedMlpTape> tape;
+  FusedMlpJet forward(const Tensor& y, int directions, int order);
+  Tensor backward(const std::vector<Tensor>& grads, bool input) const;
+  /// With an order-1 input jet (v, g [E, B, d, n]); backward -> (v~, g~).
+  FusedMlpJet forward_jet(const Tensor& v, const Tensor& g);
+  std::pair<Tensor, Tensor> backward_jet(const std::vector<Tensor>& grads) const;
+};
+
+/// A Hamiltonian head without an autograd node: H (and gradH when o_g is
+/// defined) from L_H's outputs, and its backward. The 2-state closed form
+/// (hamiltonian_head_taped) and the n-state one (general_hamiltonian_forward)
+/// share the tape and adjoint types.
+struct HamiltonianOps {
+  HamiltonianHead (*forward)(const Tensor& o, const Tensor& o_g, const Tensor& x,
+                             HamiltonianTape* tape);
+  HamiltonianAdjoints (*backward)(const HamiltonianTape& tape, const Tensor& h_bar,
+                                  const Tensor& g_bar);
+};
+
+/// The RK2 step of `field`, its mean-L1 loss per member [E] (+ the penalty
+/// of df/dx at x) and backward.
+Tensor rk2_mean_l1(const Tensor& x, const Tensor& x_next, double h, const FieldRecorder& field,
+                   const JacobianPenalty& penalty);
+
+/// RK2 of a PH model: f(y) = F(gradH(y), y), gradH from L_H's order-1 jet in
+/// the y.size(-1) state directions through `head`.
+Tensor ph_rk2_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Tensor& x,
+                      const Tensor& x_next, double h, const EffortFieldRecorder& effort_field,
+                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty);
+
+/// The DG step of a PH model (Gonzalez gradient of H_theta by `head`), its
+/// loss (+ the penalty of df/dx at x) and backward.
+Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Tensor& x,
+                     const Tensor& x_next, double h, double min_dx_norm, bool dissipation_at_start,
+                     const EffortFieldRecorder& effort_field,
+                     const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty);
+
+/// NODE's RK2 step: f = MLP([y, u]) (with its order-1 jet in the n_x state
+/// directions when `penalty` asks for df/dx); y~ = the first n_x columns of
+/// the input adjoint. u is dense [E, B, n_u].
+Tensor node_rk2_mean_l1(const StackedMlp& mlp, const Tensor& x, const Tensor& x_next,
+                        const Tensor& u, double h, const JacobianPenalty& penalty);
+
+}  // namespace manual
+}  // namespace internal
+}  // namespace phnn
