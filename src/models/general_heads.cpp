@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "models/fused_heads_common.h"
+#include "models/head_sizes.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -36,11 +37,47 @@ struct LowerFactor {
   double sig(int r, int c) const { return r == c ? aux[3 * r + 1] : 1.0; }
 };
 
-void lower_times(const LowerFactor& L, const double* x, int n, double* v) {
+template <int N>
+void lower_times(const LowerFactor& L, const double* x, int n_rt, double* v) {
+  const int n = size_of<N>(n_rt);
   for (int r = 0; r < n; ++r) {
     double s = 0.0;
     for (int c = 0; c <= r; ++c) s += L.entry(r, c) * x[c];
     v[r] = s;
+  }
+}
+
+// H (and gradH when pog is set) of every row, the diagonal's softplus
+// columns f saved into pa (formulas above).
+template <int N>
+void hamiltonian_rows_forward(const double* po, const double* px, const double* pog,
+                              const SoftplusColumns& f, int64_t rows, int n_rt, double* pa,
+                              double* ph, double* pg) {
+  const int n = size_of<N>(n_rt), K = n * (n + 1) / 2;
+  std::vector<double> heap(N > 0 ? 0 : n + K);
+  double fixed[N > 0 ? N + N * (N + 1) / 2 : 1];
+  double* v = N > 0 ? fixed : heap.data();
+  double* c = v + n;
+  for (int64_t r = 0; r < rows; ++r) {
+    double* a = pa + 3 * n * r;
+    for (int i = 0; i < n; ++i)
+      a[3 * i] = f.softplus(i, r), a[3 * i + 1] = f.sigmoid(i, r), a[3 * i + 2] = f.slope(i, r);
+    const LowerFactor L{po + K * r, a};
+    const double* xr = px + n * r;
+    lower_times<N>(L, xr, n, v);
+    double s = 0.0;
+    for (int i = 0; i < n; ++i) s += v[i] * v[i];
+    ph[r] = 0.5 * s;
+    if (!pog) continue;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j <= i; ++j) c[tri(i, j)] = v[i] * L.sig(i, j) * xr[j];
+    const double* og = pog + static_cast<int64_t>(n) * K * r;
+    for (int i = 0; i < n; ++i) {
+      double g = 0.0;
+      for (int k = i; k < n; ++k) g += L.entry(k, i) * v[k];
+      for (int k = 0; k < K; ++k) g += og[i * K + k] * c[k];
+      pg[n * r + i] = g;
+    }
   }
 }
 
@@ -62,33 +99,14 @@ HamiltonianHead general_hamiltonian_forward(const Tensor& o_in, const Tensor& o_
   const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
   double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
   double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
-  std::vector<double> v(n), c(K);
   std::vector<int> diagonal(n);
   for (int i = 0; i < n; ++i) diagonal[i] = tri(i, i);
   thread_local std::vector<double> columns;
   columns.resize(static_cast<std::size_t>(SoftplusColumns::size(n, rows)));
   const SoftplusColumns f = SoftplusColumns::compute(po, K, diagonal, rows, columns.data());
-  for (int64_t r = 0; r < rows; ++r) {
-    double* a = pa + 3 * n * r;
-    for (int i = 0; i < n; ++i)
-      a[3 * i] = f.softplus(i, r), a[3 * i + 1] = f.sigmoid(i, r), a[3 * i + 2] = f.slope(i, r);
-    const LowerFactor L{po + K * r, a};
-    const double* xr = px + n * r;
-    lower_times(L, xr, n, v.data());
-    double s = 0.0;
-    for (int i = 0; i < n; ++i) s += v[i] * v[i];
-    ph[r] = 0.5 * s;
-    if (!with_grad) continue;
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j <= i; ++j) c[tri(i, j)] = v[i] * L.sig(i, j) * xr[j];
-    const double* og = pog + static_cast<int64_t>(n) * K * r;
-    for (int i = 0; i < n; ++i) {
-      double g = 0.0;
-      for (int k = i; k < n; ++k) g += L.entry(k, i) * v[k];
-      for (int k = 0; k < K; ++k) g += og[i * K + k] * c[k];
-      pg[n * r + i] = g;
-    }
-  }
+  with_size(n, [&](auto size) {
+    hamiltonian_rows_forward<decltype(size)::value>(po, px, pog, f, rows, n, pa, ph, pg);
+  });
   *tape = HamiltonianTape{o, o_g, x, aux};
   return {h, grad};
 }
@@ -97,13 +115,17 @@ namespace {
 
 // The backward's rows: o_g~, then v~, x~ and o~ of one row (formulas above);
 // `work` holds 3 n + K doubles.
+template <int N>
 void hamiltonian_row_backward(const LowerFactor& L, const double* xr, const double* og,
-                              const double* gbr, double hb, int n, int K, double* ogb,
-                              double* ob, double* xb, double* work) {
-  double *v = work, *gb = work + n, *vb = work + 2 * n, *cb = work + 3 * n;
+                              const double* gbr, double hb, int n_rt, double* ogb, double* ob,
+                              double* xb, double* work) {
+  const int n = size_of<N>(n_rt), K = n * (n + 1) / 2;
+  double fixed[N > 0 ? 3 * N + N * (N + 1) / 2 : 1];
+  double* w = N > 0 ? fixed : work;
+  double *v = w, *gb = w + n, *vb = w + 2 * n, *cb = w + 3 * n;
   std::fill(gb, gb + n, 0.0);
   std::fill(cb, cb + K, 0.0);
-  lower_times(L, xr, n, v);
+  lower_times<N>(L, xr, n, v);
   if (gbr) {
     for (int i = 0; i < n; ++i) gb[i] = gbr[i];
     for (int i = 0; i < n; ++i) {
@@ -164,12 +186,15 @@ HamiltonianAdjoints general_hamiltonian_backward(const HamiltonianTape& tape,
   double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
   const int64_t per_row = static_cast<int64_t>(n) * K;
   std::vector<double> work(static_cast<std::size_t>(3 * n + K));
-  for (int64_t r = 0; r < rows; ++r) {
-    hamiltonian_row_backward(LowerFactor{po + K * r, pa + 3 * n * r}, px + n * r,
-                             pog ? pog + per_row * r : nullptr, pgb ? pgb + n * r : nullptr,
-                             phb[r], n, K, pogb ? pogb + per_row * r : nullptr, pob + K * r,
-                             pxb + n * r, work.data());
-  }
+  with_size(n, [&](auto size) {
+    constexpr int N = decltype(size)::value;
+    for (int64_t r = 0; r < rows; ++r) {
+      hamiltonian_row_backward<N>(LowerFactor{po + K * r, pa + 3 * n * r}, px + n * r,
+                                  pog ? pog + per_row * r : nullptr, pgb ? pgb + n * r : nullptr,
+                                  phb[r], n, pogb ? pogb + per_row * r : nullptr, pob + K * r,
+                                  pxb + n * r, work.data());
+    }
+  });
   return {o_bar, o_g_bar, x_bar};
 }
 

@@ -4,7 +4,8 @@
 // equal (they claim the same operations in the same order), for NODE, PHNN-S
 // and PHNN-JR with RK2 and the PH models with DG (R at the midpoint and at
 // the start; rows below the Gonzalez threshold included), on structures of
-// 2, 4 and 6 states with 0-3 ports and 1-2 inputs, data expanded over the
+// 2, 4, 6 and 10 states (10: the heads' loops sized at run time, above
+// head_sizes.h's fixed sizes) with 0-3 ports and 1-3 inputs, data expanded over the
 // members (the full-batch view) and gathered per member; NODE also with a
 // Jacobian regularizer (the reference is the trainer's regularized loss).
 #include <gtest/gtest.h>
@@ -150,6 +151,7 @@ INSTANTIATE_TEST_SUITE_P(
         Case{M::kPhnnS, I::kDg, 4, 2, 2, false}, Case{M::kPhnnS, I::kDg, 6, 3, 1, true},
         Case{M::kPhnnS, I::kDg, 6, 0, 1, false}, Case{M::kNode, I::kRk2, 2, 1, 1, true},
         Case{M::kNode, I::kRk2, 4, 2, 2, false}, Case{M::kNode, I::kRk2, 6, 3, 1, true},
+        Case{M::kPhnnJr, I::kRk2, 10, 1, 3, false}, Case{M::kPhnnS, I::kDg, 10, 3, 3, true},
         Case{M::kNode, I::kRk2, 2, 1, 1, false, false, Regularizer::kCn},
         Case{M::kNode, I::kRk2, 4, 2, 1, true, false, Regularizer::kSn},
         Case{M::kNode, I::kRk2, 6, 3, 1, false, false, Regularizer::kSr}),
