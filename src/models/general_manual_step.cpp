@@ -1,10 +1,13 @@
 // src/models/general_manual_step.cpp — hand-written training steps of the
 // n-dimensional NODE, PHNN-S and PHNN-JR (include/phnn/models/general_ph.h)
 // on fused float64 networks: RK2 for the three, DG for the PH models, with
-// the mean-L1 loss; NODE also with a Jacobian penalty. Forward, loss and
+// the mean-L1 loss, with or without a Jacobian penalty. Forward, loss and
 // backward run without an autograd graph through the n-state heads' taped
 // forms (general_heads.h) in the order autograd takes the model's graph, so
-// loss and gradients are bitwise those of loss.sum().backward()
+// without a penalty (and for NODE with one) loss and gradients are bitwise
+// those of loss.sum().backward(); with a penalty the PH models' field jet at
+// x runs through general_jet_heads.h (the curvature of H and the field jet
+// heads), which equal the op-by-op jets to round-off
 // (tests/models/general_manual_step_test.cpp). The composition (RK2, DG,
 // the loss) is models/manual_step.h's. Touches only the models' gradient sinks.
 //
@@ -16,12 +19,12 @@
 //   PHNN-S: w = [S_wx S_wu] [e; u], F = S_x [e; z(w); u], z from L_z(w):
 //     the S head (e~ A, w~ B) -> L_z (w~ C) -> the w head from w~ = B + C
 //     (e~ D); e~ = A + D. No ports: F = [S_xx S_xu] [e; u], one linear head.
-// A PH model's regularized steps (order-2 jets of H) stay on autograd.
 #include <array>
 #include <memory>
 
 #include "models/fused_heads_common.h"
 #include "models/general_heads.h"
+#include "models/general_jet_heads.h"
 #include "models/manual_step.h"
 #include "phnn/models/general_ph.h"
 
@@ -34,6 +37,8 @@ using torch::Tensor;
 
 const HamiltonianOps kGeneralHead{internal::general_hamiltonian_forward,
                                   internal::general_hamiltonian_backward};
+const CurvatureOps kGeneralCurvature{internal::general_curvature_forward,
+                                     internal::general_curvature_backward};
 
 // PHNN-JR: F(e, y) = JR(e, L_R(y, u), u).
 EffortFieldRecorder jr_effort_field(const StackedMlp& l_r, const Tensor& u,
@@ -87,55 +92,125 @@ EffortFieldRecorder s_effort_field(const StackedMlp& l_z, const Tensor& u,
   };
 }
 
-// No hand-written Jacobian field for the PH models (their order-2 jets run
-// op by op): the step is taken only without a penalty.
-const JacobianFieldRecorder kNoJacobianField;
+// PHNN-JR's field and df/dx at x: the curvature, L_R's order-1 jet in the
+// n_x state directions, the JR jet head. Backward: the JR jet head, L_R,
+// the curvature head, L_H.
+JacobianFieldRecorder jr_jacobian_field(const StackedMlp& l_h, const StackedMlp& l_r,
+                                        const Tensor& u, const std::vector<double>& J) {
+  return [&l_h, &l_r, u, &J](const Tensor& x) {
+    auto curvature = std::make_shared<TapedCurvature>(l_h, kGeneralCurvature, x);
+    const auto& effort = curvature->effort;
+    auto net_r = std::make_shared<TapedNet>(TapedNet{l_r, nullptr});
+    const auto jet_r = net_r->forward(cat_rows(x, u), static_cast<int>(x.size(-1)), 1);
+    const Tensor o = jet_r.v.contiguous(), o_g = jet_r.g.contiguous();
+    const auto jet =
+        internal::general_jr_field_jet_forward(effort.grad, effort.hessian, o, o_g, u, J);
+    TapedField t{jet.f, jet.g.transpose(-1, -2), {}};
+    t.backward = [=, &J](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
+      const auto jr = internal::general_jr_field_jet_backward(
+          effort.grad, effort.hessian, o, o_g, u, J, f_bar, dfdx_bar.transpose(-1, -2));
+      net_r->backward({jr.o, jr.o_g}, false);
+      curvature->backward(jr.effort, jr.effort_g);
+      return Tensor();
+    };
+    return t;
+  };
+}
+
+// PHNN-S's field and df/dx at x: the curvature, the ports' jet, L_z's
+// order-1 jet from it, the S jet head (no ports: the linear map [S_xx S_xu]
+// as a port map of n_x rows). Backward: the S jet head, L_z, the port map,
+// the curvature, L_H.
+JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp* l_z,
+                                       const Tensor& u, const std::vector<double>& s_w_rows,
+                                       const std::vector<double>& s_x_rows,
+                                       const std::vector<double>& S, int n_w) {
+  return [&l_h, l_z, u, &s_w_rows, &s_x_rows, &S, n_w](const Tensor& x) {
+    auto curvature = std::make_shared<TapedCurvature>(l_h, kGeneralCurvature, x);
+    const auto& e = curvature->effort;
+    const int n_x = static_cast<int>(x.size(-1)), n_u = static_cast<int>(u.size(-1));
+    if (n_w == 0) {
+      const auto f = internal::general_port_jet(e.grad, e.hessian, u, s_x_rows, n_x);
+      TapedField t{f.w, f.w_g.transpose(-1, -2), {}};
+      t.backward = [=, &s_x_rows](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
+        const Tensor fb = f_bar.defined() ? f_bar : torch::zeros_like(f.w);
+        const auto adj =
+            internal::general_port_jet_backward(fb, dfdx_bar.transpose(-1, -2), s_x_rows, n_x, n_u);
+        curvature->backward(adj.e, adj.e_g);
+        return Tensor();
+      };
+      return t;
+    }
+    const auto w = internal::general_port_jet(e.grad, e.hessian, u, s_w_rows, n_w);
+    auto net_z = std::make_shared<TapedNet>(TapedNet{*l_z, nullptr});
+    const auto l = net_z->forward_jet(w.w, w.w_g);
+    const Tensor o = l.v.contiguous(), o_g = l.g.contiguous();
+    const auto jet = internal::general_s_field_jet_forward(e.grad, e.hessian, u, o, o_g, w, S, n_w);
+    TapedField t{jet.f, jet.g.transpose(-1, -2), {}};
+    t.backward = [=, &s_w_rows, &S](const Tensor& f_bar, const Tensor& dfdx_bar, bool /*input*/) {
+      const auto adj = internal::general_s_field_jet_backward(o, o_g, w, S, n_x, n_w, n_u, f_bar,
+                                                              dfdx_bar.transpose(-1, -2));
+      const auto [w_bar, w_g_bar] = net_z->backward_jet({adj.o, adj.o_g});
+      const auto port =
+          internal::general_port_jet_backward(adj.w + w_bar, adj.w_g + w_g_bar, s_w_rows, n_x, n_u);
+      curvature->backward(adj.e + port.e, adj.e_g + port.e_g);
+      return Tensor();
+    };
+    return t;
+  };
+}
 
 }  // namespace
 
 Tensor GeneralPhnnJr::rk2_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
                                        double h, const JacobianPenalty& penalty) const {
-  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
+  if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
   return ph_rk2_mean_l1(l_h(), kGeneralHead, x, x_next, h,
-                        jr_effort_field(*nets_[1], u, structure().J), kNoJacobianField, penalty);
+                        jr_effort_field(*nets_[1], u, structure().J),
+                        jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
 
 Tensor GeneralPhnnJr::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
                                       double h, double min_dx_norm,
                                       const JacobianPenalty& penalty) const {
-  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
+  if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
   return ph_dg_mean_l1(l_h(), kGeneralHead, x, x_next, h, min_dx_norm, dissipation_at_start(),
-                       jr_effort_field(*nets_[1], u, structure().J), kNoJacobianField, penalty);
+                       jr_effort_field(*nets_[1], u, structure().J),
+                       jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
 
 Tensor GeneralPhnnS::rk2_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
                                       double h, const JacobianPenalty& penalty) const {
-  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
+  if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
   const ModelStructure& s = structure();
   const EffortFieldRecorder field = s.n_w == 0
                                         ? linear_effort_field(u, s_x_rows_)
                                         : s_effort_field(*nets_[1], u, s_w_rows_, s.S, s.n_w);
-  return ph_rk2_mean_l1(l_h(), kGeneralHead, x, x_next, h, field, kNoJacobianField, penalty);
+  const JacobianFieldRecorder jacobian = s_jacobian_field(
+      l_h(), s.n_w > 0 ? nets_[1].get() : nullptr, u, s_w_rows_, s_x_rows_, s.S, s.n_w);
+  return ph_rk2_mean_l1(l_h(), kGeneralHead, x, x_next, h, field, jacobian, penalty);
 }
 
 Tensor GeneralPhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
                                      double h, double min_dx_norm,
                                      const JacobianPenalty& penalty) const {
-  if (penalty || !has_manual_step(nets_, options().dtype)) return {};
+  if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
   const ModelStructure& s = structure();
   const EffortFieldRecorder field = s.n_w == 0
                                         ? linear_effort_field(u, s_x_rows_)
                                         : s_effort_field(*nets_[1], u, s_w_rows_, s.S, s.n_w);
-  return ph_dg_mean_l1(l_h(), kGeneralHead, x, x_next, h, min_dx_norm, false, field,
-                       kNoJacobianField, penalty);
+  const JacobianFieldRecorder jacobian = s_jacobian_field(
+      l_h(), s.n_w > 0 ? nets_[1].get() : nullptr, u, s_w_rows_, s_x_rows_, s.S, s.n_w);
+  return ph_dg_mean_l1(l_h(), kGeneralHead, x, x_next, h, min_dx_norm, false, field, jacobian,
+                       penalty);
 }
 
 // NODE: f = MLP([y, u]) (manual_step.h).

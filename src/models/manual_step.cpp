@@ -133,6 +133,19 @@ std::pair<Tensor, Tensor> TapedNet::backward_jet(const std::vector<Tensor>& grad
   return fused_mlp_taped_jet_backward(*tape, net.weights(), net.gradient_sinks(), grads);
 }
 
+TapedCurvature::TapedCurvature(const StackedMlp& net, const CurvatureOps& curvature_ops,
+                               const Tensor& x)
+    : l_h{net, nullptr}, ops(curvature_ops) {
+  const int n = static_cast<int>(x.size(-1));
+  const auto o = l_h.forward(x, n, 2);
+  effort = ops.forward(o.v, o.g, o.h, x, &head);
+}
+
+void TapedCurvature::backward(const Tensor& grad_bar, const Tensor& hessian_bar) const {
+  const auto c = ops.backward(head, grad_bar, hessian_bar);
+  l_h.backward({c.o, c.o_g, c.o_h}, false);
+}
+
 // The RK2 step, its loss (+ the penalty of df/dx at x) and backward (file comment).
 Tensor rk2_mean_l1(const Tensor& x_in, const Tensor& x_next_in, double h,
                    const FieldRecorder& field, const JacobianPenalty& penalty) {

@@ -79,6 +79,27 @@ struct HamiltonianOps {
                                   const Tensor& g_bar);
 };
 
+/// A curvature head without an autograd node: gradH and the Hessian from
+/// L_H's order-2 jet, and its backward (the 2-state closed form and the
+/// n-state one share the types).
+struct CurvatureOps {
+  HamiltonianCurvature (*forward)(const Tensor& o, const Tensor& o_g, const Tensor& o_h,
+                                  const Tensor& x, CurvatureTape* tape);
+  CurvatureAdjoints (*backward)(const CurvatureTape& tape, const Tensor& grad_bar,
+                                const Tensor& hessian_bar);
+};
+
+/// gradH(x) and its Hessian from L_H's order-2 jet in the x.size(-1) state
+/// directions, kept for the backward from (gradH~, Hessian~): the head, then L_H.
+struct TapedCurvature {
+  TapedNet l_h;
+  const CurvatureOps& ops;
+  CurvatureTape head;
+  HamiltonianCurvature effort;
+  TapedCurvature(const StackedMlp& net, const CurvatureOps& curvature_ops, const Tensor& x);
+  void backward(const Tensor& grad_bar, const Tensor& hessian_bar) const;
+};
+
 /// The RK2 step of `field`, its mean-L1 loss per member [E] (+ the penalty
 /// of df/dx at x) and backward.
 Tensor rk2_mean_l1(const Tensor& x, const Tensor& x_next, double h, const FieldRecorder& field,

@@ -27,6 +27,8 @@ using torch::Tensor;
 
 const HamiltonianOps kTwoStateHead{internal::hamiltonian_head_taped,
                                    internal::hamiltonian_head_backward};
+const CurvatureOps kTwoStateCurvature{internal::hamiltonian_curvature_taped,
+                                      internal::hamiltonian_curvature_backward};
 
 // PHNN-JR: F(e, y) = JR(e, L_R(y, u), u). Backward: JR~ -> L_R (y~ = c, its
 // input adjoint), e~; with gradH: y~ = (c + b) + a.
@@ -45,22 +47,6 @@ EffortFieldRecorder jr_effort_field(const StackedMlp& l_r, const Tensor& u,
   };
 }
 
-// gradH(x) and its Hessian from L_H's order-2 jet (the curvature head), kept
-// for the backward from (gradH~, Hessian~): the head, then L_H.
-struct TapedCurvature {
-  TapedNet l_h;
-  internal::CurvatureTape head;
-  internal::HamiltonianCurvature effort;
-  TapedCurvature(const StackedMlp& net, const Tensor& x) : l_h{net, nullptr} {
-    const auto o = l_h.forward(x, 2, 2);
-    effort = internal::hamiltonian_curvature_taped(o.v, o.g, o.h, x, &head);
-  }
-  void backward(const Tensor& grad_bar, const Tensor& hessian_bar) const {
-    const auto c = internal::hamiltonian_curvature_backward(head, grad_bar, hessian_bar);
-    l_h.backward({c.o, c.o_g, c.o_h}, false);
-  }
-};
-
 // PHNN-JR's field and df/dx at x: the curvature (above), L_R's order-1 jet,
 // the JR jet head. Backward, in autograd's order: the JR jet head, L_R, the
 // curvature head, L_H.
@@ -68,7 +54,7 @@ JacobianFieldRecorder jr_jacobian_field(const StackedMlp& l_h, const StackedMlp&
                                         const Tensor& u,
                                         const std::array<std::array<double, 3>, 3>& J) {
   return [&l_h, &l_r, u, J](const Tensor& x) {
-    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
+    auto curvature = std::make_shared<TapedCurvature>(l_h, kTwoStateCurvature, x);
     const auto& effort = curvature->effort;
     auto net_r = std::make_shared<TapedNet>(TapedNet{l_r, nullptr});
     const auto jet_r = net_r->forward(cat_rows(x, u), 2, 1);
@@ -95,7 +81,7 @@ JacobianFieldRecorder jr_jacobian_field(const StackedMlp& l_h, const StackedMlp&
 using EffortJetField = std::function<Jet(const Jet& effort, const Tensor& x)>;
 JacobianFieldRecorder op_by_op_jacobian_field(const StackedMlp& l_h, EffortJetField field_jet) {
   return [&l_h, field_jet](const Tensor& x) {
-    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
+    auto curvature = std::make_shared<TapedCurvature>(l_h, kTwoStateCurvature, x);
     Jet effort, f;
     {
       torch::AutoGradMode enable(true);
@@ -134,7 +120,7 @@ JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp& 
     return op_by_op_jacobian_field(l_h, std::move(field_jet));
   }
   return [&l_h, &l_z, u, structure](const Tensor& x) {
-    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
+    auto curvature = std::make_shared<TapedCurvature>(l_h, kTwoStateCurvature, x);
     const auto& e = curvature->effort;
     const auto w = internal::phnn_s_w_jet_forward(e.grad, e.hessian, u, structure);
     auto net_z = std::make_shared<TapedNet>(TapedNet{l_z, nullptr});

@@ -58,8 +58,8 @@ class GeneralPortHamiltonianModel : public PortHamiltonianModel {
 class GeneralPhnnS : public GeneralPortHamiltonianModel {
  public:
   GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
-  /// Hand-written steps (src/models/general_manual_step.cpp) without a
-  /// penalty; with one, undefined (the trainer takes autograd).
+  /// Hand-written steps (src/models/general_manual_step.cpp): without a
+  /// penalty bitwise autograd's; with one, equal to it to round-off.
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                  const torch::Tensor& u, double h,
                                  const JacobianPenalty& penalty) const override;
@@ -84,7 +84,7 @@ class GeneralPhnnS : public GeneralPortHamiltonianModel {
 class GeneralPhnnJr : public GeneralPortHamiltonianModel {
  public:
   GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
-  /// Hand-written steps without a penalty, as GeneralPhnnS's.
+  /// Hand-written steps, as GeneralPhnnS's.
   torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                  const torch::Tensor& u, double h,
                                  const JacobianPenalty& penalty) const override;
