@@ -29,6 +29,10 @@ using Clock = std::chrono::steady_clock;
 //   results = trainer.finish();                  // best weights, rollouts, results
 // Each phase is a member function that fits on a screen; the state they
 // share is the members below.
+/// Pairs per chunk of the loss passes without gradients (validation, the
+/// training set's loss); 500 unless a test sets another size.
+void set_step_chunk(int64_t rows);
+
 class CellTrainer {
  public:
   // With `checkpointing` (may be null) training states are saved and, from
@@ -60,8 +64,13 @@ class CellTrainer {
   // L_d (Eq. 30) per member in opt_.loss_norm (discrete_loss): by default the
   // mean over batch and components of |x_{n+1} - x_hat| / h.
   // `f_at_x`, when defined, is f(x, u), reused as an explicit step's first stage.
+  // Without it (validation, the training set's loss) the steps are taken a
+  // chunk of pairs at a time (set_step_chunk) and the loss over all at once.
   torch::Tensor data_loss(const torch::Tensor& x, const torch::Tensor& xn, const torch::Tensor& u,
                           const torch::Tensor& f_at_x = {}) const;
+  // x_hat of the discrete model for the pairs (x, xn, u) [E, B, .].
+  torch::Tensor discrete_step(const torch::Tensor& x, const torch::Tensor& xn,
+                              const torch::Tensor& u, const torch::Tensor& f_at_x) const;
   void step(int step, BatchSampler& sampler);
   torch::Tensor loss_and_gradients(const torch::Tensor& x, const torch::Tensor& xn,
                                    const torch::Tensor& u);

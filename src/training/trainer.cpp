@@ -109,14 +109,41 @@ CellTrainer::Tensors CellTrainer::make_tensors() const {
   return t;
 }
 
+torch::Tensor CellTrainer::discrete_step(const torch::Tensor& x, const torch::Tensor& xn,
+                                         const torch::Tensor& u,
+                                         const torch::Tensor& f_at_x) const {
+  const DynamicsModel& m = *model_;
+  return cell_.integrator == IntegratorKind::kDg
+             ? dg_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
+         : cell_.integrator == IntegratorKind::kDg4
+             ? dg4_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
+             : explicit_step(m, cell_.integrator, x, u, h_, f_at_x);
+}
+
+// Pairs per chunk of a validation pass: the jets of a chunk, not of all
+// 2 500 pairs, are what a pass holds (an n_x = 8 large cell of 10 members
+// peaked at 2 GB unchunked). Every row's step depends on that row alone
+// (per-row GEMM chains, row-wise heads), and the loss sums the same terms
+// in the same order, so chunking changes the memory, not the bits
+// (tests/training/trainer_test.cpp, which sets other sizes through
+// set_step_chunk).
+static int64_t step_chunk = 500;
+
+void set_step_chunk(int64_t rows) { step_chunk = rows; }
+
 torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor& xn,
                                      const torch::Tensor& u, const torch::Tensor& f_at_x) const {
-  const DynamicsModel& m = *model_;
-  const auto x_hat =
-      cell_.integrator == IntegratorKind::kDg    ? dg_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
-      : cell_.integrator == IntegratorKind::kDg4 ? dg4_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
-                                                 : explicit_step(m, cell_.integrator, x, u, h_, f_at_x);
-  return discrete_loss(xn, x_hat, h_, opt_.loss_norm);
+  const int64_t B = x.size(1);
+  if (f_at_x.defined() || torch::GradMode::is_enabled() || B <= step_chunk) {
+    return discrete_loss(xn, discrete_step(x, xn, u, f_at_x), h_, opt_.loss_norm);
+  }
+  std::vector<torch::Tensor> parts;
+  for (int64_t s = 0; s < B; s += step_chunk) {
+    const int64_t len = std::min(step_chunk, B - s);
+    const torch::Tensor us = u.size(1) == B ? u.narrow(1, s, len) : u;
+    parts.push_back(discrete_step(x.narrow(1, s, len), xn.narrow(1, s, len), us, {}));
+  }
+  return discrete_loss(xn, torch::cat(parts, /*dim=*/1), h_, opt_.loss_norm);
 }
 
 // Steps first_step_..steps (1.. unless a saved state was restored).

@@ -13,6 +13,9 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include "phnn/data/ph_dataset.h"
+#include "phnn/systems/system_file.h"
+#include "training/cell_trainer.h"
 #include "training/small_data.h"
 
 namespace phnn {
@@ -457,6 +460,70 @@ TEST(CellSpecTest, RejectsNodeWithDgAndBadCounts) {
   cell.training.steps = -1;
   EXPECT_THAT([&] { cell.validate(small_data(SystemKind::kHarmonic)); },
               ThrowsMessage<std::invalid_argument>(HasSubstr("steps = -1")));
+}
+
+}  // namespace
+}  // namespace phnn
+
+namespace phnn {
+namespace {
+
+// The loss passes without gradients take their steps in chunks of pairs
+// (trainer.cpp): the trace (validation and training-set losses) and the
+// MSE are bitwise those of one pass over all pairs, for chunks that divide
+// the 2 500 validation pairs and for ragged ones, on both model stacks.
+TEST(TrainerTest, ChunkedLossPassesAreOnePassToTheBit) {
+  struct Case {
+    ModelKind model;
+    IntegratorKind integrator;
+    Regularizer reg;
+    Precision precision;
+    bool general;
+  };
+  const std::unique_ptr<PhSystem> coupled = load_system_file(
+      std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/coupled-duffing.toml");
+  DatasetOptions options;
+  options.num_inference = 2;
+  const PhSystemData coupled_data = make_ph_system_data(*coupled, options, 100);
+  const Case cases[] = {
+      {ModelKind::kPhnnJr, IntegratorKind::kDg, Regularizer::kCn, Precision::kFloat64, false},
+      {ModelKind::kPhnnS, IntegratorKind::kRk2, Regularizer::kNone, Precision::kFloat64, false},
+      {ModelKind::kNode, IntegratorKind::kRk4, Regularizer::kNone, Precision::kFloat64, false},
+      {ModelKind::kPhnnS, IntegratorKind::kDg4, Regularizer::kNone, Precision::kFloat64, false},
+      {ModelKind::kPhnnJr, IntegratorKind::kRk2, Regularizer::kNone, Precision::kFloat32, false},
+      {ModelKind::kPhnnS, IntegratorKind::kDg, Regularizer::kSn, Precision::kFloat64, true},
+      {ModelKind::kPhnnJr, IntegratorKind::kRk2, Regularizer::kNone, Precision::kFloat64, true}};
+  for (const Case& c : cases) {
+    CellSpec cell;
+    cell.model = c.model;
+    cell.integrator = c.integrator;
+    cell.regularizer = c.reg;
+    cell.n_train = 100;
+    cell.training.precision = c.precision;
+    cell.training.steps = 2;
+    cell.training.eval_every = 1;
+    cell.seeds = {1, 2};
+    std::vector<std::vector<RunResult>> runs;
+    for (const int64_t chunk : {int64_t{1} << 40, int64_t{500}, int64_t{333}}) {
+      internal::set_step_chunk(chunk);
+      runs.push_back(c.general ? train_cell(cell, coupled_data, *coupled)
+                               : train_cell(cell, small_data(SystemKind::kDuffing)));
+    }
+    internal::set_step_chunk(500);
+    const std::string name = model_label(c.model, c.integrator) + " " + to_string(c.reg);
+    for (std::size_t k = 1; k < runs.size(); ++k) {
+      for (std::size_t e = 0; e < runs[0].size(); ++e) {
+        const RunResult &a = runs[0][e], &b = runs[k][e];
+        ASSERT_EQ(a.trace.size(), b.trace.size()) << name;
+        for (std::size_t i = 0; i < a.trace.size(); ++i) {
+          EXPECT_EQ(a.trace[i].validation_loss, b.trace[i].validation_loss) << name << " " << i;
+          EXPECT_EQ(a.trace[i].train_loss, b.trace[i].train_loss) << name << " " << i;
+        }
+        EXPECT_EQ(a.mse, b.mse) << name;
+        EXPECT_EQ(a.weights, b.weights) << name;
+      }
+    }
+  }
 }
 
 }  // namespace
