@@ -32,9 +32,9 @@ FieldEval DynamicsModel::discrete_gradient4_field(const torch::Tensor&, const to
   return {};
 }
 
-torch::Tensor DynamicsModel::rk2_mean_l1_step(const torch::Tensor&, const torch::Tensor&,
-                                              const torch::Tensor&, double,
-                                              const JacobianPenalty&) const {
+torch::Tensor DynamicsModel::explicit_mean_l1_step(IntegratorKind, const torch::Tensor&,
+                                                   const torch::Tensor&, const torch::Tensor&,
+                                                   double, const JacobianPenalty&) const {
   return {};
 }
 

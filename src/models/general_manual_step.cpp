@@ -162,14 +162,15 @@ JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp* 
 
 }  // namespace
 
-Tensor GeneralPhnnJr::rk2_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
-                                       double h, const JacobianPenalty& penalty) const {
+Tensor GeneralPhnnJr::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
+                                            const Tensor& x_next, const Tensor& u_in, double h,
+                                            const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
-  return ph_rk2_mean_l1(l_h(), kGeneralHead, x, x_next, h,
-                        jr_effort_field(*nets_[1], u, structure().J),
-                        jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
+  return ph_explicit_mean_l1(integrator, l_h(), kGeneralHead, x, x_next, h,
+                             jr_effort_field(*nets_[1], u, structure().J),
+                             jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
 
 Tensor GeneralPhnnJr::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
@@ -183,8 +184,9 @@ Tensor GeneralPhnnJr::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, con
                        jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
 
-Tensor GeneralPhnnS::rk2_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
-                                      double h, const JacobianPenalty& penalty) const {
+Tensor GeneralPhnnS::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
+                                           const Tensor& x_next, const Tensor& u_in, double h,
+                                           const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
@@ -194,7 +196,8 @@ Tensor GeneralPhnnS::rk2_mean_l1_step(const Tensor& x, const Tensor& x_next, con
                                         : s_effort_field(*nets_[1], u, s_w_rows_, s.S, s.n_w);
   const JacobianFieldRecorder jacobian = s_jacobian_field(
       l_h(), s.n_w > 0 ? nets_[1].get() : nullptr, u, s_w_rows_, s_x_rows_, s.S, s.n_w);
-  return ph_rk2_mean_l1(l_h(), kGeneralHead, x, x_next, h, field, jacobian, penalty);
+  return ph_explicit_mean_l1(integrator, l_h(), kGeneralHead, x, x_next, h, field, jacobian,
+                             penalty);
 }
 
 Tensor GeneralPhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
@@ -214,11 +217,12 @@ Tensor GeneralPhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, cons
 }
 
 // NODE: f = MLP([y, u]) (manual_step.h).
-Tensor GeneralNode::rk2_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
-                                     double h, const JacobianPenalty& penalty) const {
+Tensor GeneralNode::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
+                                          const Tensor& x_next, const Tensor& u_in, double h,
+                                          const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  return node_rk2_mean_l1(*nets_[0], x, x_next, rows_like(u_in, x), h, penalty);
+  return node_explicit_mean_l1(integrator, *nets_[0], x, x_next, rows_like(u_in, x), h, penalty);
 }
 
 }  // namespace phnn

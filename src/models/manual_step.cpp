@@ -30,6 +30,7 @@
 #include <cmath>
 
 #include "models/general_heads.h"
+#include "phnn/common/check.h"
 
 namespace phnn {
 namespace internal {
@@ -37,8 +38,9 @@ namespace manual {
 namespace {
 
 // L = (sum_{b,i} |(x_next - x^)_bi / h|) / N per member [E], and in *f_bar
-// the adjoint of f in x^ = x + h f: x^~ h (file comment).
-Tensor mean_l1_loss(const Tensor& x_next, const Tensor& x_hat, double h, Tensor* f_bar) {
+// the adjoint of f in x^ = x + scale f: x^~ scale (file comment).
+Tensor mean_l1_loss(const Tensor& x_next, const Tensor& x_hat, double h, double scale,
+                    Tensor* f_bar) {
   const int64_t E = x_hat.size(0), n = x_hat.size(1) * x_hat.size(2);
   const double count = static_cast<double>(n), seed = 1.0 / count;
   Tensor loss = torch::empty({E}, x_hat.options());
@@ -51,7 +53,7 @@ Tensor mean_l1_loss(const Tensor& x_next, const Tensor& x_hat, double h, Tensor*
       const double scaled = (pn[k] - ph[k]) / h;
       sum += std::fabs(scaled);
       const double sign = static_cast<double>((0.0 < scaled) - (scaled < 0.0));
-      pk[k] = (-((seed * sign) / h)) * h;
+      pk[k] = (-((seed * sign) / h)) * scale;
     }
     pl[e] = sum / count;
   }
@@ -146,23 +148,63 @@ void TapedCurvature::backward(const Tensor& grad_bar, const Tensor& hessian_bar)
   l_h.backward({c.o, c.o_g, c.o_h}, false);
 }
 
+namespace {
+
 // The RK2 step, its loss (+ the penalty of df/dx at x) and backward (file comment).
-Tensor rk2_mean_l1(const Tensor& x_in, const Tensor& x_next_in, double h,
-                   const FieldRecorder& field, const JacobianPenalty& penalty) {
-  const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
+Tensor rk2_mean_l1(const Tensor& x, const Tensor& x_next, double h, const FieldRecorder& field,
+                   const JacobianPenalty& penalty) {
   const TapedField s1 = field(x, static_cast<bool>(penalty));
   const TapedField s2 = field(add_scaled(x, 0.5 * h, s1.f), false);
   Tensor k2_bar, dfdx_bar;
-  const Tensor loss = add_penalty(mean_l1_loss(x_next, add_scaled(x, h, s2.f), h, &k2_bar), penalty,
-                                  s1.dfdx, &dfdx_bar);
+  const Tensor loss = add_penalty(mean_l1_loss(x_next, add_scaled(x, h, s2.f), h, h, &k2_bar),
+                                  penalty, s1.dfdx, &dfdx_bar);
   const Tensor x2_bar = s2.backward(k2_bar, Tensor(), true);
   s1.backward(x2_bar * (0.5 * h), dfdx_bar, false);
   return loss;
 }
 
-Tensor ph_rk2_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Tensor& x,
-                      const Tensor& x_next, double h, const EffortFieldRecorder& effort_field,
-                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty) {
+// The RK4 step (discrete_step.cpp's rk4_step):
+//   k1 = f(x), k2 = f(x + (h/2) k1), k3 = f(x + (h/2) k2), k4 = f(x + h k3),
+//   c = ((k1 + 2 k2) + 2 k3) + k4,  x^ = x + (h/6) c,
+// its loss (+ the penalty of df/dx at x) and backward, autograd's order:
+//   c~ = x^~ (h/6);  k4~ = c~;  stage 4 -> y4~;  k3~ = 2 c~ + h y4~;  stage 3
+//   -> y3~;  k2~ = 2 c~ + (h/2) y3~;  stage 2 -> y2~;  k1~ = c~ + (h/2) y2~;
+//   stage 1. Each k has two consumers, so each sum has two terms and its
+//   order does not matter; the stages add their parameter gradients 4, 3, 2, 1.
+Tensor rk4_mean_l1(const Tensor& x, const Tensor& x_next, double h, const FieldRecorder& field,
+                   const JacobianPenalty& penalty) {
+  const TapedField s1 = field(x, static_cast<bool>(penalty));
+  const TapedField s2 = field(add_scaled(x, 0.5 * h, s1.f), false);
+  const TapedField s3 = field(add_scaled(x, 0.5 * h, s2.f), false);
+  const TapedField s4 = field(add_scaled(x, h, s3.f), false);
+  const Tensor c = ((s1.f + s2.f * 2.0) + s3.f * 2.0) + s4.f;
+  Tensor c_bar, dfdx_bar;
+  const Tensor loss =
+      add_penalty(mean_l1_loss(x_next, add_scaled(x, h / 6.0, c), h, h / 6.0, &c_bar), penalty,
+                  s1.dfdx, &dfdx_bar);
+  const Tensor y4_bar = s4.backward(c_bar, Tensor(), true);
+  const Tensor y3_bar = s3.backward(c_bar * 2.0 + y4_bar * h, Tensor(), true);
+  const Tensor y2_bar = s2.backward(c_bar * 2.0 + y3_bar * (0.5 * h), Tensor(), true);
+  s1.backward(c_bar + y2_bar * (0.5 * h), dfdx_bar, false);
+  return loss;
+}
+
+}  // namespace
+
+Tensor explicit_mean_l1(IntegratorKind integrator, const Tensor& x_in, const Tensor& x_next_in,
+                        double h, const FieldRecorder& field, const JacobianPenalty& penalty) {
+  const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
+  PHNN_CHECK(integrator == IntegratorKind::kRk2 || integrator == IntegratorKind::kRk4,
+             "explicit_mean_l1: " << to_string(integrator) << " is not explicit");
+  return integrator == IntegratorKind::kRk2 ? rk2_mean_l1(x, x_next, h, field, penalty)
+                                            : rk4_mean_l1(x, x_next, h, field, penalty);
+}
+
+Tensor ph_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& l_h,
+                           const HamiltonianOps& head, const Tensor& x, const Tensor& x_next,
+                           double h, const EffortFieldRecorder& effort_field,
+                           const JacobianFieldRecorder& jacobian_field,
+                           const JacobianPenalty& penalty) {
   const FieldRecorder field = [&](const Tensor& y, bool jacobian) {
     if (jacobian) return jacobian_field(y);
     auto gradient = std::make_shared<TapedGradient>(l_h, head, y);
@@ -174,7 +216,7 @@ Tensor ph_rk2_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const T
     };
     return t;
   };
-  return rk2_mean_l1(x, x_next, h, field, penalty);
+  return explicit_mean_l1(integrator, x, x_next, h, field, penalty);
 }
 
 // The DG step of a PH model, its loss (+ the penalty of df/dx at x) and
@@ -196,7 +238,7 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Te
   const Tensor effort = gonzalez_forward(h0, h1, mid.grad, dx, min_dx_norm);
   const TapedEffortField field = effort_field(effort, dissipation_at_start ? x : m);
   Tensor f_bar, dfdx_bar;
-  const Tensor loss = add_penalty(mean_l1_loss(x_next, add_scaled(x, h, field.f), h, &f_bar),
+  const Tensor loss = add_penalty(mean_l1_loss(x_next, add_scaled(x, h, field.f), h, h, &f_bar),
                                   penalty, at_x.dfdx, &dfdx_bar);
   const auto g =
       gonzalez_backward(h0, h1, mid.grad, dx, min_dx_norm, field.backward(f_bar, false).first);
@@ -209,8 +251,9 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Te
   return loss;
 }
 
-Tensor node_rk2_mean_l1(const StackedMlp& mlp, const Tensor& x, const Tensor& x_next,
-                        const Tensor& u, double h, const JacobianPenalty& penalty) {
+Tensor node_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& mlp, const Tensor& x,
+                             const Tensor& x_next, const Tensor& u, double h,
+                             const JacobianPenalty& penalty) {
   const int n_x = static_cast<int>(x.size(-1));
   const FieldRecorder field = [&](const Tensor& y, bool jacobian) {
     auto net = std::make_shared<TapedNet>(TapedNet{mlp, nullptr});
@@ -224,7 +267,7 @@ Tensor node_rk2_mean_l1(const StackedMlp& mlp, const Tensor& x, const Tensor& x_
     };
     return t;
   };
-  return rk2_mean_l1(x, x_next, h, field, penalty);
+  return explicit_mean_l1(integrator, x, x_next, h, field, penalty);
 }
 
 }  // namespace manual

@@ -100,16 +100,18 @@ struct TapedCurvature {
   void backward(const Tensor& grad_bar, const Tensor& hessian_bar) const;
 };
 
-/// The RK2 step of `field`, its mean-L1 loss per member [E] (+ the penalty
-/// of df/dx at x) and backward.
-Tensor rk2_mean_l1(const Tensor& x, const Tensor& x_next, double h, const FieldRecorder& field,
-                   const JacobianPenalty& penalty);
+/// The explicit step of `field` (RK2 or RK4), its mean-L1 loss per member
+/// [E] (+ the penalty of df/dx at x) and backward.
+Tensor explicit_mean_l1(IntegratorKind integrator, const Tensor& x, const Tensor& x_next, double h,
+                        const FieldRecorder& field, const JacobianPenalty& penalty);
 
-/// RK2 of a PH model: f(y) = F(gradH(y), y), gradH from L_H's order-1 jet in
-/// the y.size(-1) state directions through `head`.
-Tensor ph_rk2_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Tensor& x,
-                      const Tensor& x_next, double h, const EffortFieldRecorder& effort_field,
-                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty);
+/// The explicit step of a PH model: f(y) = F(gradH(y), y), gradH from L_H's
+/// order-1 jet in the y.size(-1) state directions through `head`.
+Tensor ph_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& l_h,
+                           const HamiltonianOps& head, const Tensor& x, const Tensor& x_next,
+                           double h, const EffortFieldRecorder& effort_field,
+                           const JacobianFieldRecorder& jacobian_field,
+                           const JacobianPenalty& penalty);
 
 /// The DG step of a PH model (Gonzalez gradient of H_theta by `head`), its
 /// loss (+ the penalty of df/dx at x) and backward.
@@ -118,11 +120,12 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Te
                      const EffortFieldRecorder& effort_field,
                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty);
 
-/// NODE's RK2 step: f = MLP([y, u]) (with its order-1 jet in the n_x state
+/// NODE's explicit step: f = MLP([y, u]) (with its order-1 jet in the n_x state
 /// directions when `penalty` asks for df/dx); y~ = the first n_x columns of
 /// the input adjoint. u is dense [E, B, n_u].
-Tensor node_rk2_mean_l1(const StackedMlp& mlp, const Tensor& x, const Tensor& x_next,
-                        const Tensor& u, double h, const JacobianPenalty& penalty);
+Tensor node_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& mlp, const Tensor& x,
+                             const Tensor& x_next, const Tensor& u, double h,
+                             const JacobianPenalty& penalty);
 
 }  // namespace manual
 }  // namespace internal

@@ -164,14 +164,15 @@ EffortFieldRecorder s_effort_field(const StackedMlp& l_z, const Tensor& u,
 
 }  // namespace
 
-torch::Tensor PhnnJr::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                       const torch::Tensor& u_in, double h,
-                                       const JacobianPenalty& penalty) const {
+torch::Tensor PhnnJr::explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                            const torch::Tensor& x_next, const torch::Tensor& u_in,
+                                            double h, const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
-  return ph_rk2_mean_l1(*nets_[0], kTwoStateHead, x, x_next, h, jr_effort_field(*nets_[1], u, J_),
-                        jr_jacobian_field(*nets_[0], *nets_[1], u, J_), penalty);
+  return ph_explicit_mean_l1(integrator, *nets_[0], kTwoStateHead, x, x_next, h,
+                             jr_effort_field(*nets_[1], u, J_),
+                             jr_jacobian_field(*nets_[0], *nets_[1], u, J_), penalty);
 }
 
 torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
@@ -187,18 +188,18 @@ torch::Tensor PhnnJr::dg_mean_l1_step(const torch::Tensor& x, const torch::Tenso
 
 // PHNN-S: with a penalty its first stage (RK2) or field at x (DG) is
 // s_jacobian_field (field_from_effort's op-by-op jet for other structures).
-torch::Tensor PhnnS::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                      const torch::Tensor& u, double h,
-                                      const JacobianPenalty& penalty) const {
+torch::Tensor PhnnS::explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                           const torch::Tensor& x_next, const torch::Tensor& u,
+                                           double h, const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const EffortJetField field_jet = [this, &u](const Jet& effort, const Tensor& y) {
     return field_from_effort(effort, y, u, /*order=*/1, /*dissipation_fixed=*/false);
   };
   const Tensor u_rows = rows_like(u, x);
-  return ph_rk2_mean_l1(*nets_[0], kTwoStateHead, x, x_next, h,
-                        s_effort_field(*nets_[1], u_rows, S_),
-                        s_jacobian_field(*nets_[0], *nets_[1], u_rows, S_, field_jet), penalty);
+  return ph_explicit_mean_l1(
+      integrator, *nets_[0], kTwoStateHead, x, x_next, h, s_effort_field(*nets_[1], u_rows, S_),
+      s_jacobian_field(*nets_[0], *nets_[1], u_rows, S_, field_jet), penalty);
 }
 
 torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
@@ -216,12 +217,12 @@ torch::Tensor PhnnS::dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor
 }
 
 // NODE: f = MLP(y, u) (manual_step.h).
-torch::Tensor Node::rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                     const torch::Tensor& u_in, double h,
-                                     const JacobianPenalty& penalty) const {
+torch::Tensor Node::explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                          const torch::Tensor& x_next, const torch::Tensor& u_in,
+                                          double h, const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
-  return node_rk2_mean_l1(*nets_[0], x, x_next, rows_like(u_in, x), h, penalty);
+  return node_explicit_mean_l1(integrator, *nets_[0], x, x_next, rows_like(u_in, x), h, penalty);
 }
 
 }  // namespace phnn

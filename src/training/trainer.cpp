@@ -193,8 +193,8 @@ torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torc
   const bool regularized = cell_.regularizer != Regularizer::kNone;
   if (opt_.loss_norm == LossNorm::kMeanL1) {
     torch::Tensor loss;
-    if (cell_.integrator == IntegratorKind::kRk2) {
-      loss = model_->rk2_mean_l1_step(x, xn, u, h_, penalty_);
+    if (cell_.integrator == IntegratorKind::kRk2 || cell_.integrator == IntegratorKind::kRk4) {
+      loss = model_->explicit_mean_l1_step(cell_.integrator, x, xn, u, h_, penalty_);
     }
     if (cell_.integrator == IntegratorKind::kDg) {
       loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);

@@ -2,7 +2,7 @@
 // of the n-dimensional models (models/general_manual_step.cpp) against
 // autograd on the same model: the loss and every parameter gradient bitwise
 // equal (they claim the same operations in the same order), for NODE, PHNN-S
-// and PHNN-JR with RK2 and the PH models with DG (R at the midpoint and at
+// and PHNN-JR with RK2 and RK4 and the PH models with DG (R at the midpoint and at
 // the start; rows below the Gonzalez threshold included), on structures of
 // 2, 4, 6 and 10 states (10: the heads' loops sized at run time, above
 // head_sizes.h's fixed sizes) with 0-3 ports and 1-3 inputs, data expanded over the
@@ -90,7 +90,7 @@ torch::Tensor autograd_loss_of(const DynamicsModel& model, const Case& c, const 
   const FieldEval at_x = regularized ? model.field(x, u, true) : FieldEval{};
   const auto x_hat = c.integrator == IntegratorKind::kDg
                          ? dg_training_step(model, x, x_next, u, h, min_dx_norm)
-                         : rk2_step(model, x, u, h, at_x.f);
+                         : explicit_step(model, c.integrator, x, u, h, at_x.f);
   const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
   if (!regularized) return loss;
   return loss + regularizer_penalty(c.regularizer, jacobian_stats(at_x.dfdx, options.jacobian_eps),
@@ -137,7 +137,7 @@ TEST_P(GeneralManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
   flat.gradients.zero_();
   const JacobianPenalty penalty = jacobian_penalty(c.regularizer, trainer);
   const auto manual = dg ? model->dg_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty)
-                         : model->rk2_mean_l1_step(x, x_next, u, h, penalty);
+                         : model->explicit_mean_l1_step(c.integrator, x, x_next, u, h, penalty);
   ASSERT_TRUE(manual.defined());
   const double largest = (flat.gradients - autograd_grad).abs().max().item<double>();
   const double scale = autograd_grad.abs().max().item<double>();
@@ -178,7 +178,13 @@ INSTANTIATE_TEST_SUITE_P(
         Case{M::kPhnnS, I::kRk2, 4, 2, 1, false, false, Regularizer::kSr},
         Case{M::kPhnnS, I::kDg, 6, 3, 2, false, false, Regularizer::kSn},
         Case{M::kPhnnS, I::kDg, 4, 0, 1, true, false, Regularizer::kCn},
-        Case{M::kPhnnS, I::kRk2, 10, 3, 3, false, false, Regularizer::kCn}),
+        Case{M::kPhnnS, I::kRk2, 10, 3, 3, false, false, Regularizer::kCn},
+        Case{M::kPhnnJr, I::kRk4, 4, 2, 1, false}, Case{M::kPhnnS, I::kRk4, 6, 3, 2, true},
+        Case{M::kNode, I::kRk4, 4, 2, 1, true},
+        Case{M::kNode, I::kRk4, 6, 3, 1, false, false, Regularizer::kCn},
+        Case{M::kPhnnJr, I::kRk4, 4, 2, 1, true, false, Regularizer::kSn},
+        Case{M::kPhnnS, I::kRk4, 4, 0, 1, false, false, Regularizer::kCn},
+        Case{M::kPhnnS, I::kRk4, 4, 2, 1, true, false, Regularizer::kSr}),
     name_of);
 
 double max_rel(const torch::Tensor& a, const torch::Tensor& b) {

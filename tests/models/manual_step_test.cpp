@@ -1,10 +1,9 @@
 // tests/models/manual_step_test.cpp — the hand-written training steps
-// (models/manual_step.cpp) against autograd on the same model: the loss and
-// every parameter gradient bitwise equal (they claim the same operations in
-// the same order), for NODE, PHNN-S and PHNN-JR with RK2 and the PH models with
-// DG (R at the midpoint and at the start; rows below the Gonzalez threshold
-// included), each built-in structure, two sizes, data expanded over the
-// members (the full-batch view) and gathered per member; with a Jacobian
+// (models/manual_step.h, two_state_manual_step.cpp) against autograd on the same model: the loss
+// and every parameter gradient bitwise equal (they claim the same operations in the same order),
+// for NODE, PHNN-S and PHNN-JR with RK2 and RK4 and the PH models with DG (R at the midpoint and at
+// the start; rows below the Gonzalez threshold included), each built-in structure, two sizes, data
+// expanded over the members (the full-batch view) and gathered per member; with a Jacobian
 // regularizer (CN, SN, SR) the reference is the trainer's regularized loss,
 // L_d + the penalty of df/dx at x with the RK2 step's first stage reused.
 #include <gtest/gtest.h>
@@ -46,7 +45,7 @@ torch::Tensor autograd_loss_of(const DynamicsModel& model, const Case& c, const 
   const FieldEval at_x = regularized ? model.field(x, u, true) : FieldEval{};
   const auto x_hat = c.integrator == IntegratorKind::kDg
                          ? dg_training_step(model, x, x_next, u, h, min_dx_norm)
-                         : rk2_step(model, x, u, h, at_x.f);
+                         : explicit_step(model, c.integrator, x, u, h, at_x.f);
   const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
   if (!regularized) return loss;
   return loss + regularizer_penalty(c.regularizer, jacobian_stats(at_x.dfdx, options.jacobian_eps),
@@ -90,7 +89,7 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
   flat.gradients.zero_();
   const JacobianPenalty penalty = jacobian_penalty(c.regularizer, trainer);
   const auto manual = dg ? model->dg_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty)
-                         : model->rk2_mean_l1_step(x, x_next, u, h, penalty);
+                         : model->explicit_mean_l1_step(c.integrator, x, x_next, u, h, penalty);
   ASSERT_TRUE(manual.defined());
   EXPECT_TRUE(same_bits(manual, autograd_loss)) << manual << autograd_loss;
   EXPECT_TRUE(same_bits(flat.gradients, autograd_grad))
@@ -148,7 +147,19 @@ INSTANTIATE_TEST_SUITE_P(
         Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kHarmonic, ModelSize::kSmall,
              false, false, Regularizer::kSr},
         Case{ModelKind::kPhnnS, IntegratorKind::kDg, SystemKind::kSelfSustained, ModelSize::kSmall,
-             true, false, Regularizer::kCn}),
+             true, false, Regularizer::kCn},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk4, SystemKind::kDuffing, ModelSize::kSmall,
+             false},
+        Case{ModelKind::kPhnnS, IntegratorKind::kRk4, SystemKind::kSelfSustained, ModelSize::kSmall,
+             true},
+        Case{ModelKind::kNode, IntegratorKind::kRk4, SystemKind::kHarmonic, ModelSize::kMedium,
+             false},
+        Case{ModelKind::kPhnnJr, IntegratorKind::kRk4, SystemKind::kHarmonic, ModelSize::kSmall,
+             true, false, Regularizer::kSr},
+        Case{ModelKind::kPhnnS, IntegratorKind::kRk4, SystemKind::kDuffing, ModelSize::kSmall,
+             false, false, Regularizer::kCn},
+        Case{ModelKind::kNode, IntegratorKind::kRk4, SystemKind::kSelfSustained, ModelSize::kSmall,
+             true, false, Regularizer::kSn}),
     // A readable, deterministic name (the default prints the struct's bytes, padding included).
     [](const ::testing::TestParamInfo<Case>& case_info) {
       const Case& c = case_info.param;
@@ -172,7 +183,8 @@ TEST(ManualStepTest, ReferenceNetworksHaveNone) {
     reference.fused_networks = false;
     auto model = DynamicsModel::create(reference, {0, 1});
     model->flatten_parameters();
-    EXPECT_FALSE(model->rk2_mean_l1_step(x, x, u, 0.1, {}).defined()) << to_string(kind);
+    EXPECT_FALSE(model->explicit_mean_l1_step(IntegratorKind::kRk2, x, x, u, 0.1, {}).defined())
+        << to_string(kind);
     EXPECT_FALSE(model->dg_mean_l1_step(x, x, u, 0.1, 1e-10, {}).defined()) << to_string(kind);
   }
 }

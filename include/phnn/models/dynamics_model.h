@@ -84,18 +84,20 @@ class DynamicsModel {
                                              const torch::Tensor& u, double h,
                                              double min_dx_norm) const;
   /// A hand-written training step, where the model has one: the loss L_d
-  /// of the explicit midpoint (RK2) step in the mean-L1 norm per member [E]
+  /// of an explicit step (`integrator`: RK2, the explicit midpoint rule, or
+  /// RK4) in the mean-L1 norm per member [E]
   /// (discrete_loss with LossNorm::kMeanL1), plus `penalty` of df/dx at x if
   /// one is given (the trainer's regularized loss), with its parameter
   /// gradients added into the flat gradient buffer (after
   /// flatten_parameters), in the same operations and order as autograd's
   /// backward of that loss: the same bits, without the graph. Undefined
-  /// where there is none (the caller runs autograd); today: the 2-state
-  /// NODE, PHNN-S and PHNN-JR on fused float64 networks
-  /// (models/manual_step.cpp).
-  virtual torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                         const torch::Tensor& u, double h,
-                                         const JacobianPenalty& penalty) const;
+  /// where there is none (the caller runs autograd); today: NODE, PHNN-S
+  /// and PHNN-JR of both families on fused float64 networks
+  /// (models/manual_step.h).
+  virtual torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                              const torch::Tensor& x_next,
+                                              const torch::Tensor& u, double h,
+                                              const JacobianPenalty& penalty) const;
   /// The same for the DG training step (dg_training_step): PHNN-S and PHNN-JR.
   virtual torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                         const torch::Tensor& u, double h, double min_dx_norm,

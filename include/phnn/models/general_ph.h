@@ -60,9 +60,9 @@ class GeneralPhnnS : public GeneralPortHamiltonianModel {
   GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   /// Hand-written steps (src/models/general_manual_step.cpp): without a
   /// penalty bitwise autograd's; with one, equal to it to round-off.
-  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h,
-                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                      const torch::Tensor& x_next, const torch::Tensor& u,
+                                      double h, const JacobianPenalty& penalty) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                 const torch::Tensor& u, double h, double min_dx_norm,
                                 const JacobianPenalty& penalty) const override;
@@ -85,9 +85,9 @@ class GeneralPhnnJr : public GeneralPortHamiltonianModel {
  public:
   GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   /// Hand-written steps, as GeneralPhnnS's.
-  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h,
-                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                      const torch::Tensor& x_next, const torch::Tensor& u,
+                                      double h, const JacobianPenalty& penalty) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                 const torch::Tensor& u, double h, double min_dx_norm,
                                 const JacobianPenalty& penalty) const override;
@@ -108,9 +108,9 @@ class GeneralNode : public DynamicsModel {
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
   /// Hand-written RK2 step, with or without a penalty.
-  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h,
-                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                      const torch::Tensor& x_next, const torch::Tensor& u,
+                                      double h, const JacobianPenalty& penalty) const override;
 };
 
 }  // namespace phnn

@@ -90,9 +90,9 @@ class PortHamiltonianModel : public DynamicsModel {
 class PhnnS : public PortHamiltonianModel {
  public:
   PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
-  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h,
-                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                      const torch::Tensor& x_next, const torch::Tensor& u,
+                                      double h, const JacobianPenalty& penalty) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                 const torch::Tensor& u, double h, double min_dx_norm,
                                 const JacobianPenalty& penalty) const override;
@@ -112,9 +112,9 @@ class PhnnJr : public PortHamiltonianModel {
   PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   /// R_theta(x, u) [E, B, 3, 3] (for tests: symmetric PSD).
   torch::Tensor dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const;
-  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h,
-                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                      const torch::Tensor& x_next, const torch::Tensor& u,
+                                      double h, const JacobianPenalty& penalty) const override;
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                 const torch::Tensor& u, double h, double min_dx_norm,
                                 const JacobianPenalty& penalty) const override;
@@ -135,9 +135,9 @@ class Node : public DynamicsModel {
   Node(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
-  torch::Tensor rk2_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                 const torch::Tensor& u, double h,
-                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                      const torch::Tensor& x_next, const torch::Tensor& u,
+                                      double h, const JacobianPenalty& penalty) const override;
 };
 
 }  // namespace phnn
