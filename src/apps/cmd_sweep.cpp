@@ -181,6 +181,7 @@ class SweepRun {
       }
       return 0;
     }
+    if (int status = follow_output_link(root_, &out_)) return status;
     torch::set_num_threads(parser_.get_int_in("threads", 1, 4096));
     const Provenance session = session_provenance(MPI_COMM_WORLD, argc_, argv_);
     // Rank 0 alone creates or updates the file, serially; the other ranks open
