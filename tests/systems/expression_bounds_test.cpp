@@ -6,11 +6,15 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include "phnn/systems/system_file.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -73,6 +77,26 @@ TEST(ExpressionBoundsTest, AHugeExponentIsRefusedWithinTwoSeconds) {
   EXPECT_LT(seconds, 2.0);
   EXPECT_THAT(error_of(with("z = [\"c*w\"]", "z = [\"c*w^(10^4)\"]")),
               AllOf(HasSubstr("toy.toml:6: z = "), HasSubstr("the exponent 10000")));
+}
+
+// The whole command: `phnn sweep --dry-run` of a sweep naming such a file
+// ends with the refusal (exit 2) within 2 s, where it ran for 11 minutes.
+TEST(ExpressionBoundsTest, ASweepOfSuchASystemFileEndsWithinTwoSeconds) {
+  const std::string dir = ::testing::TempDir() + "phnn_bounds_" + std::to_string(::getpid());
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  std::ofstream(dir + "/big.toml") << with("k*q^2/2\"", "k*q^2/2 + (q^2)^1000000\"");
+  std::ofstream(dir + "/s.toml") << "name = \"s\"\n[grid]\nsystems = [\"big.toml\"]\n"
+                                    "models = [\"node-rk2\"]\nn_train = [25]\nseeds = [0]\n";
+  std::string log;
+  const auto start = std::chrono::steady_clock::now();
+  const int status = testing_util::run_shell(
+      "timeout -k 1 60 " + std::string(PHNN_BINARY) + " sweep " + dir + "/s.toml --dry-run", &log);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(status, 2) << log;
+  EXPECT_THAT(log, HasSubstr("big.toml:5: H = "));
+  EXPECT_LT(seconds, 2.0) << log;
+  std::system(("rm -rf " + dir).c_str());
 }
 
 TEST(ExpressionBoundsTest, ExponentsMadeOfParametersAndNumbersCountToo) {
