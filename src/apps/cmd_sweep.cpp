@@ -276,7 +276,8 @@ class SweepRun {
         for (const auto& s : grid_.run_studies) studies.push_back(join(s, ","));
         file.emplace(ResultsFile::create(scratch, MPI_COMM_NULL, grid_.runs, studies, spec_.name,
                                          spec_.text, spec_.text_hash, program_version(),
-                                         ResultsLayout::for_runs(grid_.runs)));
+                                         ResultsLayout::for_runs(grid_.runs),
+                                         ResultsFile::CreateMode::kInPlace));
       }
       store_missing_data(&*file, resume);
       session_ = file->begin_session(session);
