@@ -181,6 +181,7 @@ class SweepRun {
       }
       return 0;
     }
+    if (int status = follow_output_link(root_, &out_)) return status;
     torch::set_num_threads(parser_.get_int_in("threads", 1, 4096));
     const Provenance session = session_provenance(MPI_COMM_WORLD, argc_, argv_);
     // Rank 0 alone creates or updates the file, serially; the other ranks open
@@ -275,7 +276,8 @@ class SweepRun {
         for (const auto& s : grid_.run_studies) studies.push_back(join(s, ","));
         file.emplace(ResultsFile::create(scratch, MPI_COMM_NULL, grid_.runs, studies, spec_.name,
                                          spec_.text, spec_.text_hash, program_version(),
-                                         ResultsLayout::for_runs(grid_.runs)));
+                                         ResultsLayout::for_runs(grid_.runs),
+                                         ResultsFile::CreateMode::kInPlace));
       }
       store_missing_data(&*file, resume);
       session_ = file->begin_session(session);

@@ -70,6 +70,21 @@ std::string launch_problem(int size) {
          "--mpi=list`), or start the ranks with `mpirun` inside the allocation";
 }
 
+int follow_output_link(bool root, std::string* out) {
+  std::string target;
+  const std::string problem = resolve_output_link(*out, &target);
+  if (!problem.empty()) {
+    if (root) std::cerr << "phnn sweep: " << problem << "\n";
+    return cli::kUsageError;
+  }
+  if (root && target != *out) {
+    std::cerr << "phnn sweep: " << *out << " is a symbolic link; writing the file it names, "
+              << target << "\n";
+  }
+  *out = target;
+  return 0;
+}
+
 int prepare_output(const std::string& out, const std::string& sweep_path, const SweepSpec& spec,
                    const Grid& grid, WriterLock* lock) {
   make_parent_directories(out);

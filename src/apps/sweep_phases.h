@@ -57,6 +57,11 @@ int agreed(const boost::mpi::communicator& world, bool here, Body&& body) {
 /// whole sweep. "" if this launch looks right.
 std::string launch_problem(int size);
 
+/// A symbolic link as --out: *out becomes the file it names (rank 0 says
+/// so), so the sweep's lock and journals are that file's. Returns 0, or
+/// cli::kUsageError for a link that names no file (rank 0 prints why).
+int follow_output_link(bool root, std::string* out);
+
 /// Rank 0, holding nothing yet: takes the writer lock of `out`, then decides
 /// what to do with what is there; a results file of another sweep text is
 /// replaced by its new version first (sweep_growth.h). Returns 0 = create,

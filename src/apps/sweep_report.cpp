@@ -89,9 +89,12 @@ void print_summary(const std::string& out, int total_runs, double seconds, StopR
               total_runs, format_duration(seconds).c_str(), out.c_str(), counts[1], counts[2],
               counts[3], counts[0], summary.num_runs());
   if (stop == StopReason::kError) {
-    std::printf("phnn sweep: stopped by the error above; every finished run is in the journals "
-                "(%s); fix the cause (free space?) and run the same command again to resume\n",
-                journal_directory(out).c_str());
+    // A full journal does not stop the row (record_item): the file may
+    // hold runs the journals lack, so name both, with the file's count.
+    std::printf("phnn sweep: stopped by the error above; every finished run is in %s (%d "
+                "finished there) or in the journals (%s); fix the cause (free space?) and run the "
+                "same command again to resume\n",
+                out.c_str(), counts[1] + counts[2] + counts[3], journal_directory(out).c_str());
   } else if (stop == StopReason::kSignal) {
     std::printf("phnn sweep: stopped on a signal; run the same command again to resume\n");
   } else if (shard.count > 1) {

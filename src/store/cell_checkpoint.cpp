@@ -99,8 +99,14 @@ void write_cell_checkpoint(const std::string& path, const CellCheckpoint& checkp
     throw std::runtime_error(dir + ": cannot create the journal directory: " +
                              std::strerror(errno));
   }
+  struct stat st;
+  if (::lstat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    throw std::runtime_error(dir + ": a symbolic link or not a directory; the training states "
+                             "live in the journal directory itself: remove it");
+  }
   const std::string scratch = path + ".writing";
-  const int fd = ::open(scratch.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int fd =
+      ::open(scratch.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd < 0) throw std::runtime_error(scratch + ": cannot create: " + std::strerror(errno));
   try {
     try {

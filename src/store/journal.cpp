@@ -12,7 +12,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
@@ -62,9 +62,39 @@ void fsync_directory(const std::string& dir) {
   }
 }
 
+// The whole log `file`, opened without following a symbolic link.
+std::string read_log(const std::string& file) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) {
+    const bool link = errno == ELOOP;
+    throw std::runtime_error(file + (link ? ": a symbolic link where a journal log must be; "
+                                            "remove it (phnn never reads or writes through one)"
+                                          : ": cannot read the journal: " + errno_text()));
+  }
+  std::string text;
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const std::string error = errno_text();
+      ::close(fd);
+      throw std::runtime_error(file + ": cannot read the journal: " + error);
+    }
+    if (n == 0) break;
+    text.append(buf, static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return text;
+}
+
 // rank-<r>.log files of a journal directory with their rank, sorted by rank.
-std::vector<std::pair<int, std::string>> list_logs(const std::string& dir) {
+// A journal directory that is a symbolic link or not a directory throws.
+std::vector<std::pair<int, std::string>> list_logs(const std::string& results_path) {
   std::vector<std::pair<int, std::string>> logs;
+  const std::string problem = journal_directory_problem(results_path);
+  if (!problem.empty()) throw std::runtime_error(problem);
+  const std::string dir = journal_directory(results_path);
   DIR* d = ::opendir(dir.c_str());
   if (d == nullptr) {
     if (errno == ENOENT) return logs;
@@ -92,19 +122,49 @@ std::string journal_directory(const std::string& results_path) {
   return results_path + ".journal";
 }
 
+std::string journal_directory_problem(const std::string& results_path) {
+  const std::string dir = journal_directory(results_path);
+  struct stat st;
+  if (::lstat(dir.c_str(), &st) != 0 || S_ISDIR(st.st_mode)) return "";
+  if (S_ISLNK(st.st_mode)) {
+    return dir + ": a symbolic link, but the journal of " + results_path +
+           " must be a directory of its own (phnn never writes through a link); remove the "
+           "link or pass another --out path";
+  }
+  return dir + ": not a directory, but the journal of " + results_path +
+         " must live there; move it away or pass another --out path";
+}
+
+void ensure_journal_directory(const std::string& results_path, const std::string& where) {
+  const std::string dir = journal_directory(results_path);
+  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
+    throw std::runtime_error(where + ": cannot create the journal directory: " + errno_text() +
+                             "; is the output directory writable?");
+  }
+  const std::string problem = journal_directory_problem(results_path);
+  if (!problem.empty()) throw std::runtime_error(where + ": " + problem);
+}
+
 Journal::Journal(const std::string& results_path, int rank)
     : path_(log_path(results_path, rank)), rank_(rank) {
   const std::string where = "[rank " + std::to_string(rank) + "] " + path_;
   const std::string dir = journal_directory(results_path);
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw std::runtime_error(where + ": cannot create the journal directory: " +
-                             errno_text() + "; is the output directory writable?");
-  }
+  ensure_journal_directory(results_path, where);
   struct stat before {};
-  const bool existed = ::stat(path_.c_str(), &before) == 0;
-  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  const bool existed = ::lstat(path_.c_str(), &before) == 0;
+  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd_ < 0) {
+    if (errno == ELOOP) {
+      throw std::runtime_error(where + ": a symbolic link where this rank's journal must be; "
+                               "remove it (phnn never writes through one)");
+    }
     throw std::runtime_error(where + ": cannot open the journal: " + errno_text());
+  }
+  struct stat opened;
+  if (::fstat(fd_, &opened) != 0 || !S_ISREG(opened.st_mode)) {
+    ::close(fd_);
+    fd_ = -1;
+    throw std::runtime_error(where + ": not a regular file; move it away");
   }
   if (!existed) fsync_directory(dir);
   // A torn last line (no newline) gets its newline now, so the next record
@@ -154,9 +214,8 @@ std::map<std::string, RunResult> replay_journals(const std::string& results_path
   };
   std::map<std::string, Latest> latest;
   int skipped = 0;
-  for (const auto& [rank, file] : list_logs(journal_directory(results_path))) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw std::runtime_error(file + ": cannot read the journal: " + errno_text());
+  for (const auto& [rank, file] : list_logs(results_path)) {
+    std::istringstream in(read_log(file));
     std::string line;
     std::size_t line_number = 0;
     // getline also returns a last line without its newline (a torn record):
@@ -186,7 +245,9 @@ std::map<std::string, RunResult> replay_journals(const std::string& results_path
 
 void remove_journals(const std::string& results_path) {
   const std::string dir = journal_directory(results_path);
-  for (const auto& log : list_logs(dir)) {
+  struct stat st;
+  if (::lstat(dir.c_str(), &st) == 0 && !S_ISDIR(st.st_mode)) return;  // not ours to empty
+  for (const auto& log : list_logs(results_path)) {
     if (::unlink(log.second.c_str()) != 0 && errno != ENOENT) {
       throw std::runtime_error(log.second + ": cannot delete the old journal: " +
                                errno_text());

@@ -276,8 +276,8 @@ struct FileAttributes {
 // removed and the error rethrown.
 void write_new_file(const std::string& path, const ConfigColumns& columns,
                     const std::vector<std::string>& run_studies, const ResultsLayout& layout,
-                    const FileAttributes& a) {
-  write_atomically(path, "creating", [&](const std::string& scratch) {
+                    const FileAttributes& a, bool in_place) {
+  const auto write = [&](const std::string& scratch) {
     h5::File file = h5::File::create(scratch);
     file.set_attribute("/", "format", std::string(ResultsFile::kFormat));
     file.set_attribute("/", "format_version", ResultsFile::kFormatVersion);
@@ -299,7 +299,14 @@ void write_new_file(const std::string& path, const ConfigColumns& columns,
     write_config_columns(file, columns, run_studies);
     write_setting_columns(file, columns.canonical);
     file.close();  // throws if the metadata cannot be written
-  });
+  };
+  // In place: `path` is already the caller's scratch name (no
+  // r.h5.creating.creating in messages).
+  if (in_place) {
+    write(path);
+  } else {
+    write_atomically(path, "creating", write);
+  }
 }
 
 }  // namespace
@@ -311,7 +318,7 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
                                 const std::string& sweep_text,
                                 const std::string& sweep_hash,
                                 const std::string& program_version,
-                                const ResultsLayout& layout) {
+                                const ResultsLayout& layout, CreateMode mode) {
   // Every rank has the same arguments, so these throw everywhere together.
   const std::string where = "ResultsFile::create(" + path + "): ";
   layout.validate();
@@ -341,7 +348,7 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
   // stays on rank 0 and reaches every rank as one error: no rank is left in a
   // collective HDF5 call (docs/DECISIONS.md, "No rank waits forever").
   check_on_rank0(comm, [&] {
-    write_new_file(path, columns, run_studies, layout, attributes);
+    write_new_file(path, columns, run_studies, layout, attributes, mode == CreateMode::kInPlace);
     return std::string();
   });
   std::unique_ptr<Impl> impl;

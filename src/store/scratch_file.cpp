@@ -8,9 +8,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 namespace phnn {
 namespace {
@@ -53,11 +53,43 @@ std::string scratch_path(const std::string& out, const std::string& suffix) {
   return path;
 }
 
+// A plain read/write loop: std::filesystem::copy_file reports a short
+// sendfile (a full disk) as EIO, which hides the cause.
 void copy_file(const std::string& from, const std::string& to) {
-  std::error_code error;
-  std::filesystem::copy_file(from, to, error);
-  if (error) {
-    throw std::runtime_error("cannot copy " + from + " to " + to + ": " + error.message());
+  const std::string what = "cannot copy " + from + " to " + to + ": ";
+  const int in = ::open(from.c_str(), O_RDONLY | O_CLOEXEC);
+  if (in < 0) throw std::runtime_error(what + errno_text());
+  struct stat st;
+  const mode_t mode = ::fstat(in, &st) == 0 ? (st.st_mode & 0777) : 0644;
+  const int out = ::open(to.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
+  if (out < 0) {
+    const std::string error = errno_text();
+    ::close(in);
+    throw std::runtime_error(what + error);
+  }
+  std::string error;
+  std::vector<char> buffer(1 << 20);
+  for (;;) {
+    const ssize_t n = ::read(in, buffer.data(), buffer.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n < 0) error = errno_text();
+      break;
+    }
+    for (ssize_t done = 0; done < n && error.empty();) {
+      const ssize_t w = ::write(out, buffer.data() + done, static_cast<std::size_t>(n - done));
+      if (w < 0 && errno == EINTR) continue;
+      if (w < 0) error = errno_text();
+      if (w > 0) done += w;
+    }
+    if (!error.empty()) break;
+  }
+  ::close(in);
+  if (::close(out) != 0 && error.empty()) error = errno_text();
+  if (!error.empty()) {
+    ::unlink(to.c_str());
+    throw std::runtime_error(what + error + (error == std::strerror(ENOSPC) ? "; free space "
+                                             "(a resume copies the file once)" : ""));
   }
 }
 

@@ -111,6 +111,7 @@ std::vector<MeasuredTrajectory> read_trajectory_csv(const std::string& path,
   std::string line;
   for (int lineno = 1; std::getline(in, line); ++lineno) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (lineno == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 BOM
     if (trim(line).empty() || trim(line)[0] == '#') continue;
     const std::string at = path + ":" + std::to_string(lineno);
     const std::vector<std::string> fields = split_fields(line);

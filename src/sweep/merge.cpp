@@ -156,7 +156,8 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
   write_atomically(out, "partial", [&](const std::string& scratch) {
     ResultsFile merged = ResultsFile::create(scratch, MPI_COMM_NULL, grid.runs,
                                              results_copy::joined_studies(grid), spec.name,
-                                             spec.text, spec.text_hash, program_version, layout);
+                                             spec.text, spec.text_hash, program_version, layout,
+                                             ResultsFile::CreateMode::kInPlace);
     copy_data_groups(files, spec, grid, &merged);
     for (std::size_t s = 0; s < files.size(); ++s) {
       results_copy::copy_sessions(files[s], &merged);

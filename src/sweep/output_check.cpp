@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
@@ -68,13 +69,13 @@ OutputCheck inspect_hdf5(const std::string& out, const std::string& sweep_hash) 
 OutputCheck inspect_output(const std::string& out, const std::string& sweep_path,
                            const std::string& sweep_hash) {
   try {
-    struct stat journal;
-    const std::string journal_dir = journal_directory(out);
-    if (::stat(journal_dir.c_str(), &journal) == 0 && !S_ISDIR(journal.st_mode)) {
-      return refused(journal_dir + ": not a directory, but the journal of " + out +
-                     " must live there; move it away or pass another --out path");
+    if (const std::string problem = journal_directory_problem(out); !problem.empty()) {
+      return refused(problem);
     }
     struct stat st;
+    if (::lstat(out.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) {
+      return refused(out + ": a symbolic link; pass the file it names with --out");
+    }
     if (::stat(out.c_str(), &st) != 0) {
       if (errno == ENOENT) return {OutputState::kMissing, ""};
       return refused(out + ": cannot inspect the output path: " + std::strerror(errno));
@@ -91,6 +92,12 @@ OutputCheck inspect_output(const std::string& out, const std::string& sweep_path
       return refused(out + ": is the sweep file itself; pass a results-file path with --out "
                            "(e.g. results/<name>.h5)");
     }
+    if (st.st_nlink > 1) {
+      return refused(out + ": has " + std::to_string(st.st_nlink) + " names (hard links); a "
+                     "sweep replaces its results file by rename, which would leave the other "
+                     "names on an old version, and a sweep through another name would not see "
+                     "this one's lock: remove the other links (find -samefile) or pass a copy");
+    }
     if (st.st_size == 0) return {OutputState::kEmpty, "an empty file"};
     if (!has_hdf5_signature(out)) {
       return refused(out + ": exists and is not an HDF5 file, so not a phnn results file; "
@@ -101,6 +108,20 @@ OutputCheck inspect_output(const std::string& out, const std::string& sweep_path
   } catch (const std::exception& e) {
     return refused(out + ": cannot inspect the output path: " + e.what());
   }
+}
+
+std::string resolve_output_link(const std::string& out, std::string* resolved) {
+  *resolved = out;
+  struct stat st;
+  if (::lstat(out.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return "";
+  char* target = ::realpath(out.c_str(), nullptr);
+  if (target == nullptr) {
+    return out + ": a symbolic link that names no file (" + std::strerror(errno) +
+           "); pass the results file's own path with --out";
+  }
+  *resolved = target;
+  std::free(target);
+  return "";
 }
 
 std::string move_aside(const std::string& path, const std::string& reason) {
@@ -116,6 +137,10 @@ std::string move_aside(const std::string& path, const std::string& reason) {
 }
 
 std::string output_name_problem(const std::string& out) {
+  if (out.empty() || out.back() == '/') {
+    return "the output path \"" + out + "\" names no file; pass a results-file path such as "
+           "results/<name>.h5 (--out or `output` in the sweep file)";
+  }
   const std::string dir = parent_directory(out);
   const std::string name = out.substr(out.find_last_of('/') + 1);  // npos + 1 == 0
   long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);

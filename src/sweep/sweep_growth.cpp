@@ -213,7 +213,8 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
     scratch = scratch_path(out, "new-version");
     ResultsFile fresh = ResultsFile::create(
         scratch, MPI_COMM_NULL, grid.runs, studies, spec.name, spec.text, spec.text_hash,
-        program_version, results_copy::wider_layout(old.layout(), ResultsLayout::for_runs(grid.runs)));
+        program_version, results_copy::wider_layout(old.layout(), ResultsLayout::for_runs(grid.runs)),
+        ResultsFile::CreateMode::kInPlace);
     results_copy::copy_sessions(old, &fresh);
     copied = copy_results(old, cmp, &fresh);
     fresh.close();

@@ -8,6 +8,7 @@
 #include "phnn/systems/system_file.h"
 
 #include "phnn/systems/oscillators.h"
+#include "systems/expression_bounds.h"
 #include "systems/expression_code.h"
 
 #include <sys/stat.h>
@@ -76,10 +77,23 @@ std::string names_of(const GiNaC::symtab& table) {
   return out.empty() ? "(none)" : out;
 }
 
+constexpr char kWriteItWith[] =
+    "; write it with + - * / ^, parentheses and functions such as sin, cos, exp, log, sqrt";
+
+// Checked against the limits of systems/expression_bounds.h before GiNaC
+// parses it (GiNaC folds powers while parsing, without a way to stop).
 GiNaC::ex parse_expression(const SystemDefinition& def, const std::string& key,
                            const std::string& text, const GiNaC::symtab& allowed,
                            const std::string& may_use) {
   const int line = def.line_of(key);
+  internal::ExpressionSymbols symbols;
+  symbols.variables.insert(key == "H" ? def.states.begin() : def.ports.begin(),
+                           key == "H" ? def.states.end() : def.ports.end());
+  symbols.constants.insert(def.parameters.begin(), def.parameters.end());
+  if (const std::string bad = internal::expression_bound_problem(text, symbols); !bad.empty()) {
+    throw SystemFileError(def.file, line, key + " = \"" + text + "\" " + bad +
+                                              (bad.rfind("is not", 0) == 0 ? kWriteItWith : ""));
+  }
   GiNaC::parser reader(allowed);
   reader.strict = false;
   GiNaC::ex e;
@@ -87,9 +101,7 @@ GiNaC::ex parse_expression(const SystemDefinition& def, const std::string& key,
     e = reader(text);
   } catch (const std::exception& err) {
     throw SystemFileError(def.file, line, key + " = \"" + text + "\" is not an expression (" +
-                                              first_line(err.what()) +
-                                              "); write it with + - * / ^, parentheses and "
-                                              "functions such as sin, cos, exp, log, sqrt");
+                                              first_line(err.what()) + ")" + kWriteItWith);
   }
   for (const auto& [name, _] : reader.get_syms()) {
     if (allowed.count(name) == 0) {
@@ -228,6 +240,17 @@ std::unique_ptr<CompiledExpressions> FileSystem::make(const std::vector<GiNaC::e
                           "cannot evaluate " + what + " (it contains " + e.what() +
                               "); use the functions sin, cos, tan, exp, log, sqrt, sinh, cosh, "
                               "tanh, asin, acos, atan, abs");
+  } catch (const std::exception& e) {  // GiNaC: a pole, e.g. 1/m with m = 0
+    std::string zeros;
+    for (const auto& [name, value] : def_.parameters) {
+      if (value == 0) zeros += (zeros.empty() ? " (" : ", ") + name + " = 0 on line " +
+                               std::to_string(def_.line_of("parameters." + name));
+    }
+    throw SystemFileError(def_.file, def_.line_of(key),
+                          "cannot evaluate " + what + " with the values of [parameters]" +
+                              (zeros.empty() ? "" : zeros + ")") + ": " + first_line(e.what()) +
+                              "; a parameter that divides, or is the argument of log, must not "
+                              "be 0: change its value");
   }
   try {
     return std::make_unique<CompiledExpressions>(c, vars_.get(), syms_.names);

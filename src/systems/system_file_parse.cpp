@@ -154,6 +154,14 @@ void check_skew(const Reader& r, int line, const MatX& m, const std::string& key
   const double scale = std::max(1.0, m.cwiseAbs().maxCoeff());
   for (int i = 0; i < m.rows(); ++i) {
     for (int j = 0; j <= i; ++j) {
+      if (i == j && std::abs(2 * m(i, i)) > 1e-12 * scale) {
+        const std::string k = std::to_string(i + 1);
+        const std::string at = key + "[" + k + "][" + k + "]";
+        r.fail(line, "\"" + key + "\" is not skew-symmetric: " + at + " = " +
+                         Reader::num(m(i, i)) + " is on the diagonal, which must be 0 (" + at +
+                         " = -" + at + "); " + key + " = -" + key +
+                         "^T is what makes the power balance hold");
+      }
       if (std::abs(m(i, j) + m(j, i)) > 1e-12 * scale) {
         r.fail(line, "\"" + key + "\" is not skew-symmetric: " + key + "[" + std::to_string(i + 1) +
                          "][" + std::to_string(j + 1) + "] = " + Reader::num(m(i, j)) + " but " +

@@ -78,6 +78,17 @@ TEST(MeasuredDataTest, TheGoodFixtureIsAccepted) {
   std::remove(path.c_str());
 }
 
+// Spreadsheets often save CSV with a UTF-8 byte order mark (as sweep files
+// may have one): it is not part of the first column's name.
+TEST(MeasuredDataTest, AByteOrderMarkBeforeTheHeaderIsSkipped) {
+  const auto system = pendulum();
+  const std::string path = csv_file("\xEF\xBB\xBF" + kHeader + kGood);
+  ImportOptions o;
+  o.num_validation = o.num_inference = 1;
+  EXPECT_EQ(split_measured_data(*system, read_trajectory_csv(path, kPendulum), o).train.size(), 1u);
+  std::remove(path.c_str());
+}
+
 TEST(MeasuredDataTest, MalformedCsvFailsAtItsLineWithTheFix) {
   // 1. missing state column
   EXPECT_THAT(read_error("trajectory,t,q,u\n0,0,1,0\n"),

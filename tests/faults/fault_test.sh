@@ -5,7 +5,7 @@
 # without the fault must then finish every run with exactly the results of a
 # sweep that saw no fault (no finished run lost or changed).
 #   CASE: create-eio | row-eio | journal-eio | journal-enospc | disk-full-create |
-#         disk-full-journal | file-size-limit | read-only-dir
+#         disk-full-journal | disk-full-resume | file-size-limit | read-only-dir
 # Exit 77 (skipped) where the case needs what this machine lacks (a tmpfs
 # mount for the disk-full cases).
 set -u
@@ -71,13 +71,19 @@ case $case_name in
       { echo "SKIPPED: cannot mount a tmpfs here"; exit 77; }
     mounted=$out_dir
     faulty=() ;;
-  disk-full-create|disk-full-journal)
+  disk-full-create|disk-full-journal|disk-full-resume)
     reason="No space left on device"
     [[ $(id -u) -eq 0 ]] || { echo "SKIPPED: mounting a tmpfs needs root"; exit 77; }
-    if [[ $case_name == disk-full-create ]]; then size=$(( h5_kb / 2 )); else size=$(( h5_kb + journal_kb / 2 )); fi
+    case $case_name in
+      disk-full-create) size=$(( h5_kb / 2 )) ;;
+      disk-full-journal) size=$(( h5_kb + journal_kb / 2 )) ;;
+      disk-full-resume) size=$(( h5_kb + journal_kb + h5_kb / 2 )) ;;  # no room for the copy
+    esac
     mount -t tmpfs -o size=${size}k tmpfs "$out_dir" 2>/dev/null ||
       { echo "SKIPPED: cannot mount a tmpfs here"; exit 77; }
     mounted=$out_dir
+    # A finished file to resume: the resume's copy of it fills the disk.
+    [[ $case_name == disk-full-resume ]] && cp -a "$dir/ref/r.h5" "$dir/ref/r.h5.journal" "$out_dir/"
     faulty=() ;;
   file-size-limit)
     reason="File too large"
@@ -106,6 +112,13 @@ case $status in
   *) fail "the sweep exited $status, expected 1 (a clean error)" ;;
 esac
 grep -q "$reason" "$dir/log" || fail "no \"$reason\" in the error output"
+grep -q "Input/output error" "$dir/log" && [[ $reason != "Input/output error" ]] &&
+  fail "EIO reported for a fault that is not one"
+if grep -q "stopped by the error above" "$dir/log"; then  # the file may hold runs the journals lack
+  grep -qE "every finished run is in .*r\.h5 \([0-9]+ finished there\) or in the journals" \
+    "$dir/log" || fail "the stop message does not name the results file's finished runs"
+fi
+grep -q "\.creating\.creating\|\.updating\.creating" "$dir/log" && fail "a scratch name of a scratch name"
 trained=$(grep -oE "item [0-9]+/[0-9]+: .*, [0-9]+ seeds?$" "$dir/log" | grep -oE "[0-9]+ seeds?$" |
           awk '{n += $1} END {print n + 0}')
 quiet=(--quiet)

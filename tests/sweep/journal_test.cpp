@@ -1,6 +1,7 @@
 // tests/sweep/journal_test.cpp
 #include "phnn/store/journal.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "sweep/sample_results.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -161,6 +163,37 @@ TEST_F(JournalTest, ReportsAnUnwritableDirectoryWithRankAndPath) {
   EXPECT_THAT([] { Journal("/nonexistent/dir/r.h5", 3); },
               ::testing::ThrowsMessage<std::runtime_error>(
                   HasSubstr("[rank 3] /nonexistent/dir/r.h5.journal/rank-3.log")));
+}
+
+// Files, not paths: a journal directory or log that is a symbolic link is
+// refused, and what it points to is left as it was.
+TEST_F(JournalTest, ASymlinkedJournalDirectoryIsRefusedAndItsTargetUntouched) {
+  const std::string target = results_path_ + ".elsewhere";
+  ::mkdir(target.c_str(), 0755);
+  ASSERT_EQ(::symlink(target.c_str(), journal_directory(results_path_).c_str()), 0);
+  EXPECT_THAT([&] { Journal(results_path_, 0); },
+              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr(
+                  journal_directory(results_path_) + ": a symbolic link, but the journal")));
+  EXPECT_THAT([&] { replay_journals(results_path_); },
+              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("a symbolic link")));
+  EXPECT_NE(::rmdir(target.c_str()), -1) << "something was written into " << target;
+  ::unlink(journal_directory(results_path_).c_str());
+}
+
+TEST_F(JournalTest, ASymlinkedLogIsNeitherWrittenNorReadThrough) {
+  const std::string foreign = results_path_ + ".foreign.txt";
+  std::ofstream(foreign) << "someone else's text\n";
+  ::mkdir(journal_directory(results_path_).c_str(), 0755);
+  const std::string log = journal_directory(results_path_) + "/rank-0.log";
+  ASSERT_EQ(::symlink(foreign.c_str(), log.c_str()), 0);
+  EXPECT_THAT([&] { Journal(results_path_, 0); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  HasSubstr(log + ": a symbolic link where this rank's journal must be")));
+  EXPECT_THAT([&] { replay_journals(results_path_); },
+              ::testing::ThrowsMessage<std::runtime_error>(
+                  HasSubstr(log + ": a symbolic link where a journal log must be")));
+  EXPECT_EQ(testing_util::read_all(foreign), "someone else's text\n");
+  std::remove(foreign.c_str());
 }
 
 }  // namespace

@@ -133,6 +133,45 @@ TEST_F(OutputCheckTest, RefusesAJournalPathThatIsNotADirectory) {
   EXPECT_THAT(c.message, StartsWith(journal_directory(out_) + ": not a directory"));
 }
 
+// Files, not paths: a second name of the results file would escape the
+// writer lock (it keys on the name) and be split off by the next rename.
+TEST_F(OutputCheckTest, RefusesAResultsFileWithASecondName) {
+  create_results();
+  const std::string other = dir_ + "/other.h5";
+  ASSERT_EQ(::link(out_.c_str(), other.c_str()), 0);
+  for (const std::string& name : {out_, other}) {
+    const OutputCheck c = inspect_output(name, sweep_, kHash);
+    EXPECT_EQ(c.state, OutputState::kRefused);
+    EXPECT_THAT(c.message, HasSubstr(name + ": has 2 names (hard links)"));
+  }
+}
+
+TEST_F(OutputCheckTest, RefusesASymlinkedJournalDirectory) {
+  ASSERT_EQ(::symlink(dir_.c_str(), journal_directory(out_).c_str()), 0);
+  const OutputCheck c = check();
+  EXPECT_EQ(c.state, OutputState::kRefused);
+  EXPECT_THAT(c.message, HasSubstr(journal_directory(out_) + ": a symbolic link"));
+}
+
+TEST_F(OutputCheckTest, ALinkAsOutputNamesItsTargetAndADanglingOneIsRefused) {
+  create_results();
+  const std::string link = dir_ + "/link.h5";
+  ASSERT_EQ(::symlink("out.h5", link.c_str()), 0);
+  std::string resolved;
+  EXPECT_EQ(resolve_output_link(link, &resolved), "");
+  struct stat a, b;
+  ASSERT_EQ(::stat(resolved.c_str(), &a), 0);
+  ASSERT_EQ(::stat(out_.c_str(), &b), 0);
+  EXPECT_EQ(a.st_ino, b.st_ino);
+  EXPECT_EQ(resolve_output_link(out_, &resolved), "");
+  EXPECT_EQ(resolved, out_);
+  const std::string dangling = dir_ + "/dangling.h5";
+  ASSERT_EQ(::symlink("nowhere.h5", dangling.c_str()), 0);
+  EXPECT_THAT(resolve_output_link(dangling, &resolved),
+              HasSubstr(dangling + ": a symbolic link that names no file"));
+  EXPECT_EQ(inspect_output(link, sweep_, kHash).state, OutputState::kRefused);
+}
+
 TEST_F(OutputCheckTest, MoveAsidePicksAFreeNameAndKeepsTheBytes) {
   std::ofstream(out_) << "a";
   const std::string first = move_aside(out_, "damaged");
@@ -170,6 +209,8 @@ TEST(OutputNameTest, NamesTooLongForTheFileSystemAreRefusedUpFront) {
   EXPECT_THAT(output_name_problem(dir + "/" + std::string(250, 'x') + ".h5"),
               HasSubstr("choose a shorter `output` or --out"));
   EXPECT_THAT(output_name_problem(std::string(59000, 'y')), HasSubstr("bytes"));
+  EXPECT_THAT(output_name_problem(""), HasSubstr("the output path \"\" names no file"));
+  EXPECT_THAT(output_name_problem(dir + "/"), HasSubstr("names no file"));
   std::string log;
   const std::string sweep = std::string(PHNN_SOURCE_DIR) + "/sweeps/tiny.toml";
   EXPECT_EQ(testing_util::run_shell(std::string(PHNN_BINARY) + " sweep " + sweep +

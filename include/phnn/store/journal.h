@@ -32,7 +32,8 @@ namespace phnn {
 class Journal {
  public:
   /// Creates the journal directory if needed and opens this rank's log for
-  /// appending. If the log ends in a torn line (a crash mid-append), a
+  /// appending (O_NOFOLLOW: a log or directory that is a symbolic link is
+  /// refused, never written through). If the log ends in a torn line (a crash mid-append), a
   /// newline is added so that fragment stays one skipped line and does not
   /// swallow the next record. Throws std::runtime_error naming the file.
   Journal(const std::string& results_path, int rank);
@@ -58,12 +59,22 @@ class Journal {
 /// `<results path>.journal`, the directory that holds the rank-<r>.log files.
 std::string journal_directory(const std::string& results_path);
 
+/// Why the journal directory of `results_path` cannot be used ("" if it can,
+/// or is missing): it is a symbolic link (never followed: records would land
+/// in whatever it points to) or not a directory. Names the path and the fix.
+std::string journal_directory_problem(const std::string& results_path);
+
+/// Creates the journal directory if missing; throws std::runtime_error
+/// (prefixed by `where`) with journal_directory_problem() if it is a
+/// symbolic link or not a directory, or if it cannot be created.
+void ensure_journal_directory(const std::string& results_path, const std::string& where);
+
 /// Reads every rank-*.log under journal_directory(results_path), whatever the
 /// rank count that wrote them, and returns the latest record of each run id
 /// (the greatest time=; on equal times the higher rank, then the later line).
 /// Torn or corrupt lines are skipped and counted in *skipped_lines. A missing
 /// directory is an empty journal. Throws std::runtime_error if a log exists
-/// but cannot be read.
+/// but cannot be read, or if the directory or a log is a symbolic link.
 std::map<std::string, RunResult> replay_journals(
     const std::string& results_path, int* skipped_lines = nullptr);
 

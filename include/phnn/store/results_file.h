@@ -112,6 +112,11 @@ class ResultsFile {
   /// the directory of `path` is not writable. The journal of `path` is left
   /// alone (it may be what the new file is rebuilt from); a fresh start that
   /// must not replay old records calls remove_journals(path) first.
+  ///
+  /// kAtomic writes `<path>.creating` and renames it onto `path`; kInPlace
+  /// writes `path` itself, for a caller whose `path` is already its own
+  /// scratch name (phnn sweep), so messages never name a scratch of a scratch.
+  enum class CreateMode { kAtomic, kInPlace };
   static ResultsFile create(const std::string& path, MPI_Comm comm,
                             const std::vector<RunConfig>& runs,
                             const std::vector<std::string>& run_studies,
@@ -119,7 +124,8 @@ class ResultsFile {
                             const std::string& sweep_text,
                             const std::string& sweep_hash,
                             const std::string& program_version,
-                            const ResultsLayout& layout);
+                            const ResultsLayout& layout,
+                            CreateMode mode = CreateMode::kAtomic);
 
   /// Collective: opens an existing results file read-write, to resume. Throws
   /// std::runtime_error on every rank if `path` is missing, not HDF5, not a

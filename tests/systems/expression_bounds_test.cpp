@@ -1,0 +1,147 @@
+// tests/systems/expression_bounds_test.cpp — the size limits of a system
+// file's expressions (exponent, expanded terms, finite numbers), refused
+// quickly with the file and line, and the messages of a zero diagonal in S
+// and of a parameter that makes H divide by zero.
+#include "systems/expression_bounds.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "phnn/systems/system_file.h"
+#include "test_util.h"
+
+namespace phnn {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+const char* kToy = R"(name = "toy"
+states = ["q", "p"]
+ports = ["w"]
+inputs = ["u"]
+H = "p^2/(2*m) + k*q^2/2"
+z = ["c*w"]
+S = [[0, 1, 0, 0], [-1, 0, -1, -1], [0, 1, 0, 0], [0, 1, 0, 0]]
+[parameters]
+m = 1.0
+k = 2.0
+c = 0.1
+[initial]
+method = "energy"
+energy = [0.1, 1.0]
+[control]
+design = "constant"
+range = [[-1, 1]]
+)";
+
+std::string with(const std::string& from, const std::string& to) {
+  std::string text = kToy;
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    compile_system(text, "toy.toml");
+  } catch (const SystemFileError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+std::string bound(const std::string& text) {
+  internal::ExpressionSymbols symbols;
+  symbols.variables = {"q", "p"};
+  symbols.constants = {{"m", 1.0}, {"n", 1e6}};
+  return internal::expression_bound_problem(text, symbols);
+}
+
+// Refused before GiNaC folds it (which did not stop within 11 minutes).
+TEST(ExpressionBoundsTest, AHugeExponentIsRefusedWithinTwoSeconds) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string error = error_of(with("k*q^2/2\"", "k*q^2/2 + (q^2)^1000000\""));
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_THAT(error, AllOf(HasSubstr("toy.toml:5: H = "),
+                           HasSubstr("the exponent 1000000 in \"(q^2)^1000000\" is out of range"),
+                           HasSubstr("|exponent| <= 100")));
+  EXPECT_LT(seconds, 2.0);
+  EXPECT_THAT(error_of(with("z = [\"c*w\"]", "z = [\"c*w^(10^4)\"]")),
+              AllOf(HasSubstr("toy.toml:6: z = "), HasSubstr("the exponent 10000")));
+}
+
+// The whole command: `phnn sweep --dry-run` of a sweep naming such a file
+// ends with the refusal (exit 2) within 2 s, where it ran for 11 minutes.
+TEST(ExpressionBoundsTest, ASweepOfSuchASystemFileEndsWithinTwoSeconds) {
+  const std::string dir = ::testing::TempDir() + "phnn_bounds_" + std::to_string(::getpid());
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  std::ofstream(dir + "/big.toml") << with("k*q^2/2\"", "k*q^2/2 + (q^2)^1000000\"");
+  std::ofstream(dir + "/s.toml") << "name = \"s\"\n[grid]\nsystems = [\"big.toml\"]\n"
+                                    "models = [\"node-rk2\"]\nn_train = [25]\nseeds = [0]\n";
+  std::string log;
+  const auto start = std::chrono::steady_clock::now();
+  const int status = testing_util::run_shell(
+      "timeout -k 1 60 " + std::string(PHNN_BINARY) + " sweep " + dir + "/s.toml --dry-run", &log);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(status, 2) << log;
+  EXPECT_THAT(log, HasSubstr("big.toml:5: H = "));
+  EXPECT_LT(seconds, 2.0) << log;
+  std::system(("rm -rf " + dir).c_str());
+}
+
+TEST(ExpressionBoundsTest, ExponentsMadeOfParametersAndNumbersCountToo) {
+  EXPECT_THAT(bound("q^n"), HasSubstr("the exponent 1000000 in \"q^n\""));
+  EXPECT_THAT(bound("q^(2*60)"), HasSubstr("the exponent 120"));
+  EXPECT_THAT(bound("2^(10^9)"), HasSubstr("the exponent 1000000000"));
+  EXPECT_EQ(bound("q^100 + q^-100 + q^0.5 + q^p + exp(q)^2"), "");
+}
+
+TEST(ExpressionBoundsTest, ExpansionsPastTheTermBoundAreRefused) {
+  EXPECT_EQ(bound("(q + p + 1)^20"), "");  // C(24, 20) = 10626 terms
+  EXPECT_THAT(bound("(q + p + 1)^40"), HasSubstr("expands to more than 20000 terms"));
+  EXPECT_THAT(bound("((q + p)^10)^10"), HasSubstr("for \"((q + p)^10)^10\""));
+  EXPECT_THAT(bound("(q + p)^50 * (q - p)^50"), HasSubstr("expands to more than"));
+}
+
+TEST(ExpressionBoundsTest, NumbersOutOfRangeAndNonExpressionsAreRefused) {
+  EXPECT_THAT(bound("((10^100)^10)^10 * q"), HasSubstr("overflows a double"));
+  EXPECT_THAT(bound("1e999 * q"), HasSubstr("the number 1e999 overflows"));
+  EXPECT_THAT(bound("{(q^2)^1000000}"), HasSubstr("is not an expression (an unexpected \"{\""));
+  EXPECT_THAT(bound("q*(p"), HasSubstr("a missing \")\""));
+  EXPECT_EQ(bound("p^2/(2*m) + m*9.81*(1 - cos(q)) + 1.5e-3*q^4"), "");
+}
+
+TEST(ExpressionBoundsTest, TheShippedSystemFilesAreWithinTheLimits) {
+  for (const char* name : {"harmonic", "duffing", "self-sustained", "pendulum", "coupled-duffing",
+                           "mass-chain", "pendulum-forced"}) {
+    SCOPED_TRACE(name);
+    EXPECT_NO_THROW(
+        load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/" + name + ".toml"));
+  }
+}
+
+TEST(SystemFileMessagesTest, ANonZeroDiagonalOfSNamesOneEntry) {
+  const std::string error = error_of(with("[0, 1, 0, 0]]", "[0, 1, 0, 1]]"));
+  EXPECT_THAT(error, AllOf(HasSubstr("toy.toml:7:"), HasSubstr("S[4][4] = 1 is on the diagonal"),
+                           Not(HasSubstr("but S[4][4]"))));
+}
+
+TEST(SystemFileMessagesTest, AZeroParameterThatDividesNamesTheFileLineAndParameter) {
+  const std::string error = error_of(with("m = 1.0", "m = 0.0"));
+  EXPECT_THAT(error, AllOf(HasSubstr("toy.toml:5: cannot evaluate H with the values of "
+                                     "[parameters] (m = 0 on line 9)"),
+                           HasSubstr("must not be 0")));
+}
+
+}  // namespace
+}  // namespace phnn
