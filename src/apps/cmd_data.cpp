@@ -54,7 +54,7 @@ NoiseOptions noise_options(const cli::Parser& parser, int n_x) {
 int write_file_system_data(const std::string& path, const DatasetOptions& options, int n_train,
                            const std::string& out, const std::string& csv,
                            const cli::Parser& parser, std::chrono::steady_clock::time_point start) {
-  const std::unique_ptr<PhSystem> system = load_system_file(path);
+  const std::unique_ptr<PhSystem> system = load_system_file(system_file_path(path));
   PhSystemData data = make_ph_system_data(*system, options, n_train);
   add_measurement_noise(&data, system->rng_id(), noise_options(parser, system->n_x()));
   if (!csv.empty()) {

@@ -247,7 +247,7 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int a
     throw cli::UsageError{"phnn train: --damping sets the built-in systems' c; a system file sets "
                           "its own under [parameters]: edit " + path};
   }
-  const std::unique_ptr<PhSystem> system = load_system_file(path);
+  const std::unique_ptr<PhSystem> system = load_system_file(system_file_path(path));
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
   if (parser.has("out")) require_new_output(parser);
   const PhSystemData data = file_system_data(parser, *system, cell.n_train);

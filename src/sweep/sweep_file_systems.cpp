@@ -29,7 +29,8 @@ const SweepSystemFile* SweepSystems::file(const std::string& name) const {
 }
 
 std::string SweepSystems::resolve(const std::string& value, int line) {
-  if (is_system_file_argument(value) || is_data_file_entry(value)) return load(value, line);
+  if (is_data_file_entry(value)) return load(value, line);
+  if (is_system_file_argument(value)) return load(system_file_path(value), line);
   builtin_lines_.emplace(value, line);
   return value;
 }

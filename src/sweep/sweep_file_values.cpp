@@ -273,7 +273,8 @@ std::vector<std::string> ValueReader::systems(
     if (is_system_file_argument(s) || find_system(s)) return resolve(s, line_of(v));
     fail(line_of(v), "unknown systems value " + source_.raw(v) + did_you_mean(s, system_names()) +
                          "; expected one of: " + join(system_names()) +
-                         ", or a system file (a path ending in .toml, relative to this file; "
+                         ", the name of a shipped system file (in " + shipped_systems_dir() +
+                         "), or a system file (a path ending in .toml, relative to this file; "
                          "sweeps/FORMAT.md, \"System files\")");
   });
   for (std::size_t i = 0; i < names.size(); ++i) {

@@ -27,8 +27,9 @@ SystemKind parse_system(const std::string& name) {
   const std::string near = closest_name(name, {"harmonic", "duffing", "self-sustained"});
   throw std::invalid_argument("unknown system \"" + name + "\"" +
                               (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
-                              "; expected one of: harmonic, duffing, self-sustained, or a "
-                              "system file (a path ending in .toml)");
+                              "; expected one of: harmonic, duffing, self-sustained, the name "
+                              "of a shipped system file (sweeps/systems/NAME.toml), or a system "
+                              "file (a path ending in .toml)");
 }
 
 std::vector<SystemKind> all_systems() {

@@ -3,7 +3,12 @@
 // it, and the registry make_system() (built-in names and system files).
 #include "phnn/systems/ph_system.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 
 #include "phnn/systems/oscillators.h"
@@ -217,10 +222,62 @@ class BuiltinSystem : public PhSystem {
 
 }  // namespace
 
-bool is_system_file_argument(const std::string& s) {
+namespace {
+
+bool is_path_argument(const std::string& s) {
   const std::string ext = ".toml";
   return s.find('/') != std::string::npos ||
          (s.size() > ext.size() && s.compare(s.size() - ext.size(), ext.size(), ext) == 0);
+}
+
+bool is_directory(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+// The running binary's directory ("" when /proc/self/exe cannot be read).
+std::string binary_dir() {
+  std::string buf(4096, '\0');
+  const ssize_t n = ::readlink("/proc/self/exe", buf.data(), buf.size() - 1);
+  if (n <= 0) return "";
+  buf.resize(static_cast<std::size_t>(n));
+  const std::size_t slash = buf.rfind('/');
+  return slash == std::string::npos ? "" : buf.substr(0, slash);
+}
+
+}  // namespace
+
+std::string shipped_systems_dir() {
+  if (const char* env = std::getenv("PHNN_SYSTEMS_DIR"); env != nullptr && *env != '\0') return env;
+  const std::string bin = binary_dir();
+  if (!bin.empty()) {
+    for (const char* rel : {"/../share/phnn/systems", "/../sweeps/systems"}) {
+      if (is_directory(bin + rel)) return bin + rel;
+    }
+  }
+  return PHNN_SHIPPED_SYSTEMS_DIR;
+}
+
+std::string shipped_system_path(const std::string& name) {
+  if (name.empty() || is_path_argument(name)) return "";
+  for (const char c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') return "";
+  }
+  for (const SystemKind kind : all_systems()) {
+    if (to_string(kind) == name) return "";
+  }
+  const std::string path = shipped_systems_dir() + "/" + name + ".toml";
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) ? path : "";
+}
+
+std::string system_file_path(const std::string& name_or_path) {
+  const std::string shipped = shipped_system_path(name_or_path);
+  return shipped.empty() ? name_or_path : shipped;
+}
+
+bool is_system_file_argument(const std::string& s) {
+  return is_path_argument(s) || !shipped_system_path(s).empty();
 }
 
 std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
@@ -230,10 +287,12 @@ std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
       return std::make_unique<BuiltinSystem>(
           OscillatorOptions::defaults(parse_system(name_or_path)));
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string(e.what()) +
-                                  ", or a system file (a path ending in .toml)");
+      throw std::invalid_argument(std::string(e.what()) + " (shipped system files are read from " +
+                                  shipped_systems_dir() + ")");
     }
   }
+  const std::string shipped = shipped_system_path(name_or_path);
+  if (!shipped.empty()) return load_system_file(shipped);
   std::string path = name_or_path;
   if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
   return load_system_file(path);

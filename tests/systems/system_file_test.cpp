@@ -4,6 +4,7 @@
 #include "phnn/systems/system_file.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "phnn/systems/oscillators.h"
+#include "phnn/systems/ph_system.h"
 #include "systems/expression_code.h"
 
 namespace phnn {
@@ -325,8 +327,41 @@ TEST(SystemFileErrorTest, MissingFileNamesThePath) {
 }
 
 TEST(SystemFileErrorTest, UnknownSystemNameSuggestsAFile) {
-  EXPECT_THAT([] { make_system("pendulum"); },
+  EXPECT_THAT([] { make_system("double-pendulum"); },
               ::testing::ThrowsMessage<std::invalid_argument>(HasSubstr("or a system file")));
+}
+
+}  // namespace
+}  // namespace phnn
+
+namespace phnn {
+namespace {
+
+// Bare names of shipped system files resolve to sweeps/systems/NAME.toml
+// (PHNN_SYSTEMS_DIR overrides where they are read from); the paper's three
+// names stay the built-in systems; other bare names are not files.
+TEST(ShippedSystemsTest, BareNamesResolveToShippedFiles) {
+  const std::string dir = std::string(PHNN_SOURCE_DIR) + "/sweeps/systems";
+  ASSERT_EQ(setenv("PHNN_SYSTEMS_DIR", dir.c_str(), 1), 0);
+  EXPECT_EQ(shipped_systems_dir(), dir);
+  EXPECT_EQ(shipped_system_path("coupled-duffing"), dir + "/coupled-duffing.toml");
+  EXPECT_TRUE(is_system_file_argument("pendulum"));
+  EXPECT_EQ(system_file_path("pendulum"), dir + "/pendulum.toml");
+  EXPECT_EQ(make_system("coupled-duffing")->n_x(), 4);
+  for (const std::string builtin : {"harmonic", "duffing", "self-sustained"}) {
+    EXPECT_EQ(shipped_system_path(builtin), "") << builtin;  // a file of that name is shipped
+    EXPECT_FALSE(is_system_file_argument(builtin)) << builtin;
+  }
+  for (const std::string other : {"nosuch", "../systems/pendulum", "pendulum.toml", ""}) {
+    EXPECT_EQ(shipped_system_path(other), "") << other;
+  }
+  EXPECT_EQ(system_file_path("nosuch"), "nosuch");
+  EXPECT_THROW(make_system("nosuch"), std::invalid_argument);
+  ASSERT_EQ(setenv("PHNN_SYSTEMS_DIR", "/nonexistent-dir", 1), 0);
+  EXPECT_EQ(shipped_system_path("pendulum"), "");  // the override is where they are read from
+  ASSERT_EQ(unsetenv("PHNN_SYSTEMS_DIR"), 0);
+  // Without the override: the binary's ../sweeps/systems (tests run from build/).
+  EXPECT_NE(shipped_system_path("pendulum"), "");
 }
 
 }  // namespace

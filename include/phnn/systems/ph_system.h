@@ -198,13 +198,29 @@ class PhSystem {
 int system_rng_id(const std::string& name);
 
 /// A system by name or by path: "harmonic", "duffing", "self-sustained"
-/// (built-in), or a system file (an argument ending in ".toml" or containing
-/// '/'), relative paths resolved against `base_dir` when it is not empty.
-/// Throws SystemFileError (FILE:LINE and the fix) for a bad file,
+/// (built-in), the name of a shipped system file ("pendulum": below), or a
+/// system file (an argument ending in ".toml" or containing '/'), relative
+/// paths resolved against `base_dir` when it is not empty. Throws
+/// SystemFileError (FILE:LINE and the fix) for a bad file,
 /// std::invalid_argument for an unknown name.
 std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
                                       const std::string& base_dir = "");
-/// True when make_system would read `name_or_path` as a file.
+/// True when make_system would read `name_or_path` as a file (a path, or
+/// a shipped system file's name).
 bool is_system_file_argument(const std::string& name_or_path);
+
+/// The directory of the shipped system files: $PHNN_SYSTEMS_DIR when set;
+/// else, from the running binary's directory BIN, the first of
+/// BIN/../share/phnn/systems (an installation) and BIN/../sweeps/systems (a
+/// build directory inside the source tree) that exists; else the source
+/// tree's sweeps/systems compiled in.
+std::string shipped_systems_dir();
+/// The shipped file a bare name stands for (`name` made of letters, digits,
+/// '-' and '_', not a built-in name, and NAME.toml present in
+/// shipped_systems_dir()), else "".
+std::string shipped_system_path(const std::string& name);
+/// The file to read for a system argument: a shipped file's path for its
+/// name, else the argument itself.
+std::string system_file_path(const std::string& name_or_path);
 
 }  // namespace phnn
