@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -89,7 +90,41 @@ void compare_unpaired(const SeedResults& a, const SeedResults& b, const Comparis
   c->p_a_less_interval = newcombe_interval(c->p_a_less, c->n_a, c->n_b, options.confidence);
 }
 
+std::string csv_number(double v) {
+  if (std::isnan(v)) return "";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6e", v);
+  return buf;
+}
+
+std::string csv_text(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char ch : text) quoted += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return quoted + "\"";
+}
+
 }  // namespace
+
+std::string render_comparisons_csv(const std::vector<NamedComparison>& comparisons, double delta) {
+  std::string out =
+      "a,b,paired,n_a,n_b,n_pairs,diverged_a,diverged_b,effect,effect_low,effect_high,"
+      "effect_coverage,p_a_less,p_low,p_high,delta,reading\n";
+  for (const NamedComparison& named : comparisons) {
+    const Comparison& c = named.comparison;
+    out += csv_text(named.a) + "," + csv_text(named.b) + "," + (c.paired ? "1" : "0");
+    for (int count : {c.n_a, c.n_b, c.n_pairs, c.diverged_a, c.diverged_b}) {
+      out += "," + std::to_string(count);
+    }
+    for (double v : {c.effect, c.effect_interval.low, c.effect_interval.high, c.effect_coverage,
+                     c.p_a_less, c.p_a_less_interval.low, c.p_a_less_interval.high, delta}) {
+      out += "," + csv_number(v);
+    }
+    out += "," + to_string(c.reading) + "\n";
+  }
+  return out;
+}
 
 std::string to_string(ComparisonReading reading) {
   switch (reading) {

@@ -156,6 +156,18 @@ TEST(CompareCellsTest, BootstrapIntervalIsThePercentileIntervalOfTheLogRatios) {
   EXPECT_TRUE(std::isnan(c.effect_coverage));
 }
 
+TEST(ComparisonCsvTest, PrintsOneLinePerComparisonWithInfinitiesAndQuotes) {
+  SeedResults a = cell({0, 0, 0, 0, 0});
+  for (auto& entry : a) entry.second = kInf;
+  const Comparison c = compare_cells(a, cell({-2, -2, -2, -2, -2}), true);
+  const std::string csv = render_comparisons_csv({{"x,1", "y", c}}, 1.5);
+  EXPECT_EQ(csv,
+            "a,b,paired,n_a,n_b,n_pairs,diverged_a,diverged_b,effect,effect_low,effect_high,"
+            "effect_coverage,p_a_less,p_low,p_high,delta,reading\n"
+            "\"x,1\",y,1,5,5,5,5,0,inf,inf,inf,9.375000e-01,0.000000e+00,0.000000e+00,"
+            "4.344825e-01,1.500000e+00,B better\n");
+}
+
 TEST(ComparisonOptionsTest, RejectsAMarginOfOneOrLess) {
   ComparisonOptions options;
   options.delta = 1.0;

@@ -7,6 +7,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "phnn/config/run_config.h"
 #include "phnn/report/intervals.h"
@@ -97,6 +98,20 @@ struct Comparison {
 ///   if (c.reading == ComparisonReading::kABetter) ...
 Comparison compare_cells(const SeedResults& a, const SeedResults& b, bool paired,
                          const ComparisonOptions& options = {});
+
+/// A comparison with the names of its two cells (any labels the caller
+/// chooses, e.g. "study/system/model/column").
+struct NamedComparison {
+  std::string a, b;
+  Comparison comparison;
+};
+
+/// The exported form of comparisons (one header line, one line each):
+///   a,b,paired,n_a,n_b,n_pairs,diverged_a,diverged_b,effect,effect_low,
+///   effect_high,effect_coverage,p_a_less,p_low,p_high,delta,reading
+/// paired 0/1; numbers "%.6e", "inf" / "-inf" for infinities, empty for
+/// NaN; reading as to_string(); names quoted when they hold , or ".
+std::string render_comparisons_csv(const std::vector<NamedComparison>& comparisons, double delta);
 
 /// Whether runs of the cells of `a` and `b` with equal seeds share their
 /// seed effect (docs/METHOD.md "Comparisons"): the same initial weights (same
