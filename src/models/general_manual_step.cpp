@@ -160,6 +160,20 @@ JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp* 
   };
 }
 
+// PHNN-S's two recorders: the field from an effort (no ports: the linear
+// map) and the field's jet at x.
+struct SRecorders {
+  EffortFieldRecorder field;
+  JacobianFieldRecorder jacobian;
+};
+SRecorders s_recorders(const StackedMlp& l_h, const StackedMlp* l_z, const Tensor& u,
+                       const std::vector<double>& s_w_rows, const std::vector<double>& s_x_rows,
+                       const ModelStructure& s) {
+  return {
+      s.n_w == 0 ? linear_effort_field(u, s_x_rows) : s_effort_field(*l_z, u, s_w_rows, s.S, s.n_w),
+      s_jacobian_field(l_h, l_z, u, s_w_rows, s_x_rows, s.S, s.n_w)};
+}
+
 }  // namespace
 
 Tensor GeneralPhnnJr::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
@@ -190,13 +204,9 @@ Tensor GeneralPhnnS::explicit_mean_l1_step(IntegratorKind integrator, const Tens
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
-  const ModelStructure& s = structure();
-  const EffortFieldRecorder field = s.n_w == 0
-                                        ? linear_effort_field(u, s_x_rows_)
-                                        : s_effort_field(*nets_[1], u, s_w_rows_, s.S, s.n_w);
-  const JacobianFieldRecorder jacobian = s_jacobian_field(
-      l_h(), s.n_w > 0 ? nets_[1].get() : nullptr, u, s_w_rows_, s_x_rows_, s.S, s.n_w);
-  return ph_explicit_mean_l1(integrator, l_h(), kGeneralHead, x, x_next, h, field, jacobian,
+  const SRecorders r = s_recorders(l_h(), nets_.size() > 1 ? nets_[1].get() : nullptr, u, s_w_rows_,
+                                   s_x_rows_, structure());
+  return ph_explicit_mean_l1(integrator, l_h(), kGeneralHead, x, x_next, h, r.field, r.jacobian,
                              penalty);
 }
 
@@ -206,13 +216,9 @@ Tensor GeneralPhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, cons
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
-  const ModelStructure& s = structure();
-  const EffortFieldRecorder field = s.n_w == 0
-                                        ? linear_effort_field(u, s_x_rows_)
-                                        : s_effort_field(*nets_[1], u, s_w_rows_, s.S, s.n_w);
-  const JacobianFieldRecorder jacobian = s_jacobian_field(
-      l_h(), s.n_w > 0 ? nets_[1].get() : nullptr, u, s_w_rows_, s_x_rows_, s.S, s.n_w);
-  return ph_dg_mean_l1(l_h(), kGeneralHead, x, x_next, h, min_dx_norm, false, field, jacobian,
+  const SRecorders r = s_recorders(l_h(), nets_.size() > 1 ? nets_[1].get() : nullptr, u, s_w_rows_,
+                                   s_x_rows_, structure());
+  return ph_dg_mean_l1(l_h(), kGeneralHead, x, x_next, h, min_dx_norm, false, r.field, r.jacobian,
                        penalty);
 }
 

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "models/manual_step_reference.h"
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/discrete_step.h"
 #include "phnn/training/regularizers.h"
@@ -21,11 +22,8 @@
 namespace phnn {
 namespace {
 
-bool same_bits(const torch::Tensor& a, const torch::Tensor& b) {
-  const auto ca = a.contiguous(), cb = b.contiguous();
-  return ca.sizes() == cb.sizes() && std::memcmp(ca.data_ptr<double>(), cb.data_ptr<double>(),
-                                                 sizeof(double) * ca.numel()) == 0;
-}
+using testing_util::autograd_loss_of;
+using testing_util::same_bits;
 
 struct Case {
   ModelKind kind;
@@ -36,21 +34,6 @@ struct Case {
   bool at_start = false;  // DG: R at x_n
   Regularizer regularizer = Regularizer::kNone;
 };
-
-// The trainer's loss without a hand-written step (CellTrainer::loss_and_gradients).
-torch::Tensor autograd_loss_of(const DynamicsModel& model, const Case& c, const torch::Tensor& x,
-                               const torch::Tensor& x_next, const torch::Tensor& u, double h,
-                               double min_dx_norm, const TrainerOptions& options) {
-  const bool regularized = c.regularizer != Regularizer::kNone;
-  const FieldEval at_x = regularized ? model.field(x, u, true) : FieldEval{};
-  const auto x_hat = c.integrator == IntegratorKind::kDg
-                         ? dg_training_step(model, x, x_next, u, h, min_dx_norm)
-                         : explicit_step(model, c.integrator, x, u, h, at_x.f);
-  const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
-  if (!regularized) return loss;
-  return loss + regularizer_penalty(c.regularizer, jacobian_stats(at_x.dfdx, options.jacobian_eps),
-                                    options);
-}
 
 class ManualStepTest : public ::testing::TestWithParam<Case> {};
 
@@ -81,7 +64,8 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
 
   const TrainerOptions trainer;
   flat.gradients.zero_();
-  const auto loss = autograd_loss_of(*model, c, x, x_next, u, h, min_dx_norm, trainer);
+  const auto loss =
+      autograd_loss_of(*model, c.integrator, c.regularizer, x, x_next, u, h, min_dx_norm, trainer);
   loss.sum().backward();
   const auto autograd_loss = loss.detach().clone(), autograd_grad = flat.gradients.clone();
   ASSERT_GT(autograd_grad.abs().sum().item<double>(), 0.0);
