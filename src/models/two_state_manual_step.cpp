@@ -1,8 +1,8 @@
 // src/models/two_state_manual_step.cpp — the hand-written training steps of
 // the 2-state NODE, PHNN-S and PHNN-JR (include/phnn/models/port_hamiltonian.h)
 // on fused float64 networks: the field recorders of their closed-form heads
-// (fused_heads.h, phnn_s_jet_head.cpp) composed by models/manual_step.h, RK2
-// and DG, with and without a Jacobian penalty. Bitwise autograd's
+// (fused_heads.h, phnn_s_jet_head.cpp) composed by models/manual_step.h, RK2,
+// RK4 and DG, with and without a Jacobian penalty. Bitwise autograd's
 // (tests/models/manual_step_test.cpp). Touches only the gradient sinks.
 //
 // With a penalty, stage 1 of RK2 (or DG's field at x) is the order-1 jet of
