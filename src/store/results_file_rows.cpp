@@ -215,22 +215,30 @@ std::uint64_t ResultsFile::row_checksum(int row) const {
   return hash == 0 ? 1 : hash;  // 0 means "no checksum"
 }
 
+bool ResultsFile::row_damaged(int row) const {
+  const Impl& impl = *impl_;
+  if (!impl.has_checksums) return false;
+  const auto at = static_cast<std::uint64_t>(row);
+  try {
+    const std::int64_t code = impl.ints(kStatus, at, 1).at(0);
+    if (code == static_cast<std::int64_t>(RunStatus::kPending)) return false;
+    const std::int64_t stored = impl.ints(kChecksum, at, 1).at(0);
+    return !(code > 0 && code <= static_cast<std::int64_t>(RunStatus::kFailed) && stored != 0 &&
+             static_cast<std::uint64_t>(stored) == row_checksum(row));
+  } catch (const std::exception&) {
+    return true;  // unreadable is damaged too
+  }
+}
+
 std::vector<int> ResultsFile::damaged_rows() const {
   std::vector<int> damaged;
   if (!impl_->has_checksums) return damaged;
   const std::vector<std::int64_t> codes = impl_->ints(kStatus);
-  const std::vector<std::int64_t> stored = impl_->ints(kChecksum);
   for (int row = 0; row < impl_->num_runs; ++row) {
-    const auto i = static_cast<std::size_t>(row);
-    if (codes[i] == static_cast<std::int64_t>(RunStatus::kPending)) continue;
-    bool ok = false;
-    try {
-      ok = codes[i] > 0 && codes[i] <= static_cast<std::int64_t>(RunStatus::kFailed) &&
-           stored[i] != 0 && static_cast<std::uint64_t>(stored[i]) == row_checksum(row);
-    } catch (const std::exception&) {
-      ok = false;  // unreadable is damaged too
+    if (codes[static_cast<std::size_t>(row)] == static_cast<std::int64_t>(RunStatus::kPending)) {
+      continue;
     }
-    if (!ok) damaged.push_back(row);
+    if (row_damaged(row)) damaged.push_back(row);
   }
   return damaged;
 }

@@ -71,17 +71,41 @@ std::vector<ResultsFile> open_shards(const std::vector<std::string>& shards) {
   return files;
 }
 
+// The command that last wrote shard `file` (its latest session's command
+// line), to show how to repair it; "" if it recorded none.
+std::string last_command(const ResultsFile& file) {
+  const std::vector<Provenance> sessions = file.read_sessions();
+  for (auto session = sessions.rbegin(); session != sessions.rend(); ++session) {
+    for (const auto& [key, value] : *session) {
+      if (key == "command_line" && !value.empty()) return value;
+    }
+  }
+  return "";
+}
+
+constexpr std::size_t kListedDamage = 5;
+
 // Per row, the shard that gives its result (-1: none); throws if two shards
-// hold different results for a row (clocks aside). *notes names each shard
-// whose results all came from earlier shards (given twice, or a copy).
+// hold different results for a row (clocks aside). A damaged row (its
+// checksum fails: the check of `phnn verify`) is never a source: the run
+// takes a good copy from another shard, named in *notes, or, if no shard has
+// one, the merge is refused naming each damaged shard row. *notes also names
+// each shard whose results all came from earlier shards (given twice, or a
+// copy).
 std::vector<int> result_sources(const std::vector<ResultsFile>& files,
                                 const std::vector<std::string>& shards, std::string* notes) {
   std::vector<int> source(static_cast<std::size_t>(files.front().num_runs()), -1);
+  std::vector<std::pair<std::size_t, int>> damaged;  // (shard, row)
   for (std::size_t s = 0; s < files.size(); ++s) {
     const std::vector<RunStatus> status = files[s].read_statuses();
+    const std::vector<int> damaged_here = files[s].damaged_rows();
     int finished = 0, repeated = 0;
     for (std::size_t row = 0; row < source.size(); ++row) {
       if (status[row] == RunStatus::kPending) continue;
+      if (std::binary_search(damaged_here.begin(), damaged_here.end(), static_cast<int>(row))) {
+        damaged.emplace_back(s, static_cast<int>(row));
+        continue;
+      }
       ++finished;
       if (source[row] < 0) {
         source[row] = static_cast<int>(s);
@@ -102,6 +126,33 @@ std::vector<int> result_sources(const std::vector<ResultsFile>& files,
                 std::to_string(finished) + " results are all in the shards before it (given "
                 "twice, or a copy?)";
     }
+  }
+  std::string refused;
+  std::size_t unrepaired = 0;
+  for (const auto& [s, row] : damaged) {
+    const std::string where = "shard " + shards[s] + " row " + std::to_string(row) + " (run " +
+                              files[s].read_run_ids()[static_cast<std::size_t>(row)] +
+                              "): checksum mismatch";
+    if (source[static_cast<std::size_t>(row)] >= 0) {
+      *notes += "\nphnn merge: note: " + where + "; took the good copy in " +
+                shards[static_cast<std::size_t>(source[static_cast<std::size_t>(row)])];
+      continue;
+    }
+    if (unrepaired++ < kListedDamage) {
+      const std::string command = last_command(files[s]);
+      refused += (refused.empty() ? "" : "\n") + where + ", and no other shard holds the run" +
+                 (command.empty() ? "" : " (the shard was last written by `" + command + "`)");
+    }
+  }
+  if (unrepaired > 0) {
+    if (unrepaired > kListedDamage) {
+      refused += "\n... " + std::to_string(unrepaired - kListedDamage) + " more damaged rows";
+    }
+    throw std::runtime_error(
+        refused + "\nnothing written: repair each damaged shard by running `phnn sweep` on its "
+                  "sweep file again with the same --shard and --out (it rewrites the row from the "
+                  "shard's journal, or trains the run again; `phnn verify SHARD` tells which), or "
+                  "leave the shard out of the merge (its runs stay pending)");
   }
   return source;
 }
@@ -165,7 +216,13 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
       for (std::size_t row = 0; row < source.size(); ++row) {
         if (source[row] == static_cast<int>(s)) rows.emplace_back(row, row);
       }
-      results_copy::copy_rows(files[s], rows, &merged);
+      const auto damaged = results_copy::copy_rows(files[s], rows, &merged);
+      if (!damaged.empty()) {  // damaged between result_sources and now
+        throw std::runtime_error("shard " + shards[s] + " row " +
+                                 std::to_string(damaged.front().first) +
+                                 ": checksum mismatch (it changed while being merged); nothing "
+                                 "written: merge again once no program writes the shards");
+      }
     }
     merged.close();
   });

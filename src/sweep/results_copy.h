@@ -23,10 +23,16 @@ ResultsLayout wider_layout(const ResultsLayout& a, const ResultsLayout& b);
 /// Appends `from`'s provenance sessions, in order, to `to` (serial files).
 void copy_sessions(const ResultsFile& from, ResultsFile* to);
 
-/// Copies each (row of `from`, row of `to`) pair: the run times, then the
-/// result.
-void copy_rows(const ResultsFile& from, const std::vector<std::pair<int, int>>& rows,
-               ResultsFile* to);
+/// The one way rows move between results files (merge, a grown sweep):
+/// copies each (row of `from`, row of `to`) pair whose row is intact (the
+/// check of `phnn verify`: ResultsFile::row_damaged), the run times, then the
+/// result. A damaged row is never copied as it stands (write_run would give
+/// the wrong values a valid checksum): its pair is returned, its row of `to`
+/// left pending, and the caller repairs it from a journal, takes another
+/// copy, or names it.
+std::vector<std::pair<int, int>> copy_rows(const ResultsFile& from,
+                                           const std::vector<std::pair<int, int>>& rows,
+                                           ResultsFile* to);
 
 /// The studies of each run of `grid`, joined for ResultsFile::create ("I,II").
 std::vector<std::string> joined_studies(const Grid& grid);

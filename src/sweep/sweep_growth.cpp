@@ -7,6 +7,7 @@
 #include <set>
 #include <utility>
 
+#include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "phnn/store/scratch_file.h"
 #include "results_copy.h"
@@ -168,40 +169,88 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
                 "unchanged";
 }
 
-// Copies every row of `from` that holds a result into its row of `to`;
-// returns the (sweep run, file row) pairs copied.
-std::vector<std::pair<int, int>> copy_results(const ResultsFile& from, const RunSetComparison& cmp,
-                                              ResultsFile* to) {
+// What became of the rows of the old version that hold a result, as
+// (sweep run, old row) pairs.
+struct CopiedRows {
+  std::vector<std::pair<int, int>> kept;      // intact: copied bitwise
+  std::vector<std::pair<int, int>> repaired;  // damaged: written from the journal's record
+  std::vector<std::pair<int, int>> requeued;  // damaged, not in the journals: left pending
+};
+
+// Copies every row of `from` that holds a result into its row of `to`. A
+// damaged row (its checksum fails) is written from the journals' record of
+// its run instead, or, if they lack it, left pending to be trained again.
+CopiedRows copy_results(const ResultsFile& from, const std::string& out,
+                        const RunSetComparison& cmp,
+                        std::map<std::string, RunResult>* journal, ResultsFile* to) {
   const std::vector<RunStatus> status = from.read_statuses();
-  std::vector<std::pair<int, int>> copied, rows;  // (run, row), (row, run)
+  std::vector<std::pair<int, int>> rows;  // (row, run)
   for (std::size_t run = 0; run < cmp.file_row_of_run.size(); ++run) {
     const int row = cmp.file_row_of_run[run];
     if (row < 0 || status[row] == RunStatus::kPending) continue;
-    copied.emplace_back(static_cast<int>(run), row);
     rows.emplace_back(row, static_cast<int>(run));
   }
-  results_copy::copy_rows(from, rows, to);
-  return copied;
+  const std::vector<std::pair<int, int>> damaged = results_copy::copy_rows(from, rows, to);
+  CopiedRows result;
+  for (const auto& [row, run] : rows) {
+    if (std::find(damaged.begin(), damaged.end(), std::make_pair(row, run)) == damaged.end()) {
+      result.kept.emplace_back(run, row);
+    }
+  }
+  if (damaged.empty()) return result;
+  *journal = replay_journals(out);
+  const std::vector<std::string> ids = from.read_run_ids();
+  for (const auto& [row, run] : damaged) {
+    const auto it = journal->find(ids[static_cast<std::size_t>(row)]);
+    if (it != journal->end()) {
+      to->write_run(run, it->second);
+      result.repaired.emplace_back(run, row);
+    } else {
+      result.requeued.emplace_back(run, row);
+    }
+  }
+  return result;
 }
 
-// Every copied row reads back bit for bit.
-void verify_copies(const ResultsFile& from, const std::string& written,
-                   const std::vector<std::pair<int, int>>& copied) {
+// Every kept row reads back bit for bit as the old version's, every repaired
+// row as the journal's record.
+void verify_copies(const ResultsFile& from, const std::string& written, const CopiedRows& copied,
+                   const std::map<std::string, RunResult>& journal) {
   const ResultsFile check = ResultsFile::open_read_only(written);
-  for (const auto& [run, row] : copied) {
+  for (const auto& [run, row] : copied.kept) {
     if (!results_copy::same_result(check.read_run(run), from.read_run(row))) {
       throw std::runtime_error(written + ": row " + std::to_string(run) + " does not read back as "
                                "row " + std::to_string(row) + " of the previous version; the "
                                "previous version is left in place");
     }
   }
+  const std::vector<std::string> ids = from.read_run_ids();
+  for (const auto& [run, row] : copied.repaired) {
+    if (!results_copy::same_result(check.read_run(run),
+                                   journal.at(ids[static_cast<std::size_t>(row)]))) {
+      throw std::runtime_error(written + ": row " + std::to_string(run) + " does not read back as "
+                               "the journal's record of its run; the previous version is left "
+                               "in place");
+    }
+  }
+}
+
+// "run a, run b" for the old rows of `pairs`.
+std::string run_list(const std::vector<std::pair<int, int>>& pairs,
+                     const std::vector<std::string>& ids) {
+  std::string text;
+  for (const auto& pair : pairs) {
+    text += (text.empty() ? "" : ", ") + ids[static_cast<std::size_t>(pair.second)];
+  }
+  return text;
 }
 
 }  // namespace
 
 std::string write_grown_results(const std::string& out, const SweepSpec& spec, const Grid& grid,
                                 const std::string& program_version) {
-  std::vector<std::pair<int, int>> copied;
+  CopiedRows copied;
+  std::vector<std::string> old_ids;
   std::string scratch;
   RunSetComparison cmp;
   {
@@ -216,12 +265,24 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
         program_version, results_copy::wider_layout(old.layout(), ResultsLayout::for_runs(grid.runs)),
         ResultsFile::CreateMode::kInPlace);
     results_copy::copy_sessions(old, &fresh);
-    copied = copy_results(old, cmp, &fresh);
+    std::map<std::string, RunResult> journal;
+    copied = copy_results(old, out, cmp, &journal, &fresh);
     fresh.close();
-    verify_copies(old, scratch, copied);
+    verify_copies(old, scratch, copied, journal);
+    old_ids = old.read_run_ids();
   }
   commit_scratch(scratch, out);
-  const std::string kept = std::to_string(copied.size()) + " runs with results kept bitwise";
+  std::string kept = std::to_string(copied.kept.size()) + " runs with results kept bitwise";
+  if (!copied.repaired.empty()) {
+    kept += "; " + std::to_string(copied.repaired.size()) +
+            " damaged rows (checksum mismatch) repaired from the journals: " +
+            run_list(copied.repaired, old_ids);
+  }
+  if (!copied.requeued.empty()) {
+    kept += "; " + std::to_string(copied.requeued.size()) +
+            " damaged rows (checksum mismatch) not in the journals, left pending to train "
+            "again: " + run_list(copied.requeued, old_ids);
+  }
   const std::size_t dropped = cmp.dropped_pending_rows.size();
   std::string what;
   if (cmp.added) {

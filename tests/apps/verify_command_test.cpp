@@ -1,8 +1,10 @@
 // tests/apps/verify_command_test.cpp — damaged bytes in a finished results
 // file are found (phnn verify, phnn reduce) and repaired by the next `phnn
-// sweep`: from the journal when it holds the run, else by training it again.
+// sweep`: from the journal when it holds the run, else by training it again;
+// also when the sweep grew (a new version of the file).
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -88,6 +90,47 @@ TEST_F(VerifyCommandTest, DamagedRowsAreFoundThenRepairedFromTheJournalOrTrained
   EXPECT_EQ(std::memcmp(&original, &retrained, sizeof original), 0);
   EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
   EXPECT_THAT(log, Not(HasSubstr("damaged:")));
+}
+
+// A sweep resumed with more seeds writes a new version of the file: a
+// damaged row is repaired from the journal, or trained again without it,
+// never copied as it stands (it used to be, with a fresh valid checksum).
+TEST_F(VerifyCommandTest, GrowingASweepRepairsDamagedRowsInsteadOfCopyingThem) {
+  std::string log;
+  ASSERT_EQ(sweep(&log), 0) << log;
+  const std::string id = ResultsFile::open_read_only(out_).read_run_ids()[1];
+  const double original = mse(1);
+  auto grow = [&](const std::string& seeds, std::string* grow_log) {
+    std::string text = testing_util::read_all(std::string(PHNN_SOURCE_DIR) + "/sweeps/tiny.toml");
+    text.replace(text.find("seeds = [0, 1, 2]"), 17, "seeds = " + seeds);
+    const std::string path = dir_ + "/grown.toml";
+    std::ofstream(path) << text;
+    return testing_util::run_shell(testing_util::mpiexec_phnn(2) + " sweep " + path +
+                                       " --quiet --out " + out_,
+                                   grow_log);
+  };
+  auto mse_of = [&](const std::string& run) {
+    const ResultsFile file = ResultsFile::open_read_only(out_);
+    const std::vector<std::string> ids = file.read_run_ids();
+    const auto row = std::find(ids.begin(), ids.end(), run) - ids.begin();
+    return file.read_run(static_cast<int>(row)).mse;
+  };
+
+  flip_mse(1);
+  ASSERT_EQ(grow("[0, 1, 2, 3]", &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("(checksum mismatch) repaired from the journals: " + id));
+  const double repaired = mse_of(id);
+  EXPECT_EQ(std::memcmp(&original, &repaired, sizeof original), 0);
+  EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
+
+  const std::vector<std::string> ids = ResultsFile::open_read_only(out_).read_run_ids();
+  flip_mse(static_cast<int>(std::find(ids.begin(), ids.end(), id) - ids.begin()));
+  ASSERT_EQ(std::system(("rm -rf " + out_ + ".journal").c_str()), 0);
+  ASSERT_EQ(grow("[0, 1, 2, 3, 4]", &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("not in the journals, left pending to train again: " + id));
+  const double retrained = mse_of(id);
+  EXPECT_EQ(std::memcmp(&original, &retrained, sizeof original), 0);
+  EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // tests/sweep/merge_test.cpp — shards of one sweep merged into one results
-// file: every result kept bitwise, conflicts and foreign files refused.
+// file: every result kept bitwise, conflicts and foreign files refused, a
+// damaged shard row replaced by a good copy or named, never copied.
 #include "phnn/sweep/merge.h"
 
 #include <sys/stat.h>
@@ -11,6 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "h5/h5file.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
@@ -78,6 +80,14 @@ class MergeShardsTest : public ::testing::Test {
     for (int row : rows) file.write_run(row, testing_util::sample_result(row + salt, file.layout()));
     file.close();
     return path;
+  }
+
+  // Multiplies the stored MSE of `row` of `path` by 1.5 behind the file's
+  // back: the row's checksum no longer matches.
+  static void alter_mse(const std::string& path, int row) {
+    const double mse = ResultsFile::open_read_only(path).read_run(row).mse * 1.5;
+    h5::File file = h5::File::open(path, h5::Access::kReadWrite);
+    file.write_rows("/runs/mse", static_cast<std::uint64_t>(row), 1, &mse);
   }
 
   std::string dir_;
@@ -152,6 +162,49 @@ TEST_F(MergeShardsTest, ResultsDifferingOnlyInWallTimesMergeAndADuplicateShardIs
   EXPECT_THAT(twice, HasSubstr(a + " adds nothing"));
   const std::string distinct = merge_shards({a, shard("c.h5", {2})}, dir_ + "/distinct.h5", "v2");
   EXPECT_THAT(distinct, ::testing::Not(HasSubstr("adds nothing")));
+}
+
+// A damaged row is never a source: the good copy in another shard is taken,
+// whichever shard comes first, and the damage is named.
+TEST_F(MergeShardsTest, ADamagedShardRowTakesTheGoodCopyInAnotherShard) {
+  const std::string a = shard("a.h5", {0, 3}), b = shard("b.h5", {1, 3});
+  const RunResult good = ResultsFile::open_read_only(b).read_run(3);
+  for (const std::string& damaged : {a, b}) {
+    const std::string other = damaged == a ? b : a;
+    const std::string copy = dir_ + "/damaged-" + std::to_string(damaged == a) + ".h5";
+    std::system(("cp " + damaged + " " + copy).c_str());
+    alter_mse(copy, 3);
+    ASSERT_EQ(ResultsFile::open_read_only(copy).damaged_rows(), std::vector<int>{3});
+    const std::string out = dir_ + "/merged-" + std::to_string(damaged == a) + ".h5";
+    const std::vector<std::string> order =
+        damaged == a ? std::vector<std::string>{copy, other}
+                     : std::vector<std::string>{other, copy};
+    const std::string summary = merge_shards(order, out, "v2");
+    EXPECT_THAT(summary, HasSubstr("shard " + copy + " row 3 (run "));
+    EXPECT_THAT(summary, HasSubstr("checksum mismatch; took the good copy in " + other));
+    const ResultsFile merged = ResultsFile::open_read_only(out);
+    testing_util::expect_bit_equal(good, merged.read_run(3));
+    EXPECT_TRUE(merged.damaged_rows().empty());
+  }
+}
+
+TEST_F(MergeShardsTest, ADamagedShardRowWithoutAGoodCopyIsNamedAndNothingIsWritten) {
+  const std::string a = shard("a.h5", {0, 3}), b = shard("b.h5", {1});
+  alter_mse(a, 3);
+  const std::string out = dir_ + "/merged.h5";
+  try {
+    merge_shards({a, b}, out, "v2");
+    FAIL() << "a damaged row was merged";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("shard " + a + " row 3 (run "));
+    EXPECT_THAT(e.what(), HasSubstr("checksum mismatch, and no other shard holds the run"));
+    EXPECT_THAT(e.what(), HasSubstr("last written by `a.h5`"));  // its session's command line
+    EXPECT_THAT(e.what(), HasSubstr("nothing written: repair each damaged shard"));
+    EXPECT_THAT(e.what(), HasSubstr("or leave the shard out of the merge"));
+  }
+  struct stat st;
+  EXPECT_NE(::stat(out.c_str(), &st), 0) << "a merged file was left behind";
+  EXPECT_NE(::stat((out + ".partial").c_str(), &st), 0) << "scratch file left behind";
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // tests/sweep/sweep_growth_test.cpp — a results file's identity is its set
 // of runs: added runs grow it (finished runs kept bitwise), text-only edits
-// rewrite it, changed runs and dropped results are refused.
+// rewrite it, changed runs and dropped results are refused; a damaged row is
+// repaired from the journal or left to train again, never copied.
 #include "phnn/sweep/sweep_growth.h"
 
 #include <unistd.h>
@@ -13,6 +14,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "h5/h5file.h"
+#include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "sample_results.h"
 
@@ -197,6 +200,43 @@ TEST_F(WriteGrownResultsTest, ChangedRunsAreRefusedAndTheFileIsUntouched) {
     EXPECT_THAT(e.what(), HasSubstr("duffing phnn-s-dg small n_train=25 none seed=1"));
   }
   EXPECT_EQ(ResultsFile::open_read_only(out_).sweep_hash(), before);
+}
+
+// The defect this guards against: a row whose MSE was altered was copied as
+// it stood and got a valid checksum in the new version ("kept bitwise").
+TEST_F(WriteGrownResultsTest, DamagedRowsAreRepairedFromTheJournalOrLeftToTrainAgain) {
+  create_original();
+  const Grid old_grid = grid_of(kSweep);
+  {
+    Journal journal(out_, /*rank=*/0);  // holds row 0's run, not row 3's
+    journal.append(old_grid.runs[0].id(), original_[old_grid.runs[0].canonical()]);
+  }
+  for (int row : {0, 3}) {
+    const double mse = ResultsFile::open_read_only(out_).read_run(row).mse * 1.5;
+    h5::File file = h5::File::open(out_, h5::Access::kReadWrite);
+    file.write_rows("/runs/mse", static_cast<std::uint64_t>(row), 1, &mse);
+  }
+  ASSERT_THAT(ResultsFile::open_read_only(out_).damaged_rows(), ElementsAre(0, 3));
+  const SweepSpec grown =
+      parse_sweep_text(edited(kSweep, "seeds = [0, 1]", "seeds = [0, 1, 2]"), "sweep.toml");
+  const Grid grid = expand_grid(grown);
+  const std::string message = write_grown_results(out_, grown, grid, "v2");
+  EXPECT_THAT(message, HasSubstr("1 runs with results kept bitwise"));
+  EXPECT_THAT(message, HasSubstr("1 damaged rows (checksum mismatch) repaired from the journals: " +
+                                 old_grid.runs[0].id()));
+  EXPECT_THAT(message, HasSubstr("1 damaged rows (checksum mismatch) not in the journals, left "
+                                 "pending to train again: " + old_grid.runs[3].id()));
+  const ResultsFile file = ResultsFile::open_read_only(out_);
+  EXPECT_TRUE(file.damaged_rows().empty());
+  const auto status = file.read_statuses();
+  for (int run = 0; run < file.num_runs(); ++run) {
+    const std::string canonical = grid.runs[run].canonical();
+    if (canonical == old_grid.runs[0].canonical() || canonical == old_grid.runs[1].canonical()) {
+      testing_util::expect_bit_equal(original_[canonical], file.read_run(run));
+    } else {
+      EXPECT_EQ(status[run], RunStatus::kPending) << run;  // new, or row 3 to train again
+    }
+  }
 }
 
 }  // namespace

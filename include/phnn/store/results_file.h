@@ -235,6 +235,11 @@ class ResultsFile {
   /// (not pending) whose checksum is missing or wrong, or that cannot be
   /// read; empty for a file written before checksums (has_checksums()).
   std::vector<int> damaged_rows() const;
+  /// The same check for one row: true if it holds a result (not pending)
+  /// whose checksum is missing or wrong, or if it cannot be read; false in a
+  /// file written before checksums. Every copy of a row into another file
+  /// (merge, a grown sweep) asks this first (src/sweep/results_copy.h).
+  bool row_damaged(int row) const;
   /// What makes the file unusable as a whole: an empty or repeated run id, a
   /// status outside 0..3, an unreadable column ("" entries none).
   std::vector<std::string> structure_problems() const;

@@ -27,6 +27,10 @@ constexpr int kMaxShards = 100000;
 /// same sweep text (equal sweep hash). Every run gets the result of the first
 /// shard that has one; a run finished in two shards must be bitwise equal in
 /// both (results depend only on configuration and seed), else it throws.
+/// Every row is checked against its checksum (as `phnn verify` does) before
+/// it is copied: a damaged shard row gives way to a good copy of the run in
+/// another shard (named in the summary); with none, it throws naming the
+/// shard, the row, "checksum mismatch" and the fix, and writes nothing.
 /// Also copies the /data groups and every shard's provenance sessions. The
 /// file is written under a scratch name and renamed when complete. Throws
 /// std::invalid_argument for bad arguments (no shard, `out` exists or is a

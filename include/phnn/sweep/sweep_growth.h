@@ -59,7 +59,10 @@ class RunSetRefused : public std::invalid_argument {
 /// another sweep text) for `spec`/`grid`: a new file with the grid's runs,
 /// the spec's text and hash, the old file's provenance sessions, and every
 /// row of the old file that holds a result copied bitwise (verified by
-/// reading it back) with its run times; /data is left to the caller (the
+/// reading it back) with its run times. A row whose checksum fails is never
+/// copied as it stands: it is written from the journals' record of its run
+/// (`out`'s journal directory), or, if they lack the run, left pending to be
+/// trained again; both are named in the account. /data is left to the caller (the
 /// sweep writes missing data groups on resume). The new file replaces `out`
 /// by an atomic rename, so a crash leaves either version whole. Throws
 /// RunSetRefused (nothing written) when compare_run_sets() refuses, and
