@@ -14,6 +14,7 @@
 #include <string>
 
 #include "phnn/systems/system_file.h"
+#include "systems/toy_system.h"
 #include "test_util.h"
 
 namespace phnn {
@@ -23,40 +24,12 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-const char* kToy = R"(name = "toy"
-states = ["q", "p"]
-ports = ["w"]
-inputs = ["u"]
-H = "p^2/(2*m) + k*q^2/2"
-z = ["c*w"]
-S = [[0, 1, 0, 0], [-1, 0, -1, -1], [0, 1, 0, 0], [0, 1, 0, 0]]
-[parameters]
-m = 1.0
-k = 2.0
-c = 0.1
-[initial]
-method = "energy"
-energy = [0.1, 1.0]
-[control]
-design = "constant"
-range = [[-1, 1]]
-)";
+using testing_util::toy_error_of;
+using testing_util::toy_with;
+const char* const kToy = testing_util::kToySystem;
 
-std::string with(const std::string& from, const std::string& to) {
-  std::string text = kToy;
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  return text.replace(at, from.size(), to);
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    compile_system(text, "toy.toml");
-  } catch (const SystemFileError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string with(const std::string& from, const std::string& to) { return toy_with(from, to); }
+std::string error_of(const std::string& text) { return toy_error_of(text); }
 
 std::string bound(const std::string& text) {
   internal::ExpressionSymbols symbols;

@@ -3,17 +3,18 @@
 // computations, and the errors of malformed files (FILE:LINE and the fix).
 #include "phnn/systems/system_file.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <random>
 #include <string>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-
 #include "phnn/systems/oscillators.h"
 #include "phnn/systems/ph_system.h"
 #include "systems/expression_code.h"
+#include "systems/toy_system.h"
 
 namespace phnn {
 namespace {
@@ -40,9 +41,9 @@ TEST(SystemFileTest, ShippedSystemsHaveTheirDeclaredDimensions) {
     const char* name;
     int nx, nw, nu;
   };
-  for (const Dims& d : {Dims{"harmonic", 2, 1, 1}, Dims{"pendulum", 2, 1, 1},
-                        Dims{"pendulum-forced", 2, 1, 1},
-                        Dims{"coupled-duffing", 4, 2, 1}, Dims{"mass-chain", 6, 3, 1}}) {
+  for (const Dims& d :
+       {Dims{"harmonic", 2, 1, 1}, Dims{"pendulum", 2, 1, 1}, Dims{"pendulum-forced", 2, 1, 1},
+        Dims{"coupled-duffing", 4, 2, 1}, Dims{"mass-chain", 6, 3, 1}}) {
     const auto sys = load_system_file(shipped(d.name));
     EXPECT_EQ(sys->n_x(), d.nx) << d.name;
     EXPECT_EQ(sys->n_w(), d.nw) << d.name;
@@ -68,7 +69,8 @@ TEST(SystemFileTest, DerivativesMatchCentralDifferences) {
         e(i) = eps;
         const double fd = (sys->hamiltonian(x + e) - sys->hamiltonian(x - e)) / (2 * eps);
         EXPECT_NEAR(g(i), fd, 1e-7 * (1 + std::abs(fd))) << name << " dH/dx" << i;
-        const VecX fd_col = (sys->grad_hamiltonian(x + e) - sys->grad_hamiltonian(x - e)) / (2 * eps);
+        const VecX fd_col =
+            (sys->grad_hamiltonian(x + e) - sys->grad_hamiltonian(x - e)) / (2 * eps);
         for (int j = 0; j < n; ++j) {
           EXPECT_NEAR(hess(j, i), fd_col(j), 1e-6 * (1 + std::abs(fd_col(j)))) << name;
         }
@@ -141,7 +143,8 @@ TEST(SystemFileTest, DiscreteGradientJacobianMatchesDifferences) {
     for (int j = 0; j < n; ++j) {
       VecX e = VecX::Zero(n);
       e(j) = eps;
-      const VecX fd = (sys->discrete_gradient(x, dx + e) - sys->discrete_gradient(x, dx - e)) / (2 * eps);
+      const VecX fd =
+          (sys->discrete_gradient(x, dx + e) - sys->discrete_gradient(x, dx - e)) / (2 * eps);
       EXPECT_LE((jac.col(j) - fd).norm(), 1e-6 * (1 + fd.norm())) << name << " column " << j;
     }
   }
@@ -172,40 +175,12 @@ TEST(SystemFileTest, PhasePairsComeFromThePlotsTableOrConsecutiveStates) {
 
 // ---- malformed files: FILE:LINE and the fix ---------------------------------
 
-const char* kGood = R"(name = "toy"
-states = ["q", "p"]
-inputs = ["u"]
-ports = ["w"]
-H = "p^2/(2*m) + k*q^2/2"
-z = ["c*w"]
-S = [[0, 1, 0, 0], [-1, 0, -1, -1], [0, 1, 0, 0], [0, 1, 0, 0]]
-[parameters]
-m = 1.0
-k = 2.0
-c = 0.1
-[initial]
-method = "energy"
-energy = [0.1, 1.0]
-[control]
-design = "constant"
-range = [[-1, 1]]
-)";
+using testing_util::toy_error_of;
+using testing_util::toy_with;
+const char* const kGood = testing_util::kToySystem;
 
-std::string replaced(const std::string& from, const std::string& to) {
-  std::string text = kGood;
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  return text.replace(at, from.size(), to);
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    compile_system(text, "toy.toml");
-  } catch (const SystemFileError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string replaced(const std::string& from, const std::string& to) { return toy_with(from, to); }
+std::string error_of(const std::string& text) { return toy_error_of(text); }
 
 TEST(SystemFileErrorTest, TheGoodFileCompiles) { EXPECT_EQ(error_of(kGood), "(no error)"); }
 
@@ -216,8 +191,9 @@ TEST(SystemFileErrorTest, UnknownSymbolInTheEnergy) {
 }
 
 TEST(SystemFileErrorTest, StructureMatrixNotSkewSymmetric) {
-  EXPECT_THAT(error_of(replaced("[-1, 0, -1, -1]", "[-1, 0, -1, 1]")),
-              AllOf(HasSubstr("toy.toml:7:"), HasSubstr("not skew-symmetric"), HasSubstr("S[4][2]")));
+  EXPECT_THAT(
+      error_of(replaced("[-1, 0, -1, -1]", "[-1, 0, -1, 1]")),
+      AllOf(HasSubstr("toy.toml:7:"), HasSubstr("not skew-symmetric"), HasSubstr("S[4][2]")));
 }
 
 TEST(SystemFileErrorTest, StructureMatrixOfTheWrongSize) {
@@ -230,9 +206,9 @@ TEST(SystemFileErrorTest, StructureMatrixOfTheWrongSize) {
 TEST(SystemFileErrorTest, StructureLargerThanTheSupportedSize) {
   std::string ports = "\"w\"";
   for (int i = 2; i <= kMaxDimension; ++i) ports += ", \"w" + std::to_string(i) + "\"";
-  EXPECT_THAT(error_of(replaced("ports = [\"w\"]", "ports = [" + ports + "]")),
-              AllOf(HasSubstr("toy.toml:7:"), HasSubstr("make S 35 square"),
-                    HasSubstr("at most 32")));
+  EXPECT_THAT(
+      error_of(replaced("ports = [\"w\"]", "ports = [" + ports + "]")),
+      AllOf(HasSubstr("toy.toml:7:"), HasSubstr("make S 35 square"), HasSubstr("at most 32")));
 }
 
 // Structure only (measured data): no H, z, [initial], [control]. It
@@ -248,8 +224,8 @@ TEST(SystemFileErrorTest, StructureOnlyFilesDescribeButDoNotGenerate) {
     sys->hamiltonian(VecX::Zero(2));
     ADD_FAILURE() << "no energy, yet hamiltonian() returned";
   } catch (const SystemFileError& e) {
-    EXPECT_THAT(e.what(), AllOf(HasSubstr("pendulum-structure.toml:7:"), HasSubstr("defines no energy H"),
-                                HasSubstr("phnn import")));
+    EXPECT_THAT(e.what(), AllOf(HasSubstr("pendulum-structure.toml:7:"),
+                                HasSubstr("defines no energy H"), HasSubstr("phnn import")));
   }
   std::string text = kGood;
   text.erase(text.find("H = "), text.find('\n', text.find("H = ")) - text.find("H = ") + 1);
