@@ -9,6 +9,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "phnn/common/counted.h"
 #include "phnn/data/measured.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/output_path.h"
@@ -74,8 +75,9 @@ int write_file_system_data(const std::string& path, const DatasetOptions& option
   write_atomically(out, "writing", [&](const std::string& scratch) { write_ph_dataset_file(scratch, data); });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << "phnn data: " << system->name() << " (" << path << ", " << system->n_x()
-            << " states, " << system->n_w() << " ports, " << system->n_u() << " inputs): "
+  std::cout << "phnn data: " << system->name() << " (" << path << ", "
+            << counted(system->n_x(), "state") << ", " << counted(system->n_w(), "port") << ", "
+            << counted(system->n_u(), "input") << "): "
             << data.train.size() << " train pairs, " << data.validation.size()
             << " validation pairs, " << data.inference.size() << " inference trajectories x "
             << (data.inference.size() ? data.inference.states[0].size() : 0) << " samples -> "

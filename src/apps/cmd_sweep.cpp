@@ -35,6 +35,7 @@
 #include "apps/sweep_phases.h"
 #include "apps/sweep_report.h"
 #include "h5/h5file.h"
+#include "phnn/common/counted.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "phnn/store/scratch_file.h"
@@ -680,7 +681,7 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
               << " runs asked for of at most " << grid_.runs.size() << " ("
               << (round == 0 ? std::string("every cell's first ") +
                                    std::to_string(spec_.adaptive.initial_seeds.size()) + " seeds"
-                             : std::to_string(cells_grown.back()) + " cells got " +
+                             : counted(cells_grown.back(), "cell") + " got " +
                                    std::to_string(spec_.adaptive.batch) + " more seeds after round " +
                                    std::to_string(round - 1))
               << ", rule " << to_string(spec_.adaptive.rule) << ")" << std::endl;

@@ -17,6 +17,7 @@
 #include "apps/provenance.h"
 #include "apps/sweep_report.h"
 #include "apps/train_cell_file.h"
+#include "phnn/common/counted.h"
 #include "phnn/common/check.h"
 #include "phnn/common/closest_name.h"
 #include "phnn/common/utc_time.h"
@@ -251,8 +252,8 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int a
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
   if (parser.has("out")) require_new_output(parser);
   const PhSystemData data = file_system_data(parser, *system, cell.n_train);
-  std::cout << "phnn train: " << system->name() << " (" << system->n_x() << " states, "
-            << system->n_w() << " ports, " << system->n_u() << " inputs) "
+  std::cout << "phnn train: " << system->name() << " (" << counted(system->n_x(), "state") << ", "
+            << counted(system->n_w(), "port") << ", " << counted(system->n_u(), "input") << ") "
             << model_label(cell.model, cell.integrator) << " size=" << to_string(cell.size)
             << " n_train=" << cell.n_train << " reg=" << to_string(cell.regularizer)
             << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << std::endl;

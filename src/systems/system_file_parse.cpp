@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "phnn/common/counted.h"
 #include "phnn/common/closest_name.h"
 #include "phnn/systems/system_file.h"
 
@@ -284,9 +285,10 @@ void read_expressions(const Reader& r, const toml::table& t, SystemDefinition* d
     def->lines["z"] = Reader::line(*z);
     def->dissipation = r.strings(*z, "z");
     if (def->dissipation.size() != def->ports.size()) {
-      r.fail(Reader::line(*z), "\"z\" has " + std::to_string(def->dissipation.size()) +
-                                   " expressions for " + std::to_string(def->ports.size()) +
-                                   " ports; give one z_k(w) per port in \"ports\"");
+      r.fail(Reader::line(*z),
+             "\"z\" has " + counted(static_cast<long long>(def->dissipation.size()), "expression") +
+                 " for " + counted(static_cast<long long>(def->ports.size()), "port") +
+                 "; give one z_k(w) per port in \"ports\"");
     }
   }
 }

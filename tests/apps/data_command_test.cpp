@@ -100,7 +100,7 @@ TEST(TrainCommandTest, TrainsOnASystemFileAndWritesItsResults) {
   std::string log;
   ASSERT_EQ(phnn("train --system " + sys + " --model phnn-s-rk2 --seeds 0 --steps 5 --quiet", &log), 0)
       << log;
-  EXPECT_THAT(log, HasSubstr("coupled-duffing (4 states, 2 ports, 1 inputs) PHNN-S-RK2"));
+  EXPECT_THAT(log, HasSubstr("coupled-duffing (4 states, 2 ports, 1 input) PHNN-S-RK2"));
   EXPECT_THAT(log, HasSubstr("median [IQR]"));
   const std::string out = ::testing::TempDir() + "phnn_train_file_out.h5";
   std::remove(out.c_str());

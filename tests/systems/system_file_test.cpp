@@ -12,6 +12,7 @@
 #include <string>
 
 #include "phnn/systems/oscillators.h"
+#include "phnn/common/counted.h"
 #include "phnn/systems/ph_system.h"
 #include "systems/expression_code.h"
 #include "systems/toy_system.h"
@@ -271,7 +272,7 @@ energy = [0.1, 1.0]
 
 TEST(SystemFileErrorTest, DissipationLawCountDiffersFromPorts) {
   EXPECT_THAT(error_of(replaced("z = [\"c*w\"]", "z = [\"c*w\", \"w\"]")),
-              AllOf(HasSubstr("toy.toml:6:"), HasSubstr("2 expressions for 1 ports")));
+              AllOf(HasSubstr("toy.toml:6:"), HasSubstr("2 expressions for 1 port;")));
 }
 
 TEST(SystemFileErrorTest, UnknownInitialMethod) {
@@ -338,6 +339,18 @@ TEST(ShippedSystemsTest, BareNamesResolveToShippedFiles) {
   ASSERT_EQ(unsetenv("PHNN_SYSTEMS_DIR"), 0);
   // Without the override: the binary's ../sweeps/systems (tests run from build/).
   EXPECT_NE(shipped_system_path("pendulum"), "");
+}
+
+}  // namespace
+}  // namespace phnn
+
+namespace phnn {
+namespace {
+
+TEST(CountedTest, OneIsSingular) {
+  EXPECT_EQ(counted(1, "input"), "1 input");
+  EXPECT_EQ(counted(0, "port"), "0 ports");
+  EXPECT_EQ(counted(4, "state"), "4 states");
 }
 
 }  // namespace
