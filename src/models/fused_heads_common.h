@@ -4,12 +4,13 @@
 // backward, and the row and lower-triangle indexing of the n-state heads.
 #pragma once
 
+#include <torch/torch.h>
+
 #include <array>
 #include <cmath>
 #include <vector>
 
-#include <torch/torch.h>
-
+#include "models/head_sizes.h"
 #include "models/vector_math.h"
 
 namespace phnn {
@@ -21,7 +22,9 @@ using torch::autograd::AutogradContext;
 using torch::autograd::variable_list;
 
 // sigmoid(x) from z = exp(-|x|), without overflow for either sign.
-inline double sigmoid_from(double x, double z) { return x >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z); }
+inline double sigmoid_from(double x, double z) {
+  return x >= 0.0 ? 1.0 / (1.0 + z) : z / (1.0 + z);
+}
 
 // sigmoid(x) alone (one exp).
 inline double sigmoid_of(double x) { return sigmoid_from(x, exp_nonpositive(-std::fabs(x))); }
@@ -84,6 +87,35 @@ inline Tensor rows_like(const Tensor& u, const Tensor& like) {
 
 // Row-major lower triangle: entry (r, c), c <= r, is output r (r + 1) / 2 + c.
 inline int tri(int r, int c) { return r * (r + 1) / 2 + c; }
+
+// y = L x and x = L^T y for a lower-triangular n x n L stored as its
+// row-major triangle, each entry one sum in index order (N: head_sizes.h).
+template <int N = 0>
+void lower_times(const double* L, const double* x, int n_rt, double* y) {
+  const int n = size_of<N>(n_rt);
+  for (int r = 0; r < n; ++r) {
+    double s = 0.0;
+    for (int c = 0; c <= r; ++c) s += L[tri(r, c)] * x[c];
+    y[r] = s;
+  }
+}
+template <int N = 0>
+void lower_transpose_times(const double* L, const double* y, int n_rt, double* x) {
+  const int n = size_of<N>(n_rt);
+  for (int c = 0; c < n; ++c) {
+    double s = 0.0;
+    for (int r = c; r < n; ++r) s += L[tri(r, c)] * y[r];
+    x[c] = s;
+  }
+}
+
+// (K - K^T)_rc of a port network's outputs o [n (n + 1) / 2 + n (n - 1) / 2]:
+// L's triangle, then K's strictly lower triangle row by row.
+inline double skew_entry(const double* o, int n, int r, int c) {
+  if (r == c) return 0.0;
+  const int base = n * (n + 1) / 2;
+  return r > c ? o[base + r * (r - 1) / 2 + c] : -o[base + c * (c - 1) / 2 + r];
+}
 
 // A head's constant structure matrix (J or S), kept for its backward as one
 // list entry of the context.

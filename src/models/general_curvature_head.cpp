@@ -3,6 +3,7 @@
 // and the Hessian from L_H's order-2 jet, forward and written-out backward,
 // row by row, no autograd node. Private to src/models; the op-by-op
 // general_hamiltonian_jet (general_ph.cpp) is the reference.
+#include <algorithm>
 #include <vector>
 
 #include "models/fused_heads_common.h"
@@ -34,9 +35,20 @@ using namespace heads;
 struct CurvatureRow {
   int n, K;
   std::vector<double> l, li, lij, v, vi, vij;  // [K], [n][K], [n][n][K], [n], [n][n], [n][n][n]
+  std::vector<double> lb, lib, lijb;           // the backward's adjoints of l, li, lij
 
   CurvatureRow(int states, int outputs)
-      : n(states), K(outputs), l(K), li(n * K), lij(n * n * K), v(n), vi(n * n), vij(n * n * n) {}
+      : n(states),
+        K(outputs),
+        l(K),
+        li(n * K),
+        lij(n * n * K),
+        v(n),
+        vi(n * n),
+        vij(n * n * n),
+        lb(K),
+        lib(n * K),
+        lijb(n * n * K) {}
 
   // The L entries' jet of one row (aux: softplus, sigmoid, softplus' per diagonal entry).
   void entries(const double* o, const double* og, const double* oh, const double* aux) {
@@ -96,11 +108,14 @@ struct CurvatureRow {
 
 // The adjoints of one row (file comment): from G~ (gb [n]) and K~ (kb [n][n])
 // into ob [K], ogb [n][K], ohb [n][n][K], xb [n].
-void curvature_row_backward(const CurvatureRow& w, const double* og, const double* oh,
-                            const double* aux, const double* x, const double* gb, const double* kb,
-                            double* ob, double* ogb, double* ohb, double* xb) {
+void curvature_row_backward(CurvatureRow& w, const double* og, const double* oh, const double* aux,
+                            const double* x, const double* gb, const double* kb, double* ob,
+                            double* ogb, double* ohb, double* xb) {
   const int n = w.n, K = w.K;
-  std::vector<double> lb(K, 0.0), lib(n * K, 0.0), lijb(n * n * K, 0.0);
+  std::vector<double>&lb = w.lb, &lib = w.lib, &lijb = w.lijb;
+  std::fill(lb.begin(), lb.end(), 0.0);
+  std::fill(lib.begin(), lib.end(), 0.0);
+  std::fill(lijb.begin(), lijb.end(), 0.0);
   std::fill(xb, xb + n, 0.0);
   for (int r = 0; r < n; ++r) {
     double vb = 0.0;

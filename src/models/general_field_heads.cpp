@@ -13,26 +13,6 @@ namespace {
 
 using namespace heads;
 
-// y = L x and x~ = L^T y~ for a lower-triangular L stored as its row-major triangle.
-template <int N = 0>
-void lower_times(const double* L, const double* x, int n_rt, double* y) {
-  const int n = size_of<N>(n_rt);
-  for (int r = 0; r < n; ++r) {
-    double s = 0.0;
-    for (int c = 0; c <= r; ++c) s += L[tri(r, c)] * x[c];
-    y[r] = s;
-  }
-}
-template <int N = 0>
-void lower_transpose_times(const double* L, const double* y, int n_rt, double* x) {
-  const int n = size_of<N>(n_rt);
-  for (int c = 0; c < n; ++c) {
-    double s = 0.0;
-    for (int r = c; r < n; ++r) s += L[tri(r, c)] * y[r];
-    x[c] = s;
-  }
-}
-
 // ---------------------------------------------------------------- PHNN-S
 // Per row, L = L_z (raw outputs), K strictly lower (the outputs after L's),
 // A = K - K^T, W = n_x + n_w + n_u:
@@ -43,11 +23,7 @@ void lower_transpose_times(const double* L, const double* y, int n_rt, double* x
 struct PortRow {
   const double* o;  // L's triangle, then K's
   int nw;
-  double a(int r, int c) const {  // (K - K^T)_rc
-    if (r == c) return 0.0;
-    const int base = nw * (nw + 1) / 2;
-    return r > c ? o[base + r * (r - 1) / 2 + c] : -o[base + c * (c - 1) / 2 + r];
-  }
+  double a(int r, int c) const { return skew_entry(o, nw, r, c); }  // (K - K^T)_rc
 };
 
 // The PHNN-S head's rows for n_x = NX, n_w = NW (head_sizes.h).
@@ -131,7 +107,7 @@ Tensor general_s_field_forward(const Tensor& e_in, const Tensor& u_in, const Ten
   with_size(nx, [&](auto x_size) {
     with_count(n, [&](auto w_count) {
       s_rows_forward<decltype(x_size)::value, decltype(w_count)::value>(pe, pu, po, pw, S.data(),
-                                                                         rows, nx, n, nu, pf);
+                                                                        rows, nx, n, nu, pf);
     });
   });
   return f;
@@ -141,9 +117,9 @@ SFieldAdjoints general_s_field_backward(const Tensor& o_in, const Tensor& w_in,
                                         const std::vector<double>& S, int nx, int n, int nu,
                                         const Tensor& f_bar) {
   const Tensor o = dense(o_in), w = dense(w_in);
-  PHNN_CHECK(o.size(-1) == static_cast<int64_t>(n) * n &&
-                 static_cast<int>(S.size()) >= nx * (nx + n + nu),
-             "general_s_field_head: structure or output sizes");
+  PHNN_CHECK(
+      o.size(-1) == static_cast<int64_t>(n) * n && static_cast<int>(S.size()) >= nx * (nx + n + nu),
+      "general_s_field_head: structure or output sizes");
   const Tensor fb = dense(f_bar);
   const int64_t E = o.size(0), B = o.size(1), rows = rows_of(o);
   SFieldAdjoints out{torch::empty({E, B, nx}, o.options()), torch::empty({E, B, nu}, o.options()),
@@ -259,7 +235,7 @@ Tensor general_jr_field_forward(const Tensor& e_in, const Tensor& u_in, const Te
   with_size(nx, [&](auto x_size) {
     with_count(nu, [&](auto u_count) {
       jr_rows_forward<decltype(x_size)::value, decltype(u_count)::value>(pe, pu, po, J.data(), rows,
-                                                                          nx, nu, pf);
+                                                                         nx, nu, pf);
     });
   });
   return f;

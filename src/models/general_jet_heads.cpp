@@ -261,19 +261,9 @@ namespace {
 struct PortMatrices {
   int n, T;
   // (K - K^T)_ab from outputs o (L's triangle first).
-  double skew(const double* o, int a, int b) const {
-    if (a == b) return 0.0;
-    const int base = n * (n + 1) / 2;
-    return a > b ? o[base + a * (a - 1) / 2 + b] : -o[base + b * (b - 1) / 2 + a];
-  }
+  double skew(const double* o, int a, int b) const { return skew_entry(o, n, a, b); }
   // y = L w (L = the triangle of o).
-  void lower(const double* o, const double* w, double* y) const {
-    for (int q = 0; q < n; ++q) {
-      double s = 0.0;
-      for (int c = 0; c <= q; ++c) s += o[tri(q, c)] * w[c];
-      y[q] = s;
-    }
-  }
+  void lower(const double* o, const double* w, double* y) const { lower_times(o, w, n, y); }
   // z = L^T y + A w (A from o; accumulated into z).
   void upper_plus_skew(const double* o, const double* y, const double* w, double* z) const {
     for (int c = 0; c < n; ++c) {

@@ -68,8 +68,10 @@ void PhSystem::port_flows(const VecX& effort, const VecX& u, bool outputs, PhFlo
   // S_ww = 0: w depends on the effort and u only.
   out->w.resize(nw);
   for (int k = 0; k < nw; ++k) out->w(k) = row(nx + k);
-  if (nw > 0) out->z = dissipation(out->w);
-  else out->z.resize(0);
+  if (nw > 0)
+    out->z = dissipation(out->w);
+  else
+    out->z.resize(0);
   for (int j = 0; j < nw; ++j) operand[nx + j] = out->z(j);
   out->x_dot.resize(nx);
   for (int i = 0; i < nx; ++i) out->x_dot(i) = row(i);
@@ -131,7 +133,8 @@ MatX PhSystem::discrete_gradient_jacobian(const VecX& x, const VecX& dx) const {
 }
 
 std::array<double, 2> PhSystem::self_oscillation_interval() const {
-  throw std::invalid_argument(name() + ": no self-oscillation interval I_w = {w : z'(w) < 0}; "
+  throw std::invalid_argument(name() +
+                              ": no self-oscillation interval I_w = {w : z'(w) < 0}; "
                               "the limit-cycle design needs one port with a polynomial z(w) "
                               "whose z' is quadratic and negative between two roots");
 }
@@ -182,9 +185,7 @@ class BuiltinSystem : public PhSystem {
   const std::vector<std::string>& state_units() const override { return units_; }
   const std::vector<std::string>& input_names() const override { return inputs_; }
   double hamiltonian(const VecX& x) const override { return osc_.hamiltonian(as2(x)); }
-  VecX grad_hamiltonian(const VecX& x) const override {
-    return osc_.grad_hamiltonian(as2(x));
-  }
+  VecX grad_hamiltonian(const VecX& x) const override { return osc_.grad_hamiltonian(as2(x)); }
   MatX hessian(const VecX& x) const override { return osc_.hessian(as2(x)); }
   VecX dissipation(const VecX& w) const override {
     return VecX::Constant(1, osc_.dissipation(w(0)));
@@ -282,7 +283,9 @@ bool is_system_file_argument(const std::string& s) {
 
 std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
                                       const std::string& base_dir) {
-  if (!is_system_file_argument(name_or_path)) {
+  const std::string shipped = shipped_system_path(name_or_path);
+  if (!shipped.empty()) return load_system_file(shipped);
+  if (!is_path_argument(name_or_path)) {
     try {
       return std::make_unique<BuiltinSystem>(
           OscillatorOptions::defaults(parse_system(name_or_path)));
@@ -291,8 +294,6 @@ std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
                                   shipped_systems_dir() + ")");
     }
   }
-  const std::string shipped = shipped_system_path(name_or_path);
-  if (!shipped.empty()) return load_system_file(shipped);
   std::string path = name_or_path;
   if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;
   return load_system_file(path);
