@@ -23,6 +23,7 @@
 // Backward of Z = A W + b (all channels stacked as rows, per member):
 //   W~ = A^T Z~,   b~ = sum over the batch of channel 0 of Z~,   A~ = Z~ W^T.
 #include "models/fused_mlp.h"
+#include "models/fused_mlp_plan.h"
 
 #include <algorithm>
 #include <utility>
@@ -36,26 +37,8 @@
 
 namespace phnn {
 namespace internal {
-namespace {
 
 using torch::Tensor;
-using torch::autograd::AutogradContext;
-using torch::autograd::variable_list;
-
-// Channel bookkeeping of one jet.
-struct Channels {
-  int64_t d = 0, order = 0;
-  std::vector<std::pair<int64_t, int64_t>> pairs;  // (i, j), i <= j
-
-  Channels(int64_t directions, int64_t jet_order) : d(directions), order(jet_order) {
-    if (order >= 2)
-      for (int64_t i = 0; i < d; ++i)
-        for (int64_t j = i; j < d; ++j) pairs.emplace_back(i, j);
-  }
-  int64_t count() const { return 1 + (order >= 1 ? d : 0) + static_cast<int64_t>(pairs.size()); }
-  int64_t tangent(int64_t i) const { return 1 + i; }
-  int64_t pair(std::size_t p) const { return 1 + d + static_cast<int64_t>(p); }
-};
 
 // Row-major per member: C[e] = A[e] B[e] with A [rows, k], B [k, cols]
 // (trans_b: B[e] is stored as [cols, k]); member_gemm.h's kernel.
@@ -73,28 +56,6 @@ void gemm_tn(int64_t E, int rows, int n_in, int n_out, const double* a, const do
   const MatrixView<double> at{a, int64_t{rows} * n_in, 1, n_in};
   const MatrixView<double> zv{z, int64_t{rows} * n_out, n_out, 1};
   member_gemm(E, n_in, rows, n_out, at, zv, w, accumulate);
-}
-
-// dst[e][b][k] = src[e][b][k] for a 3-D view with any strides (expanded
-// inputs too); dst is dense [E, B, n] with the given member stride.
-void gather_3d(const Tensor& src, double* dst, int64_t dst_member_stride) {
-  const int64_t E = src.size(0), B = src.size(1), n = src.size(2);
-  const int64_t se = src.stride(0), sb = src.stride(1), sk = src.stride(2);
-  const double* p = src.data_ptr<double>();
-  for (int64_t e = 0; e < E; ++e)
-    for (int64_t b = 0; b < B; ++b)
-      for (int64_t k = 0; k < n; ++k) dst[e * dst_member_stride + b * n + k] = p[e * se + b * sb + k * sk];
-}
-
-// The inverse: a dense [B, n] block per member (member stride given) into a
-// 3-D view with any strides.
-void scatter_3d(const double* src, int64_t src_member_stride, Tensor* dst) {
-  const int64_t E = dst->size(0), B = dst->size(1), n = dst->size(2);
-  const int64_t se = dst->stride(0), sb = dst->stride(1), sk = dst->stride(2);
-  double* p = dst->data_ptr<double>();
-  for (int64_t e = 0; e < E; ++e)
-    for (int64_t b = 0; b < B; ++b)
-      for (int64_t k = 0; k < n; ++k) p[e * se + b * sb + k * sk] = src[e * src_member_stride + b * n + k];
 }
 
 // A workspace buffer of `numel` doubles, reused across calls: the per-thread
@@ -123,34 +84,32 @@ Tensor reusable_buffer(int64_t numel) {
   return fresh;
 }
 
-// Sizes of one call and where each saved buffer lives in the workspace.
-struct Plan {
-  Channels ch{0, 0};
-  int64_t E = 0, B = 0;
-  std::vector<int64_t> widths;  // n_0 .. n_L
-  std::vector<int64_t> act, pre, tanh;  // offsets: A_l (l < L), Z_l and T_l (l < L - 1)
-  int64_t out = 0, total = 0;           // Z_L, workspace size
+namespace {
 
-  Plan(const Channels& channels, int64_t members, int64_t batch, std::vector<int64_t> sizes)
-      : ch(channels), E(members), B(batch), widths(std::move(sizes)) {
-    const int64_t C = ch.count();
-    for (int64_t l = 0; l < layers(); ++l) {
-      act.push_back(total);
-      total += E * C * B * widths[l];
-      if (l + 1 < layers()) {
-        pre.push_back(total);
-        total += E * C * B * widths[l + 1];
-        tanh.push_back(total);
-        total += E * B * widths[l + 1];
-      }
-    }
-    out = total;
-    total += E * C * B * widths.back();
-  }
-  int64_t layers() const { return static_cast<int64_t>(widths.size()) - 1; }
-  int64_t rows() const { return ch.count() * B; }  // rows of a member's GEMM
-  int64_t block(int64_t n) const { return rows() * n; }  // a member's [C, B, n]
-};
+using torch::autograd::AutogradContext;
+using torch::autograd::variable_list;
+
+// dst[e][b][k] = src[e][b][k] for a 3-D view with any strides (expanded
+// inputs too); dst is dense [E, B, n] with the given member stride.
+void gather_3d(const Tensor& src, double* dst, int64_t dst_member_stride) {
+  const int64_t E = src.size(0), B = src.size(1), n = src.size(2);
+  const int64_t se = src.stride(0), sb = src.stride(1), sk = src.stride(2);
+  const double* p = src.data_ptr<double>();
+  for (int64_t e = 0; e < E; ++e)
+    for (int64_t b = 0; b < B; ++b)
+      for (int64_t k = 0; k < n; ++k) dst[e * dst_member_stride + b * n + k] = p[e * se + b * sb + k * sk];
+}
+
+// The inverse: a dense [B, n] block per member (member stride given) into a
+// 3-D view with any strides.
+void scatter_3d(const double* src, int64_t src_member_stride, Tensor* dst) {
+  const int64_t E = dst->size(0), B = dst->size(1), n = dst->size(2);
+  const int64_t se = dst->stride(0), sb = dst->stride(1), sk = dst->stride(2);
+  double* p = dst->data_ptr<double>();
+  for (int64_t e = 0; e < E; ++e)
+    for (int64_t b = 0; b < B; ++b)
+      for (int64_t k = 0; k < n; ++k) p[e * se + b * sb + k * sk] = src[e * src_member_stride + b * n + k];
+}
 
 // The input jet into the packed A_0 (channels per the file comment).
 void pack_input(const Tensor& x_v, const Tensor& x_g, const Tensor& x_h, const Plan& plan,
@@ -233,6 +192,11 @@ void pack_output_adjoint(const Plan& plan, const torch::autograd::variable_list&
   }
 }
 
+// a[k] += b[k], k < n.
+void add_into(const double* b, int64_t n, double* a) {
+  for (int64_t k = 0; k < n; ++k) a[k] += b[k];
+}
+
 // The adjoint of x_v's channel `channel` ([E, B, n_0]) from the packed A~_0.
 Tensor input_adjoint(const Plan& plan, const double* a_bar, int64_t channel) {
   const int64_t n = plan.widths[0];
@@ -264,10 +228,14 @@ Tensor input_curvature_adjoint(const Plan& plan, const double* a_bar) {
 // undefined = 0): parameter gradients added into `sinks` (or, without
 // sinks, returned as out[3 + l] and out[3 + L + l] where `need` asks), and
 // the input adjoints x_v~, x_g~, x_h~ (out[0..2]) where `need` asks.
-// `need` has one entry per output (3 + 2 L).
+// `need` has one entry per output (3 + 2 L). `act_extra` (order 0 only;
+// empty, or one per layer l with entry 0 unused): adjoints [E, B, n_l] added
+// to the hidden activations' adjoints A~_l before their tanh backward (the
+// reverse-mode gradient's second pass, fused_mlp_gradient.cpp).
 variable_list backward_pass(const Plan& p, const Tensor& workspace,
                             const std::vector<Tensor>& weights, const std::vector<Tensor>& sinks,
-                            const variable_list& grads, const std::vector<bool>& need) {
+                            const variable_list& grads, const std::vector<bool>& need,
+                            const std::vector<const double*>& act_extra = {}) {
   const int64_t L = p.layers(), E = p.E;
   const bool need_v = need[0], need_g = need[1], need_h = need[2];
   const int64_t widest = *std::max_element(p.widths.begin(), p.widths.end());
@@ -302,6 +270,7 @@ variable_list backward_pass(const Plan& p, const Tensor& workspace,
     gemm_nn(E, static_cast<int>(p.rows()), static_cast<int>(n_out), static_cast<int>(n_in), z_bar,
             weights[ul].data_ptr<double>(), a_bar, /*transpose_b=*/true);  // A~ = Z~ W^T
     if (l == 0) break;
+    if (!act_extra.empty()) add_into(act_extra[ul], E * p.B * n_in, a_bar);
     tanh_jet_backward(p.ch.d, p.ch.order, E, p.B * n_in, ws + p.pre[ul - 1], ws + p.tanh[ul - 1],
                       a_bar, z_bar);
   }
@@ -430,12 +399,6 @@ FusedMlpJet fused_mlp(const std::vector<torch::Tensor>& weights,
   return jet;
 }
 
-// The plan and workspace of a taped call (fused_mlp.h).
-struct FusedMlpTape {
-  Plan plan;
-  Tensor workspace;
-};
-
 FusedMlpJet fused_mlp_taped(const std::vector<torch::Tensor>& weights,
                             const std::vector<torch::Tensor>& biases, const torch::Tensor& x_v,
                             const FusedMlpOptions& options, std::shared_ptr<FusedMlpTape>* tape,
@@ -451,13 +414,14 @@ namespace {
 // (need_v) and x_g~ (need_g) where asked for.
 variable_list taped_backward(const FusedMlpTape& tape, const std::vector<torch::Tensor>& weights,
                              const std::vector<torch::Tensor>& gradient_sinks,
-                             const std::vector<torch::Tensor>& grads, bool need_v, bool need_g) {
+                             const std::vector<torch::Tensor>& grads, bool need_v, bool need_g,
+                             const std::vector<const double*>& act_extra = {}) {
   TORCH_CHECK(gradient_sinks.size() == 2 * weights.size(),
               "fused_mlp_taped_backward: expected one gradient sink per weight and bias");
   std::vector<bool> need(static_cast<std::size_t>(3 + 2 * tape.plan.layers()), false);
   need[0] = need_v;
   need[1] = need_g;
-  return backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need);
+  return backward_pass(tape.plan, tape.workspace, weights, gradient_sinks, grads, need, act_extra);
 }
 }  // namespace
 
@@ -466,6 +430,16 @@ torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
                                        const std::vector<torch::Tensor>& gradient_sinks,
                                        const std::vector<torch::Tensor>& grads, bool input_adjoint) {
   return taped_backward(tape, weights, gradient_sinks, grads, input_adjoint, false)[0];
+}
+
+torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
+                                       const std::vector<torch::Tensor>& weights,
+                                       const std::vector<torch::Tensor>& gradient_sinks,
+                                       const torch::Tensor& v_bar,
+                                       const std::vector<const double*>& act_extra, bool input_adjoint) {
+  TORCH_CHECK(tape.plan.ch.order == 0 && act_extra.size() == weights.size(),
+              "fused_mlp_taped_backward: activation adjoints need an order-0 tape, one per layer");
+  return taped_backward(tape, weights, gradient_sinks, {v_bar}, input_adjoint, false, act_extra)[0];
 }
 
 std::pair<torch::Tensor, torch::Tensor> fused_mlp_taped_jet_backward(

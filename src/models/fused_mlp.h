@@ -71,6 +71,17 @@ torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
                                        const std::vector<torch::Tensor>& gradient_sinks,
                                        const std::vector<torch::Tensor>& grads, bool input_adjoint);
 
+/// The backward of an order-0 taped call from v~ with, per layer l > 0,
+/// adjoints act_extra[l] [E, B, n_l] added to those of the hidden
+/// activations a_l (act_extra[0] unused): the second pass of the
+/// reverse-mode gradient (fused_mlp_gradient.h).
+torch::Tensor fused_mlp_taped_backward(const FusedMlpTape& tape,
+                                       const std::vector<torch::Tensor>& weights,
+                                       const std::vector<torch::Tensor>& gradient_sinks,
+                                       const torch::Tensor& v_bar,
+                                       const std::vector<const double*>& act_extra,
+                                       bool input_adjoint);
+
 /// The same backward for a call with an input jet x_g: returns (x_v~, x_g~).
 std::pair<torch::Tensor, torch::Tensor> fused_mlp_taped_jet_backward(
     const FusedMlpTape& tape, const std::vector<torch::Tensor>& weights,

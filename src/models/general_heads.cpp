@@ -49,10 +49,11 @@ void lower_times(const LowerFactor& L, const double* x, int n_rt, double* v) {
 
 // H (and gradH when pog is set) of every row, the diagonal's softplus
 // columns f saved into pa (formulas above).
+// Reverse mode (pc set, pog null): the cotangent c into pc and L^T v into pg.
 template <int N>
 void hamiltonian_rows_forward(const double* po, const double* px, const double* pog,
                               const SoftplusColumns& f, int64_t rows, int n_rt, double* pa,
-                              double* ph, double* pg) {
+                              double* ph, double* pg, double* pc = nullptr) {
   const int n = size_of<N>(n_rt), K = n * (n + 1) / 2;
   std::vector<double> heap(N > 0 ? 0 : n + K);
   double fixed[N > 0 ? N + N * (N + 1) / 2 : 1];
@@ -68,14 +69,15 @@ void hamiltonian_rows_forward(const double* po, const double* px, const double* 
     double s = 0.0;
     for (int i = 0; i < n; ++i) s += v[i] * v[i];
     ph[r] = 0.5 * s;
-    if (!pog) continue;
+    if (!pog && !pc) continue;
+    double* cr = pc ? pc + K * r : c;
     for (int i = 0; i < n; ++i)
-      for (int j = 0; j <= i; ++j) c[tri(i, j)] = v[i] * L.sig(i, j) * xr[j];
-    const double* og = pog + static_cast<int64_t>(n) * K * r;
+      for (int j = 0; j <= i; ++j) cr[tri(i, j)] = v[i] * L.sig(i, j) * xr[j];
+    const double* og = pog ? pog + static_cast<int64_t>(n) * K * r : nullptr;
     for (int i = 0; i < n; ++i) {
       double g = 0.0;
       for (int k = i; k < n; ++k) g += L.entry(k, i) * v[k];
-      for (int k = 0; k < K; ++k) g += og[i * K + k] * c[k];
+      for (int k = 0; og && k < K; ++k) g += og[i * K + k] * cr[k];
       pg[n * r + i] = g;
     }
   }
@@ -83,8 +85,15 @@ void hamiltonian_rows_forward(const double* po, const double* px, const double* 
 
 }  // namespace
 
-HamiltonianHead general_hamiltonian_forward(const Tensor& o_in, const Tensor& o_g_in,
-                                            const Tensor& x_in, HamiltonianTape* tape) {
+namespace {
+
+// H, and gradH from o_g (forward mode) or, with `cotangent`, the cotangent c
+// [E, B, K] and L^T v in `grad` (reverse mode); what the backward reads in *tape.
+struct HamiltonianRows {
+  Tensor h, grad, c;
+};
+HamiltonianRows hamiltonian_forward(const Tensor& o_in, const Tensor& o_g_in, const Tensor& x_in,
+                                    bool cotangent, HamiltonianTape* tape) {
   const Tensor o = dense(o_in), x = dense(x_in);
   const bool with_grad = o_g_in.defined();
   const Tensor o_g = with_grad ? dense(o_g_in) : Tensor();
@@ -92,33 +101,50 @@ HamiltonianHead general_hamiltonian_forward(const Tensor& o_in, const Tensor& o_
   PHNN_CHECK(K == n * (n + 1) / 2,
              "general_hamiltonian_head: " << K << " outputs for " << n << " states");
   const int64_t rows = rows_of(o);
-  Tensor h = torch::empty({o.size(0), o.size(1), 1}, o.options());
-  Tensor grad = with_grad ? torch::empty_like(x) : Tensor();
+  HamiltonianRows out{torch::empty({o.size(0), o.size(1), 1}, o.options()),
+                      with_grad || cotangent ? torch::empty_like(x) : Tensor(),
+                      cotangent ? torch::empty_like(o) : Tensor()};
   Tensor aux = torch::empty({rows, 3 * n}, o.options());
   const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
   const double* pog = with_grad ? o_g.data_ptr<double>() : nullptr;
-  double *ph = h.data_ptr<double>(), *pa = aux.data_ptr<double>();
-  double* pg = with_grad ? grad.data_ptr<double>() : nullptr;
+  double *ph = out.h.data_ptr<double>(), *pa = aux.data_ptr<double>();
+  double* pg = out.grad.defined() ? out.grad.data_ptr<double>() : nullptr;
+  double* pc = cotangent ? out.c.data_ptr<double>() : nullptr;
   std::vector<int> diagonal(n);
   for (int i = 0; i < n; ++i) diagonal[i] = tri(i, i);
   thread_local std::vector<double> columns;
   columns.resize(static_cast<std::size_t>(SoftplusColumns::size(n, rows)));
   const SoftplusColumns f = SoftplusColumns::compute(po, K, diagonal, rows, columns.data());
   with_size(n, [&](auto size) {
-    hamiltonian_rows_forward<decltype(size)::value>(po, px, pog, f, rows, n, pa, ph, pg);
+    hamiltonian_rows_forward<decltype(size)::value>(po, px, pog, f, rows, n, pa, ph, pg, pc);
   });
   *tape = HamiltonianTape{o, o_g, x, aux};
-  return {h, grad};
+  return out;
+}
+
+}  // namespace
+
+HamiltonianHead general_hamiltonian_forward(const Tensor& o, const Tensor& o_g, const Tensor& x,
+                                            HamiltonianTape* tape) {
+  const HamiltonianRows r = hamiltonian_forward(o, o_g, x, false, tape);
+  return {r.h, r.grad};
+}
+
+HamiltonianCotangent general_hamiltonian_cotangent(const Tensor& o, const Tensor& x,
+                                                   HamiltonianTape* tape) {
+  const HamiltonianRows r = hamiltonian_forward(o, Tensor(), x, true, tape);
+  return {r.h, r.c, r.grad};
 }
 
 namespace {
 
 // The backward's rows: o_g~, then v~, x~ and o~ of one row (formulas above);
 // `work` holds 3 n + K doubles.
+// Reverse mode: og null and cbr the given c~ of the row.
 template <int N>
 void hamiltonian_row_backward(const LowerFactor& L, const double* xr, const double* og,
                               const double* gbr, double hb, int n_rt, double* ogb, double* ob,
-                              double* xb, double* work) {
+                              double* xb, double* work, const double* cbr = nullptr) {
   const int n = size_of<N>(n_rt), K = n * (n + 1) / 2;
   double fixed[N > 0 ? 3 * N + N * (N + 1) / 2 : 1];
   double* w = N > 0 ? fixed : work;
@@ -126,7 +152,10 @@ void hamiltonian_row_backward(const LowerFactor& L, const double* xr, const doub
   std::fill(gb, gb + n, 0.0);
   std::fill(cb, cb + K, 0.0);
   lower_times<N>(L, xr, n, v);
-  if (gbr) {
+  if (cbr) {
+    for (int i = 0; i < n; ++i) gb[i] = gbr[i];
+    for (int k = 0; k < K; ++k) cb[k] = cbr[k];
+  } else if (gbr) {
     for (int i = 0; i < n; ++i) gb[i] = gbr[i];
     for (int i = 0; i < n; ++i) {
       for (int j = 0; j <= i; ++j) {
@@ -167,22 +196,28 @@ void hamiltonian_row_backward(const LowerFactor& L, const double* xr, const doub
 
 }  // namespace
 
-HamiltonianAdjoints general_hamiltonian_backward(const HamiltonianTape& tape,
-                                                 const Tensor& h_bar_in, const Tensor& g_bar_in) {
+HamiltonianAdjoints general_hamiltonian_cotangent_backward(const HamiltonianTape& tape,
+                                                           const Tensor& h_bar_in,
+                                                           const Tensor& g_bar_in,
+                                                           const Tensor& c_bar_in) {
   const Tensor &o = tape.o, &x = tape.x, &aux = tape.aux;
-  const bool with_grad = tape.o_g.defined();
+  const bool with_grad = tape.o_g.defined(), reverse = c_bar_in.defined();
+  PHNN_CHECK(!reverse || (!with_grad && g_bar_in.defined()),
+             "general_hamiltonian_cotangent_backward: c~ goes with a reverse-mode tape and gradH~");
+  const Tensor c_bar = reverse ? dense(c_bar_in) : Tensor();
   const int n = static_cast<int>(x.size(-1)), K = static_cast<int>(o.size(-1));
   const int64_t rows = rows_of(o);
   const Tensor h_bar = h_bar_in.defined() ? dense(h_bar_in)
                                           : torch::zeros({o.size(0), o.size(1), 1}, o.options());
-  const Tensor g_bar = with_grad && g_bar_in.defined() ? dense(g_bar_in) : Tensor();
+  const Tensor g_bar = (with_grad || reverse) && g_bar_in.defined() ? dense(g_bar_in) : Tensor();
   Tensor o_bar = torch::empty_like(o), x_bar = torch::empty_like(x);
   Tensor o_g_bar = with_grad ? torch::zeros_like(tape.o_g) : Tensor();
   const double *po = o.data_ptr<double>(), *px = x.data_ptr<double>();
   const double *phb = h_bar.data_ptr<double>(), *pa = aux.data_ptr<double>();
-  const double* pog = g_bar.defined() ? tape.o_g.data_ptr<double>() : nullptr;
+  const double* pog = g_bar.defined() && with_grad ? tape.o_g.data_ptr<double>() : nullptr;
   const double* pgb = g_bar.defined() ? g_bar.data_ptr<double>() : nullptr;
-  double* pogb = g_bar.defined() ? o_g_bar.data_ptr<double>() : nullptr;
+  double* pogb = g_bar.defined() && with_grad ? o_g_bar.data_ptr<double>() : nullptr;
+  const double* pcb = reverse ? c_bar.data_ptr<double>() : nullptr;
   double *pob = o_bar.data_ptr<double>(), *pxb = x_bar.data_ptr<double>();
   const int64_t per_row = static_cast<int64_t>(n) * K;
   std::vector<double> work(static_cast<std::size_t>(3 * n + K));
@@ -192,10 +227,15 @@ HamiltonianAdjoints general_hamiltonian_backward(const HamiltonianTape& tape,
       hamiltonian_row_backward<N>(LowerFactor{po + K * r, pa + 3 * n * r}, px + n * r,
                                   pog ? pog + per_row * r : nullptr, pgb ? pgb + n * r : nullptr,
                                   phb[r], n, pogb ? pogb + per_row * r : nullptr, pob + K * r,
-                                  pxb + n * r, work.data());
+                                  pxb + n * r, work.data(), pcb ? pcb + K * r : nullptr);
     }
   });
   return {o_bar, o_g_bar, x_bar};
+}
+
+HamiltonianAdjoints general_hamiltonian_backward(const HamiltonianTape& tape, const Tensor& h_bar,
+                                                 const Tensor& g_bar) {
+  return general_hamiltonian_cotangent_backward(tape, h_bar, g_bar, Tensor());
 }
 
 namespace {

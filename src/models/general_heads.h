@@ -40,6 +40,21 @@ HamiltonianAdjoints general_hamiltonian_backward(const HamiltonianTape& tape,
                                                  const torch::Tensor& h_bar,
                                                  const torch::Tensor& g_bar);
 
+/// Reverse mode: gradH = L^T v + J_o(x)^T c, the second term a
+/// vector-Jacobian product of L_H (fused_mlp_gradient.h) with the cotangent
+///   c_k = v_r x_c (sigmoid(o_k) on the diagonal), entry k = (r, c).
+/// The head gives H, c and L^T v (o_g undefined in *tape); its backward
+/// takes H~ (undefined = 0), gradH~ and the product's c~ (o_g~ undefined).
+struct HamiltonianCotangent {
+  torch::Tensor h, c, l_t_v;  // [E, B, 1], [E, B, K], [E, B, n]
+};
+HamiltonianCotangent general_hamiltonian_cotangent(const torch::Tensor& o, const torch::Tensor& x,
+                                                   HamiltonianTape* tape);
+HamiltonianAdjoints general_hamiltonian_cotangent_backward(const HamiltonianTape& tape,
+                                                           const torch::Tensor& h_bar,
+                                                           const torch::Tensor& g_bar,
+                                                           const torch::Tensor& c_bar);
+
 /// Gonzalez discrete gradient for n states (eq: gonzalez-discrete-gradient):
 ///   dg = g + (H1 - H0 - g.dx) / |dx|^2 dx,  = g where |dx| < min_dx_norm.
 torch::Tensor general_gonzalez_head(const torch::Tensor& h0, const torch::Tensor& h1,

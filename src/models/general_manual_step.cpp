@@ -35,8 +35,9 @@ using internal::heads::rows_like;
 using namespace internal::manual;
 using torch::Tensor;
 
-const HamiltonianOps kGeneralHead{internal::general_hamiltonian_forward,
-                                  internal::general_hamiltonian_backward};
+const HamiltonianOps kGeneralHead{
+    internal::general_hamiltonian_forward, internal::general_hamiltonian_backward,
+    internal::general_hamiltonian_cotangent, internal::general_hamiltonian_cotangent_backward};
 const CurvatureOps kGeneralCurvature{internal::general_curvature_forward,
                                      internal::general_curvature_backward};
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "models/general_heads.h"
+#include "models/manual_step.h"
 #include "models/ordered_sum.h"
 #include "phnn/common/check.h"
 
@@ -157,9 +158,10 @@ torch::Tensor GeneralPortHamiltonianModel::block_t(const std::vector<double>& ma
   return from_values(t, cols, rows, options().dtype);
 }
 
-// With fused networks, H and gradH come from one fused head on the network's
-// order-1 jet (general_heads.h); otherwise from the op-by-op jet (the
-// reference the tests compare the heads with).
+// With fused networks, H and gradH come from the fused head (general_heads.h):
+// without a graph in reverse mode, with one on the network's order-1 jet;
+// otherwise from the op-by-op jet (the reference the tests compare the
+// heads with).
 torch::Tensor GeneralPortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
   if (l_h().options().fused) {
     return internal::general_hamiltonian_head(l_h().forward(x), {}, x).h.squeeze(-1);
@@ -169,6 +171,14 @@ torch::Tensor GeneralPortHamiltonianModel::hamiltonian(const torch::Tensor& x) c
 
 HamiltonianAndGradient GeneralPortHamiltonianModel::energy_and_gradient(
     const torch::Tensor& x) const {
+  if (l_h().options().fused && !torch::GradMode::is_enabled()) {
+    // No graph to keep (rollouts): gradH in reverse mode, the hand-written
+    // steps' arithmetic (manual_step.cpp), two passes through L_H for any n_x.
+    internal::manual::TapedNet net{l_h(), nullptr};
+    internal::HamiltonianTape tape;
+    const auto h = internal::general_hamiltonian_cotangent(net.forward(x, 0, 0).v, x, &tape);
+    return {h.h, h.l_t_v + net.vjp(h.c)};
+  }
   if (l_h().options().fused) {
     const Jet o = l_h().forward_input(x, static_cast<int>(x.size(-1)), /*order=*/1);
     const auto head = internal::general_hamiltonian_head(o.v, o.g, x);

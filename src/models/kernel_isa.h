@@ -24,10 +24,11 @@ const char* kernel_isa_name(KernelIsa isa);
 
 /// The version of our kernels' arithmetic: results are bitwise equal across
 /// CPUs within one kernel set; it changes when a kernel's operation order
-/// does (then the results change by round-off).
-constexpr int kKernelSet = 1;
+/// does (then the results change by round-off). Set 2: gradH in reverse mode
+/// (fused_mlp_gradient.h), tanh with one division (vector_math.h).
+constexpr int kKernelSet = 2;
 
-/// For provenance: "phnn kernels 1; avx512 of avx512 (CPU: avx512f avx2 fma)".
+/// For provenance: "phnn kernels 2; avx512 of avx512 (CPU: avx512f avx2 fma)".
 std::string kernel_description();
 
 /// For tests: kernel_isa() returns `isa` (capped by the CPU) while this

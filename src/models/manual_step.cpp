@@ -75,14 +75,28 @@ struct TapedGradient {
   Tensor grad;
   TapedGradient(const StackedMlp& net, const HamiltonianOps& head_ops, const Tensor& y)
       : l_h{net, nullptr}, ops(head_ops) {
+    if (ops.cotangent) {  // reverse mode: gradH = L^T v + J^T c
+      const auto h = ops.cotangent(l_h.forward(y, 0, 0).v, y, &head);
+      grad = h.l_t_v + l_h.vjp(h.c);
+      return;
+    }
     const auto o = l_h.forward(y, static_cast<int>(y.size(-1)), 1);
     grad = ops.forward(o.v, o.g, y, &head).grad;
   }
   // y~ = (c + the head's x adjoint b) + L_H's input adjoint a, autograd's
-  // order; c (another node's adjoint of y, created after these) may be undefined.
+  // order; c (another node's adjoint of y, created after these) may be
+  // undefined. Reverse mode: the product's backward gives c~ first.
   Tensor backward(const Tensor& grad_bar, bool input, const Tensor& c = Tensor()) const {
-    const auto adj = ops.backward(head, Tensor(), grad_bar);
-    const Tensor a = l_h.backward({adj.o, adj.o_g}, input);
+    HamiltonianAdjoints adj;
+    Tensor a;
+    if (ops.cotangent) {
+      const Tensor c_bar = l_h.vjp_backward(grad_bar);
+      adj = ops.cotangent_backward(head, Tensor(), grad_bar, c_bar);
+      a = l_h.backward_after_vjp(adj.o, input);
+    } else {
+      adj = ops.backward(head, Tensor(), grad_bar);
+      a = l_h.backward({adj.o, adj.o_g}, input);
+    }
     if (!input) return Tensor();
     return (c.defined() ? c + adj.x : adj.x) + a;
   }
@@ -124,6 +138,19 @@ FusedMlpJet TapedNet::forward(const Tensor& y, int directions, int order) {
 
 Tensor TapedNet::backward(const std::vector<Tensor>& grads, bool input) const {
   return fused_mlp_taped_backward(*tape, net.weights(), net.gradient_sinks(), grads, input);
+}
+
+Tensor TapedNet::vjp(const Tensor& c) {
+  return fused_mlp_taped_vjp(*tape, net.weights(), c, &vjp_tape);
+}
+
+Tensor TapedNet::vjp_backward(const Tensor& s_bar) const {
+  return fused_mlp_taped_vjp_backward(*vjp_tape, *tape, net.weights(), net.gradient_sinks(), s_bar);
+}
+
+Tensor TapedNet::backward_after_vjp(const Tensor& v_bar, bool input) const {
+  return fused_mlp_vjp_value_backward(*vjp_tape, *tape, net.weights(), net.gradient_sinks(), v_bar,
+                                      input);
 }
 
 FusedMlpJet TapedNet::forward_jet(const Tensor& v, const Tensor& g) {

@@ -17,6 +17,8 @@
 
 #include "models/fused_heads.h"
 #include "models/fused_mlp.h"
+#include "models/fused_mlp_gradient.h"
+#include "models/general_heads.h"
 #include "phnn/models/dynamics_model.h"
 #include "phnn/models/stacked_mlp.h"
 
@@ -61,8 +63,14 @@ bool has_manual_step(const std::vector<std::unique_ptr<StackedMlp>>& nets, torch
 struct TapedNet {
   const StackedMlp& net;
   std::shared_ptr<FusedMlpTape> tape;
+  std::shared_ptr<FusedMlpVjpTape> vjp_tape = nullptr;
   FusedMlpJet forward(const Tensor& y, int directions, int order);
   Tensor backward(const std::vector<Tensor>& grads, bool input) const;
+  /// After an order-0 forward: s = J(y)^T c (fused_mlp_gradient.h); its
+  /// backward s~ -> c~, then the value pass's backward from v~ (-> y~ if `input`).
+  Tensor vjp(const Tensor& c);
+  Tensor vjp_backward(const Tensor& s_bar) const;
+  Tensor backward_after_vjp(const Tensor& v_bar, bool input) const;
   /// With an order-1 input jet (v, g [E, B, d, n]); backward -> (v~, g~).
   FusedMlpJet forward_jet(const Tensor& v, const Tensor& g);
   std::pair<Tensor, Tensor> backward_jet(const std::vector<Tensor>& grads) const;
@@ -72,11 +80,17 @@ struct TapedNet {
 /// defined) from L_H's outputs, and its backward. The 2-state closed form
 /// (hamiltonian_head_taped) and the n-state one (general_hamiltonian_forward)
 /// share the tape and adjoint types.
+/// With `cotangent` set, gradH runs in reverse mode (general_heads.h):
+/// L_H's value, the head's cotangent c, then the product J^T c.
 struct HamiltonianOps {
   HamiltonianHead (*forward)(const Tensor& o, const Tensor& o_g, const Tensor& x,
                              HamiltonianTape* tape);
   HamiltonianAdjoints (*backward)(const HamiltonianTape& tape, const Tensor& h_bar,
                                   const Tensor& g_bar);
+  HamiltonianCotangent (*cotangent)(const Tensor& o, const Tensor& x,
+                                    HamiltonianTape* tape) = nullptr;
+  HamiltonianAdjoints (*cotangent_backward)(const HamiltonianTape& tape, const Tensor& h_bar,
+                                            const Tensor& g_bar, const Tensor& c_bar) = nullptr;
 };
 
 /// A curvature head without an autograd node: gradH and the Hessian from

@@ -9,16 +9,18 @@
 namespace phnn {
 namespace internal {
 
-/// y[i] = tanh(x[i]) for i < n, to within 2 ulp of std::tanh (tested), NaN
-/// and +-inf handled like std::tanh. x and y may alias.
+/// y[i] = tanh(x[i]) for i < n, within 1.6 ulp of the exact tanh (tested
+/// against long double), NaN and +-inf handled like std::tanh. x and y may alias.
 ///
-/// Method (the Cephes library's, S. L. Moshier): for |x| < 0.625 the odd
-/// rational approximation tanh x = x + x^3 P(x^2) / Q(x^2); otherwise
-/// tanh |x| = 1 - 2 / (exp(2|x|) + 1) with |x| clamped at 22 (where tanh
-/// rounds to 1) and exp by the reduction 2|x| = k ln 2 + r, |r| <= ln2/2,
-/// exp r = 1 + 2 r P(r^2) / (Q(r^2) - r P(r^2)) (a Pade form), times 2^k
-/// built from its bits. Both branches are computed and blended, so the loop
-/// has no branch and vectorizes.
+/// Method (the Cephes library's rational forms, S. L. Moshier, with one
+/// division per element): for |x| < 0.625 the odd rational approximation
+/// tanh x = x + x^3 P(x^2) / Q(x^2); otherwise tanh |x| = 1 - 2 / (exp(2|x|)
+/// + 1) with |x| clamped at 22 (where tanh rounds to 1), exp by the
+/// reduction 2|x| = k ln 2 + r, |r| <= ln2/2, exp r = (q + p) / (q - p)
+/// (p = r P(r^2), q = Q(r^2): a Pade form) times 2^k built from its bits,
+/// so tanh |x| = 1 - 2 (q - p) / (2^k (q + p) + (q - p)). Both branches are
+/// computed and blended before their one division, so the loop has no
+/// branch and vectorizes.
 void tanh_array(const double* x, double* y, int64_t n);
 
 /// exp(x) for x <= 0 (0 below -745.2, NaN stays NaN; x > 0 falls back to

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -182,24 +183,31 @@ TEST(FusedMlpTest, HamiltonianAndDiscreteGradientMatchReference) {
       << "d f_bar / d dx";
 }
 
-// Within 2 ulp of std::tanh from 1e-20 to 30 (both signs), the branch point
-// 0.625 and the clamp at 22 included; exact at 0, +-inf and NaN.
-TEST(VectorTanhTest, WithinTwoUlpOfStdTanh) {
+// Within 1.6 ulp of the exact tanh (long double: 11 more bits than the
+// result) on a log grid of |x| in [1e-20, 31.6] (both signs) and random
+// points around the branch switch at 0.625, where the one-division form is
+// least accurate (1.59 ulp measured there over 4e7 points); the clamp at 22
+// included; exact at 0, +-inf and NaN.
+TEST(VectorTanhTest, WithinOnePointSixUlpOfTheExactTanh) {
   std::vector<double> x;
   for (double e = -20.0; e <= 1.5; e += 1e-4) {
     x.push_back(std::pow(10.0, e));
     x.push_back(-std::pow(10.0, e));
   }
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> near_switch(0.55, 0.8);
+  for (int i = 0; i < 400000; ++i) x.push_back(near_switch(rng));
   for (double v : {0.625, std::nextafter(0.625, 0.0), 22.0, 0.0, -0.0}) x.push_back(v);
   std::vector<double> y(x.size());
   internal::tanh_array(x.data(), y.data(), static_cast<int64_t>(x.size()));
   double worst = 0.0;
   for (std::size_t i = 0; i < x.size(); ++i) {
-    const double ref = std::tanh(x[i]);
-    const double ulp = std::nextafter(std::fabs(ref), 2.0) - std::fabs(ref);
-    worst = std::max(worst, std::fabs(y[i] - ref) / ulp);
+    const long double exact = tanhl(static_cast<long double>(x[i]));
+    const double rounded = static_cast<double>(exact);
+    const double ulp = std::nextafter(std::fabs(rounded), 2.0) - std::fabs(rounded);
+    worst = std::max(worst, static_cast<double>(std::fabs(y[i] - exact) / ulp));
   }
-  EXPECT_LE(worst, 2.0);
+  EXPECT_LE(worst, 1.6);
   const double special[] = {std::numeric_limits<double>::infinity(),
                             -std::numeric_limits<double>::infinity(),
                             std::numeric_limits<double>::quiet_NaN()};

@@ -1,20 +1,22 @@
 // tests/models/general_manual_step_test.cpp — the hand-written training steps
 // of the n-dimensional models (models/general_manual_step.cpp) against
-// autograd on the same model: the loss and every parameter gradient bitwise
-// equal (they claim the same operations in the same order), for NODE, PHNN-S
-// and PHNN-JR with RK2 and RK4 and the PH models with DG (R at the midpoint and at
-// the start; rows below the Gonzalez threshold included), on structures of
-// 2, 4, 6 and 10 states (10: the heads' loops sized at run time, above
-// head_sizes.h's fixed sizes) with 0-3 ports and 1-3 inputs, data expanded over the
-// members (the full-batch view) and gathered per member; with a Jacobian
-// regularizer (CN, SN, SR) the reference is the trainer's regularized loss:
-// bitwise for NODE, to round-off for the PH models, whose field jet at x the
-// step computes by the jet heads of general_jet_heads.h instead of the
-// op-by-op jets. Those jets (f and df/dx at x) are compared with the
-// op-by-op ones to 1e-12 of their largest entry (JetHeadsMatchTheOpByOpJets);
-// the penalty's kappa and rho then amplify that round-off by the Jacobian's
-// condition, so the whole step is compared to 1e-10 (loss, relative) and 1e-10
-// of the largest gradient.
+// autograd on the same model, for NODE, PHNN-S and PHNN-JR with RK2 and RK4
+// and the PH models with DG (R at the midpoint and at the start; rows below
+// the Gonzalez threshold included), on structures of 2, 4, 6 and 10 states
+// (10: the heads' loops sized at run time, above head_sizes.h's fixed sizes)
+// with 0-3 ports and 1-3 inputs, data expanded over the members (the
+// full-batch view) and gathered per member, with and without a Jacobian
+// regularizer (CN, SN, SR; the reference is then the trainer's regularized
+// loss). NODE: the loss and every parameter gradient bitwise equal (the same
+// operations in the same order). PH models: to 1e-12 (loss relative, and of
+// the largest gradient): the step takes gradH in reverse mode (a
+// vector-Jacobian product of L_H, fused_mlp_gradient.h) where autograd's
+// graph propagates L_H's forward-mode jet. With a regularizer the field jet
+// at x runs through the jet heads of general_jet_heads.h instead of the
+// op-by-op jets (those agree to 1e-12 of their largest entry,
+// JetHeadsMatchTheOpByOpJets); the penalty's kappa and rho amplify that
+// round-off by the Jacobian's condition (gradients up to 1e8 here), so those
+// steps are compared to 1e-10.
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
@@ -82,7 +84,7 @@ std::string name_of(const ::testing::TestParamInfo<Case>& info) {
 
 class GeneralManualStepTest : public ::testing::TestWithParam<Case> {};
 
-TEST_P(GeneralManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
+TEST_P(GeneralManualStepTest, LossAndGradientsAreAutograds) {
   const Case c = GetParam();
   const std::vector<std::uint64_t> seeds = {3, 4, 5};
   const int64_t E = 3, B = 29;
@@ -125,10 +127,12 @@ TEST_P(GeneralManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
   ASSERT_TRUE(manual.defined());
   const double largest = (flat.gradients - autograd_grad).abs().max().item<double>();
   const double scale = autograd_grad.abs().max().item<double>();
-  if (c.regularizer != Regularizer::kNone && c.kind != ModelKind::kNode) {
-    EXPECT_LT(((manual - autograd_loss).abs() / autograd_loss.abs()).max().item<double>(), 1e-10)
+  if (c.kind != ModelKind::kNode) {  // gradH in reverse mode, the jets through the jet heads
+    const double tolerance = c.regularizer == Regularizer::kNone ? 1e-12 : 1e-10;
+    EXPECT_LT(((manual - autograd_loss).abs() / autograd_loss.abs()).max().item<double>(),
+              tolerance)
         << manual << autograd_loss;
-    EXPECT_LT(largest, 1e-10 * scale) << "largest difference " << largest << " of " << scale;
+    EXPECT_LT(largest, tolerance * scale) << "largest difference " << largest << " of " << scale;
     return;
   }
   EXPECT_TRUE(same_bits(manual, autograd_loss)) << manual << autograd_loss;
