@@ -4,6 +4,7 @@
 #include "phnn/common/check.h"
 #include "phnn/models/general_ph.h"
 #include "phnn/models/port_hamiltonian.h"
+#include "phnn/systems/oscillators.h"
 
 namespace phnn {
 
@@ -102,19 +103,28 @@ const std::vector<const StackedMlp*> DynamicsModel::networks() const {
   return out;
 }
 
-std::unique_ptr<DynamicsModel> DynamicsModel::create(const ModelOptions& options,
+ModelStructure builtin_structure(SystemKind kind) {
+  const Oscillator system(OscillatorOptions::defaults(kind));
+  ModelStructure s{2, 1, 1, {}, {}};
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) s.S.push_back(system.S()(r, c));
+  const Eigen::Matrix3d J = system.J();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) s.J.push_back(J(r, c));
+  return s;
+}
+
+// One model family for every system: a built-in system's models are the
+// n-state ones on its structure.
+std::unique_ptr<DynamicsModel> DynamicsModel::create(const ModelOptions& options_in,
                                                      const std::vector<std::uint64_t>& seeds) {
-  if (options.general) {
-    switch (options.kind) {
-      case ModelKind::kNode: return std::make_unique<GeneralNode>(options, seeds);
-      case ModelKind::kPhnnS: return std::make_unique<GeneralPhnnS>(options, seeds);
-      case ModelKind::kPhnnJr: return std::make_unique<GeneralPhnnJr>(options, seeds);
-    }
-  }
+  ModelOptions options = options_in;
+  if (!options.general)
+    options.general = std::make_shared<ModelStructure>(builtin_structure(options.structure));
   switch (options.kind) {
-    case ModelKind::kNode: return std::make_unique<Node>(options, seeds);
-    case ModelKind::kPhnnS: return std::make_unique<PhnnS>(options, seeds);
-    case ModelKind::kPhnnJr: return std::make_unique<PhnnJr>(options, seeds);
+    case ModelKind::kNode: return std::make_unique<GeneralNode>(options, seeds);
+    case ModelKind::kPhnnS: return std::make_unique<GeneralPhnnS>(options, seeds);
+    case ModelKind::kPhnnJr: return std::make_unique<GeneralPhnnJr>(options, seeds);
   }
   PHNN_CHECK(false, "unknown model kind");
   return nullptr;

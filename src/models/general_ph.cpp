@@ -317,6 +317,17 @@ GeneralPhnnJr::GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64
   place_lt_ = triangle_placement(m, m * (m + 1) / 2, true, 0, o.dtype);
 }
 
+torch::Tensor GeneralPhnnJr::dissipation_matrix(const torch::Tensor& x,
+                                                const torch::Tensor& u) const {
+  const int64_t m = structure().n_x + structure().n_u;
+  const auto o = nets_[1]->forward(torch::cat({x, u}, -1));  // [E, B, m (m + 1) / 2]
+  auto L = torch::zeros({x.size(0), x.size(1), m, m}, x.options());
+  int64_t k = 0;
+  for (int64_t r = 0; r < m; ++r)
+    for (int64_t c = 0; c <= r; ++c) L.select(-2, r).select(-1, c).copy_(o.select(-1, k++));
+  return internal::ordered_matmul(L.transpose(-1, -2), L);
+}
+
 Jet GeneralPhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
                                      const torch::Tensor& u, int order,
                                      bool dissipation_fixed) const {

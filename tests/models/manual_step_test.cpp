@@ -1,11 +1,14 @@
 // tests/models/manual_step_test.cpp — the hand-written training steps
-// (models/manual_step.h, two_state_manual_step.cpp) against autograd on the same model: the loss
-// and every parameter gradient bitwise equal (they claim the same operations in the same order),
-// for NODE, PHNN-S and PHNN-JR with RK2 and RK4 and the PH models with DG (R at the midpoint and at
-// the start; rows below the Gonzalez threshold included), each built-in structure, two sizes, data
-// expanded over the members (the full-batch view) and gathered per member; with a Jacobian
-// regularizer (CN, SN, SR) the reference is the trainer's regularized loss,
-// L_d + the penalty of df/dx at x with the RK2 step's first stage reused.
+// (models/manual_step.h, general_manual_step.cpp) on the built-in systems'
+// structures (DynamicsModel::create without a ModelStructure) against
+// autograd on the same model, for NODE, PHNN-S and PHNN-JR with RK2 and RK4
+// and the PH models with DG (R at the midpoint and at the start; rows below
+// the Gonzalez threshold included), each built-in structure, two sizes, data
+// expanded over the members (the full-batch view) and gathered per member;
+// with a Jacobian regularizer (CN, SN, SR) the reference is the trainer's
+// regularized loss, L_d + the penalty of df/dx at x with the RK2 step's first
+// stage reused. NODE: bitwise; PH models: to 1e-12 (1e-10 with a penalty),
+// the tolerances and their reasons of general_manual_step_test.cpp.
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
@@ -37,7 +40,7 @@ struct Case {
 
 class ManualStepTest : public ::testing::TestWithParam<Case> {};
 
-TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
+TEST_P(ManualStepTest, LossAndGradientsAreAutograds) {
   const Case c = GetParam();
   const std::vector<std::uint64_t> seeds = {3, 4, 5, 6};
   const int64_t E = 4, B = 37;
@@ -75,10 +78,19 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutogradsToTheBit) {
   const auto manual = dg ? model->dg_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty)
                          : model->explicit_mean_l1_step(c.integrator, x, x_next, u, h, penalty);
   ASSERT_TRUE(manual.defined());
+  const double largest = (flat.gradients - autograd_grad).abs().max().item<double>();
+  const double scale = autograd_grad.abs().max().item<double>();
+  if (c.kind != ModelKind::kNode) {
+    const double tolerance = c.regularizer == Regularizer::kNone ? 1e-12 : 1e-10;
+    EXPECT_LT(((manual - autograd_loss).abs() / autograd_loss.abs()).max().item<double>(),
+              tolerance)
+        << manual << autograd_loss;
+    EXPECT_LT(largest, tolerance * scale) << "largest difference " << largest << " of " << scale;
+    return;
+  }
   EXPECT_TRUE(same_bits(manual, autograd_loss)) << manual << autograd_loss;
   EXPECT_TRUE(same_bits(flat.gradients, autograd_grad))
-      << "largest difference " << (flat.gradients - autograd_grad).abs().max().item<double>()
-      << " of " << autograd_grad.abs().max().item<double>();
+      << "largest difference " << largest << " of " << scale;
 }
 
 INSTANTIATE_TEST_SUITE_P(

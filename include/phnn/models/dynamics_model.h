@@ -47,9 +47,8 @@ struct ModelOptions {
   /// float64 either way and then rounded, so a float32 model starts from the
   /// float64 model's weights rounded to float32.
   torch::ScalarType dtype = torch::kFloat64;
-  /// Set for a file-defined system: the n-dimensional models of
-  /// general_ph.h on this structure (`structure` is then ignored); unset,
-  /// the 2-state models of port_hamiltonian.h on a built-in structure.
+  /// The structure of the n-dimensional models of general_ph.h (every
+  /// system's); unset, that of the built-in `structure` (builtin_structure).
   std::shared_ptr<const ModelStructure> general = nullptr;
 };
 
@@ -125,7 +124,9 @@ class DynamicsModel {
   /// The networks, for per-component parameter counts and tests.
   const std::vector<const StackedMlp*> networks() const;
 
-  /// Builds the model stack, member e initialized from seeds[e].
+  /// Builds the model stack, member e initialized from seeds[e]: the
+  /// n-dimensional models of general_ph.h on options.general, or on the
+  /// built-in system's structure when that is unset.
   static std::unique_ptr<DynamicsModel> create(const ModelOptions& options,
                                                const std::vector<std::uint64_t>& seeds);
 
@@ -138,5 +139,10 @@ class DynamicsModel {
   ModelOptions options_;
   int64_t members_;
 };
+
+/// A built-in system's structure for the n-state models: its S (rows dq/dt,
+/// dp/dt, w, y; columns dH/dq, dH/dp, z, u) and J (PHNN-JR's, on (dH/dq,
+/// dH/dp, u)), row-major; n_x = 2, n_w = 1, n_u = 1.
+ModelStructure builtin_structure(SystemKind kind);
 
 }  // namespace phnn

@@ -84,6 +84,8 @@ class GeneralPhnnS : public GeneralPortHamiltonianModel {
 class GeneralPhnnJr : public GeneralPortHamiltonianModel {
  public:
   GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  /// R_theta(x, u) = L^T L [E, B, m, m], m = n_x + n_u (for tests: symmetric PSD).
+  torch::Tensor dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const;
   /// Hand-written steps, as GeneralPhnnS's.
   torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
                                       const torch::Tensor& x_next, const torch::Tensor& u,
