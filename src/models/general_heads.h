@@ -15,7 +15,7 @@
 
 #include <torch/torch.h>
 
-#include "models/fused_heads.h"
+#include "models/head_types.h"
 
 namespace phnn {
 namespace internal {

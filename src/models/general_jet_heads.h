@@ -13,7 +13,7 @@
 
 #include <vector>
 
-#include "models/fused_heads.h"
+#include "models/head_types.h"
 
 namespace phnn {
 namespace internal {

@@ -35,12 +35,6 @@ using internal::heads::rows_like;
 using namespace internal::manual;
 using torch::Tensor;
 
-const HamiltonianOps kGeneralHead{
-    internal::general_hamiltonian_forward, internal::general_hamiltonian_backward,
-    internal::general_hamiltonian_cotangent, internal::general_hamiltonian_cotangent_backward};
-const CurvatureOps kGeneralCurvature{internal::general_curvature_forward,
-                                     internal::general_curvature_backward};
-
 // PHNN-JR: F(e, y) = JR(e, L_R(y, u), u).
 EffortFieldRecorder jr_effort_field(const StackedMlp& l_r, const Tensor& u,
                                     const std::vector<double>& J) {
@@ -99,7 +93,7 @@ EffortFieldRecorder s_effort_field(const StackedMlp& l_z, const Tensor& u,
 JacobianFieldRecorder jr_jacobian_field(const StackedMlp& l_h, const StackedMlp& l_r,
                                         const Tensor& u, const std::vector<double>& J) {
   return [&l_h, &l_r, u, &J](const Tensor& x) {
-    auto curvature = std::make_shared<TapedCurvature>(l_h, kGeneralCurvature, x);
+    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
     const auto& effort = curvature->effort;
     auto net_r = std::make_shared<TapedNet>(TapedNet{l_r, nullptr});
     const auto jet_r = net_r->forward(cat_rows(x, u), static_cast<int>(x.size(-1)), 1);
@@ -127,7 +121,7 @@ JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp* 
                                        const std::vector<double>& s_x_rows,
                                        const std::vector<double>& S, int n_w) {
   return [&l_h, l_z, u, &s_w_rows, &s_x_rows, &S, n_w](const Tensor& x) {
-    auto curvature = std::make_shared<TapedCurvature>(l_h, kGeneralCurvature, x);
+    auto curvature = std::make_shared<TapedCurvature>(l_h, x);
     const auto& e = curvature->effort;
     const int n_x = static_cast<int>(x.size(-1)), n_u = static_cast<int>(u.size(-1));
     if (n_w == 0) {
@@ -183,7 +177,7 @@ Tensor GeneralPhnnJr::explicit_mean_l1_step(IntegratorKind integrator, const Ten
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
-  return ph_explicit_mean_l1(integrator, l_h(), kGeneralHead, x, x_next, h,
+  return ph_explicit_mean_l1(integrator, l_h(), x, x_next, h,
                              jr_effort_field(*nets_[1], u, structure().J),
                              jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
@@ -194,7 +188,7 @@ Tensor GeneralPhnnJr::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, con
   if (!has_manual_step(nets_, options().dtype)) return {};
   torch::NoGradGuard no_grad;
   const Tensor u = rows_like(u_in, x);
-  return ph_dg_mean_l1(l_h(), kGeneralHead, x, x_next, h, min_dx_norm, dissipation_at_start(),
+  return ph_dg_mean_l1(l_h(), x, x_next, h, min_dx_norm, dissipation_at_start(),
                        jr_effort_field(*nets_[1], u, structure().J),
                        jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
@@ -207,7 +201,7 @@ Tensor GeneralPhnnS::explicit_mean_l1_step(IntegratorKind integrator, const Tens
   const Tensor u = rows_like(u_in, x);
   const SRecorders r = s_recorders(l_h(), nets_.size() > 1 ? nets_[1].get() : nullptr, u, s_w_rows_,
                                    s_x_rows_, structure());
-  return ph_explicit_mean_l1(integrator, l_h(), kGeneralHead, x, x_next, h, r.field, r.jacobian,
+  return ph_explicit_mean_l1(integrator, l_h(), x, x_next, h, r.field, r.jacobian,
                              penalty);
 }
 
@@ -219,7 +213,7 @@ Tensor GeneralPhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, cons
   const Tensor u = rows_like(u_in, x);
   const SRecorders r = s_recorders(l_h(), nets_.size() > 1 ? nets_[1].get() : nullptr, u, s_w_rows_,
                                    s_x_rows_, structure());
-  return ph_dg_mean_l1(l_h(), kGeneralHead, x, x_next, h, min_dx_norm, false, r.field, r.jacobian,
+  return ph_dg_mean_l1(l_h(), x, x_next, h, min_dx_norm, false, r.field, r.jacobian,
                        penalty);
 }
 

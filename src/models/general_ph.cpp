@@ -13,8 +13,9 @@
 namespace phnn {
 namespace {
 
-// The 2-state models' network streams (port_hamiltonian.cpp), so that on a
-// 2-state structure both start from the same weights.
+// Network streams: distinct initializations for the networks of one member
+// (the values of the former 2-state models, so a member starts from the
+// weights it always had).
 constexpr std::uint64_t kStreamLH = 1, kStreamLR = 2, kStreamLz = 3, kStreamNode = 4;
 
 torch::Tensor from_values(const std::vector<double>& v, int64_t rows, int64_t cols,

@@ -1,11 +1,14 @@
 // src/models/manual_step.cpp — the shared parts of the hand-written training
 // steps (models/manual_step.h): the mean-L1 loss, RK2 and DG around field
-// recorders, the PH models' gradient and DG around a Hamiltonian head, and
-// NODE's RK2 step. Forward, loss and backward run without an autograd graph,
-// through the same kernels as the autograd path (fused_mlp_taped, the heads'
-// taped forms) with the same operations in the same order, so loss and
-// gradients are bitwise those of loss.sum().backward()
-// (tests/models/manual_step_test.cpp, general_manual_step_test.cpp).
+// recorders, the PH models' gradient (reverse mode) and DG around the
+// Hamiltonian head, and NODE's RK2 step. Forward, loss and backward run
+// without an autograd graph, through the same kernels as the autograd path
+// (fused_mlp_taped, the heads' taped forms) with the same operations in the
+// same order, so NODE's loss and gradients are bitwise those of
+// loss.sum().backward() and the PH models' equal them to round-off (gradH by
+// a vector-Jacobian product of L_H, fused_mlp_gradient.h, where autograd
+// propagates L_H's forward-mode jet; tests/models/manual_step_test.cpp,
+// general_manual_step_test.cpp).
 // Touches only the models' gradient sinks (their flat gradient buffer).
 //
 // Forward (per member, batch rows b, h the step):
@@ -30,6 +33,7 @@
 #include <cmath>
 
 #include "models/general_heads.h"
+#include "models/general_jet_heads.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
@@ -66,37 +70,23 @@ Tensor add_penalty(const Tensor& loss, const JacobianPenalty& penalty, const Ten
   return penalty ? loss + penalty(dfdx, dfdx_bar) : loss;
 }
 
-// gradH(y) from L_H's first-order jet in the y.size(-1) state directions
-// and `ops`' head, kept for its backward.
+// gradH(y) in reverse mode (general_heads.h): L_H's value, the head's
+// cotangent c, then gradH = L^T v + J^T c; kept for its backward.
 struct TapedGradient {
   TapedNet l_h;
-  const HamiltonianOps& ops;
   HamiltonianTape head;
   Tensor grad;
-  TapedGradient(const StackedMlp& net, const HamiltonianOps& head_ops, const Tensor& y)
-      : l_h{net, nullptr}, ops(head_ops) {
-    if (ops.cotangent) {  // reverse mode: gradH = L^T v + J^T c
-      const auto h = ops.cotangent(l_h.forward(y, 0, 0).v, y, &head);
-      grad = h.l_t_v + l_h.vjp(h.c);
-      return;
-    }
-    const auto o = l_h.forward(y, static_cast<int>(y.size(-1)), 1);
-    grad = ops.forward(o.v, o.g, y, &head).grad;
+  TapedGradient(const StackedMlp& net, const Tensor& y) : l_h{net, nullptr} {
+    const auto h = general_hamiltonian_cotangent(l_h.forward(y, 0, 0).v, y, &head);
+    grad = h.l_t_v + l_h.vjp(h.c);
   }
   // y~ = (c + the head's x adjoint b) + L_H's input adjoint a, autograd's
   // order; c (another node's adjoint of y, created after these) may be
-  // undefined. Reverse mode: the product's backward gives c~ first.
+  // undefined. The product's backward gives the head's c~ first.
   Tensor backward(const Tensor& grad_bar, bool input, const Tensor& c = Tensor()) const {
-    HamiltonianAdjoints adj;
-    Tensor a;
-    if (ops.cotangent) {
-      const Tensor c_bar = l_h.vjp_backward(grad_bar);
-      adj = ops.cotangent_backward(head, Tensor(), grad_bar, c_bar);
-      a = l_h.backward_after_vjp(adj.o, input);
-    } else {
-      adj = ops.backward(head, Tensor(), grad_bar);
-      a = l_h.backward({adj.o, adj.o_g}, input);
-    }
+    const Tensor c_bar = l_h.vjp_backward(grad_bar);
+    const auto adj = general_hamiltonian_cotangent_backward(head, Tensor(), grad_bar, c_bar);
+    const Tensor a = l_h.backward_after_vjp(adj.o, input);
     if (!input) return Tensor();
     return (c.defined() ? c + adj.x : adj.x) + a;
   }
@@ -162,16 +152,14 @@ std::pair<Tensor, Tensor> TapedNet::backward_jet(const std::vector<Tensor>& grad
   return fused_mlp_taped_jet_backward(*tape, net.weights(), net.gradient_sinks(), grads);
 }
 
-TapedCurvature::TapedCurvature(const StackedMlp& net, const CurvatureOps& curvature_ops,
-                               const Tensor& x)
-    : l_h{net, nullptr}, ops(curvature_ops) {
+TapedCurvature::TapedCurvature(const StackedMlp& net, const Tensor& x) : l_h{net, nullptr} {
   const int n = static_cast<int>(x.size(-1));
   const auto o = l_h.forward(x, n, 2);
-  effort = ops.forward(o.v, o.g, o.h, x, &head);
+  effort = general_curvature_forward(o.v, o.g, o.h, x, &head);
 }
 
 void TapedCurvature::backward(const Tensor& grad_bar, const Tensor& hessian_bar) const {
-  const auto c = ops.backward(head, grad_bar, hessian_bar);
+  const auto c = general_curvature_backward(head, grad_bar, hessian_bar);
   l_h.backward({c.o, c.o_g, c.o_h}, false);
 }
 
@@ -228,13 +216,13 @@ Tensor explicit_mean_l1(IntegratorKind integrator, const Tensor& x_in, const Ten
 }
 
 Tensor ph_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& l_h,
-                           const HamiltonianOps& head, const Tensor& x, const Tensor& x_next,
+                           const Tensor& x, const Tensor& x_next,
                            double h, const EffortFieldRecorder& effort_field,
                            const JacobianFieldRecorder& jacobian_field,
                            const JacobianPenalty& penalty) {
   const FieldRecorder field = [&](const Tensor& y, bool jacobian) {
     if (jacobian) return jacobian_field(y);
-    auto gradient = std::make_shared<TapedGradient>(l_h, head, y);
+    auto gradient = std::make_shared<TapedGradient>(l_h, y);
     const TapedEffortField effort = effort_field(gradient->grad, y);
     TapedField t{effort.f, Tensor(), {}};
     t.backward = [=](const Tensor& f_bar, const Tensor&, bool input) {
@@ -248,7 +236,7 @@ Tensor ph_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& l_h,
 
 // The DG step of a PH model, its loss (+ the penalty of df/dx at x) and
 // backward (file comment); the field at x, created first, goes back last.
-Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Tensor& x_in,
+Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x_in,
                      const Tensor& x_next_in, double h, double min_dx_norm,
                      bool dissipation_at_start, const EffortFieldRecorder& effort_field,
                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty) {
@@ -259,8 +247,8 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Te
   const Tensor ends = torch::cat({x, add_scaled(x, 1.0, dx)}, /*dim=*/1);
   TapedNet ends_net{l_h, nullptr};
   HamiltonianTape ends_head;
-  const Tensor h_ends = head.forward(ends_net.forward(ends, 0, 0).v, Tensor(), ends, &ends_head).h;
-  const TapedGradient mid(l_h, head, m);
+  const Tensor h_ends = general_hamiltonian_forward(ends_net.forward(ends, 0, 0).v, Tensor(), ends, &ends_head).h;
+  const TapedGradient mid(l_h, m);
   const Tensor h0 = h_ends.narrow(1, 0, B), h1 = h_ends.narrow(1, B, B);
   const Tensor effort = gonzalez_forward(h0, h1, mid.grad, dx, min_dx_norm);
   const TapedEffortField field = effort_field(effort, dissipation_at_start ? x : m);
@@ -272,7 +260,7 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Te
   mid.backward(g.grad, false);
   // The ends' adjoint is two narrow adjoints summed over zeros (-0 becomes +0).
   const Tensor h_ends_bar = torch::cat({g.h0, g.h1}, /*dim=*/1) + 0.0;
-  const auto ends_adj = head.backward(ends_head, h_ends_bar, Tensor());
+  const auto ends_adj = general_hamiltonian_backward(ends_head, h_ends_bar, Tensor());
   ends_net.backward({ends_adj.o}, false);
   if (penalty) at_x.backward(Tensor(), dfdx_bar, false);
   return loss;

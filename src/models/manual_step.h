@@ -1,11 +1,14 @@
 // src/models/manual_step.h — the parts of the hand-written training steps
 // that do not depend on a model's structure or size: taped networks, the
 // mean-L1 loss and its adjoint, the RK2 and DG steps of a field recorder,
-// and the PH models' steps around a Hamiltonian head. Private to src/models
-// (manual_step.cpp: the 2-state models; general_manual_step.cpp: any n_x).
-// Every function computes the operations of the autograd path in its order,
-// so the loss and the gradients are bitwise those of loss.sum().backward()
-// (tests/models/manual_step_test.cpp, general_manual_step_test.cpp).
+// and the PH models' steps around the Hamiltonian head of general_heads.h
+// (gradH in reverse mode). Private to src/models (general_manual_step.cpp
+// composes them per model). Every function computes the operations of the
+// autograd path in its order, so NODE's loss and gradients are bitwise those
+// of loss.sum().backward(), and the PH models' equal them to round-off (their
+// gradH is a vector-Jacobian product of L_H where autograd's graph has
+// L_H's forward-mode jet; tests/models/manual_step_test.cpp,
+// general_manual_step_test.cpp).
 #pragma once
 
 #include <torch/torch.h>
@@ -15,10 +18,10 @@
 #include <utility>
 #include <vector>
 
-#include "models/fused_heads.h"
 #include "models/fused_mlp.h"
 #include "models/fused_mlp_gradient.h"
 #include "models/general_heads.h"
+#include "models/head_types.h"
 #include "phnn/models/dynamics_model.h"
 #include "phnn/models/stacked_mlp.h"
 
@@ -76,41 +79,13 @@ struct TapedNet {
   std::pair<Tensor, Tensor> backward_jet(const std::vector<Tensor>& grads) const;
 };
 
-/// A Hamiltonian head without an autograd node: H (and gradH when o_g is
-/// defined) from L_H's outputs, and its backward. The 2-state closed form
-/// (hamiltonian_head_taped) and the n-state one (general_hamiltonian_forward)
-/// share the tape and adjoint types.
-/// With `cotangent` set, gradH runs in reverse mode (general_heads.h):
-/// L_H's value, the head's cotangent c, then the product J^T c.
-struct HamiltonianOps {
-  HamiltonianHead (*forward)(const Tensor& o, const Tensor& o_g, const Tensor& x,
-                             HamiltonianTape* tape);
-  HamiltonianAdjoints (*backward)(const HamiltonianTape& tape, const Tensor& h_bar,
-                                  const Tensor& g_bar);
-  HamiltonianCotangent (*cotangent)(const Tensor& o, const Tensor& x,
-                                    HamiltonianTape* tape) = nullptr;
-  HamiltonianAdjoints (*cotangent_backward)(const HamiltonianTape& tape, const Tensor& h_bar,
-                                            const Tensor& g_bar, const Tensor& c_bar) = nullptr;
-};
-
-/// A curvature head without an autograd node: gradH and the Hessian from
-/// L_H's order-2 jet, and its backward (the 2-state closed form and the
-/// n-state one share the types).
-struct CurvatureOps {
-  HamiltonianCurvature (*forward)(const Tensor& o, const Tensor& o_g, const Tensor& o_h,
-                                  const Tensor& x, CurvatureTape* tape);
-  CurvatureAdjoints (*backward)(const CurvatureTape& tape, const Tensor& grad_bar,
-                                const Tensor& hessian_bar);
-};
-
 /// gradH(x) and its Hessian from L_H's order-2 jet in the x.size(-1) state
 /// directions, kept for the backward from (gradH~, Hessian~): the head, then L_H.
 struct TapedCurvature {
   TapedNet l_h;
-  const CurvatureOps& ops;
   CurvatureTape head;
   HamiltonianCurvature effort;
-  TapedCurvature(const StackedMlp& net, const CurvatureOps& curvature_ops, const Tensor& x);
+  TapedCurvature(const StackedMlp& net, const Tensor& x);
   void backward(const Tensor& grad_bar, const Tensor& hessian_bar) const;
 };
 
@@ -122,14 +97,14 @@ Tensor explicit_mean_l1(IntegratorKind integrator, const Tensor& x, const Tensor
 /// The explicit step of a PH model: f(y) = F(gradH(y), y), gradH from L_H's
 /// order-1 jet in the y.size(-1) state directions through `head`.
 Tensor ph_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& l_h,
-                           const HamiltonianOps& head, const Tensor& x, const Tensor& x_next,
+                           const Tensor& x, const Tensor& x_next,
                            double h, const EffortFieldRecorder& effort_field,
                            const JacobianFieldRecorder& jacobian_field,
                            const JacobianPenalty& penalty);
 
 /// The DG step of a PH model (Gonzalez gradient of H_theta by `head`), its
 /// loss (+ the penalty of df/dx at x) and backward.
-Tensor ph_dg_mean_l1(const StackedMlp& l_h, const HamiltonianOps& head, const Tensor& x,
+Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x,
                      const Tensor& x_next, double h, double min_dx_norm, bool dissipation_at_start,
                      const EffortFieldRecorder& effort_field,
                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty);

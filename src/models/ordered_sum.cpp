@@ -55,7 +55,7 @@ class OrderedSum : public torch::autograd::Function<OrderedSum> {
 // t summed down to `shape` (same dimension count; 1 where t was broadcast):
 // all broadcast dimensions at once by ordered_sum, their elements in
 // row-major order (the order LibTorch's scalar reduction takes for the small
-// sums of the 2-state paths, whose bits stay as they were).
+// sums of the op-by-op reference path).
 torch::Tensor sum_to_shape(const torch::Tensor& t, const std::vector<int64_t>& shape) {
   std::vector<int64_t> kept, summed;
   for (int64_t d = 0; d < t.dim(); ++d) {

@@ -1,51 +1,16 @@
-// src/models/port_hamiltonian.cpp — the 2-state PHNN-S and PHNN-JR (fused heads) and the
-// virtual hooks the n-dimensional models override.
-// Size: both formulations share the energy, curvature and discrete-gradient paths.
+// src/models/port_hamiltonian.cpp — what PHNN-S and PHNN-JR share on top of
+// their energy (PortHamiltonianModel): the field from gradH, the DG field
+// and its Newton Jacobian, the AVF gradient and the DG4 field. H, gradH and
+// the Hessian are the models' (general_ph.cpp).
 #include "phnn/models/port_hamiltonian.h"
 
 #include <cmath>
 #include <utility>
 
-#include "models/fused_heads.h"
-#include "models/general_heads.h"
 #include "models/ordered_sum.h"
-#include "models/pinned_activations.h"
 #include "phnn/common/check.h"
 
 namespace phnn {
-namespace {
-
-// Network streams: distinct initializations for the networks of one member.
-constexpr std::uint64_t kStreamLH = 1, kStreamLR = 2, kStreamLz = 3, kStreamNode = 4;
-
-// sum_k c_k a_k over the non-zero coefficients (the structure matrices are
-// sparse {-1, 0, 1}).
-Jet lincomb(const std::vector<std::pair<double, const Jet*>>& terms, const Jet& zero_like) {
-  Jet out;
-  bool first = true;
-  for (const auto& [c, jet] : terms) {
-    if (c == 0.0) continue;
-    const Jet term = c == 1.0 ? *jet : jet_scale(*jet, c);
-    out = first ? term : jet_add(out, term);
-    first = false;
-  }
-  return first ? jet_scale(zero_like, 0.0) : out;
-}
-
-}  // namespace
-
-Jet hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order) {
-  const Jet X = Jet::input(x, /*directions=*/2, order);
-  const Jet o = l_h.forward_input(x, /*directions=*/2, order);
-  const Jet l00 = jet_softplus(o.component(0));
-  const Jet l10 = o.component(1);
-  const Jet l11 = jet_softplus(o.component(2));
-  const Jet x0 = X.component(0), x1 = X.component(1);
-  // v = L_H x, H = |v|^2 / 2.
-  const Jet v0 = jet_mul(l00, x0);
-  const Jet v1 = jet_add(jet_mul(l10, x0), jet_mul(l11, x1));
-  return jet_scale(jet_add(jet_mul(v0, v0), jet_mul(v1, v1)), 0.5);
-}
 
 Jet gradient_jet(const Jet& h) {
   PHNN_CHECK(h.g.defined(), "gradient_jet needs an order >= 1 jet of H");
@@ -55,47 +20,8 @@ Jet gradient_jet(const Jet& h) {
   return g;
 }
 
-HamiltonianAndGradient hamiltonian_and_gradient(const StackedMlp& l_h, const torch::Tensor& x) {
-  const Jet o = l_h.forward_input(x, /*directions=*/2, /*order=*/1);
-  if (l_h.options().fused) {
-    const auto head = internal::hamiltonian_head(o.v, o.g, x);
-    return {head.h, head.grad};
-  }
-  const auto q = x.narrow(-1, 0, 1), p = x.narrow(-1, 1, 1);
-  const auto o0 = o.v.narrow(-1, 0, 1), l10 = o.v.narrow(-1, 1, 1), o2 = o.v.narrow(-1, 2, 1);
-  const auto l00 = internal::pinned_softplus(o0), l11 = internal::pinned_softplus(o2);
-  const auto v0 = l00 * q, v1 = l10 * q + l11 * p;
-  HamiltonianAndGradient out;
-  out.h = 0.5 * (v0 * v0 + v1 * v1);
-  // L^T v = (l00 v0 + l10 v1, l11 v1).
-  const auto lt_v = torch::cat({l00 * v0 + l10 * v1, l11 * v1}, -1);
-  const auto c = torch::cat({v0 * internal::pinned_sigmoid(o0) * q, v1 * q, v1 * internal::pinned_sigmoid(o2) * p}, -1);
-  // (do/dx) c: o.g is [E, B, 2 (directions), 3 (outputs)].
-  out.grad = lt_v + internal::ordered_sum(o.g * c.unsqueeze(-2), 1);
-  return out;
-}
-
-torch::Tensor PortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
-  if (l_h().options().fused) {
-    return internal::hamiltonian_head(l_h().forward(x), {}, x).h.squeeze(-1);
-  }
-  return hamiltonian_jet(l_h(), x, 0).v.squeeze(-1);
-}
-
 torch::Tensor PortHamiltonianModel::grad_hamiltonian(const torch::Tensor& x) const {
   return energy_and_gradient(x).grad;
-}
-
-HamiltonianAndGradient PortHamiltonianModel::energy_and_gradient(const torch::Tensor& x) const {
-  return hamiltonian_and_gradient(l_h(), x);
-}
-
-Jet PortHamiltonianModel::curvature_jet(const torch::Tensor& x) const {
-  if (!l_h().options().fused) return gradient_jet(hamiltonian_jet(l_h(), x, /*order=*/2));
-  // Closed-form gradH and Hessian from L_H's order-2 jet (one fused head).
-  const Jet o = l_h().forward_input(x, /*directions=*/2, /*order=*/2);
-  const auto curvature = internal::hamiltonian_curvature_head(o.v, o.g, o.h, x);
-  return Jet{curvature.grad, curvature.hessian, {}};
 }
 
 FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tensor& u,
@@ -113,35 +39,6 @@ FieldEval PortHamiltonianModel::field(const torch::Tensor& x, const torch::Tenso
   out.f = f.v;
   if (with_jacobian) out.dfdx = f.g.transpose(-1, -2);
   return out;
-}
-
-torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
-                                                      const torch::Tensor& dx,
-                                                      double min_dx_norm) const {
-  const int64_t B = x.size(1);
-  if (l_h().options().fused) {
-    // H at x and x + dx needs no derivative: one order-0 network call for
-    // both, one order-1 call at the midpoint.
-    const auto ends = torch::cat({x, x + dx}, /*dim=*/1);
-    const auto h_ends = internal::hamiltonian_head(l_h().forward(ends), {}, ends).h;
-    const auto grad_mid = hamiltonian_and_gradient(l_h(), x + 0.5 * dx).grad;
-    // The n-state Gonzalez head: for n = 2 the same operations in the same
-    // order as the former 2-state one (bitwise; PaperPathTest).
-    return internal::general_gonzalez_head(h_ends.narrow(1, 0, B), h_ends.narrow(1, B, B), grad_mid,
-                                           dx, min_dx_norm);
-  }
-  // One network call for H(x), H(x + dx) and gradH(x + dx/2).
-  const auto points = torch::cat({x, x + dx, x + 0.5 * dx}, /*dim=*/1);
-  const HamiltonianAndGradient h = energy_and_gradient(points);
-  const auto h_x = h.h.narrow(1, 0, B);
-  const auto h_xdx = h.h.narrow(1, B, B);
-  const auto grad_mid = h.grad.narrow(1, 2 * B, B);  // [E, B, 2]
-  const auto n2 = internal::ordered_sum(dx * dx, 1).unsqueeze(-1);
-  const auto defect = h_xdx - h_x - internal::ordered_sum(grad_mid * dx, 1).unsqueeze(-1);
-  const auto small = n2 < min_dx_norm * min_dx_norm;
-  const auto coef = torch::where(small, torch::zeros_like(defect),
-                                 defect / torch::where(small, torch::ones_like(n2), n2));
-  return grad_mid + coef * dx;
 }
 
 torch::Tensor PortHamiltonianModel::discrete_gradient_field(const torch::Tensor& x,
@@ -206,153 +103,6 @@ FieldEval PortHamiltonianModel::discrete_gradient_field_with_jacobian(
   out.dfdx = 0.5 * f.g.transpose(-1, -2);  // [E, B, component, dx_i]
   return out;
 }
-
-namespace {
-// The L_H network shared by both formulations, then the dissipation network.
-void add_networks(std::vector<std::unique_ptr<StackedMlp>>* nets, const ModelOptions& options,
-                  const std::vector<std::uint64_t>& seeds, int dissipation_in,
-                  const std::vector<int>& dissipation_hidden, int dissipation_out,
-                  std::uint64_t dissipation_stream) {
-  nets->push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{2, network_widths(options.size).l_h, 3, options.fused_networks,
-                        options.dtype}, seeds, kStreamLH));
-  nets->push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{dissipation_in, dissipation_hidden, dissipation_out,
-                        options.fused_networks, options.dtype}, seeds,
-      dissipation_stream));
-}
-}  // namespace
-
-// ---------------------------------------------------------------- PHNN-S
-PhnnS::PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds)
-    : PortHamiltonianModel(options, static_cast<int64_t>(seeds.size())) {
-  PHNN_REQUIRE(options.kind == ModelKind::kPhnnS, "PhnnS: options.kind must be phnn-s");
-  add_networks(&nets_, options, seeds, 1, network_widths(options.size).l_z, 1, kStreamLz);
-  const Oscillator structure(OscillatorOptions::defaults(options.structure));
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) S_[r][c] = structure.S()(r, c);
-}
-
-Jet PhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_dissipation*/,
-                             const torch::Tensor& u, int order,
-                             bool /*dissipation_fixed*/) const {
-  if (order == 0 && nets_[1]->options().fused) {
-    const auto w = internal::phnn_s_w_head(effort.v, u, {S_[2][0], S_[2][1], S_[2][3]});
-    return Jet{internal::phnn_s_field_head(effort.v, u, nets_[1]->forward(w), w, S_), {}, {}};
-  }
-  const Jet eq = effort.component(0), ep = effort.component(1);
-  const Jet U = Jet::constant(u, /*directions=*/2, order);
-  // w = S_wx e + S_wu u (S_ww = 0 for the three systems).
-  const Jet w = lincomb({{S_[2][0], &eq}, {S_[2][1], &ep}, {S_[2][3], &U}}, U);
-  // z(w) = Gamma(w) w, Gamma = L_z^T L_z >= 0 (eq:physical_constraints_Gamma).
-  const Jet l = nets_[1]->forward(w);
-  const Jet z = jet_mul(jet_mul(l, l), w);
-  const Jet f0 = lincomb({{S_[0][0], &eq}, {S_[0][1], &ep}, {S_[0][2], &z}, {S_[0][3], &U}}, U);
-  const Jet f1 = lincomb({{S_[1][0], &eq}, {S_[1][1], &ep}, {S_[1][2], &z}, {S_[1][3], &U}}, U);
-  return Jet::cat({f0, f1});
-}
-
-// --------------------------------------------------------------- PHNN-JR
-PhnnJr::PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds)
-    : PortHamiltonianModel(options, static_cast<int64_t>(seeds.size())) {
-  PHNN_REQUIRE(options.kind == ModelKind::kPhnnJr, "PhnnJr: options.kind must be phnn-jr");
-  add_networks(&nets_, options, seeds, 3, network_widths(options.size).l_r, 6, kStreamLR);
-  const Oscillator structure(OscillatorOptions::defaults(options.structure));
-  const Eigen::Matrix3d J = structure.J();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) J_[r][c] = J(r, c);
-  // Entries 0, +-1: exact in either dtype.
-  j_matrix_ = torch::zeros({3, 3}, options.dtype);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) j_matrix_[r][c] = J_[r][c];
-  // Output k of L_R goes to row-major lower-triangle entry (row, col).
-  placement_ = torch::zeros({6, 9}, options.dtype);
-  int k = 0;
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col <= row; ++col) placement_[k++][3 * row + col] = 1.0;
-}
-
-torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const {
-  const auto o = nets_[1]->forward(torch::cat({x, u}, -1));  // [E, B, 6]
-  auto L = torch::zeros({x.size(0), x.size(1), 3, 3}, x.options());
-  int idx = 0;
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j <= k; ++j) L.select(-2, k).select(-1, j).copy_(o.select(-1, idx++));
-  return internal::ordered_matmul(L.transpose(-1, -2), L);
-}
-
-Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
-                              const torch::Tensor& u, int order, bool dissipation_fixed) const {
-  if (order == 0 && nets_[1]->options().fused) {
-    const auto o = nets_[1]->forward(torch::cat({x_dissipation, u}, -1));  // [E, B, 6]
-    return Jet{internal::jr_field_head(effort.v, o, u, J_), {}, {}};
-  }
-  if (order == 0) {
-    // Matrix form: L_R from its 6 outputs by one placement matmul, then
-    // f = [J e - L^T (L e)]_{1:2} with e = (gradH, u).
-    const auto o = nets_[1]->forward(torch::cat({x_dissipation, u}, -1));  // [E, B, 6]
-    const auto L = internal::ordered_matmul(o, placement_).unflatten(-1, {3, 3});    // [E, B, 3, 3]
-    const auto e = torch::cat({effort.v, u}, -1).unsqueeze(-1);            // [E, B, 3, 1]
-    const auto re = internal::ordered_matmul(L.transpose(-1, -2), internal::ordered_matmul(L, e));
-    const auto je = internal::ordered_matmul(j_matrix_, e);
-    return Jet{(je - re).squeeze(-1).narrow(-1, 0, 2), {}, {}};
-  }
-  // L_R(x, u): lower triangular 3 x 3 from 6 outputs, row by row (constant
-  // along the jet's directions when the dissipation is fixed).
-  const auto input = torch::cat({x_dissipation, u}, -1);
-  const Jet o = dissipation_fixed ? Jet::constant(nets_[1]->forward(input), 2, order)
-                                  : nets_[1]->forward_input(input, 2, order);
-  if (order == 1 && nets_[1]->options().fused && effort.g.defined()) {
-    const auto jet = internal::jr_field_jet_head(effort.v, effort.g, o.v, o.g, u, J_);
-    return Jet{jet.f, jet.g, {}};
-  }
-  Jet L[3][3];
-  int idx = 0;
-  for (int k = 0; k < 3; ++k)
-    for (int j = 0; j <= k; ++j) L[k][j] = o.component(idx++);
-  const Jet U = Jet::constant(u, 2, order);
-  const Jet e[3] = {effort.component(0), effort.component(1), U};
-  // v = L_R e;  R e = L_R^T v.
-  Jet v[3];
-  for (int k = 0; k < 3; ++k) {
-    v[k] = jet_mul(L[k][0], e[0]);
-    for (int j = 1; j <= k; ++j) v[k] = jet_add(v[k], jet_mul(L[k][j], e[j]));
-  }
-  Jet f[2];
-  for (int i = 0; i < 2; ++i) {
-    Jet re = jet_mul(L[i][i], v[i]);
-    for (int k = i + 1; k < 3; ++k) re = jet_add(re, jet_mul(L[k][i], v[k]));
-    const Jet je = lincomb({{J_[i][0], &e[0]}, {J_[i][1], &e[1]}, {J_[i][2], &e[2]}}, U);
-    f[i] = jet_sub(je, re);
-  }
-  return Jet::cat({f[0], f[1]});
-}
-
-// ------------------------------------------------------------------ NODE
-Node::Node(ModelOptions options, const std::vector<std::uint64_t>& seeds)
-    : DynamicsModel(options, static_cast<int64_t>(seeds.size())) {
-  PHNN_REQUIRE(options.kind == ModelKind::kNode, "Node: options.kind must be node");
-  nets_.push_back(std::make_unique<StackedMlp>(
-      StackedMlpOptions{3, network_widths(options.size).node, 2, options.fused_networks,
-                        options.dtype}, seeds, kStreamNode));
-}
-
-FieldEval Node::field(const torch::Tensor& x, const torch::Tensor& u, bool with_jacobian) const {
-  FieldEval out;
-  const auto input = torch::cat({x, u}, -1);
-  if (!with_jacobian) {
-    out.f = nets_[0]->forward(input);
-    return out;
-  }
-  const Jet f = nets_[0]->forward_input(input, /*directions=*/2, /*order=*/1);
-  out.f = f.v;
-  out.dfdx = f.g.transpose(-1, -2);
-  return out;
-}
-
-}  // namespace phnn
-
-namespace phnn {
 
 // ------------------------------------------------ fourth-order DG (DG4)
 torch::Tensor PortHamiltonianModel::average_vector_field_gradient(const torch::Tensor& x,

@@ -37,7 +37,7 @@ struct CellData {
   std::size_t inference_count = 0;
   int inference_steps = 0;
   double inference_step = 0.01;
-  // The built-in system's kind (the structure of the fused 2-state models).
+  // The built-in system's kind (its models' structure: builtin_structure).
   SystemKind builtin = SystemKind::kHarmonic;
   // The two figure trajectories: their x0 (n_x), input (n_u) and true
   // trajectory ([steps + 1][n_x]). Built-in systems: the paper's, from

@@ -1,12 +1,13 @@
 // include/phnn/models/general_ph.h — NODE, PHNN-S and PHNN-JR for any n_x
 // states, n_w dissipation ports and n_u inputs (paper §4 in its general
 // form; docs/METHOD.md "n-dimensional models"), on the known structure of a
-// file-defined system. Built from the same stacked MLPs and forward-mode
-// jets as the 2-state models, with the matrix algebra written for any size;
-// on the paper's 2-state structures they compute the 2-state models' fields
-// (tested to round-off). With fused networks, the order-0 and order-1 parts
-// (H, gradH, the DG, the fields) run through fused heads with hand-written
-// backwards (src/models/general_heads.h); jets of order 2 run op by op.
+// system: a file's, or a built-in oscillator's (builtin_structure); the one
+// model family of every system. Built from stacked MLPs and forward-mode
+// jets with the matrix algebra written for any size. With fused networks,
+// the order-0 and order-1 parts (H, gradH, the DG, the fields) run through
+// fused heads with hand-written backwards (src/models/general_heads.h), and
+// training through the hand-written steps of general_manual_step.cpp; jets
+// of order 2 run op by op.
 #pragma once
 
 #include "phnn/models/port_hamiltonian.h"
@@ -53,8 +54,7 @@ class GeneralPortHamiltonianModel : public PortHamiltonianModel {
 ///   z_theta(w) = (L_z(w)^T L_z(w) + K(w) - K(w)^T) w,
 ///   f = S_xx gradH + S_xw z_theta(w) + S_xu u,
 /// one network n_w -> n_w (n_w + 1) / 2 (L_z, lower triangle) + n_w (n_w - 1) / 2
-/// (K, strictly lower); for n_w = 1 that is the 2-state model's 1 -> 1
-/// network and K is empty.
+/// (K, strictly lower); for n_w = 1 a 1 -> 1 network and K is empty.
 class GeneralPhnnS : public GeneralPortHamiltonianModel {
  public:
   GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);

@@ -1,36 +1,27 @@
-// include/phnn/models/port_hamiltonian.h — PHNN-S and PHNN-JR (paper §4).
+// include/phnn/models/port_hamiltonian.h — what PHNN-S and PHNN-JR (paper §4)
+// share above their energy: the field from gradH, the DG fields; the models
+// themselves are general_ph.h's.
 #pragma once
 
-#include <array>
 
 #include "phnn/models/dynamics_model.h"
 
 namespace phnn {
 
-/// H_theta(x) = 1/2 x^T L_H(x)^T L_H(x) x (eq:quadratic_H,
-/// eq:physical_constraints_H) with L_H = [[softplus(o0), 0], [o1, softplus(o2)]]
-/// from a 2 -> 3 MLP: Q = L^T L is positive definite by construction.
-/// Returns the jet of H ([E, B, 1]): g = gradH, h = Hessian, up to `order`.
-Jet hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order);
-
-/// Jet whose value is gradH [E, B, 2] and whose g is the Hessian, from the
+/// Jet whose value is gradH [E, B, n_x] and whose g is the Hessian, from the
 /// order-(k+1) jet of H.
 Jet gradient_jet(const Jet& h);
 
-/// H [E, B, 1] and gradH [E, B, 2] in closed form from the order-1 jet of
-/// the L_H outputs o (fewer ops than hamiltonian_jet(.., 1), same values to
-/// round-off). With v = L_H x, s_k = sigmoid(o_k):
-///   gradH = L_H^T v + (do/dx) c,  c = (v0 s0 q, v1 q, v1 s2 p).
+/// H [E, B, 1] and gradH [E, B, n_x].
 struct HamiltonianAndGradient {
   torch::Tensor h, grad;
 };
-HamiltonianAndGradient hamiltonian_and_gradient(const StackedMlp& l_h, const torch::Tensor& x);
 
 /// Shared by PHNN-S and PHNN-JR: H_theta, gradH_theta, the Gonzalez DG.
 class PortHamiltonianModel : public DynamicsModel {
  public:
   bool is_port_hamiltonian() const override { return true; }
-  torch::Tensor hamiltonian(const torch::Tensor& x) const override;
+  torch::Tensor hamiltonian(const torch::Tensor& x) const override = 0;
   torch::Tensor grad_hamiltonian(const torch::Tensor& x) const override;
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
@@ -59,7 +50,7 @@ class PortHamiltonianModel : public DynamicsModel {
   ///   dg = gradH(x + dx/2) + (H(x+dx) - H(x) - gradH(x+dx/2)^T dx) / |dx|^2 dx,
   /// = gradH(x + dx/2) where |dx| < min_dx_norm (docs/METHOD.md §4).
   virtual torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
-                                          double min_dx_norm) const;
+                                          double min_dx_norm) const = 0;
 
  protected:
   PortHamiltonianModel(ModelOptions options, int64_t members)
@@ -76,68 +67,11 @@ class PortHamiltonianModel : public DynamicsModel {
   /// ModelOptions::dg_structure_point = kStart).
   bool dissipation_at_start() const;
   const StackedMlp& l_h() const { return *nets_[0]; }
-  /// H [E, B, 1] and gradH [E, B, n_x] (the 2-state closed form; the
-  /// n-dimensional models of general_ph.h override it).
-  virtual HamiltonianAndGradient energy_and_gradient(const torch::Tensor& x) const;
+  /// H [E, B, 1] and gradH [E, B, n_x].
+  virtual HamiltonianAndGradient energy_and_gradient(const torch::Tensor& x) const = 0;
   /// Jet whose value is gradH(x) [E, B, n_x] and whose g is the Hessian
   /// [E, B, n_x, n_x].
-  virtual Jet curvature_jet(const torch::Tensor& x) const;
-};
-
-/// PHNN-S (eq:f_theta-PHS-DAF): w = S_wx gradH + S_wu u,
-/// z_theta(w) = Gamma(w) w with Gamma = L_z(w)^T L_z(w) (n_w = 1: K omitted),
-/// f = S_xx gradH + S_xw z_theta(w) + S_xu u.
-class PhnnS : public PortHamiltonianModel {
- public:
-  PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
-  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
-                                      const torch::Tensor& x_next, const torch::Tensor& u,
-                                      double h, const JacobianPenalty& penalty) const override;
-  torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                const torch::Tensor& u, double h, double min_dx_norm,
-                                const JacobianPenalty& penalty) const override;
-
- protected:
-  Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
-                        const torch::Tensor& u, int order, bool dissipation_fixed) const override;
-
- private:
-  std::array<std::array<double, 4>, 4> S_;
-};
-
-/// PHNN-JR (eq:f_theta-PHS-JR): f = [(J - R_theta(x, u)) [gradH; u]]_{1:2},
-/// R = L_R^T L_R with L_R lower triangular 3 x 3 from a 3 -> 6 MLP.
-class PhnnJr : public PortHamiltonianModel {
- public:
-  PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
-  /// R_theta(x, u) [E, B, 3, 3] (for tests: symmetric PSD).
-  torch::Tensor dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const;
-  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
-                                      const torch::Tensor& x_next, const torch::Tensor& u,
-                                      double h, const JacobianPenalty& penalty) const override;
-  torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
-                                const torch::Tensor& u, double h, double min_dx_norm,
-                                const JacobianPenalty& penalty) const override;
-
- protected:
-  Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
-                        const torch::Tensor& u, int order, bool dissipation_fixed) const override;
-
- private:
-  std::array<std::array<double, 3>, 3> J_;
-  torch::Tensor j_matrix_;   // J [3, 3]
-  torch::Tensor placement_;  // [6, 9]: L_R outputs -> row-major 3 x 3 lower triangle
-};
-
-/// NODE baseline (eq: neural-ode): f = MLP([x; u]), 3 -> 2.
-class Node : public DynamicsModel {
- public:
-  Node(ModelOptions options, const std::vector<std::uint64_t>& seeds);
-  FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
-                  bool with_jacobian) const override;
-  torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
-                                      const torch::Tensor& x_next, const torch::Tensor& u,
-                                      double h, const JacobianPenalty& penalty) const override;
+  virtual Jet curvature_jet(const torch::Tensor& x) const = 0;
 };
 
 }  // namespace phnn
