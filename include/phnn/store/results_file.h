@@ -232,7 +232,7 @@ class ResultsFile {
   /// written before provenance have neither and drop the times).
   bool has_run_times() const;
   /// One entry per row; "" where unknown (pending, recovered from a
-  /// journal, or an older file).
+  /// journal record written before 2026-11-28, or an older file).
   std::vector<std::string> read_started_utc() const;
   std::vector<std::string> read_finished_utc() const;
   /// sessions_with_runs(read_sessions(), read_finished_utc()), every
