@@ -271,6 +271,7 @@ class SweepRun {
         if (!problem.empty() && !parser_.flag_set("mix-kernels")) {
           throw cli::UsageError{"phnn sweep: " + problem};
         }
+        repair_file_damage(&*file, out_, spec_, grid_, &data_);
         if (!parser_.flag_set("mix-kernels")) check_stored_data(*file);
       } else {
         std::vector<std::string> studies;
@@ -440,8 +441,8 @@ void announce_item(const std::string& prefix, int number, std::size_t items,
   }
 }
 
-// Journal record first (the source of truth), then the run times and the
-// row, for each run of the item. A failed journal append (a full disk) does
+// Journal record first (the source of truth), then the row, each with the
+// item's run times, for each run of the item. A failed journal append (a full disk) does
 // not stop the row: its space was allocated when the file was made, so the
 // result is kept there. Returns "" or the first I/O error.
 std::string record_item(const Grid& grid, const WorkItem& item,
@@ -457,11 +458,11 @@ std::string record_item(const Grid& grid, const WorkItem& item,
   };
   for (std::size_t k = 0; k < item.runs.size(); ++k) {
     const int row = item.runs[k];
-    attempt([&] { journal->append(grid.runs[static_cast<std::size_t>(row)].id(), cell_results[k]); });
-    attempt([&] {
-      results->write_run_times(row, started, finished);
-      results->write_run(row, cell_results[k]);
-    });
+    RunResult result = cell_results[k];
+    result.started_utc = started;
+    result.finished_utc = finished;
+    attempt([&] { journal->append(grid.runs[static_cast<std::size_t>(row)].id(), result); });
+    attempt([&] { results->write_run(row, result); });
   }
   return error;
 }

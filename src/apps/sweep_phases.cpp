@@ -12,6 +12,7 @@
 #include <boost/serialization/string.hpp>
 #include <boost/serialization/vector.hpp>
 
+#include "apps/sweep_data.h"
 #include "phnn/store/journal.h"
 #include "phnn/sweep/output_check.h"
 #include "phnn/sweep/sweep_growth.h"
@@ -124,35 +125,78 @@ int prepare_output(const std::string& out, const std::string& sweep_path, const 
 
 namespace {
 
-// Rows whose checksum fails: rewritten from the journal's record, or, if the
-// journal lacks it, made pending again (trained anew); both named.
+// Rows whose check fails (their checksum, or a value out of range):
+// every result column rewritten from the journal's record, or, if the
+// journal lacks it or its record does not fit the row, made pending again
+// (trained anew: the same bits); each named. `phnn verify` tells the same
+// apart with the same calls (ResultsFile::rewrite_problem).
 void repair_damaged_rows(ResultsFile* results, const std::map<std::string, RunResult>& journal,
                          const std::vector<std::string>& ids, const std::string& out) {
-  std::vector<std::string> repaired, requeued;
+  std::vector<std::string> repaired, requeued, unfit;
   for (int row : results->damaged_rows()) {
     const std::string& id = ids[static_cast<std::size_t>(row)];
     const auto it = journal.find(id);
-    if (it != journal.end()) {
+    const std::string problem =
+        it == journal.end() ? "" : results->rewrite_problem(row, it->second);
+    if (it != journal.end() && problem.empty()) {
       results->write_run(row, it->second);
       repaired.push_back(id);
     } else {
       results->requeue_run(row);
-      requeued.push_back(id);
+      if (problem.empty()) {
+        requeued.push_back(id);
+      } else {
+        unfit.push_back(id + " (" + problem + ")");
+      }
     }
   }
+  const std::string head = "phnn sweep: " + out + ": ";
   if (!repaired.empty()) {
-    std::cerr << "phnn sweep: " << out << ": " << repaired.size()
+    std::cerr << head << repaired.size()
               << " damaged rows (checksum mismatch) repaired from the journals: "
               << join(repaired, ", ") << "\n";
   }
   if (!requeued.empty()) {
-    std::cerr << "phnn sweep: " << out << ": " << requeued.size()
-              << " damaged rows not in the journals, trained again: " << join(requeued, ", ")
-              << "\n";
+    std::cerr << head << requeued.size() << " damaged rows not in the journals, trained again: "
+              << join(requeued, ", ") << "\n";
+  }
+  if (!unfit.empty()) {
+    std::cerr << head << unfit.size() << " damaged rows whose journal record does not fit the "
+              << "row, trained again: " << join(unfit, ", ") << "\n";
   }
 }
 
 }  // namespace
+
+void repair_file_damage(ResultsFile* file, const std::string& out, const SweepSpec& spec,
+                        const Grid& grid, SweepDataSets* data) {
+  if (file->checksum_version() != ResultsFile::kChecksumVersion) return;
+  std::vector<std::string> studies;
+  for (const auto& s : grid.run_studies) studies.push_back(join(s, ","));
+  std::vector<std::string> repaired;
+  try {
+    repaired = file->repair_configuration(grid.runs, studies, spec.name, spec.text,
+                                          spec.text_hash);
+    std::set<std::string> systems;
+    for (const RunConfig& run : grid.runs) systems.insert(run.system_name());
+    for (const std::string& name : systems) {
+      const auto fixed = file->repair_system_data(name, [&] {
+        data->make(name);
+        data->store(name, file);
+      });
+      repaired.insert(repaired.end(), fixed.begin(), fixed.end());
+    }
+  } catch (const std::exception& e) {
+    throw cli::UsageError{"phnn sweep: " + std::string(e.what()) +
+                          "; nothing changed. Move the file aside: `phnn sweep` then rebuilds "
+                          "it from the journals in " + journal_directory(out) +
+                          " (runs they lack are trained again)"};
+  }
+  if (!repaired.empty()) {
+    std::cerr << "phnn sweep: " << out << ": damaged, rewritten from the sweep file and its "
+              << "data as recorded: " << join(repaired, ", ") << "\n";
+  }
+}
 
 std::vector<int> recover_from_journals(ResultsFile* results, const std::string& out,
                                        bool created) {

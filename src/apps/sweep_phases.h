@@ -70,8 +70,20 @@ int follow_output_link(bool root, std::string* out);
 int prepare_output(const std::string& out, const std::string& sweep_path, const SweepSpec& spec,
                    const Grid& grid, WriterLock* lock);
 
+class SweepDataSets;  // apps/sweep_data.h
+
+/// Rank 0, resuming (a serial copy of the file, checksum rule 2): repairs
+/// what ResultsFile::file_damage finds: the sweep attributes and
+/// configuration columns rewritten from the sweep's runs, a damaged /data
+/// group stored again from the data this program makes (both must give the
+/// recorded bytes), each named on stderr. Throws cli::UsageError naming
+/// what it cannot repair and the way out (move the file aside).
+void repair_file_damage(ResultsFile* file, const std::string& out, const SweepSpec& spec,
+                        const Grid& grid, SweepDataSets* data);
+
 /// Rank 0: replays the journals (the source of truth) into the file and
-/// returns every row's status code.
+/// returns every row's status code; damaged rows first (rewritten from
+/// their record, or trained again).
 std::vector<int> recover_from_journals(ResultsFile* results, const std::string& out,
                                        bool created);
 

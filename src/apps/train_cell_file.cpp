@@ -100,8 +100,10 @@ void write_cell_file(const std::string& path, const CellSpec& cell, const std::s
   // Grid rows are ordered by seed, like the cell's members.
   for (std::size_t i = 0; i < grid.runs.size(); ++i) {
     const auto it = std::find(cell.seeds.begin(), cell.seeds.end(), grid.runs[i].seed);
-    file.write_run_times(static_cast<int>(i), started, finished);
-    file.write_run(static_cast<int>(i), results[static_cast<std::size_t>(it - cell.seeds.begin())]);
+    RunResult result = results[static_cast<std::size_t>(it - cell.seeds.begin())];
+    result.started_utc = started;
+    result.finished_utc = finished;
+    file.write_run(static_cast<int>(i), result);
   }
   file.end_session(finished);
   file.close();

@@ -2,6 +2,7 @@
 // groups and attributes. Datasets and row I/O: h5file_datasets.cpp.
 #include "h5/h5file.h"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <numeric>
@@ -156,6 +157,27 @@ std::vector<std::string> File::link_names(const std::string& group) const {
   return names;
 }
 
+std::vector<std::string> File::objects_under(const std::string& group) const {
+  std::vector<std::string> out;
+  const std::string base = group == "/" ? "" : group;
+  for (const std::string& name : link_names(group)) {
+    const std::string path = base + "/" + name;
+    out.push_back(path);
+    if (!is_dataset(path)) {
+      const std::vector<std::string> below = objects_under(path);
+      out.insert(out.end(), below.begin(), below.end());
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+bool File::is_dataset(const std::string& object) const {
+  if (!exists(object)) return false;
+  Handle obj(open_object(id_, object), H5Oclose);
+  return obj.ok() && H5Iget_type(obj.get()) == H5I_DATASET;
+}
+
 std::string library_version() {
   unsigned major = 0, minor = 0, release = 0;
   H5get_libversion(&major, &minor, &release);
@@ -222,6 +244,12 @@ bool File::has_attribute(const std::string& object, const std::string& name) con
   return obj.ok() && H5Aexists(obj.get(), name.c_str()) > 0;
 }
 
+void File::remove_attribute(const std::string& object, const std::string& name) {
+  if (!has_attribute(object, name)) return;
+  Handle obj(open_object(id_, object), H5Oclose);
+  if (H5Adelete(obj.get(), name.c_str()) < 0) fail(path_, "cannot delete " + object + "@" + name);
+}
+
 namespace {
 Handle open_attribute(hid_t file, const std::string& fname, const std::string& object,
                       const std::string& name) {
@@ -254,6 +282,23 @@ std::string File::string_attribute(const std::string& object,
   std::string out(size, '\0');
   if (H5Aread(attr.get(), type.get(), out.data()) < 0) fail(path_, "cannot read " + name);
   out.resize(std::strlen(out.c_str()));
+  return out;
+}
+
+std::string File::attribute_bytes(const std::string& object, const std::string& name) const {
+  Handle attr = open_attribute(id_, path_, object, name);
+  Handle type(H5Aget_type(attr.get()), H5Tclose);
+  if (H5Tget_class(type.get()) == H5T_STRING && H5Tis_variable_str(type.get()) > 0) {
+    return string_attribute(object, name);
+  }
+  Handle space(H5Aget_space(attr.get()), H5Sclose);
+  const hssize_t count = H5Sget_simple_extent_npoints(space.get());
+  std::string out(static_cast<std::size_t>(std::max<hssize_t>(count, 0)) *
+                      H5Tget_size(type.get()),
+                  '\0');
+  if (!out.empty() && H5Aread(attr.get(), type.get(), out.data()) < 0) {
+    fail(path_, "cannot read attribute " + object + "@" + name);
+  }
   return out;
 }
 

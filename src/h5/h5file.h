@@ -66,13 +66,24 @@ class File {
   void set_attribute(const std::string& object, const std::string& name,
                      std::int64_t value);
   bool has_attribute(const std::string& object, const std::string& name) const;
+  /// Deletes attribute `name` of `object` (none: no error).
+  void remove_attribute(const std::string& object, const std::string& name);
   /// Names of the attributes of `object`, in creation-index order if
   /// tracked, else by name.
   std::vector<std::string> attribute_names(const std::string& object) const;
   /// Names of the links (groups, datasets) in group `group`, by name.
   std::vector<std::string> link_names(const std::string& group) const;
+  /// Every group and dataset below `group` (not `group` itself), as
+  /// absolute paths ("/data/duffing/train/x"), sorted.
+  std::vector<std::string> objects_under(const std::string& group) const;
+  /// True if `object` is a dataset (false for a group or a missing path).
+  bool is_dataset(const std::string& object) const;
   std::string string_attribute(const std::string& object,
                                const std::string& name) const;
+  /// The stored bytes of an attribute's value, in the attribute's own type
+  /// (a fixed-length string with its padding; a variable-length string's
+  /// characters): what a checksum of every stored byte reads.
+  std::string attribute_bytes(const std::string& object, const std::string& name) const;
   double double_attribute(const std::string& object,
                           const std::string& name) const;
   std::int64_t int_attribute(const std::string& object,
@@ -115,6 +126,15 @@ class File {
   std::vector<std::int64_t> read_ints(const std::string& path,
                                       std::uint64_t row = 0,
                                       std::uint64_t count = 0) const;
+  /// The stored bytes of rows [row, row + count) (count = 0: to the end) in
+  /// the dataset's own type: fixed-length strings with their padding,
+  /// numbers in the file's byte order. What a checksum of every stored byte
+  /// reads.
+  std::string read_row_bytes(const std::string& path, std::uint64_t row = 0,
+                             std::uint64_t count = 0) const;
+  /// Where the data of a contiguous dataset start in the file, in bytes
+  /// (tests damage bytes there); throws if it has no such address.
+  std::uint64_t data_address(const std::string& path) const;
   /// Fixed-length strings without their NUL padding; rows as above.
   std::vector<std::string> read_strings(const std::string& path,
                                         std::uint64_t row = 0,

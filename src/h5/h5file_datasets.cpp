@@ -194,6 +194,27 @@ std::vector<std::int64_t> File::read_ints(const std::string& path, std::uint64_t
   return out;
 }
 
+std::string File::read_row_bytes(const std::string& path, std::uint64_t row,
+                                 std::uint64_t count) const {
+  Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!dset.ok()) fail(path_, "no dataset " + path);
+  Handle type(H5Dget_type(dset.get()), H5Tclose);
+  std::vector<hsize_t> d = dataset_dims(dset.get());
+  std::uint64_t rows = 0;
+  rows_io(id_, path_, path, row, count, type.get(), nullptr, false, &rows);
+  std::string out(rows * row_size(d) * H5Tget_size(type.get()), '\0');
+  rows_io(id_, path_, path, row, rows, type.get(), out.data(), false);
+  return out;
+}
+
+std::uint64_t File::data_address(const std::string& path) const {
+  Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!dset.ok()) fail(path_, "no dataset " + path);
+  const haddr_t address = H5Dget_offset(dset.get());
+  if (address == HADDR_UNDEF) fail(path_, "dataset " + path + " has no contiguous data address");
+  return static_cast<std::uint64_t>(address);
+}
+
 std::vector<std::string> File::read_strings(const std::string& path, std::uint64_t row,
                                             std::uint64_t count) const {
   Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);

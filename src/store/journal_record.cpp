@@ -283,6 +283,10 @@ std::string encode_journal_record(const std::string& run_id, const RunResult& r,
     << " figure_reference_075=" << format_doubles(r.figure_reference_075);
   write_checkpoints(s, r);
   if (!r.weights.empty()) s << " weights=" << format_doubles(r.weights);
+  // The run's times (since 2026-11-28), so a row rewritten from its record
+  // is the row as it was; a record without them reads as unknown times.
+  if (!r.started_utc.empty()) s << " started=" << escape(r.started_utc);
+  if (!r.finished_utc.empty()) s << " finished=" << escape(r.finished_utc);
   const std::string body = s.str();
   return body + kChecksumKey + hex64(fnv1a64(body));
 }
@@ -340,7 +344,9 @@ bool decode_journal_record(const std::string& line_in, std::string* run_id,
       !parse_doubles(fields["figure_reference_05"], &r.figure_reference_05) ||
       !parse_doubles(fields["figure_reference_075"], &r.figure_reference_075) ||
       !read_checkpoints(fields, &r) ||
-      (fields.count("weights") != 0 && !parse_doubles(fields["weights"], &r.weights))) {
+      (fields.count("weights") != 0 && !parse_doubles(fields["weights"], &r.weights)) ||
+      (fields.count("started") != 0 && !unescape(fields["started"], &r.started_utc)) ||
+      (fields.count("finished") != 0 && !unescape(fields["finished"], &r.finished_utc))) {
     return false;
   }
   r.diverged_rollouts = static_cast<int>(diverged);

@@ -251,6 +251,13 @@ void ResultsFile::store_data_group(const std::string& system_name,
   impl_->collective([&] {
     impl_->file.remove(group);  // a group left incomplete by a crash
     write(group);
+    if (impl_->checksum_version == 2) {
+      // Rank 0 reads what it wrote (after the flush every rank could).
+      impl_->file.flush();
+      const std::string digest =
+          broadcast(impl_->comm, impl_->rank == 0 ? group_digest(impl_->file, group) : "");
+      impl_->file.set_attribute(group, kDigestAttribute, digest);
+    }
     impl_->file.set_attribute(group, "complete", std::int64_t{1});
     impl_->file.flush();
   });

@@ -4,17 +4,12 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 
 #include <algorithm>
-#include <map>
 
 #include "phnn/common/utc_time.h"
-#include "phnn/config/model_config.h"
-#include "phnn/config/setting_columns.h"
 #include "phnn/store/scratch_file.h"
 #include "store/results_file_internal.h"
 
@@ -23,53 +18,6 @@ namespace phnn {
 using namespace results_io;
 
 namespace {
-
-// The config columns of /runs, one entry per run, validated (every
-// rank has the same arguments, so these throw everywhere).
-struct ConfigColumns {
-  std::vector<std::string> ids, canonical, systems, models, integrators, sizes, regularizers;
-  std::vector<std::int64_t> n_train, seeds, states;
-  // Where each run's weights start in /weights, and their total count.
-  std::vector<std::int64_t> weights_offset;
-  std::int64_t weights_total = 0;
-  // Names and shapes of each run's weights, and the longest such text.
-  std::vector<std::string> weights_layout;
-  std::size_t weights_layout_length = 1;
-
-  ConfigColumns(const std::vector<RunConfig>& runs, const std::vector<std::string>& run_studies,
-                const std::string& where) {
-    std::map<std::string, std::size_t> row_of_id;
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-      const RunConfig& run = runs[i];
-      canonical.push_back(run.canonical());
-      ids.push_back(run.id());
-      require(canonical[i].size() <= kCanonicalLength,
-              where + "run " + std::to_string(i) + " has a canonical config of " +
-                  std::to_string(canonical[i].size()) + " bytes, more than " +
-                  std::to_string(kCanonicalLength) + ": " + canonical[i]);
-      require(run_studies[i].size() <= kStudiesLength,
-              where + "run " + std::to_string(i) + " has studies \"" + run_studies[i] +
-                  "\", longer than " + std::to_string(kStudiesLength) + " bytes");
-      const auto [it, inserted] = row_of_id.emplace(ids[i], i);
-      require(inserted, where + "runs " + std::to_string(it->second) + " and " +
-                            std::to_string(i) + " are the same run (id " + ids[i] +
-                            "); the grid must list each run once");
-      systems.push_back(run.system_name());
-      models.push_back(to_string(run.model));
-      integrators.push_back(to_string(run.integrator));
-      sizes.push_back(to_string(run.size));
-      regularizers.push_back(to_string(run.regularizer));
-      n_train.push_back(run.n_train);
-      states.push_back(run.n_x);
-      seeds.push_back(run.seed);
-      weights_offset.push_back(weights_total);
-      weights_total += parameter_count(run.model, run.size, run.n_x, run.n_w, run.n_u);
-      weights_layout.push_back(
-          weight_layout_text(weight_layout(run.model, run.size, run.n_x, run.n_w, run.n_u)));
-      weights_layout_length = std::max(weights_layout_length, weights_layout.back().size());
-    }
-  }
-};
 
 // Creates datasets of R rows with a `units` attribute (a unit: "s", "1" for
 // counts and dimensionless numbers, "m^2 and (kg m/s)^2" where states of
@@ -122,8 +70,9 @@ void create_result_datasets(const DatasetMaker& make, const ResultsLayout& layou
   make.file.create_enum_dataset(kStatus, {R}, {"pending", "done", "diverged", "failed"});
   make.describe(kStatus, "", "0 pending, 1 done, 2 diverged, 3 failed");
   make.ints(kChecksum, {R},
-            "FNV-1a 64 of the row as stored (id, configuration, result, weights; clocks of "
-            "started_utc/finished_utc excepted), written after the status; 0: none yet", "");
+            "FNV-1a 64 of every stored byte of the row (each dataset of /runs but this one, "
+            "then the run's weights; checksum rule 2), written after the status; 0: none yet",
+            "");
   make.text(kMessage, kMessageLength, "why a run diverged or failed (truncated)");
   make.floats(kMse, {R}, kMseUnit, kMseUnits);
   make.floats(kTrajectoryErrors, {R, I}, kMseUnit, kMseUnits + "; per inference trajectory");
@@ -201,71 +150,6 @@ void create_weight_datasets(const DatasetMaker& make, std::int64_t total,
               "order, each tensor row-major without its member axis; NaN where none stored");
 }
 
-// Independent raw-data writes of rank 0.
-void write_config_columns(h5::File& file, const ConfigColumns& c,
-                          const std::vector<std::string>& run_studies) {
-  const auto R = static_cast<std::uint64_t>(c.ids.size());
-  file.write_string_rows(kId, 0, c.ids);
-  file.write_string_rows(kCanonical, 0, c.canonical);
-  file.write_string_rows(kSystem, 0, c.systems);
-  file.write_string_rows(kModel, 0, c.models);
-  file.write_string_rows(kIntegrator, 0, c.integrators);
-  file.write_string_rows(kSize, 0, c.sizes);
-  file.write_string_rows(kRegularizer, 0, c.regularizers);
-  file.write_string_rows(kStudies, 0, run_studies);
-  file.write_rows(kNTrain, 0, R, c.n_train.data());
-  file.write_rows(kSeed, 0, R, c.seeds.data());
-  file.write_rows(kStates, 0, R, c.states.data());
-  if (file.exists(kWeightsOffset)) {
-    file.write_rows(kWeightsOffset, 0, R, c.weights_offset.data());
-    file.write_string_rows(kWeightsLayout, 0, c.weights_layout);
-  }
-}
-
-// /runs/config/<name>: every run setting its own column, named as in the
-// per-run CSV (setting_columns()): float64 where each run that has the
-// setting has one number (NaN where a run lacks it), else a NUL-padded
-// string (empty where it lacks it). The canonical key stays the identity.
-void write_setting_columns(h5::File& file, const std::vector<std::string>& canonical) {
-  std::vector<std::vector<std::pair<std::string, std::string>>> columns;
-  for (const std::string& c : canonical) columns.push_back(setting_columns(c));
-  const auto R = static_cast<std::uint64_t>(canonical.size());
-  file.create_group(kSettings);
-  for (const std::string& key : setting_keys(columns)) {
-    std::vector<std::string> text(R);
-    std::vector<double> numbers(R, kNaN);
-    bool numeric = true;
-    for (std::size_t r = 0; r < R; ++r) {
-      for (const auto& [name, value] : columns[r]) {
-        if (name != key) continue;
-        text[r] = value;
-        numbers[r] = std::strtod(value.c_str(), nullptr);
-        // A number only if the text is the canonical key's spelling of that
-        // double (%.17g): a hash of digits or a seed beyond 2^53 stays text.
-        char back[40];
-        std::snprintf(back, sizeof back, "%.17g", numbers[r]);
-        numeric = numeric && !value.empty() && value == back && std::isfinite(numbers[r]);
-      }
-    }
-    std::string name = key;
-    std::replace(name.begin(), name.end(), '/', '_');
-    const std::string path = kSettings + "/" + name;
-    if (numeric) {
-      file.create_dataset(path, h5::Type::kFloat64, {R}, 0, kNaN);
-      file.write_rows(path, 0, R, numbers.data());
-    } else {
-      std::size_t length = 1;
-      for (const std::string& t : text) length = std::max(length, t.size());
-      file.create_dataset(path, h5::Type::kString, {R}, length);
-      file.write_string_rows(path, 0, text);
-    }
-    file.set_attribute(path, "description",
-                       "run setting `" + key + "` of each run (sweeps/FORMAT.md; per-run CSV "
-                       "column of the same name)" +
-                           (numeric ? "; NaN: the run has no such setting" : std::string()));
-  }
-}
-
 struct FileAttributes {
   std::string sweep_name, sweep_text, sweep_hash, program_version, created;
 };
@@ -275,8 +159,7 @@ struct FileAttributes {
 // complete or absent, never half-created. On an error the scratch file is
 // removed and the error rethrown.
 void write_new_file(const std::string& path, const ConfigColumns& columns,
-                    const std::vector<std::string>& run_studies, const ResultsLayout& layout,
-                    const FileAttributes& a, bool in_place) {
+                    const ResultsLayout& layout, const FileAttributes& a, bool in_place) {
   const auto write = [&](const std::string& scratch) {
     h5::File file = h5::File::create(scratch);
     file.set_attribute("/", "format", std::string(ResultsFile::kFormat));
@@ -296,8 +179,12 @@ void write_new_file(const std::string& path, const ConfigColumns& columns,
     if (layout.weights) {
       create_weight_datasets(make, columns.weights_total, columns.weights_layout_length);
     }
-    write_config_columns(file, columns, run_studies);
-    write_setting_columns(file, columns.canonical);
+    write_config_columns(file, columns);
+    write_setting_columns(file, columns.canonical, /*create=*/true);
+    // Checksum rule 2: the rule, then the file digest over what is now
+    // written (sweep attributes, configuration columns).
+    file.set_attribute("/", kChecksumVersionAttribute, ResultsFile::kChecksumVersion);
+    file.set_attribute("/", kDigestAttribute, file_digest(file));
     file.close();  // throws if the metadata cannot be written
   };
   // In place: `path` is already the caller's scratch name (no
@@ -348,7 +235,7 @@ ResultsFile ResultsFile::create(const std::string& path, MPI_Comm comm,
   // stays on rank 0 and reaches every rank as one error: no rank is left in a
   // collective HDF5 call (docs/DECISIONS.md, "No rank waits forever").
   check_on_rank0(comm, [&] {
-    write_new_file(path, columns, run_studies, layout, attributes, mode == CreateMode::kInPlace);
+    write_new_file(path, columns, layout, attributes, mode == CreateMode::kInPlace);
     return std::string();
   });
   std::unique_ptr<Impl> impl;

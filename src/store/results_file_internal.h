@@ -1,8 +1,8 @@
 // src/store/results_file_internal.h — shared by the results_file*.cpp files
 // only: the dataset names and units texts of docs/RESULTS_FORMAT.md,
-// ResultsFile::Impl (the open h5::File and the layout read from it), and the
-// helpers that make every rank fail together. Includes HDF5 only through
-// src/h5.
+// ResultsFile::Impl (the open h5::File and the layout read from it), the
+// configuration columns and digests, and the helpers that make every rank
+// fail together. Includes HDF5 only through src/h5.
 #pragma once
 
 #include <mpi.h>
@@ -12,6 +12,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "h5/h5file.h"
@@ -76,6 +77,10 @@ inline const std::string kCheckpointTrainSeconds = "/runs/checkpoint_train_secon
 inline const std::string kStartedUtc = "/runs/started_utc";
 inline const std::string kFinishedUtc = "/runs/finished_utc";
 inline const std::string kProvenance = "/provenance";
+// Checksum rule 2 (2026-11-28): the rule's number on "/", the file digest on
+// "/" (sweep attributes, configuration columns) and one on each /data group.
+inline const std::string kChecksumVersionAttribute = "checksum_version";
+inline const std::string kDigestAttribute = "digest";
 inline constexpr std::size_t kUtcLength = 20;  // "2024-05-01T12:00:00Z"
 
 inline const std::string kStateUnits = "q [m], p [kg m/s]";
@@ -108,6 +113,39 @@ void check_on_rank0(MPI_Comm comm, const std::function<std::string()>& check);
 std::string truncate_message(const std::string& text, std::size_t length);
 /// Throws std::invalid_argument(message) unless ok.
 void require(bool ok, const std::string& message);
+/// The configuration columns of /runs for a run list, as create() writes
+/// them (results_file_config.cpp); the constructor validates them and
+/// throws std::invalid_argument prefixed by `where`.
+struct ConfigColumns {
+  std::vector<std::string> ids, canonical, systems, models, integrators, sizes, regularizers;
+  std::vector<std::int64_t> n_train, seeds, states;
+  // Where each run's weights start in /weights, and their total count.
+  std::vector<std::int64_t> weights_offset;
+  std::int64_t weights_total = 0;
+  // Names and shapes of each run's weights, and the longest such text.
+  std::vector<std::string> weights_layout;
+  std::size_t weights_layout_length = 1;
+  std::vector<std::string> studies;
+
+  ConfigColumns(const std::vector<RunConfig>& runs, const std::vector<std::string>& run_studies,
+                const std::string& where);
+};
+/// Writes every row of the configuration columns (into datasets that exist).
+void write_config_columns(h5::File& file, const ConfigColumns& columns);
+/// /runs/config/<name>, one column per run setting: created (and written),
+/// or, with create = false, written over the columns that exist.
+void write_setting_columns(h5::File& file, const std::vector<std::string>& canonical,
+                           bool create);
+/// The configuration columns of `file` (written by create, never by
+/// write_run): id, canonical, system, ..., weights_layout, /runs/config/*.
+std::vector<std::string> configuration_columns(const h5::File& file);
+/// Digest lines "<object> <16 hex digits>\n" (results_file_digest.cpp): of
+/// the sweep attributes and configuration columns (the file digest), or of
+/// every object under a /data group (its data, and the attributes of the
+/// group and of each object in it but `digest` and `complete`).
+std::string file_digest(const h5::File& file);
+std::string group_digest(const h5::File& file, const std::string& group);
+
 /// Runs collective HDF5 code. Serial: exceptions propagate. Parallel: an
 /// exception is printed with the rank prefix and ends the job (docs/DECISIONS.md,
 /// "No rank waits forever"), since the other ranks would wait for this one forever.
@@ -126,6 +164,10 @@ struct ResultsFile::Impl {
   std::vector<std::int64_t> run_states;  // /runs/n_x
   bool has_run_times = false;  // false in files written before provenance
   bool has_checksums = false;  // false in files written before row checksums
+  // Checksum rule: 0 none, 1 (until 2026-11-28), 2 (checksum_version on "/").
+  std::int64_t checksum_version = 0;
+  // Rule 2: every dataset of /runs but the checksum, sorted (a row's bytes).
+  std::vector<std::string> row_columns;
   std::string session;         // this process's /provenance/session_<k>
 
   Impl(h5::File f, MPI_Comm c)
@@ -146,7 +188,24 @@ struct ResultsFile::Impl {
     has_run_times = file.exists(results_io::kStartedUtc) && file.exists(results_io::kFinishedUtc);
     has_checksums = file.exists(results_io::kChecksum);
     layout.weights = file.exists(results_io::kWeights);
+    // The attribute exists only in files of rule 2 (a damaged value is
+    // named by ResultsFile::file_damage).
+    checksum_version = file.has_attribute("/", results_io::kChecksumVersionAttribute) ? 2
+                       : has_checksums                                               ? 1
+                                                                                     : 0;
+    row_columns.clear();
+    if (checksum_version == 2) {
+      for (const std::string& name : file.objects_under("/runs")) {
+        if (name != results_io::kChecksum && file.is_dataset(name)) row_columns.push_back(name);
+      }
+    }
   }
+
+  // Row `row`'s n_x, checked against the layout before anything is sized
+  // by it.
+  std::size_t states_of(std::uint64_t row) const;
+  // Row `row`'s slice of /weights (offset, length), checked against its size.
+  std::pair<std::uint64_t, std::uint64_t> weights_of(std::uint64_t row) const;
 
   // "[rank 3/8] " in a parallel file, "" in a serial one.
   std::string prefix() const {

@@ -1,9 +1,11 @@
 // src/store/results_file_rows.cpp — one row of /runs: ResultsFile::write_run
-// (independent raw-data writes, status last) and read_run, and the column
-// readers of the reducer.
+// (independent raw-data writes, status last) and read_run (every integer
+// checked against its range before it sizes or indexes anything), and the
+// column readers of the reducer. Checksums: results_file_checks.cpp.
 #include <algorithm>
 #include <array>
-#include <set>
+#include <cmath>
+#include <limits>
 
 #include "phnn/config/run_config.h"  // fnv1a64
 #include "phnn/store/journal.h"
@@ -132,39 +134,61 @@ void write_figures_and_checkpoints(h5::File& f, std::uint64_t at, const RunResul
   }
 }
 
-// Offset of row `at`'s weights in /weights and the room it has there (its
-// model's parameter count).
+// Offset of row `at`'s weights in /weights and the room it has there (to
+// the next run's offset: its model's parameter count), both checked against
+// the size of /weights.
 std::pair<std::int64_t, std::int64_t> weights_slot(const h5::File& f, std::uint64_t at,
-                                                   int num_runs) {
+                                                   int num_runs, const std::string& where) {
+  const auto total = static_cast<std::int64_t>(f.dims(kWeights).at(0));
   const std::int64_t offset = f.read_ints(kWeightsOffset, at, 1).at(0);
   const std::int64_t end = at + 1 < static_cast<std::uint64_t>(num_runs)
                                ? f.read_ints(kWeightsOffset, at + 1, 1).at(0)
-                               : static_cast<std::int64_t>(f.dims(kWeights).at(0));
+                               : total;
+  if (offset < 0 || offset > end || end > total) {
+    throw std::runtime_error(where + kWeightsOffset + "[" + std::to_string(at) + "] = " +
+                             std::to_string(offset) + " (next " + std::to_string(end) +
+                             ") outside 0.." + std::to_string(total) +
+                             " (the size of /weights); the file is damaged");
+  }
   return {offset, end - offset};
 }
 
 }  // namespace
+
+std::int64_t ResultsFile::row_fit(int row, const RunResult& r, const std::string& where) const {
+  const Impl& impl = *impl_;
+  require(row >= 0 && row < impl.num_runs,
+          where + "row outside [0, " + std::to_string(impl.num_runs) + ")");
+  const auto states = static_cast<std::int64_t>(impl.states_of(static_cast<std::uint64_t>(row)));
+  require_fits(r, impl.layout, states, where);
+  // A file written before weights were stored drops them.
+  if (!impl.layout.weights || r.weights.empty()) return -1;
+  const auto [offset, room] = impl.independent([&] {
+    return weights_slot(impl.file, static_cast<std::uint64_t>(row), impl.num_runs, where);
+  });
+  require(static_cast<std::int64_t>(r.weights.size()) <= room,
+          where + "has " + std::to_string(r.weights.size()) + " weights, the file holds " +
+              std::to_string(room) + " for this run (its model's parameter count)");
+  return offset;
+}
+
+std::string ResultsFile::rewrite_problem(int row, const RunResult& r) const {
+  try {
+    row_fit(row, r, "");
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
 
 void ResultsFile::write_run(int row, const RunResult& r) {
   Impl& impl = *impl_;
   const ResultsLayout& L = impl.layout;
   const std::string where =
       impl.prefix() + path() + ": write_run(row " + std::to_string(row) + "): ";
-  require(row >= 0 && row < impl.num_runs,
-          where + "row outside [0, " + std::to_string(impl.num_runs) + ")");
-  const std::int64_t states = impl.run_states.at(static_cast<std::size_t>(row));
-  require_fits(r, L, states, where);
-  // A file written before weights were stored drops them.
-  std::int64_t weights_offset = 0;
-  const bool store_weights = L.weights && !r.weights.empty();
-  if (store_weights) {
-    const auto [offset, room] = impl.independent(
-        [&] { return weights_slot(impl.file, static_cast<std::uint64_t>(row), impl.num_runs); });
-    require(static_cast<std::int64_t>(r.weights.size()) <= room,
-            where + "has " + std::to_string(r.weights.size()) + " weights, the file holds " +
-                std::to_string(room) + " for this run (its model's parameter count)");
-    weights_offset = offset;
-  }
+  const std::int64_t weights_offset = row_fit(row, r, where);
+  const bool store_weights = weights_offset >= 0;
+  const std::size_t states = impl.states_of(static_cast<std::uint64_t>(row));
   const std::vector<double> trace = trace_row(r.trace, L.trace_points);
 
   impl.independent([&] {
@@ -187,13 +211,17 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     put_int(kNewtonFailures, r.newton_failures);
     f.write_rows(kTrace, at, 1, trace.data());
     put_int(kTraceLength, static_cast<std::int64_t>(r.trace.size()));
-    write_figures_and_checkpoints(f, at, r, static_cast<std::size_t>(states), L);
+    write_figures_and_checkpoints(f, at, r, states, L);
     f.write_string_rows(kMessage, at, {truncate_message(r.message, kMessageLength)});
     if (store_weights) {
       f.write_rows(kWeights, static_cast<std::uint64_t>(weights_offset), r.weights.size(),
                    r.weights.data());
     }
     if (L.weights) put_int(kWeightsLength, static_cast<std::int64_t>(store_weights ? r.weights.size() : 0));
+    if (impl.has_run_times) {
+      f.write_string_rows(kStartedUtc, at, {r.started_utc.substr(0, kUtcLength)});
+      f.write_string_rows(kFinishedUtc, at, {r.finished_utc.substr(0, kUtcLength)});
+    }
     // Last but the checksum: until this lands the row reads as pending.
     put_int(kStatus, static_cast<std::int64_t>(r.status));
   });
@@ -201,78 +229,6 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     const auto checksum = static_cast<std::int64_t>(row_checksum(row));
     impl.independent([&] { impl.file.write_rows(kChecksum, static_cast<std::uint64_t>(row), 1, &checksum); });
   }
-}
-
-// FNV-1a 64 (run_config.h) of the row's id, configuration, seed and result
-// as read back (the journal's encoding: every double bit for bit).
-std::uint64_t ResultsFile::row_checksum(int row) const {
-  const Impl& impl = *impl_;
-  const auto at = static_cast<std::uint64_t>(row);
-  const std::string id = impl.strings_at(kId, at);
-  const std::uint64_t hash = fnv1a64(id + "\n" + impl.strings_at(kCanonical, at) + "\n" +
-                                     std::to_string(impl.ints(kSeed, at, 1).at(0)) + "\n" +
-                                     internal::encode_journal_record(id, read_run(row), 0));
-  return hash == 0 ? 1 : hash;  // 0 means "no checksum"
-}
-
-bool ResultsFile::row_damaged(int row) const {
-  const Impl& impl = *impl_;
-  if (!impl.has_checksums) return false;
-  const auto at = static_cast<std::uint64_t>(row);
-  try {
-    const std::int64_t code = impl.ints(kStatus, at, 1).at(0);
-    if (code == static_cast<std::int64_t>(RunStatus::kPending)) return false;
-    const std::int64_t stored = impl.ints(kChecksum, at, 1).at(0);
-    return !(code > 0 && code <= static_cast<std::int64_t>(RunStatus::kFailed) && stored != 0 &&
-             static_cast<std::uint64_t>(stored) == row_checksum(row));
-  } catch (const std::exception&) {
-    return true;  // unreadable is damaged too
-  }
-}
-
-std::vector<int> ResultsFile::damaged_rows() const {
-  std::vector<int> damaged;
-  if (!impl_->has_checksums) return damaged;
-  const std::vector<std::int64_t> codes = impl_->ints(kStatus);
-  for (int row = 0; row < impl_->num_runs; ++row) {
-    if (codes[static_cast<std::size_t>(row)] == static_cast<std::int64_t>(RunStatus::kPending)) {
-      continue;
-    }
-    if (row_damaged(row)) damaged.push_back(row);
-  }
-  return damaged;
-}
-
-std::vector<std::string> ResultsFile::structure_problems() const {
-  std::vector<std::string> problems;
-  try {
-    const std::vector<std::string> ids = read_run_ids();
-    std::set<std::string> seen;
-    for (std::size_t row = 0; row < ids.size(); ++row) {
-      if (ids[row].empty()) {
-        problems.push_back("row " + std::to_string(row) + " has no run id");
-      } else if (!seen.insert(ids[row]).second) {
-        problems.push_back("run id " + ids[row] + " repeats (row " + std::to_string(row) + ")");
-      }
-      if (problems.size() >= 5) break;
-    }
-    read_statuses();
-    read_canonical();
-  } catch (const std::exception& e) {
-    problems.push_back(e.what());
-  }
-  return problems;
-}
-
-bool ResultsFile::has_checksums() const { return impl_->has_checksums; }
-
-void ResultsFile::requeue_run(int row) {
-  Impl& impl = *impl_;
-  const std::int64_t zero = 0;
-  impl.independent([&] {
-    impl.file.write_rows(kStatus, static_cast<std::uint64_t>(row), 1, &zero);
-    if (impl.has_checksums) impl.file.write_rows(kChecksum, static_cast<std::uint64_t>(row), 1, &zero);
-  });
 }
 
 namespace {
@@ -296,85 +252,122 @@ std::vector<RunStatus> ResultsFile::read_statuses() const {
   return out;
 }
 
+namespace {
+
+constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
+const std::string kDamaged =
+    "; the file is damaged (`phnn verify` names the damage and its repair)";
+
+// A value of an integer column, checked before anything is sized or cast
+// by it: std::runtime_error naming dataset, row and value unless it lies in
+// [lowest, highest].
+std::int64_t checked(std::int64_t value, std::int64_t lowest, std::int64_t highest,
+                     const std::string& dataset, std::uint64_t row, const std::string& where) {
+  if (value < lowest || value > highest) {
+    throw std::runtime_error(where + dataset + "[" + std::to_string(row) + "] = " +
+                             std::to_string(value) + ", outside " + std::to_string(lowest) +
+                             ".." + std::to_string(highest) + kDamaged);
+  }
+  return value;
+}
+
+// The first `length` points of a trace row; each step must be a whole
+// number that fits an int.
+std::vector<TracePoint> trace_of_row(const std::vector<double>& row, std::int64_t length,
+                                     std::uint64_t at, const std::string& where) {
+  std::vector<TracePoint> trace;
+  for (std::int64_t i = 0; i < length; ++i) {
+    const double* p = row.data() + i * kTraceColumns;
+    if (!(p[0] >= 0 && p[0] <= static_cast<double>(kIntMax) && p[0] == std::floor(p[0]))) {
+      throw std::runtime_error(where + kTrace + "[" + std::to_string(at) + "][" +
+                               std::to_string(i) + "] has step " + std::to_string(p[0]) +
+                               ", not a step count" + kDamaged);
+    }
+    trace.push_back({static_cast<int>(p[0]), p[1], p[2], p[3], p[4], p[5], p[6]});
+  }
+  return trace;
+}
+
+}  // namespace
+
+std::size_t ResultsFile::Impl::states_of(std::uint64_t row) const {
+  return static_cast<std::size_t>(checked(run_states.at(row), 1, layout.figure_states, kStates,
+                                          row, prefix() + file.path() + ": "));
+}
+
+std::pair<std::uint64_t, std::uint64_t> ResultsFile::Impl::weights_of(std::uint64_t row) const {
+  const std::string where = prefix() + file.path() + ": ";
+  const auto total = static_cast<std::int64_t>(file.dims(kWeights).at(0));
+  const std::int64_t offset =
+      checked(ints(kWeightsOffset, row, 1).at(0), 0, total, kWeightsOffset, row, where);
+  const std::int64_t length =
+      checked(ints(kWeightsLength, row, 1).at(0), 0, total - offset, kWeightsLength, row, where);
+  return {static_cast<std::uint64_t>(offset), static_cast<std::uint64_t>(length)};
+}
+
 RunResult ResultsFile::read_run(int row) const {
   const Impl& impl = *impl_;
-  require(row >= 0 && row < impl.num_runs,
-          impl.prefix() + path() + ": read_run(row " + std::to_string(row) +
-              "): row outside [0, " + std::to_string(impl.num_runs) + ")");
+  const ResultsLayout& L = impl.layout;
+  const std::string where = impl.prefix() + path() + ": ";
+  require(row >= 0 && row < impl.num_runs, where + "read_run(row " + std::to_string(row) +
+                                               "): row outside [0, " +
+                                               std::to_string(impl.num_runs) + ")");
   const auto at = static_cast<std::uint64_t>(row);
-  auto one_int = [&](const std::string& name) { return impl.ints(name, at, 1).at(0); };
+  auto one_int = [&](const std::string& name, std::int64_t lowest, std::int64_t highest) {
+    return checked(impl.ints(name, at, 1).at(0), lowest, highest, name, at, where);
+  };
   auto one_double = [&](const std::string& name) { return impl.doubles(name, at, 1).at(0); };
   RunResult r;
-  r.status = status_from_code(one_int(kStatus), impl.prefix() + path() + ": " + kStatus +
-                                                    "[" + std::to_string(row) + "]");
-  r.message = impl.independent([&] { return impl.file.read_strings(kMessage, at, 1).at(0); });
+  r.status = status_from_code(impl.ints(kStatus, at, 1).at(0),
+                              where + kStatus + "[" + std::to_string(row) + "]");
+  r.message = impl.strings_at(kMessage, at);
   r.mse = one_double(kMse);
-  r.trajectory_errors =
-      unpadded(impl.doubles(kTrajectoryErrors, at, 1), one_int(kTrajectoryErrorsLength));
-  r.diverged_rollouts = static_cast<int>(one_int(kDivergedRollouts));
-  r.best_step = static_cast<int>(one_int(kBestStep));
+  r.trajectory_errors = unpadded(impl.doubles(kTrajectoryErrors, at, 1),
+                                 one_int(kTrajectoryErrorsLength, 0, L.num_inference));
+  r.diverged_rollouts = static_cast<int>(one_int(kDivergedRollouts, 0, kIntMax));
+  r.best_step = static_cast<int>(one_int(kBestStep, 0, kIntMax));
   r.best_validation_loss = one_double(kBestValidationLoss);
   r.wall_time_s = one_double(kWallTime);
-  r.steps = static_cast<int>(one_int(kSteps));
-  r.parameter_count = static_cast<long>(one_int(kParameterCount));
-  r.newton_failures = one_int(kNewtonFailures);
-  const std::vector<double> trace = impl.doubles(kTrace, at, 1);
-  const std::int64_t trace_length =
-      std::clamp<std::int64_t>(one_int(kTraceLength), 0, impl.layout.trace_points);
-  for (std::int64_t i = 0; i < trace_length; ++i) {
-    const double* p = trace.data() + i * kTraceColumns;
-    TracePoint t;
-    t.step = static_cast<int>(p[0]);
-    t.elapsed_s = p[1];
-    t.train_loss = p[2];
-    t.validation_loss = p[3];
-    t.kappa = p[4];
-    t.sigma_max = p[5];
-    t.rho = p[6];
-    r.trace.push_back(t);
+  r.steps = static_cast<int>(one_int(kSteps, 0, kIntMax));
+  r.parameter_count = static_cast<long>(
+      one_int(kParameterCount, 0, std::numeric_limits<std::int64_t>::max()));
+  r.newton_failures = one_int(kNewtonFailures, 0, std::numeric_limits<std::int64_t>::max());
+  r.trace = trace_of_row(impl.doubles(kTrace, at, 1), one_int(kTraceLength, 0, L.trace_points),
+                         at, where);
+  read_figures_and_checkpoints(row, &r);
+  if (L.weights) {
+    const auto [offset, length] = impl.independent([&] { return impl.weights_of(at); });
+    if (length > 0) r.weights = impl.doubles(kWeights, offset, length);
   }
-  const std::vector<std::int64_t> lengths = impl.ints(kFigureLength, at, 1);
-  const auto states = static_cast<std::size_t>(impl.run_states.at(at));
-  const ResultsLayout& L = impl.layout;
-  r.figure_prediction_05 = figure_of_row(impl.doubles(kPrediction05, at, 1), lengths.at(0), states, L);
-  r.figure_prediction_075 = figure_of_row(impl.doubles(kPrediction075, at, 1), lengths.at(1), states, L);
-  r.figure_reference_05 = figure_of_row(impl.doubles(kReference05, at, 1), lengths.at(2), states, L);
-  r.figure_reference_075 = figure_of_row(impl.doubles(kReference075, at, 1), lengths.at(3), states, L);
-  if (impl.layout.checkpoints > 0) {
-    for (std::int64_t s : impl.ints(kCheckpointSteps, at, 1)) {
-      if (s > 0) r.checkpoint_steps.push_back(static_cast<int>(s));
-    }
-    const auto count = static_cast<std::int64_t>(r.checkpoint_steps.size());
-    r.checkpoint_mse = unpadded(impl.doubles(kCheckpointMse, at, 1), count);
-    r.checkpoint_train_seconds = unpadded(impl.doubles(kCheckpointTrainSeconds, at, 1), count);
-  }
-  if (impl.layout.weights) {
-    const std::int64_t length = one_int(kWeightsLength);
-    if (length > 0) {
-      const auto offset = static_cast<std::uint64_t>(one_int(kWeightsOffset));
-      r.weights = impl.doubles(kWeights, offset, static_cast<std::uint64_t>(length));
-    }
+  if (impl.has_run_times) {
+    r.started_utc = impl.strings_at(kStartedUtc, at);
+    r.finished_utc = impl.strings_at(kFinishedUtc, at);
   }
   return r;
 }
 
-std::vector<std::string> ResultsFile::read_run_ids() const { return impl_->strings(kId); }
-std::vector<std::string> ResultsFile::read_canonical() const {
-  return impl_->strings(kCanonical);
+void ResultsFile::read_figures_and_checkpoints(int row, RunResult* r) const {
+  const Impl& impl = *impl_;
+  const ResultsLayout& L = impl.layout;
+  const std::string where = impl.prefix() + path() + ": ";
+  const auto at = static_cast<std::uint64_t>(row);
+  const std::size_t states = impl.states_of(at);
+  const std::vector<std::int64_t> lengths = impl.ints(kFigureLength, at, 1);
+  for (std::int64_t length : lengths) checked(length, 0, L.figure_points, kFigureLength, at, where);
+  r->figure_prediction_05 = figure_of_row(impl.doubles(kPrediction05, at, 1), lengths.at(0), states, L);
+  r->figure_prediction_075 = figure_of_row(impl.doubles(kPrediction075, at, 1), lengths.at(1), states, L);
+  r->figure_reference_05 = figure_of_row(impl.doubles(kReference05, at, 1), lengths.at(2), states, L);
+  r->figure_reference_075 = figure_of_row(impl.doubles(kReference075, at, 1), lengths.at(3), states, L);
+  if (L.checkpoints == 0) return;
+  for (std::int64_t s : impl.ints(kCheckpointSteps, at, 1)) {
+    if (checked(s, 0, kIntMax, kCheckpointSteps, at, where) > 0) {
+      r->checkpoint_steps.push_back(static_cast<int>(s));
+    }
+  }
+  const auto count = static_cast<std::int64_t>(r->checkpoint_steps.size());
+  r->checkpoint_mse = unpadded(impl.doubles(kCheckpointMse, at, 1), count);
+  r->checkpoint_train_seconds = unpadded(impl.doubles(kCheckpointTrainSeconds, at, 1), count);
 }
-std::vector<std::string> ResultsFile::read_systems() const { return impl_->strings(kSystem); }
-std::vector<std::string> ResultsFile::read_models() const { return impl_->strings(kModel); }
-std::vector<std::string> ResultsFile::read_integrators() const {
-  return impl_->strings(kIntegrator);
-}
-std::vector<std::string> ResultsFile::read_sizes() const { return impl_->strings(kSize); }
-std::vector<std::string> ResultsFile::read_regularizers() const {
-  return impl_->strings(kRegularizer);
-}
-std::vector<std::string> ResultsFile::read_studies() const { return impl_->strings(kStudies); }
-std::vector<std::int64_t> ResultsFile::read_n_train() const { return impl_->ints(kNTrain); }
-std::vector<std::int64_t> ResultsFile::read_n_x() const { return impl_->run_states; }
-std::vector<std::int64_t> ResultsFile::read_seeds() const { return impl_->ints(kSeed); }
 
 std::vector<double> ResultsFile::read_double_column(const std::string& column) const {
   return impl_->doubles(kRuns + column);

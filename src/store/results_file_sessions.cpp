@@ -1,6 +1,6 @@
 // src/store/results_file_sessions.cpp — ResultsFile: when each run was
-// trained (/runs/started_utc, finished_utc) and who wrote the file
-// (/provenance/session_<k>).
+// trained (the readers of /runs/started_utc, finished_utc; write_run stores
+// them) and who wrote the file (/provenance/session_<k>).
 #include "phnn/store/results_file.h"
 #include "store/results_file_internal.h"
 
@@ -40,20 +40,6 @@ std::vector<bool> sessions_with_runs(const std::vector<Provenance>& sessions,
     }
   }
   return out;
-}
-
-void ResultsFile::write_run_times(int row, const std::string& started,
-                                  const std::string& finished) {
-  Impl& impl = *impl_;
-  require(row >= 0 && row < impl.num_runs,
-          impl.prefix() + path() + ": write_run_times(row " + std::to_string(row) +
-              "): row outside [0, " + std::to_string(impl.num_runs) + ")");
-  if (!impl.has_run_times) return;
-  impl.independent([&] {
-    const auto at = static_cast<std::uint64_t>(row);
-    impl.file.write_string_rows(kStartedUtc, at, {started.substr(0, kUtcLength)});
-    impl.file.write_string_rows(kFinishedUtc, at, {finished.substr(0, kUtcLength)});
-  });
 }
 
 bool ResultsFile::has_run_times() const { return impl_->has_run_times; }

@@ -157,6 +157,30 @@ std::vector<int> result_sources(const std::vector<ResultsFile>& files,
   return source;
 }
 
+// The objects of `file` that its digests find damaged and whose names start
+// with `prefix` ("@sweep_", "/data/duffing"): none in files before rule 2.
+bool damaged_under(const ResultsFile& file, const std::string& prefix) {
+  for (const ResultsFile::Damage& d : file.file_damage()) {
+    if (d.object == prefix || d.object.rfind(prefix + "/", 0) == 0 ||
+        (prefix.back() == '_' && d.object.rfind(prefix, 0) == 0)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// The shard whose sweep attributes are intact (the first); throws if none.
+const ResultsFile& intact_sweep_text(const std::vector<ResultsFile>& files) {
+  for (const ResultsFile& file : files) {
+    if (!damaged_under(file, "@sweep_")) return file;
+  }
+  throw std::runtime_error(files.front().path() + " and every other shard: the stored sweep text "
+                           "is damaged (its digest differs); nothing written: repair a shard by "
+                           "running `phnn sweep` on its sweep file with the same --shard and --out");
+}
+
+// Each system's data group from the first shard that holds it intact (its
+// digest matches); a damaged group is never copied.
 void copy_data_groups(const std::vector<ResultsFile>& files, const SweepSpec& spec,
                       const Grid& grid, ResultsFile* to) {
   std::vector<std::string> systems;
@@ -166,14 +190,26 @@ void copy_data_groups(const std::vector<ResultsFile>& files, const SweepSpec& sp
   }
   for (const std::string& name : systems) {
     const SweepSystemFile* system_file = spec.system_file(name);
+    std::string damaged;
     for (const ResultsFile& file : files) {
       if (!file.has_system_data(name)) continue;
+      if (damaged_under(file, "/data/" + name)) {
+        damaged += (damaged.empty() ? "" : ", ") + file.path();
+        continue;
+      }
+      damaged.clear();
       if (system_file) {
         to->store_file_system_data(name, file.read_file_system_data(name), system_file->entry);
       } else {
         to->store_system_data(name, file.read_system_data(name));
       }
       break;
+    }
+    if (!damaged.empty()) {
+      throw std::runtime_error("/data/" + name + " is damaged in " + damaged + " (its digest "
+                               "differs) and no other shard holds it intact; nothing written: "
+                               "repair a shard by running `phnn sweep` on its sweep file with the "
+                               "same --shard and --out");
     }
   }
 }
@@ -197,8 +233,9 @@ std::string merge_shards(const std::vector<std::string>& shards, const std::stri
   const std::string problem = output_problem("merge", out, OutputKind::kResults, shards);
   if (!problem.empty()) throw std::invalid_argument(problem);
   const std::vector<ResultsFile> files = open_shards(shards);
-  const SweepSpec spec = parse_sweep_text(files.front().sweep_text(), shards.front() + "@sweep_text",
-                                          files.front().stored_system_files());
+  const ResultsFile& text = intact_sweep_text(files);
+  const SweepSpec spec = parse_sweep_text(text.sweep_text(), text.path() + "@sweep_text",
+                                          text.stored_system_files());
   const Grid grid = expand_grid(spec);
   ResultsLayout layout = files.front().layout();
   for (const ResultsFile& file : files) layout = results_copy::wider_layout(layout, file.layout());

@@ -17,10 +17,12 @@
 namespace phnn {
 namespace results_copy {
 namespace {
-// The result without its clocks (wall times), which differ between two
-// trainings of the same run.
+// The result without its clocks (wall times, run times), which differ
+// between two trainings of the same run.
 RunResult without_clocks(RunResult r) {
   r.wall_time_s = 0.0;
+  r.started_utc.clear();
+  r.finished_utc.clear();
   for (TracePoint& p : r.trace) p.elapsed_s = 0.0;
   std::fill(r.checkpoint_train_seconds.begin(), r.checkpoint_train_seconds.end(), 0.0);
   return r;
@@ -60,17 +62,13 @@ void copy_sessions(const ResultsFile& from, ResultsFile* to) {
 std::vector<std::pair<int, int>> copy_rows(const ResultsFile& from,
                                            const std::vector<std::pair<int, int>>& rows,
                                            ResultsFile* to) {
-  const bool times = from.has_run_times();
-  const std::vector<std::string> started = times ? from.read_started_utc() : std::vector<std::string>();
-  const std::vector<std::string> finished = times ? from.read_finished_utc() : std::vector<std::string>();
   std::vector<std::pair<int, int>> damaged;
   for (const auto& [row, to_row] : rows) {
     if (from.row_damaged(row)) {
       damaged.emplace_back(row, to_row);
       continue;
     }
-    if (times) to->write_run_times(to_row, started[row], finished[row]);
-    to->write_run(to_row, from.read_run(row));
+    to->write_run(to_row, from.read_run(row));  // with its run times
   }
   return damaged;
 }

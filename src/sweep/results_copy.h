@@ -14,7 +14,8 @@ namespace phnn {
 namespace results_copy {
 
 /// Every field of both equal, doubles bit for bit (their journal encodings),
-/// but the clocks: wall times of the run, its trace and its checkpoints.
+/// but the clocks: wall times of the run, its trace and its checkpoints,
+/// and its run times.
 bool same_result(const RunResult& a, const RunResult& b);
 
 /// The layout that holds rows of both.
@@ -25,9 +26,9 @@ void copy_sessions(const ResultsFile& from, ResultsFile* to);
 
 /// The one way rows move between results files (merge, a grown sweep):
 /// copies each (row of `from`, row of `to`) pair whose row is intact (the
-/// check of `phnn verify`: ResultsFile::row_damaged), the run times, then the
-/// result. A damaged row is never copied as it stands (write_run would give
-/// the wrong values a valid checksum): its pair is returned, its row of `to`
+/// check of `phnn verify`: ResultsFile::row_damaged), result and run times.
+/// A damaged row is never copied as it stands (write_run would give the
+/// wrong values a valid checksum): its pair is returned, its row of `to`
 /// left pending, and the caller repairs it from a journal, takes another
 /// copy, or names it.
 std::vector<std::pair<int, int>> copy_rows(const ResultsFile& from,

@@ -179,7 +179,8 @@ struct CopiedRows {
 
 // Copies every row of `from` that holds a result into its row of `to`. A
 // damaged row (its checksum fails) is written from the journals' record of
-// its run instead, or, if they lack it, left pending to be trained again.
+// its run instead (every result column and its run times), or, if they
+// lack it or it does not fit the row, left pending to be trained again.
 CopiedRows copy_results(const ResultsFile& from, const std::string& out,
                         const RunSetComparison& cmp,
                         std::map<std::string, RunResult>* journal, ResultsFile* to) {
@@ -202,7 +203,8 @@ CopiedRows copy_results(const ResultsFile& from, const std::string& out,
   const std::vector<std::string> ids = from.read_run_ids();
   for (const auto& [row, run] : damaged) {
     const auto it = journal->find(ids[static_cast<std::size_t>(row)]);
-    if (it != journal->end()) {
+    // A record that does not fit the row is trained again, as on resume.
+    if (it != journal->end() && to->rewrite_problem(run, it->second).empty()) {
       to->write_run(run, it->second);
       result.repaired.emplace_back(run, row);
     } else {

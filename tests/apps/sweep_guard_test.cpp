@@ -26,6 +26,7 @@
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/writer_lock.h"
+#include "store/results_file_internal.h"  // group_digest: another build's file
 #include "sweep/sample_results.h"
 #include "test_util.h"
 
@@ -393,9 +394,12 @@ TEST(SweepGuardTest, ResultsFilesWithoutProvenanceStillResume) {
   run_tiny(sweep, out, 1);
   {
     h5::File file = h5::File::open(out, h5::Access::kReadWrite);
-    file.remove("/provenance");
-    file.remove("/runs/started_utc");
-    file.remove("/runs/finished_utc");
+    for (const char* name : {"/provenance", "/runs/started_utc", "/runs/finished_utc",
+                             "/runs/checksum"}) {  // nor checksums, which came later
+      file.remove(name);
+    }
+    for (const char* object : {"/", "/data/harmonic"}) file.remove_attribute(object, "digest");
+    file.remove_attribute("/", "checksum_version");
   }
   ASSERT_EQ(shell("rm -rf " + journal_directory(out)), 0);
   const std::string hash = ResultsFile::open_read_only(out).sweep_hash();
@@ -475,6 +479,8 @@ TEST(SweepGuardTest, ResumeRefusesDataThatAreNotTheStoredOnes) {
     std::vector<double> row = file.read_doubles("/data/harmonic/validation/x_next", 3, 1);
     row[1] = std::nextafter(row[1], 1e300);  // one ulp: what another generator gives
     file.write_rows("/data/harmonic/validation/x_next", 3, 1, row.data());
+    const std::string group = "/data/harmonic";  // whose digest that generator recorded
+    file.set_attribute(group, "digest", results_io::group_digest(file, group));
   }
   {
     ResultsFile file = ResultsFile::open(out, MPI_COMM_NULL, hash);

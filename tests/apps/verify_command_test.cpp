@@ -1,7 +1,8 @@
 // tests/apps/verify_command_test.cpp — damaged bytes in a finished results
 // file are found (phnn verify, phnn reduce) and repaired by the next `phnn
 // sweep`: from the journal when it holds the run, else by training it again;
-// also when the sweep grew (a new version of the file).
+// also when the sweep grew (a new version of the file), and in files of the
+// old checksum rule. Every column class: tests/faults/damage_matrix_test.cpp.
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "h5/h5file.h"
 #include "phnn/store/results_file.h"
 #include "test_util.h"
 
@@ -68,7 +70,8 @@ TEST_F(VerifyCommandTest, DamagedRowsAreFoundThenRepairedFromTheJournalOrTrained
   flip_mse(1);
   EXPECT_NE(mse(1), original);
   EXPECT_EQ(phnn("verify " + out_, &log), 1) << log;
-  EXPECT_THAT(log, HasSubstr("damaged: run " + id + " (row 1): the journal holds it"));
+  EXPECT_THAT(log,
+              HasSubstr("damaged: run " + id + " (row 1): checksum mismatch; the journal holds it"));
   EXPECT_EQ(phnn("reduce " + out_, &log), 0) << log;
   EXPECT_THAT(log, HasSubstr("1 damaged rows (checksum mismatch) left out, counted as pending: " + id));
   ASSERT_EQ(sweep(&log), 0) << log;
@@ -131,6 +134,62 @@ TEST_F(VerifyCommandTest, GrowingASweepRepairsDamagedRowsInsteadOfCopyingThem) {
   const double retrained = mse_of(id);
   EXPECT_EQ(std::memcmp(&original, &retrained, sizeof original), 0);
   EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
+}
+
+// Files written before 2026-11-28 keep checksum rule 1 (what read_run
+// returns, with id, canonical and seed; no digests): made here from a new
+// file by dropping the rule's attributes and rewriting each row under rule
+// 1, as the build of that time wrote it. They verify, a damaged row is
+// found and repaired under rule 1 (the file keeps its rule), and they reduce
+// and merge (the merged file is a new one, of rule 2).
+TEST_F(VerifyCommandTest, AFileOfTheOldChecksumRuleVerifiesResumesReducesAndMerges) {
+  std::string log;
+  ASSERT_EQ(sweep(&log), 0) << log;
+  {
+    h5::File raw = h5::File::open(out_, h5::Access::kReadWrite);
+    for (const std::string& group : raw.link_names("/data")) {
+      raw.remove_attribute("/data/" + group, "digest");
+    }
+    raw.remove_attribute("/", "digest");
+    raw.remove_attribute("/", "checksum_version");
+  }
+  {
+    const std::string hash = ResultsFile::open_read_only(out_).sweep_hash();
+    ResultsFile file = ResultsFile::open(out_, MPI_COMM_NULL, hash);
+    ASSERT_EQ(file.checksum_version(), 1);
+    for (int row = 0; row < file.num_runs(); ++row) file.write_run(row, file.read_run(row));
+  }
+  ASSERT_EQ(phnn("verify " + out_, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("checksums (rule 1): 6 finished rows checked, 0 damaged"));
+  EXPECT_THAT(log, Not(HasSubstr("digests")));
+  const std::string id = ResultsFile::open_read_only(out_).read_run_ids()[1];
+  const double original = mse(1);
+  flip_mse(1);
+  EXPECT_EQ(phnn("verify " + out_, &log), 1) << log;
+  EXPECT_THAT(log,
+              HasSubstr("damaged: run " + id + " (row 1): checksum mismatch; the journal holds it"));
+  ASSERT_EQ(sweep(&log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("repaired from the journals: " + id));
+  const double repaired = mse(1);
+  EXPECT_EQ(std::memcmp(&original, &repaired, sizeof original), 0);
+  EXPECT_EQ(ResultsFile::open_read_only(out_).checksum_version(), 1);
+  EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
+  EXPECT_EQ(phnn("reduce " + out_, &log), 0) << log;
+  const std::string merged = dir_ + "/merged.h5";
+  ASSERT_EQ(phnn("merge " + merged + " " + out_, &log), 0) << log;
+  EXPECT_EQ(ResultsFile::open_read_only(merged).checksum_version(), 2);
+  EXPECT_EQ(phnn("verify " + merged, &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("checksums (rule 2): 6 finished rows checked, 0 damaged"));
+}
+
+// The file of the 2026-11-25 build (tests/fixtures) verifies under rule 1.
+TEST_F(VerifyCommandTest, TheFixtureOfTheOldRuleVerifies) {
+  std::string log;
+  EXPECT_EQ(phnn("verify " + std::string(PHNN_SOURCE_DIR) + "/tests/fixtures/results-2026-11-25.h5",
+                 &log),
+            0)
+      << log;
+  EXPECT_THAT(log, HasSubstr("checksums (rule 1): 4 finished rows checked, 0 damaged"));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // tests/sweep/merge_test.cpp — shards of one sweep merged into one results
 // file: every result kept bitwise, conflicts and foreign files refused, a
-// damaged shard row replaced by a good copy or named, never copied.
+// damaged shard row replaced by a good copy or named, never copied; damaged
+// data or sweep text taken from an intact shard.
 #include "phnn/sweep/merge.h"
 
 #include <sys/stat.h>
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
+#include "phnn/data/dataset.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
@@ -205,6 +207,53 @@ TEST_F(MergeShardsTest, ADamagedShardRowWithoutAGoodCopyIsNamedAndNothingIsWritt
   struct stat st;
   EXPECT_NE(::stat(out.c_str(), &st), 0) << "a merged file was left behind";
   EXPECT_NE(::stat((out + ".partial").c_str(), &st), 0) << "scratch file left behind";
+}
+
+// Checksum rule 2: a shard whose /data group or sweep text is damaged (its
+// digest differs) is not their source; another shard's intact copy is
+// taken, and with none the merge is refused naming the group.
+TEST_F(MergeShardsTest, DamagedDataOrSweepTextComesFromAnIntactShardOrIsRefused) {
+  DatasetOptions options;
+  options.num_train_max = 4;
+  options.num_validation = 4;
+  options.num_inference = 1;
+  const SystemData data =
+      make_system_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 4);
+  auto with_data = [&](const std::string& name, int row) {
+    const std::string path = shard(name, {row});
+    const std::string hash = parse_sweep_text(kSweep, "sweep.toml").text_hash;
+    ResultsFile(ResultsFile::open(path, MPI_COMM_NULL, hash)).store_system_data("duffing", data);
+    return path;
+  };
+  auto damage = [](const std::string& path) {
+    h5::File file = h5::File::open(path, h5::Access::kReadWrite);
+    const double wrong = 42.0;
+    file.write_rows("/data/duffing/train/u", 1, 1, &wrong);
+    file.set_attribute("/", "sweep_text", std::string("name = \"damaged\"\n"));
+  };
+  const std::string a = with_data("a.h5", 0), b = with_data("b.h5", 1);
+  damage(a);
+  ASSERT_EQ(ResultsFile::open_read_only(a).file_damage().size(), 2u);
+  const std::string out = dir_ + "/merged.h5";
+  merge_shards({a, b}, out, "v2");
+  const ResultsFile merged = ResultsFile::open_read_only(out);
+  EXPECT_TRUE(merged.file_damage().empty());
+  EXPECT_EQ(merged.sweep_text(), kSweep);
+  EXPECT_EQ(merged.read_system_data("duffing").train.u, data.train.u);
+  damage(b);
+  try {
+    merge_shards({a, b}, dir_ + "/none.h5", "v2");
+    FAIL() << "damaged data were merged";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("the stored sweep text is damaged"));
+  }
+  h5::File::open(b, h5::Access::kReadWrite).set_attribute("/", "sweep_text", std::string(kSweep));
+  try {
+    merge_shards({a, b}, dir_ + "/none.h5", "v2");
+    FAIL() << "damaged data were merged";
+  } catch (const std::runtime_error& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/data/duffing is damaged in " + a + ", " + b));
+  }
 }
 
 }  // namespace

@@ -165,6 +165,8 @@ inline void expect_bit_equal(const RunResult& expected, const RunResult& actual)
   EXPECT_EQ(bits(expected.checkpoint_mse), bits(actual.checkpoint_mse));
   EXPECT_EQ(bits(expected.checkpoint_train_seconds), bits(actual.checkpoint_train_seconds));
   EXPECT_EQ(bits(expected.weights), bits(actual.weights));
+  EXPECT_EQ(expected.started_utc, actual.started_utc);
+  EXPECT_EQ(expected.finished_utc, actual.finished_utc);
 }
 
 }  // namespace testing_util

@@ -125,9 +125,11 @@ class WriteGrownResultsTest : public ::testing::Test {
     file.begin_session({{"command_line", "phnn sweep a"}, {"started", "t0"}});
     file.end_session("t1");
     for (int row : {0, 1, 3}) {
-      original_[grid.runs[row].canonical()] = testing_util::sample_result(row, file.layout());
-      file.write_run_times(row, "s" + std::to_string(row), "f" + std::to_string(row));
-      file.write_run(row, original_[grid.runs[row].canonical()]);
+      RunResult result = testing_util::sample_result(row, file.layout());
+      result.started_utc = "s" + std::to_string(row);
+      result.finished_utc = "f" + std::to_string(row);
+      original_[grid.runs[row].canonical()] = result;
+      file.write_run(row, result);
     }
     file.close();
   }

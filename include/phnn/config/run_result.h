@@ -56,6 +56,10 @@ struct RunResult {
   /// parameters() order, each tensor flattened row-major without its member
   /// axis): `phnn eval` reloads them. Empty for a run that failed.
   std::vector<double> weights;
+  /// UTC, ISO 8601 ("2026-11-28T08:43:21Z"): when the work item that trained
+  /// the run started and finished; "" where unknown (a journal record
+  /// written before 2026-11-28, or a file without /runs/started_utc).
+  std::string started_utc, finished_utc;
 };
 
 }  // namespace phnn

@@ -100,6 +100,12 @@ class ResultsFile {
   /// Value of the file attribute "format" and of "format_version".
   static constexpr const char* kFormat = "phnn-results";
   static constexpr std::int64_t kFormatVersion = 1;
+  /// The checksum rule of new files (file attribute "checksum_version";
+  /// docs/RESULTS_FORMAT.md, "Checksums"): 2, every stored byte of a row,
+  /// and a digest of /data, the sweep attributes and the configuration
+  /// columns (2026-11-28). Files without the attribute keep rule 1: a row's
+  /// checksum covers what read_run returns with its id, canonical and seed.
+  static constexpr std::int64_t kChecksumVersion = 2;
 
   /// Collective over comm: creates (truncates) `path`, creates every dataset
   /// for `runs`, writes the config columns, the file attributes
@@ -160,7 +166,8 @@ class ResultsFile {
   /// UTC creation time, ISO 8601 ("2024-05-01T12:00:00Z").
   std::string created() const;
 
-  /// Independent: writes every column of row `row`, the status last. Throws
+  /// Independent: writes every result column of row `row` (its run times
+  /// too, where the file has them), the status last, then its checksum. Throws
   /// std::invalid_argument if the row is out of range or an array of
   /// `result` is longer than the layout allows (trajectory_errors >
   /// num_inference, trace > trace_points, a figure > figure_points points or
@@ -172,6 +179,10 @@ class ResultsFile {
   std::vector<RunStatus> read_statuses() const;
   /// Row `row` as written by write_run (bit-exact, except a truncated
   /// message); a pending row reads as a default RunResult with NaN scalars.
+  /// Every integer is range-checked before it sizes or indexes anything (a
+  /// length within the layout, n_x within figure_states, counts and steps
+  /// within int, the weights within /weights): std::runtime_error naming
+  /// the dataset, row and value.
   RunResult read_run(int row) const;
 
   /// Config columns, one entry per row.
@@ -216,14 +227,12 @@ class ResultsFile {
   /// throws std::runtime_error naming the file when none is stored.
   SystemFileReader stored_system_files() const;
 
-  /// Independent: UTC start and end (ISO 8601) of the work item that
-  /// trained run `row`, in /runs/started_utc and /runs/finished_utc. Call
-  /// it before write_run (whose status lands last). A no-op in a file
-  /// written before these columns existed (has_run_times() false).
-  void write_run_times(int row, const std::string& started, const std::string& finished);
+  /// Whether the file has /runs/started_utc and /runs/finished_utc, where
+  /// write_run stores RunResult::started_utc and finished_utc (files
+  /// written before provenance have neither and drop the times).
   bool has_run_times() const;
   /// One entry per row; "" where unknown (pending, recovered from a
-  /// journal, or an older file).
+  /// journal record written before 2026-11-28, or an older file).
   std::vector<std::string> read_started_utc() const;
   std::vector<std::string> read_finished_utc() const;
   /// sessions_with_runs(read_sessions(), read_finished_utc()), every
@@ -231,23 +240,78 @@ class ResultsFile {
   std::vector<bool> sessions_with_runs() const;
 
   /// Integrity (docs/RESULTS_FORMAT.md, "Checksums"): every row written by
-  /// write_run carries a checksum of what it stores. The rows with a result
-  /// (not pending) whose checksum is missing or wrong, or that cannot be
-  /// read; empty for a file written before checksums (has_checksums()).
+  /// write_run carries a checksum of what it stores, by the file's rule
+  /// (checksum_version()). The rows with a result (not pending) whose
+  /// checksum is missing or wrong, or that cannot be read (a value out of
+  /// range: read_run's message); empty for a file written before checksums
+  /// (has_checksums()).
   std::vector<int> damaged_rows() const;
   /// The same check for one row: true if it holds a result (not pending)
   /// whose checksum is missing or wrong, or if it cannot be read; false in a
   /// file written before checksums. Every copy of a row into another file
   /// (merge, a grown sweep) asks this first (src/sweep/results_copy.h).
   bool row_damaged(int row) const;
+  /// Why row `row` is damaged ("" if it is not): "checksum mismatch", or
+  /// read_run's message for a value out of range.
+  std::string row_damage(int row) const;
   /// What makes the file unusable as a whole: an empty or repeated run id, a
   /// status outside 0..3, an unreadable column ("" entries none).
   std::vector<std::string> structure_problems() const;
   bool has_checksums() const;
-  /// The checksum of row `row` as stored now.
+  /// 0 (no checksums), 1 or 2: the rule of this file's checksums.
+  std::int64_t checksum_version() const;
+  /// The checksum of row `row` as stored now, by the file's rule.
   std::uint64_t row_checksum(int row) const;
   /// Independent: marks row `row` pending again (its result to be trained anew).
   void requeue_run(int row);
+  /// "" if write_run(row, result) can rewrite every result column of row
+  /// `row` from `result` (a journal record); else why not (an array longer
+  /// than the layout, more weights than the row's room, a bad n_x). What
+  /// `phnn verify` calls repairable is what `phnn sweep` repairs.
+  std::string rewrite_problem(int row, const RunResult& result) const;
+
+  /// A damaged object outside the result rows (file_damage).
+  struct Damage {
+    std::string object;  ///< "@sweep_text", "/runs/model", "/data/duffing/train/x"
+    std::string what;    ///< what is wrong with it
+  };
+  /// Rule 2 only (empty otherwise): each object whose bytes differ from the
+  /// digests recorded with the file: the sweep attributes (@sweep_name,
+  /// @sweep_text, @sweep_hash) and configuration columns (/runs/id, ...,
+  /// /runs/config/*) against the file digest, every object of each complete
+  /// /data group against the group's digest; a damaged or missing digest
+  /// or checksum_version attribute.
+  std::vector<Damage> file_damage() const;
+  /// Each configuration column whose values differ from what create()
+  /// writes for `runs` (the runs of the file's sweep text), with the rows
+  /// ("rows 3, 7 differ from the sweep file's runs"): names the rows of
+  /// damage the file digest finds in a column.
+  std::vector<Damage> configuration_differences(const std::vector<RunConfig>& runs,
+                                                const std::vector<std::string>& run_studies) const;
+  /// Rank 0 on a serial file: rewrites the sweep attributes and every
+  /// configuration column from the sweep's own runs (the file's sweep text
+  /// must hash to `sweep_hash`), as create() wrote them.
+  void rewrite_configuration(const std::vector<RunConfig>& runs,
+                             const std::vector<std::string>& run_studies,
+                             const std::string& sweep_name, const std::string& sweep_text,
+                             const std::string& sweep_hash);
+  /// The repair of file_damage() outside /data (rule 2, serial): when the
+  /// file digest finds damage, rewrite_configuration, then the digest is
+  /// checked again. Returns the repaired objects (empty: nothing damaged);
+  /// throws std::runtime_error naming the objects that rewriting does not
+  /// restore to the recorded bytes.
+  std::vector<std::string> repair_configuration(const std::vector<RunConfig>& runs,
+                                                const std::vector<std::string>& run_studies,
+                                                const std::string& sweep_name,
+                                                const std::string& sweep_text,
+                                                const std::string& sweep_hash);
+  /// The same for /data/<system_name>: if its digest finds damage, the
+  /// group is removed and `store` stores it again (store_system_data or
+  /// store_file_system_data); the new bytes must be the recorded ones (or
+  /// the old ones, when only the digest was damaged), else
+  /// std::runtime_error. Returns the repaired objects.
+  std::vector<std::string> repair_system_data(const std::string& system_name,
+                                              const std::function<void()>& store);
 
   /// Collective (same `provenance` on every rank): records a session as the
   /// string attributes of a new group /provenance/session_<k> (k = 0, 1, ...
@@ -269,6 +333,12 @@ class ResultsFile {
  private:
   struct Impl;
   explicit ResultsFile(std::unique_ptr<Impl> impl);
+  /// What write_run checks before it writes (the row, its n_x, the arrays
+  /// against the layout, the weights against the row's room); returns where
+  /// the weights go in /weights, -1 if none are stored. Throws with `where`.
+  std::int64_t row_fit(int row, const RunResult& result, const std::string& where) const;
+  /// read_run's figures and checkpoints of row `row`, into *result.
+  void read_figures_and_checkpoints(int row, RunResult* result) const;
   /// Collective: /data/<system_name> written by `write(group)`, then marked complete.
   void store_data_group(const std::string& system_name,
                         const std::function<void(const std::string&)>& write);
