@@ -122,9 +122,9 @@ std::unique_ptr<DynamicsModel> DynamicsModel::create(const ModelOptions& options
   if (!options.general)
     options.general = std::make_shared<ModelStructure>(builtin_structure(options.structure));
   switch (options.kind) {
-    case ModelKind::kNode: return std::make_unique<GeneralNode>(options, seeds);
-    case ModelKind::kPhnnS: return std::make_unique<GeneralPhnnS>(options, seeds);
-    case ModelKind::kPhnnJr: return std::make_unique<GeneralPhnnJr>(options, seeds);
+    case ModelKind::kNode: return std::make_unique<Node>(options, seeds);
+    case ModelKind::kPhnnS: return std::make_unique<PhnnS>(options, seeds);
+    case ModelKind::kPhnnJr: return std::make_unique<PhnnJr>(options, seeds);
   }
   PHNN_CHECK(false, "unknown model kind");
   return nullptr;

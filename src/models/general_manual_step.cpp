@@ -171,7 +171,7 @@ SRecorders s_recorders(const StackedMlp& l_h, const StackedMlp* l_z, const Tenso
 
 }  // namespace
 
-Tensor GeneralPhnnJr::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
+Tensor PhnnJr::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
                                             const Tensor& x_next, const Tensor& u_in, double h,
                                             const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
@@ -182,7 +182,7 @@ Tensor GeneralPhnnJr::explicit_mean_l1_step(IntegratorKind integrator, const Ten
                              jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
 
-Tensor GeneralPhnnJr::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
+Tensor PhnnJr::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
                                       double h, double min_dx_norm,
                                       const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
@@ -193,7 +193,7 @@ Tensor GeneralPhnnJr::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, con
                        jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
 }
 
-Tensor GeneralPhnnS::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
+Tensor PhnnS::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
                                            const Tensor& x_next, const Tensor& u_in, double h,
                                            const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
@@ -205,7 +205,7 @@ Tensor GeneralPhnnS::explicit_mean_l1_step(IntegratorKind integrator, const Tens
                              penalty);
 }
 
-Tensor GeneralPhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
+Tensor PhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
                                      double h, double min_dx_norm,
                                      const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};
@@ -218,7 +218,7 @@ Tensor GeneralPhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, cons
 }
 
 // NODE: f = MLP([y, u]) (manual_step.h).
-Tensor GeneralNode::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
+Tensor Node::explicit_mean_l1_step(IntegratorKind integrator, const Tensor& x,
                                           const Tensor& x_next, const Tensor& u_in, double h,
                                           const JacobianPenalty& penalty) const {
   if (!has_manual_step(nets_, options().dtype)) return {};

@@ -141,13 +141,13 @@ Jet general_hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int o
 }
 
 // ------------------------------------------------------- shared PH parts
-GeneralPortHamiltonianModel::GeneralPortHamiltonianModel(ModelOptions options, int64_t members)
-    : PortHamiltonianModel(std::move(options), members) {
+PortHamiltonianModel::PortHamiltonianModel(ModelOptions options, int64_t members)
+    : DynamicsModel(std::move(options), members) {
   PHNN_REQUIRE(this->options().general != nullptr,
-               "GeneralPortHamiltonianModel: ModelOptions::general (the structure) is not set");
+               "PortHamiltonianModel: ModelOptions::general (the structure) is not set");
 }
 
-torch::Tensor GeneralPortHamiltonianModel::block_t(const std::vector<double>& matrix, int width,
+torch::Tensor PortHamiltonianModel::block_t(const std::vector<double>& matrix, int width,
                                                   int r0, int rows, int c0, int cols) const {
   std::vector<double> t(static_cast<std::size_t>(rows * cols));
   for (int r = 0; r < rows; ++r) {
@@ -163,14 +163,14 @@ torch::Tensor GeneralPortHamiltonianModel::block_t(const std::vector<double>& ma
 // without a graph in reverse mode, with one on the network's order-1 jet;
 // otherwise from the op-by-op jet (the reference the tests compare the
 // heads with).
-torch::Tensor GeneralPortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
+torch::Tensor PortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
   if (l_h().options().fused) {
     return internal::general_hamiltonian_head(l_h().forward(x), {}, x).h.squeeze(-1);
   }
   return general_hamiltonian_jet(l_h(), x, 0).v.squeeze(-1);
 }
 
-HamiltonianAndGradient GeneralPortHamiltonianModel::energy_and_gradient(
+HamiltonianAndGradient PortHamiltonianModel::energy_and_gradient(
     const torch::Tensor& x) const {
   if (l_h().options().fused && !torch::GradMode::is_enabled()) {
     // No graph to keep (rollouts): gradH in reverse mode, the hand-written
@@ -189,13 +189,13 @@ HamiltonianAndGradient GeneralPortHamiltonianModel::energy_and_gradient(
   return {H.v, H.g.squeeze(-1)};
 }
 
-Jet GeneralPortHamiltonianModel::curvature_jet(const torch::Tensor& x) const {
+Jet PortHamiltonianModel::curvature_jet(const torch::Tensor& x) const {
   return gradient_jet(general_hamiltonian_jet(l_h(), x, 2));
 }
 
 // dg = gradH(x + dx/2) + (H(x + dx) - H(x) - gradH(x + dx/2)^T dx) / |dx|^2 dx
 // (= gradH(x + dx/2) below min_dx_norm), one network call for the three points.
-torch::Tensor GeneralPortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
+torch::Tensor PortHamiltonianModel::discrete_gradient(const torch::Tensor& x,
                                                              const torch::Tensor& dx,
                                                              double min_dx_norm) const {
   const int64_t B = x.size(1);
@@ -220,11 +220,11 @@ torch::Tensor GeneralPortHamiltonianModel::discrete_gradient(const torch::Tensor
 }
 
 // ---------------------------------------------------------------- PHNN-S
-GeneralPhnnS::GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds)
-    : GeneralPortHamiltonianModel(std::move(options), static_cast<int64_t>(seeds.size())) {
+PhnnS::PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds)
+    : PortHamiltonianModel(std::move(options), static_cast<int64_t>(seeds.size())) {
   const ModelOptions& o = this->options();
   const ModelStructure& s = structure();
-  PHNN_REQUIRE(o.kind == ModelKind::kPhnnS, "GeneralPhnnS: options.kind must be phnn-s");
+  PHNN_REQUIRE(o.kind == ModelKind::kPhnnS, "PhnnS: options.kind must be phnn-s");
   const int nx = s.n_x, nw = s.n_w, nu = s.n_u, width = nx + nw + nu;
   const NetworkWidths widths = network_widths(o.size);
   nets_.push_back(std::make_unique<StackedMlp>(
@@ -265,7 +265,7 @@ GeneralPhnnS::GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t
   }
 }
 
-Jet GeneralPhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_dissipation*/,
+Jet PhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_dissipation*/,
                                     const torch::Tensor& u, int order,
                                     bool /*dissipation_fixed*/) const {
   const ModelStructure& s = structure();
@@ -300,11 +300,11 @@ Jet GeneralPhnnS::field_from_effort(const Jet& effort, const torch::Tensor& /*x_
 }
 
 // --------------------------------------------------------------- PHNN-JR
-GeneralPhnnJr::GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds)
-    : GeneralPortHamiltonianModel(std::move(options), static_cast<int64_t>(seeds.size())) {
+PhnnJr::PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds)
+    : PortHamiltonianModel(std::move(options), static_cast<int64_t>(seeds.size())) {
   const ModelOptions& o = this->options();
   const ModelStructure& s = structure();
-  PHNN_REQUIRE(o.kind == ModelKind::kPhnnJr, "GeneralPhnnJr: options.kind must be phnn-jr");
+  PHNN_REQUIRE(o.kind == ModelKind::kPhnnJr, "PhnnJr: options.kind must be phnn-jr");
   const int nx = s.n_x, m = s.n_x + s.n_u;
   const NetworkWidths widths = network_widths(o.size);
   nets_.push_back(std::make_unique<StackedMlp>(
@@ -318,7 +318,7 @@ GeneralPhnnJr::GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64
   place_lt_ = triangle_placement(m, m * (m + 1) / 2, true, 0, o.dtype);
 }
 
-torch::Tensor GeneralPhnnJr::dissipation_matrix(const torch::Tensor& x,
+torch::Tensor PhnnJr::dissipation_matrix(const torch::Tensor& x,
                                                 const torch::Tensor& u) const {
   const int64_t m = structure().n_x + structure().n_u;
   const auto o = nets_[1]->forward(torch::cat({x, u}, -1));  // [E, B, m (m + 1) / 2]
@@ -329,7 +329,7 @@ torch::Tensor GeneralPhnnJr::dissipation_matrix(const torch::Tensor& x,
   return internal::ordered_matmul(L.transpose(-1, -2), L);
 }
 
-Jet GeneralPhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
+Jet PhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
                                      const torch::Tensor& u, int order,
                                      bool dissipation_fixed) const {
   const ModelStructure& s = structure();
@@ -355,10 +355,10 @@ Jet GeneralPhnnJr::field_from_effort(const Jet& effort, const torch::Tensor& x_d
 }
 
 // ------------------------------------------------------------------ NODE
-GeneralNode::GeneralNode(ModelOptions options, const std::vector<std::uint64_t>& seeds)
+Node::Node(ModelOptions options, const std::vector<std::uint64_t>& seeds)
     : DynamicsModel(options, static_cast<int64_t>(seeds.size())) {
-  PHNN_REQUIRE(options.kind == ModelKind::kNode, "GeneralNode: options.kind must be node");
-  PHNN_REQUIRE(options.general != nullptr, "GeneralNode: ModelOptions::general is not set");
+  PHNN_REQUIRE(options.kind == ModelKind::kNode, "Node: options.kind must be node");
+  PHNN_REQUIRE(options.general != nullptr, "Node: ModelOptions::general is not set");
   const ModelStructure& s = *options.general;
   nets_.push_back(std::make_unique<StackedMlp>(
       StackedMlpOptions{s.n_x + s.n_u, network_widths(options.size).node, s.n_x,
@@ -366,7 +366,7 @@ GeneralNode::GeneralNode(ModelOptions options, const std::vector<std::uint64_t>&
       seeds, kStreamNode));
 }
 
-FieldEval GeneralNode::field(const torch::Tensor& x, const torch::Tensor& u,
+FieldEval Node::field(const torch::Tensor& x, const torch::Tensor& u,
                              bool with_jacobian) const {
   FieldEval out;
   const auto input = torch::cat({x, u}, -1);

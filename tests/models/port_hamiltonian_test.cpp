@@ -53,7 +53,7 @@ TEST(PortHamiltonianStructureTest, QIsPositiveDefiniteAndRIsPositiveSemidefinite
   const auto u = random_states(3, 1000, 2.0, 2).narrow(-1, 0, 1);
   // H > 0 away from 0 (Q > 0 implies x^T Q x > 0).
   EXPECT_GT(jr->hamiltonian(x).min().item<double>(), 0.0);
-  const auto R = dynamic_cast<const GeneralPhnnJr&>(*jr).dissipation_matrix(x, u);
+  const auto R = dynamic_cast<const PhnnJr&>(*jr).dissipation_matrix(x, u);
   EXPECT_LT((R - R.transpose(-1, -2)).abs().max().item<double>(), 1e-15);
   const auto eig = torch::linalg_eigvalsh(R, "L");
   const double scale = R.abs().max().item<double>();

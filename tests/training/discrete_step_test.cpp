@@ -94,7 +94,7 @@ TEST(DiscreteStepTest, DgStructurePointKeepsThePowerBalanceAndChangesTheStep) {
     const auto model = DynamicsModel::create(
         ModelOptions{ModelKind::kPhnnJr, ModelSize::kSmall, SystemKind::kDuffing, true, point},
         {0, 1});
-    const auto& jr = dynamic_cast<const GeneralPhnnJr&>(*model);
+    const auto& jr = dynamic_cast<const PhnnJr&>(*model);
     torch::NoGradGuard no_grad;
     const auto x = 2.0 * states(2, 64, 11);
     const auto u = states(2, 64, 12).narrow(-1, 0, 1);

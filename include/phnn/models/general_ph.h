@@ -28,36 +28,15 @@ Jet jet_narrow(const Jet& a, int64_t start, int64_t length);
 /// diagonal), as a jet in the n state directions up to `order`.
 Jet general_hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int order);
 
-/// Shared by the n-dimensional PHNN-S and PHNN-JR: H_theta, its gradient
-/// and Hessian from general_hamiltonian_jet, the Gonzalez DG by its
-/// reference formula; everything else is PortHamiltonianModel's.
-class GeneralPortHamiltonianModel : public PortHamiltonianModel {
- public:
-  torch::Tensor hamiltonian(const torch::Tensor& x) const override;
-  torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
-                                  double min_dx_norm) const override;
-
- protected:
-  GeneralPortHamiltonianModel(ModelOptions options, int64_t members);
-  HamiltonianAndGradient energy_and_gradient(const torch::Tensor& x) const override;
-  Jet curvature_jet(const torch::Tensor& x) const override;
-  const ModelStructure& structure() const { return *options().general; }
-  /// Row-major matrix block [r0, r0 + rows) x [c0, c0 + cols) of a
-  /// structure matrix with `width` columns, as a [cols, rows] tensor (the
-  /// right factor of jet_linear: y = a M^T).
-  torch::Tensor block_t(const std::vector<double>& matrix, int width, int r0, int rows, int c0,
-                        int cols) const;
-};
-
 /// PHNN-S (eq:f_theta-PHS-DAF) for n_w ports:
 ///   w = S_wx gradH + S_wu u,
 ///   z_theta(w) = (L_z(w)^T L_z(w) + K(w) - K(w)^T) w,
 ///   f = S_xx gradH + S_xw z_theta(w) + S_xu u,
 /// one network n_w -> n_w (n_w + 1) / 2 (L_z, lower triangle) + n_w (n_w - 1) / 2
 /// (K, strictly lower); for n_w = 1 a 1 -> 1 network and K is empty.
-class GeneralPhnnS : public GeneralPortHamiltonianModel {
+class PhnnS : public PortHamiltonianModel {
  public:
-  GeneralPhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   /// Hand-written steps (src/models/general_manual_step.cpp): without a
   /// penalty bitwise autograd's; with one, equal to it to round-off.
   torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
@@ -81,12 +60,12 @@ class GeneralPhnnS : public GeneralPortHamiltonianModel {
 /// PHNN-JR (eq:f_theta-PHS-JR): f = [(J - R_theta(x, u)) [gradH; u]]_{1:n_x},
 /// R = L_R^T L_R, L_R lower triangular m x m (m = n_x + n_u) from an
 /// m -> m (m + 1) / 2 network of (x, u).
-class GeneralPhnnJr : public GeneralPortHamiltonianModel {
+class PhnnJr : public PortHamiltonianModel {
  public:
-  GeneralPhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  PhnnJr(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   /// R_theta(x, u) = L^T L [E, B, m, m], m = n_x + n_u (for tests: symmetric PSD).
   torch::Tensor dissipation_matrix(const torch::Tensor& x, const torch::Tensor& u) const;
-  /// Hand-written steps, as GeneralPhnnS's.
+  /// Hand-written steps, as PhnnS's.
   torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
                                       const torch::Tensor& x_next, const torch::Tensor& u,
                                       double h, const JacobianPenalty& penalty) const override;
@@ -104,9 +83,9 @@ class GeneralPhnnJr : public GeneralPortHamiltonianModel {
 };
 
 /// NODE (eq: neural-ode): f = MLP([x; u]), n_x + n_u -> n_x.
-class GeneralNode : public DynamicsModel {
+class Node : public DynamicsModel {
  public:
-  GeneralNode(ModelOptions options, const std::vector<std::uint64_t>& seeds);
+  Node(ModelOptions options, const std::vector<std::uint64_t>& seeds);
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
   /// Hand-written RK2 step, with or without a penalty.

@@ -1,5 +1,5 @@
 // include/phnn/models/port_hamiltonian.h — what PHNN-S and PHNN-JR (paper §4)
-// share above their energy: the field from gradH, the DG fields; the models
+// share: the energy, the field from gradH, the DG fields; the models
 // themselves are general_ph.h's.
 #pragma once
 
@@ -17,11 +17,14 @@ struct HamiltonianAndGradient {
   torch::Tensor h, grad;
 };
 
-/// Shared by PHNN-S and PHNN-JR: H_theta, gradH_theta, the Gonzalez DG.
+/// Shared by PHNN-S and PHNN-JR on a system's structure (ModelOptions::
+/// general): H_theta = 1/2 |L_H(x) x|^2 (general_hamiltonian_jet), gradH,
+/// the Hessian, the Gonzalez DG, the fields from an effort and the DG
+/// fields (general_ph.cpp, port_hamiltonian.cpp).
 class PortHamiltonianModel : public DynamicsModel {
  public:
   bool is_port_hamiltonian() const override { return true; }
-  torch::Tensor hamiltonian(const torch::Tensor& x) const override = 0;
+  torch::Tensor hamiltonian(const torch::Tensor& x) const override;
   torch::Tensor grad_hamiltonian(const torch::Tensor& x) const override;
   FieldEval field(const torch::Tensor& x, const torch::Tensor& u,
                   bool with_jacobian) const override;
@@ -49,12 +52,12 @@ class PortHamiltonianModel : public DynamicsModel {
   /// Gonzalez discrete gradient of H_theta (eq: gonzalez-discrete-gradient):
   ///   dg = gradH(x + dx/2) + (H(x+dx) - H(x) - gradH(x+dx/2)^T dx) / |dx|^2 dx,
   /// = gradH(x + dx/2) where |dx| < min_dx_norm (docs/METHOD.md §4).
-  virtual torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
-                                          double min_dx_norm) const = 0;
+  torch::Tensor discrete_gradient(const torch::Tensor& x, const torch::Tensor& dx,
+                                  double min_dx_norm) const;
 
  protected:
-  PortHamiltonianModel(ModelOptions options, int64_t members)
-      : DynamicsModel(options, members) {}
+  /// Requires options.general (the structure).
+  PortHamiltonianModel(ModelOptions options, int64_t members);
   /// f from an effort jet e ([E,B,2], directions x) evaluated with the
   /// dissipation network at `x_dissipation` (PHNN-JR: R(x, u)); with
   /// `dissipation_fixed`, R does not move along the jet's directions (its
@@ -68,10 +71,16 @@ class PortHamiltonianModel : public DynamicsModel {
   bool dissipation_at_start() const;
   const StackedMlp& l_h() const { return *nets_[0]; }
   /// H [E, B, 1] and gradH [E, B, n_x].
-  virtual HamiltonianAndGradient energy_and_gradient(const torch::Tensor& x) const = 0;
+  HamiltonianAndGradient energy_and_gradient(const torch::Tensor& x) const;
   /// Jet whose value is gradH(x) [E, B, n_x] and whose g is the Hessian
   /// [E, B, n_x, n_x].
-  virtual Jet curvature_jet(const torch::Tensor& x) const = 0;
+  Jet curvature_jet(const torch::Tensor& x) const;
+  const ModelStructure& structure() const { return *options().general; }
+  /// Row-major matrix block [r0, r0 + rows) x [c0, c0 + cols) of a
+  /// structure matrix with `width` columns, as a [cols, rows] tensor (the
+  /// right factor of jet_linear: y = a M^T).
+  torch::Tensor block_t(const std::vector<double>& matrix, int width, int r0, int rows, int c0,
+                        int cols) const;
 };
 
 }  // namespace phnn
