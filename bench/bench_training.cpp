@@ -435,7 +435,11 @@ int main(int argc, char** argv) {
     cell.seeds.resize(argc > 8 ? static_cast<std::size_t>(std::atoi(argv[8])) : 10);
     std::iota(cell.seeds.begin(), cell.seeds.end(), 0);
     cell.fused_networks = std::getenv("PHNN_REFERENCE_NETWORKS") == nullptr;
-    std::printf("%.3f s\n", time_cell(cell, std::atoi(argv[5])));
+    const std::uint64_t m0 = phnn::internal::gemm_multiply_adds();
+    const double seconds = time_cell(cell, std::atoi(argv[5]));
+    // The member GEMMs' multiply-adds of the whole cell (for FLOP bounds).
+    std::printf("%.3f s %.0f MAC\n", seconds,
+                static_cast<double>(phnn::internal::gemm_multiply_adds() - m0));
     return 0;
   }
   if (mode == "compare") {

@@ -96,21 +96,19 @@ struct CostModel {
   /// costs member_us x (1 - small_batch_saving x (64 - batch) / 64) per
   /// member (validation and inference are not affected).
   double small_batch_saving = 0.85;  // PHNN-JR-RK2 E = 10: 64 us at batch 25, 110 at 64
-  /// Runs of a system file train the n-dimensional models (general_ph.h):
-  /// their fixed and member costs are the fused 2-state path's times
+  /// Runs of a system file cost the built-in path's times
   ///   general_node_factor                                   (NODE)
   ///   general_phnn_base + general_phnn_per_state2 * n_x^2   (PHNNs)
-  /// fit to `bench_training general` (docs/BENCHMARKS.md, "n-dimensional
-  /// systems", E = 10): PHNN-JR-RK2 1 053, 1 247, 1 982, 3 325 us per
-  /// member-step at n_x = 2, 4, 6, 8 against this model's 78 for the fused
-  /// path at E = 10 (70 + 82 / 10): 13.5, 16.0, 25.4, 42.6x (PHNN-S-RK2 at
-  /// n_x = 4: 1 450 against 80, 18x); NODE 48-56 against 49 measured.
-  /// Checked on sweeps/examples/coupled-duffing.toml (n_x = 4): its two
-  /// largest cells took 34-35 min on a core shared with builds, the model
-  /// says 14 min alone.
-  double general_node_factor = 1.1;
-  double general_phnn_base = 11.6;
-  double general_phnn_per_state2 = 0.48;
+  /// (the same models and steps since kernel set 2; the factor is the
+  /// larger networks and heads), fit to `bench_training general`
+  /// (docs/BENCHMARKS.md, 2026-11-28, E = 10, chains of masses): PHNN-JR-RK2
+  /// 34-36, 43-45, 75-93, 88-111 us per member-step at n_x = 2, 4, 6, 8
+  /// against 34-36 for the built-in Duffing; PHNN-S-RK2 37-38, 48-49, 64-69,
+  /// 86-105; NODE 16-20 at every n_x. Kernel set 1's n-state path cost
+  /// 11.6 + 0.48 n_x^2 times the built-in path.
+  double general_node_factor = 1.0;
+  double general_phnn_base = 0.9;
+  double general_phnn_per_state2 = 0.026;
   /// Pairs per batch-step in the validation and inference terms.
   double reference_batch = 64.0;
   /// A rollout state-step costs 1 / rollout_speedup of a training pair-step
