@@ -79,6 +79,33 @@ TEST_F(EvalCommandTest, ReloadedRunsReproduceTheirStoredMseBitwise) {
   }
 }
 
+// A file of another kernel set (the 2026-11-25 fixture, computed before our
+// own kernels) evaluates to round-off, and says which sets; a stored MSE off
+// by 1e-3 is named a difference beyond round-off, with exit status 1.
+TEST_F(EvalCommandTest, AnotherKernelSetsRunsAgreeToRoundOffAndDamageDoesNot) {
+  const std::string fixture = std::string(PHNN_SOURCE_DIR) + "/tests/fixtures/results-2026-11-25.h5";
+  const std::vector<std::string> ids = ResultsFile::open_read_only(fixture).read_run_ids();
+  ASSERT_EQ(ids.size(), 4u);
+  int rounded = 0;
+  for (const std::string& id : ids) {
+    std::string log;
+    EXPECT_EQ(run("eval " + fixture + " --run " + id, &log), 0) << log;
+    if (log.find("equal to round-off (stored by no phnn kernels") != std::string::npos) ++rounded;
+    else EXPECT_THAT(log, HasSubstr("bitwise equal"));
+  }
+  EXPECT_GE(rounded, 1) << "kernel set 2 reproduces kernel set 0's rollouts bitwise everywhere?";
+  std::string copy_log;
+  ASSERT_EQ(testing_util::run_shell("cp " + fixture + " " + out_ +
+                                        " && /usr/bin/python3 -c \"import h5py; f = h5py.File('" +
+                                        out_ + "', 'r+'); m = f['runs/mse']; m[0] = m[0] * 1.001\"",
+                                    &copy_log),
+            0)
+      << copy_log;
+  std::string log;
+  EXPECT_EQ(run("eval " + out_ + " --run " + ids[0], &log), 1) << log;
+  EXPECT_THAT(log, HasSubstr("DIFFERENT beyond round-off"));
+}
+
 // The seeds of one cell share their ids' first digits: a short prefix names
 // them all and says so; --seed picks one of them.
 TEST_F(EvalCommandTest, AnAmbiguousPrefixIsResolvedBySeed) {
