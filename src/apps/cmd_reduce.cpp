@@ -12,6 +12,7 @@
 #include "apps/commands.h"
 #include "apps/reduce_rule.h"
 #include "phnn/report/per_run.h"
+#include "phnn/report/table_comparisons.h"
 #include "phnn/report/tables.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/adaptive.h"
@@ -320,8 +321,28 @@ int run_reduce(int argc, char** argv, int first) {
                 "adaptive sweeps: replay the [adaptive] table of sweep file SWEEP (same grid, "
                 "another rule, batch or max_seeds) on FILE's runs instead of FILE's own; the "
                 "runs it asks for that FILE lacks count as pending");
+  parser.flag("comparisons",
+              "instead of the tables, compare the cells of each table as CSV: in each column "
+              "every pair of models, in each row every column against the first (effect = "
+              "median log10 MSE ratio, paired by seed where the runs share weights, batches and "
+              "data, with its interval, P(A < B), and the reading A better / B better / "
+              "equivalent / undecided; docs/METHOD.md \"Comparisons\")");
+  parser.option("delta", "--comparisons: the equivalence margin, a factor on the MSE (> 1)",
+                "1.5");
   if (!parser.parse(argc, argv, first)) return 0;
   const bool per_run = parser.flag_set("per-run"), seeds_summary = parser.flag_set("seeds-summary");
+  const bool comparisons = parser.flag_set("comparisons");
+  if (comparisons + per_run + seeds_summary > 1) {
+    throw cli::UsageError{"phnn reduce: --comparisons, --per-run and --seeds-summary exclude "
+                          "each other; pass one of them"};
+  }
+  ComparisonOptions comparison_options;
+  comparison_options.delta = parser.get_double("delta");
+  if (!(comparison_options.delta > 1.0)) {
+    throw cli::UsageError{"phnn reduce: --delta " + parser.get("delta") +
+                          " must be greater than 1 (a factor on the MSE: 1.5 reads cells within "
+                          "x1.5 of each other as equivalent)"};
+  }
   // --per-run writes CSV: it needs no --format csv, only refuses another one.
   const TableFormat format = per_run && !parser.has("format")
                                  ? TableFormat::kCsv
@@ -357,6 +378,11 @@ int run_reduce(int argc, char** argv, int first) {
   }
   const auto entries =
       make_table_entries(grid, statuses, in.mse, adaptive ? &adaptive->active : nullptr);
+  if (comparisons) {
+    std::cout << render_comparisons_csv(compare_table_cells(grid, entries, comparison_options),
+                                        comparison_options.delta);
+    return 0;
+  }
   std::size_t expected_seeds = 0;
   for (const StudySpec& s : spec.studies) expected_seeds = std::max(expected_seeds, s.seeds.size());
   if (adaptive) expected_seeds = 0;

@@ -41,6 +41,8 @@ std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<R
       e.column = study.run_columns[i];
       e.status = status[r];
       e.mse = mse[r];
+      e.seed = run.seed;
+      e.run = r;
       entries.push_back(std::move(e));
     }
   }

@@ -189,6 +189,31 @@ TEST_F(ReduceCommandTest, PerRunIsCsvAndExcludesSeedsSummary) {
   EXPECT_THAT(out, HasSubstr("exclude each other"));
 }
 
+// --comparisons: the exported CSV, one line per pair of models in a column
+// (2 systems x 2 columns x 1 pair) and per column against the first in a row
+// (2 systems x 2 rows x 1 pair); --delta must exceed 1; exclusive with the
+// other views.
+TEST_F(ReduceCommandTest, ComparisonsAreOneCsvLinePerPairOfCells) {
+  std::string out;
+  ASSERT_EQ(reduce("--comparisons", &out), 0) << out;
+  const auto rows = parse_csv(out);
+  ASSERT_EQ(rows.size(), 1u + 8u) << out;
+  EXPECT_EQ(rows[0][0], "a");
+  EXPECT_EQ(rows[0].back(), "reading");
+  EXPECT_EQ(rows[1][0], "a/harmonic/NODE-RK2/25");
+  EXPECT_EQ(rows[1][1], "a/harmonic/PHNN-S-DG/25");
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    EXPECT_EQ(rows[r][15], "1.500000e+00");
+    EXPECT_EQ(rows[r][16], "undecided") << "3 seeds are too few for a reading";
+  }
+  ASSERT_EQ(reduce("--comparisons --delta 2", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr(",2.000000e+00,undecided"));
+  EXPECT_EQ(reduce("--comparisons --delta 1", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--delta 1 must be greater than 1"));
+  EXPECT_EQ(reduce("--comparisons --per-run", &out), 2);
+  EXPECT_THAT(out, HasSubstr("exclude each other"));
+}
+
 // A sweep file given instead of its results file: named as such, and no
 // advice to delete it or to pass an --out that reduce does not have.
 TEST(ReduceCommandMissingFileTest, ASweepFileIsNamedWithoutDeleteAdvice) {

@@ -27,6 +27,8 @@ struct TableEntry {
   /// Inference MSE (Eq. 31); +inf for a diverged run (NaN is read as +inf);
   /// ignored unless done or diverged.
   double mse = 0.0;
+  /// The run's seed and its index into Grid::runs (-1: not from a grid).
+  int seed = 0, run = -1;
 };
 
 /// Entries for every run of every study of `grid`; status[i] and mse[i]
