@@ -2,7 +2,9 @@
 // tables (median [IQR] and bootstrap interval of the inference MSE over
 // seeds), the seeds-per-mode view, or one CSV row per run, from a results
 // file, complete or partial; --round K and --rule SWEEP show an adaptive
-// sweep after round K or under another rule (apps/reduce_rule.h).
+// sweep after round K or under another rule (apps/reduce_rule.h);
+// --comparisons the pairs of cells a table invites (report/table_comparisons.h).
+// Size: the views share the inputs read once (grid, statuses, MSEs, rounds).
 #include <algorithm>
 #include <iostream>
 #include <limits>
@@ -294,19 +296,9 @@ std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
   return records;
 }
 
-}  // namespace
-
-int run_reduce(int argc, char** argv, int first) {
-  cli::Parser parser(
-      "reduce",
-      "Prints, for each study and system of the sweep that wrote FILE, a table with\n"
-      "rows = models, columns = the study's varied axis and cells = median [IQR]\n"
-      "(low, high) of the inference MSE over seeds: quartiles by numpy's default linear\n"
-      "interpolation, (low, high) a percentile-bootstrap 95 % interval of the median\n"
-      "(100 000 resamples, fixed seed). The best median of a column is bold only if its\n"
-      "interval overlaps no other cell's; otherwise the overlapping cells are marked\n"
-      "(tie). Works on partial files: missing and diverged runs are counted.");
-  parser.positional("FILE", "results file written by `phnn sweep`");
+// The options of `phnn reduce` beyond FILE (the views and the replay).
+void declare_options(cli::Parser* p) {
+  cli::Parser& parser = *p;
   parser.option("format", "markdown | latex | csv", "markdown");
   parser.flag("seeds-summary",
               "instead of the statistics, count per cell the seeds below / above the column's "
@@ -329,32 +321,59 @@ int run_reduce(int argc, char** argv, int first) {
               "equivalent / undecided; docs/METHOD.md \"Comparisons\")");
   parser.option("delta", "--comparisons: the equivalence margin, a factor on the MSE (> 1)",
                 "1.5");
-  if (!parser.parse(argc, argv, first)) return 0;
-  const bool per_run = parser.flag_set("per-run"), seeds_summary = parser.flag_set("seeds-summary");
-  const bool comparisons = parser.flag_set("comparisons");
-  if (comparisons + per_run + seeds_summary > 1) {
+}
+
+// Which view reduce prints, checked: one of the tables (in `format`),
+// --per-run, --seeds-summary or --comparisons.
+struct View {
+  bool per_run = false, seeds_summary = false, comparisons = false;
+  TableFormat format = TableFormat::kMarkdown;
+  ComparisonOptions comparison;
+};
+
+View read_view(const cli::Parser& parser) {
+  View v;
+  v.per_run = parser.flag_set("per-run");
+  v.seeds_summary = parser.flag_set("seeds-summary");
+  v.comparisons = parser.flag_set("comparisons");
+  if (v.comparisons + v.per_run + v.seeds_summary > 1) {
     throw cli::UsageError{"phnn reduce: --comparisons, --per-run and --seeds-summary exclude "
                           "each other; pass one of them"};
   }
-  ComparisonOptions comparison_options;
-  comparison_options.delta = parser.get_double("delta");
-  if (!(comparison_options.delta > 1.0)) {
+  v.comparison.delta = parser.get_double("delta");
+  if (!(v.comparison.delta > 1.0)) {
     throw cli::UsageError{"phnn reduce: --delta " + parser.get("delta") +
                           " must be greater than 1 (a factor on the MSE: 1.5 reads cells within "
                           "x1.5 of each other as equivalent)"};
   }
   // --per-run writes CSV: it needs no --format csv, only refuses another one.
-  const TableFormat format = per_run && !parser.has("format")
-                                 ? TableFormat::kCsv
-                                 : parse_table_format(parser.get("format"));
-  if (per_run && format != TableFormat::kCsv) {
+  v.format = v.per_run && !parser.has("format") ? TableFormat::kCsv
+                                                : parse_table_format(parser.get("format"));
+  if (v.per_run && v.format != TableFormat::kCsv) {
     throw cli::UsageError{"phnn reduce: --per-run writes CSV only; drop --format " +
                           parser.get("format") + " (or give --format csv)"};
   }
-  if (per_run && seeds_summary) {
-    throw cli::UsageError{"phnn reduce: --per-run and --seeds-summary exclude each other; "
-                          "pass one of them"};
-  }
+  return v;
+}
+
+}  // namespace
+
+int run_reduce(int argc, char** argv, int first) {
+  cli::Parser parser(
+      "reduce",
+      "Prints, for each study and system of the sweep that wrote FILE, a table with\n"
+      "rows = models, columns = the study's varied axis and cells = median [IQR]\n"
+      "(low, high) of the inference MSE over seeds: quartiles by numpy's default linear\n"
+      "interpolation, (low, high) a percentile-bootstrap 95 % interval of the median\n"
+      "(100 000 resamples, fixed seed). The best median of a column is bold only if its\n"
+      "interval overlaps no other cell's; otherwise the overlapping cells are marked\n"
+      "(tie). Works on partial files: missing and diverged runs are counted.");
+  parser.positional("FILE", "results file written by `phnn sweep`");
+  declare_options(&parser);
+  if (!parser.parse(argc, argv, first)) return 0;
+  const View view = read_view(parser);
+  const bool per_run = view.per_run, seeds_summary = view.seeds_summary;
+  const TableFormat format = view.format;
   const std::string path = parser.get("FILE");
   const ResultsFile file = ResultsFile::open_read_only(path);
   const Inputs in = read_inputs(file, parser);
@@ -378,9 +397,9 @@ int run_reduce(int argc, char** argv, int first) {
   }
   const auto entries =
       make_table_entries(grid, statuses, in.mse, adaptive ? &adaptive->active : nullptr);
-  if (comparisons) {
-    std::cout << render_comparisons_csv(compare_table_cells(grid, entries, comparison_options),
-                                        comparison_options.delta);
+  if (view.comparisons) {
+    std::cout << render_comparisons_csv(compare_table_cells(grid, entries, view.comparison),
+                                        view.comparison.delta);
     return 0;
   }
   std::size_t expected_seeds = 0;

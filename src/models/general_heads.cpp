@@ -3,6 +3,8 @@
 // gradient, the Gonzalez DG, the PHNN-S port map and field, the PHNN-JR
 // field. Plain loops per row over small n; the backward formulas are written
 // above each class.
+// Size: the Hamiltonian head's two modes (gradH from L_H's jet, or the
+// cotangent of reverse mode) share its row loops and tape.
 #include "models/general_heads.h"
 
 #include <algorithm>

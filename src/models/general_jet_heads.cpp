@@ -5,6 +5,7 @@
 // row = one member and one batch element), no autograd node; the backward
 // formulas are written above each function. Private to src/models; the
 // op-by-op jets of general_ph.cpp are the reference.
+// Size: the two fields' jets and backwards share the per-row accessors.
 #include "models/general_jet_heads.h"
 
 #include <algorithm>
