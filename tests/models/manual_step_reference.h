@@ -1,7 +1,10 @@
 // tests/models/manual_step_reference.h — what the hand-written training steps
 // are compared with (manual_step_test.cpp, general_manual_step_test.cpp): the
-// trainer's loss taken by autograd, and a bitwise comparison of tensors.
+// trainer's loss taken by autograd, a bitwise comparison of tensors, and the
+// comparison rule of a step with autograd.
 #pragma once
+
+#include <gtest/gtest.h>
 
 #include <cstring>
 
@@ -37,6 +40,29 @@ inline torch::Tensor autograd_loss_of(const DynamicsModel& model, IntegratorKind
   if (!regularized) return loss;
   return loss + regularizer_penalty(regularizer, jacobian_stats(at_x.dfdx, options.jacobian_eps),
                                     options);
+}
+
+/// A hand-written step's loss per member and parameter gradients against
+/// autograd's: NODE bitwise (the same operations in the same order); the
+/// PH models to 1e-12 relative (loss) and of the largest gradient (gradH in
+/// reverse mode where autograd's graph carries L_H's forward jet), 1e-10
+/// with a regularizer (the jet heads' round-off, amplified by the penalty's
+/// condition numbers).
+inline void expect_step_matches(ModelKind kind, Regularizer regularizer, const torch::Tensor& loss,
+                                const torch::Tensor& autograd_loss, const torch::Tensor& grads,
+                                const torch::Tensor& autograd_grads) {
+  const double largest = (grads - autograd_grads).abs().max().item<double>();
+  const double scale = autograd_grads.abs().max().item<double>();
+  if (kind == ModelKind::kNode) {
+    EXPECT_TRUE(same_bits(loss, autograd_loss)) << loss << autograd_loss;
+    EXPECT_TRUE(same_bits(grads, autograd_grads))
+        << "largest difference " << largest << " of " << scale;
+    return;
+  }
+  const double tolerance = regularizer == Regularizer::kNone ? 1e-12 : 1e-10;
+  EXPECT_LT(((loss - autograd_loss).abs() / autograd_loss.abs()).max().item<double>(), tolerance)
+      << loss << autograd_loss;
+  EXPECT_LT(largest, tolerance * scale) << "largest difference " << largest << " of " << scale;
 }
 
 }  // namespace testing_util

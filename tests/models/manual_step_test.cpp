@@ -26,7 +26,6 @@ namespace phnn {
 namespace {
 
 using testing_util::autograd_loss_of;
-using testing_util::same_bits;
 
 struct Case {
   ModelKind kind;
@@ -78,19 +77,8 @@ TEST_P(ManualStepTest, LossAndGradientsAreAutograds) {
   const auto manual = dg ? model->dg_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty)
                          : model->explicit_mean_l1_step(c.integrator, x, x_next, u, h, penalty);
   ASSERT_TRUE(manual.defined());
-  const double largest = (flat.gradients - autograd_grad).abs().max().item<double>();
-  const double scale = autograd_grad.abs().max().item<double>();
-  if (c.kind != ModelKind::kNode) {
-    const double tolerance = c.regularizer == Regularizer::kNone ? 1e-12 : 1e-10;
-    EXPECT_LT(((manual - autograd_loss).abs() / autograd_loss.abs()).max().item<double>(),
-              tolerance)
-        << manual << autograd_loss;
-    EXPECT_LT(largest, tolerance * scale) << "largest difference " << largest << " of " << scale;
-    return;
-  }
-  EXPECT_TRUE(same_bits(manual, autograd_loss)) << manual << autograd_loss;
-  EXPECT_TRUE(same_bits(flat.gradients, autograd_grad))
-      << "largest difference " << largest << " of " << scale;
+  testing_util::expect_step_matches(c.kind, c.regularizer, manual, autograd_loss, flat.gradients,
+                                    autograd_grad);
 }
 
 INSTANTIATE_TEST_SUITE_P(
