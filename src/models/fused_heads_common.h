@@ -1,5 +1,5 @@
 // src/models/fused_heads_common.h — shared by the fused heads of src/models
-// only (fused_heads*.cpp, general*_heads.cpp; manual_step.cpp for rows_like):
+// only (general*_heads.cpp, general_curvature_head.cpp; manual_step.cpp for rows_like):
 // softplus/sigmoid from one exp, the structure matrices a head saves for its
 // backward, and the row and lower-triangle indexing of the n-state heads.
 #pragma once

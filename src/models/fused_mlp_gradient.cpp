@@ -26,9 +26,11 @@ namespace internal {
 using torch::Tensor;
 
 struct FusedMlpVjpTape {
+  const FusedMlpTape* value = nullptr;  // the value pass this product belongs to
   Tensor c;     // [E, B, n_L], dense
   Tensor work;  // S_l (l < L), U_l (l < L - 1), then the A~_l left by the backward (0 < l < L)
   std::vector<int64_t> s, u, extra;  // offsets into work
+  bool backward_done = false;          // the A~_l are written
 };
 
 namespace {
@@ -66,6 +68,7 @@ Tensor fused_mlp_taped_vjp(const FusedMlpTape& tape, const std::vector<Tensor>& 
   TORCH_CHECK(p.ch.order == 0, "fused_mlp_taped_vjp: needs an order-0 taped call");
   const int64_t L = p.layers(), E = p.E, B = p.B;
   auto t = new_tape(p, dense_rows(c_in, p, p.widths.back(), "the cotangent"));
+  t->value = &tape;
   double* w = t->work.data_ptr<double>();
   const double* ws = tape.workspace.data_ptr<double>();
   gemm_nn(E, as_int(B), as_int(p.widths[L]), as_int(p.widths[L - 1]), t->c.data_ptr<double>(),
@@ -90,6 +93,9 @@ Tensor fused_mlp_taped_vjp_backward(FusedMlpVjpTape& vjp, const FusedMlpTape& ta
   const Plan& p = tape.plan;
   TORCH_CHECK(gradient_sinks.size() == 2 * weights.size(),
               "fused_mlp_taped_vjp_backward: expected one gradient sink per weight and bias");
+  TORCH_CHECK(vjp.value == &tape && !vjp.backward_done,
+              "fused_mlp_taped_vjp_backward: the product's tape belongs to another value pass, "
+              "or its backward ran already");
   const int64_t L = p.layers(), E = p.E, B = p.B;
   const int64_t widest = *std::max_element(p.widths.begin(), p.widths.end());
   const Tensor s_bar = dense_rows(s_bar_in, p, p.widths[0], "the gradient's adjoint");
@@ -117,6 +123,7 @@ Tensor fused_mlp_taped_vjp_backward(FusedMlpVjpTape& vjp, const FusedMlpTape& ta
   Tensor c_bar = torch::empty({E, B, p.widths[L]}, torch::kFloat64);
   gemm_nn(E, as_int(B), n_last, n_out, sb, weights[L - 1].data_ptr<double>(),
           c_bar.data_ptr<double>(), /*transpose_b=*/false);
+  vjp.backward_done = true;
   return c_bar;
 }
 
@@ -124,6 +131,9 @@ Tensor fused_mlp_vjp_value_backward(const FusedMlpVjpTape& vjp, const FusedMlpTa
                                     const std::vector<Tensor>& weights,
                                     const std::vector<Tensor>& gradient_sinks, const Tensor& v_bar,
                                     bool input_adjoint) {
+  TORCH_CHECK(vjp.value == &tape && vjp.backward_done,
+              "fused_mlp_vjp_value_backward: run fused_mlp_taped_vjp_backward of this value "
+              "pass's product first");
   const double* w = vjp.work.data_ptr<double>();
   std::vector<const double*> extra(weights.size(), nullptr);
   for (std::size_t l = 1; l < extra.size(); ++l) extra[l] = w + vjp.extra[l];

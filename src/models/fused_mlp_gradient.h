@@ -23,7 +23,8 @@ struct FusedMlpVjpTape;
 
 /// s = (d v / d x)^T c [E, B, n_0] for the order-0 taped call `tape`
 /// (v = the network's output at x), c [E, B, n_L]; what the backward reads
-/// goes into *vjp.
+/// goes into *vjp, which belongs to `tape` (the backwards check it). c is
+/// kept, not copied: leave it unchanged until the product's backward.
 torch::Tensor fused_mlp_taped_vjp(const FusedMlpTape& tape, const std::vector<torch::Tensor>& weights,
                                   const torch::Tensor& c, std::shared_ptr<FusedMlpVjpTape>* vjp);
 

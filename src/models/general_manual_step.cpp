@@ -3,18 +3,21 @@
 // on fused float64 networks: RK2 for the three, DG for the PH models, with
 // the mean-L1 loss, with or without a Jacobian penalty. Forward, loss and
 // backward run without an autograd graph through the n-state heads' taped
-// forms (general_heads.h) in the order autograd takes the model's graph, so
-// without a penalty (and for NODE with one) loss and gradients are bitwise
-// those of loss.sum().backward(); with a penalty the PH models' field jet at
-// x runs through general_jet_heads.h (the curvature of H and the field jet
-// heads), which equal the op-by-op jets to round-off
-// (tests/models/general_manual_step_test.cpp). The composition (RK2, DG,
-// the loss) is models/manual_step.h's. Touches only the models' gradient sinks.
+// forms (general_heads.h) in the order autograd takes the model's graph:
+// NODE's loss and gradients are bitwise those of loss.sum().backward(); the
+// PH models' equal them to round-off, since gradH is a vector-Jacobian
+// product of L_H (manual_step.cpp's TapedGradient) where autograd's graph
+// carries L_H's forward jet, and with a penalty the field jet at x runs
+// through general_jet_heads.h (the curvature of H and the field jet heads)
+// (tests/models/general_manual_step_test.cpp, manual_step_test.cpp). The
+// composition (RK2, RK4, DG, the loss) is models/manual_step.h's. Touches
+// only the models' gradient sinks.
 //
 // Backward of one PH field evaluation f(y) = F(gradH(y), y), as autograd
 // orders it (of the nodes ready at once, the one created last runs first):
 //   PHNN-JR: F = [(J - L^T L) [e; u]]_{1:n_x}, L from L_R([y, u]):
-//     the JR head (e~, o~) -> L_R (y~ c) -> the H head (y~ b) -> L_H (y~ a);
+//     the JR head (e~, o~) -> L_R (y~ c) -> the H head and L_H's product
+//     and value passes (y~ b from the head, a from L_H);
 //     y~ = (c + b) + a.
 //   PHNN-S: w = [S_wx S_wu] [e; u], F = S_x [e; z(w); u], z from L_z(w):
 //     the S head (e~ A, w~ B) -> L_z (w~ C) -> the w head from w~ = B + C

@@ -123,6 +123,7 @@ bool has_manual_step(const std::vector<std::unique_ptr<StackedMlp>>& nets,
 }
 
 FusedMlpJet TapedNet::forward(const Tensor& y, int directions, int order) {
+  vjp_tape = nullptr;  // a product belongs to the value pass it was taken on
   return fused_mlp_taped(net.weights(), net.biases(), y, {directions, order}, &tape);
 }
 

@@ -94,15 +94,15 @@ struct TapedCurvature {
 Tensor explicit_mean_l1(IntegratorKind integrator, const Tensor& x, const Tensor& x_next, double h,
                         const FieldRecorder& field, const JacobianPenalty& penalty);
 
-/// The explicit step of a PH model: f(y) = F(gradH(y), y), gradH from L_H's
-/// order-1 jet in the y.size(-1) state directions through `head`.
+/// The explicit step of a PH model: f(y) = F(gradH(y), y), gradH in reverse
+/// mode (L_H's value, the Hamiltonian head's cotangent, the product J^T c).
 Tensor ph_explicit_mean_l1(IntegratorKind integrator, const StackedMlp& l_h,
                            const Tensor& x, const Tensor& x_next,
                            double h, const EffortFieldRecorder& effort_field,
                            const JacobianFieldRecorder& jacobian_field,
                            const JacobianPenalty& penalty);
 
-/// The DG step of a PH model (Gonzalez gradient of H_theta by `head`), its
+/// The DG step of a PH model (Gonzalez gradient of H_theta), its
 /// loss (+ the penalty of df/dx at x) and backward.
 Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x,
                      const Tensor& x_next, double h, double min_dx_norm, bool dissipation_at_start,

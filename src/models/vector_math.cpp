@@ -74,7 +74,7 @@ PHNN_KERNEL_INLINE double tanh_one(double x) {
   const bool small = std::fabs(x) < 0.625;
   const double f = (small ? x * z * num : 2.0 * down) / (small ? den : up + down);
   const double y = small ? x + f : std::copysign(1.0 - f, x);
-  return x == x ? y : x;  // NaN in, NaN out
+  return x == x && x != 0.0 ? y : x;  // NaN in, NaN out; -0 stays -0
 }
 
 PHNN_KERNEL_INLINE void tanh_body(const double* x, double* y, int64_t n) {

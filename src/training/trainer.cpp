@@ -187,7 +187,8 @@ void CellTrainer::step(int step, BatchSampler& sampler) {
 
 // L_d per member (+ the regularizer's penalty) on a minibatch, its parameter
 // gradients added into the flat gradient buffer: by the model's hand-written
-// step where it has one (the same bits, no graph), else by autograd.
+// step where it has one (no graph; autograd's values to round-off, NODE's
+// bitwise), else by autograd.
 torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torch::Tensor& xn,
                                               const torch::Tensor& u) {
   const bool regularized = cell_.regularizer != Regularizer::kNone;

@@ -210,12 +210,14 @@ TEST(VectorTanhTest, WithinOnePointSixUlpOfTheExactTanh) {
   EXPECT_LE(worst, 1.6);
   const double special[] = {std::numeric_limits<double>::infinity(),
                             -std::numeric_limits<double>::infinity(),
-                            std::numeric_limits<double>::quiet_NaN()};
-  double out[3];
-  internal::tanh_array(special, out, 3);
+                            std::numeric_limits<double>::quiet_NaN(), 0.0, -0.0};
+  double out[5];
+  internal::tanh_array(special, out, 5);
   EXPECT_EQ(out[0], 1.0);
   EXPECT_EQ(out[1], -1.0);
   EXPECT_TRUE(std::isnan(out[2]));
+  EXPECT_TRUE(out[3] == 0.0 && !std::signbit(out[3]));
+  EXPECT_TRUE(out[4] == 0.0 && std::signbit(out[4])) << "tanh(-0) = -0, as std::tanh";
 }
 
 // The softplus/sigmoid pieces: exp on (-750, 0] (subnormal results

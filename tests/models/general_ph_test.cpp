@@ -70,6 +70,32 @@ TEST(GeneralModelTest, BuiltinNamesAndShippedFilesGiveTheSameModels) {
   }
 }
 
+// gradH without a graph (rollouts: reverse mode through L_H) against
+// autograd's gradient of H on the op-by-op networks with the same weights,
+// on the coupled oscillator (n_x = 4) with x expanded over the members.
+TEST(GeneralModelTest, RolloutGradientIsAutogradsGradientOfH) {
+  const auto system = load_system_file(shipped("coupled-duffing"));
+  for (ModelKind m : {ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
+    for (ModelSize size : {ModelSize::kSmall, ModelSize::kLarge}) {
+      ModelOptions options{m, size, SystemKind::kHarmonic};
+      options.general = std::make_shared<ModelStructure>(model_structure(*system));
+      const auto fused = DynamicsModel::create(options, kSeeds);
+      options.fused_networks = false;
+      const auto reference = DynamicsModel::create(options, kSeeds);
+      const auto x = uniform({1, 30, 4}, 0.8, 6).expand({3, 30, 4});
+      torch::Tensor g;
+      {
+        torch::NoGradGuard no_grad;
+        g = fused->grad_hamiltonian(x);
+      }
+      const auto xr = x.contiguous().clone().requires_grad_(true);
+      const auto expected =
+          torch::autograd::grad({reference->hamiltonian(xr).sum()}, {xr})[0];
+      EXPECT_LT(max_rel(g, expected), 1e-12) << to_string(m) << " " << to_string(size);
+    }
+  }
+}
+
 // Forward-mode jets against autograd on the coupled oscillator (n_x = 4).
 TEST(GeneralModelTest, JetsMatchAutogradInFourStates) {
   const auto system = load_system_file(shipped("coupled-duffing"));

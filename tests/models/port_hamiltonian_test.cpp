@@ -102,7 +102,7 @@ TEST(ForwardModeTest, GradientAndJacobianMatchAutogradForEveryModel) {
         const double scale = 1.0 + ref.abs().max().item<double>();
         EXPECT_LE((jet.dfdx - ref).abs().max().item<double>(), 1e-12 * scale)
             << to_string(kind) << " " << to_string(sys) << " " << to_string(size);
-        // The order-0 fast path (matrix form, closed-form gradH) and the jet
+        // The order-0 fast path (fused heads, reverse-mode gradH) and the jet
         // path compute f in different operation orders: equal to round-off.
         const auto f_fast = model->field(x, u, false).f;
         EXPECT_LE((jet.f - f_fast).abs().max().item<double>(),

@@ -68,7 +68,7 @@ class DynamicsModel {
   virtual torch::Tensor discrete_gradient_field(const torch::Tensor& x, const torch::Tensor& dx,
                                                 const torch::Tensor& u,
                                                 double min_dx_norm) const;
-  /// The DG field f_bar(x, dx, u) and its Jacobian d f_bar / d dx [E, B, 2, 2]
+  /// The DG field f_bar(x, dx, u) and its Jacobian d f_bar / d dx [E, B, n_x, n_x]
   /// (row = component of f_bar), for Newton at inference (PH models only).
   virtual FieldEval discrete_gradient_field_with_jacobian(const torch::Tensor& x,
                                                           const torch::Tensor& dx,
@@ -77,7 +77,7 @@ class DynamicsModel {
   /// Fourth-order DG (docs/METHOD.md "Fourth-order schemes"; PH models
   /// only): x_next = x + h f, with f = F(m, e) + h^2 C in FieldEval::f, where
   /// m = x + dx/2, e = the AVF discrete gradient of H_theta along dx, and in
-  /// FieldEval::dfdx the Jacobian A = dF/dx at (m, e) [E, B, 2, 2] that C
+  /// FieldEval::dfdx the Jacobian A = dF/dx at (m, e) [E, B, n_x, n_x] that C
   /// uses (Newton at inference takes I - (h/2) A as its matrix).
   virtual FieldEval discrete_gradient4_field(const torch::Tensor& x, const torch::Tensor& dx,
                                              const torch::Tensor& u, double h,
@@ -88,11 +88,11 @@ class DynamicsModel {
   /// (discrete_loss with LossNorm::kMeanL1), plus `penalty` of df/dx at x if
   /// one is given (the trainer's regularized loss), with its parameter
   /// gradients added into the flat gradient buffer (after
-  /// flatten_parameters), in the same operations and order as autograd's
-  /// backward of that loss: the same bits, without the graph. Undefined
+  /// flatten_parameters), without the graph: NODE's in the same operations
+  /// and order as autograd's backward of that loss (the same bits), the PH
+  /// models' equal to it to round-off (gradH in reverse mode). Undefined
   /// where there is none (the caller runs autograd); today: NODE, PHNN-S
-  /// and PHNN-JR of both families on fused float64 networks
-  /// (models/manual_step.h).
+  /// and PHNN-JR on fused float64 networks (models/manual_step.h).
   virtual torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
                                               const torch::Tensor& x_next,
                                               const torch::Tensor& u, double h,
@@ -101,7 +101,7 @@ class DynamicsModel {
   virtual torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                         const torch::Tensor& u, double h, double min_dx_norm,
                                         const JacobianPenalty& penalty) const;
-  /// H_theta(x) [E, B] and gradH_theta(x) [E, B, 2] (PH models only).
+  /// H_theta(x) [E, B] and gradH_theta(x) [E, B, n_x] (PH models only).
   virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;
 

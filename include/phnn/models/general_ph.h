@@ -37,8 +37,8 @@ Jet general_hamiltonian_jet(const StackedMlp& l_h, const torch::Tensor& x, int o
 class PhnnS : public PortHamiltonianModel {
  public:
   PhnnS(ModelOptions options, const std::vector<std::uint64_t>& seeds);
-  /// Hand-written steps (src/models/general_manual_step.cpp): without a
-  /// penalty bitwise autograd's; with one, equal to it to round-off.
+  /// Hand-written steps (src/models/general_manual_step.cpp), equal to
+  /// autograd's loss and gradients to round-off (gradH in reverse mode).
   torch::Tensor explicit_mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
                                       const torch::Tensor& x_next, const torch::Tensor& u,
                                       double h, const JacobianPenalty& penalty) const override;

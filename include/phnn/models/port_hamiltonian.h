@@ -58,7 +58,7 @@ class PortHamiltonianModel : public DynamicsModel {
  protected:
   /// Requires options.general (the structure).
   PortHamiltonianModel(ModelOptions options, int64_t members);
-  /// f from an effort jet e ([E,B,2], directions x) evaluated with the
+  /// f from an effort jet e ([E,B,n_x], directions x) evaluated with the
   /// dissipation network at `x_dissipation` (PHNN-JR: R(x, u)); with
   /// `dissipation_fixed`, R does not move along the jet's directions (its
   /// derivatives are zero: the DG field with R at the start x_n, where only
