@@ -159,7 +159,7 @@ int run_eval(int argc, char** argv, int first) {
   parser.option("out", "CSV of t, states and energies along the figure trajectories", "");
   if (!parser.parse(argc, argv, first)) return 0;
   if (parser.get("run").empty()) throw cli::UsageError{"phnn eval: --run ID is required"};
-  if (!parser.get("out").empty()) {
+  if (parser.has("out")) {  // given, even empty: checked
     const std::string problem =
         output_problem("eval", parser.get("out"), OutputKind::kEvalCsv, {parser.get("RESULTS")});
     if (!problem.empty()) throw cli::UsageError{"phnn eval: --out " + problem};

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -95,6 +96,38 @@ TEST_F(OutputRuleTest, MergeNeverReplacesAFileNorAShard) {
   const std::string shard = train_results("r.h5");
   expect_refused("merge " + shard + " " + shard, shard, "is the input");
   expect_refused("merge " + notes_ + " " + shard, notes_, "never overwrites other files");
+}
+
+// An empty --out (or merge output) is refused by every command that writes,
+// with status 2 and a message saying the path is empty, and nothing appears
+// in the working directory (no ".creating" file, no journal).
+TEST_F(OutputRuleTest, AnEmptyOutputPathIsRefusedAndWritesNothing) {
+  const std::string results = train_results("r.h5");
+  std::string ids;
+  ASSERT_EQ(phnn("reduce --per-run --format csv " + results + " | cut -d, -f1 | sed -n 2p", &ids), 0);
+  const std::string run = ids.substr(0, ids.find('\n'));
+  const std::string sweep = dir_ + "/s.toml";
+  std::ofstream(sweep) << "name = \"s\"\n[training]\nsteps = 2\n[grid]\nsystems = "
+                          "[\"harmonic\"]\nmodels = [\"node-rk2\"]\nseeds = [0]\n";
+  const std::string work = dir_ + "/cwd";
+  ASSERT_EQ(std::system(("mkdir -p " + work).c_str()), 0);
+  const std::vector<std::string> commands = {
+      "sweep " + sweep + " --out ''", "train --system harmonic --model node-rk2 --out ''",
+      "data --system harmonic --out ''", "merge '' " + results,
+      "eval " + results + " --run " + run + " --out ''"};
+  for (const std::string& args : commands) {
+    std::string log;
+    EXPECT_EQ(testing_util::run_shell("cd " + work + " && " + std::string(PHNN_BINARY) + " " +
+                                          args,
+                                      &log),
+              2)
+        << args << ": " << log;
+    EXPECT_THAT(log, ::testing::AnyOf(HasSubstr("empty path"), HasSubstr("names no file")))
+        << args;
+    std::string listing;
+    ASSERT_EQ(testing_util::run_shell("ls -A " + work, &listing), 0);
+    EXPECT_EQ(listing, "") << args << " left files behind";
+  }
 }
 
 }  // namespace
