@@ -250,7 +250,6 @@ int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int a
   }
   const std::unique_ptr<PhSystem> system = load_system_file(system_file_path(path));
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  if (parser.has("out")) require_new_output(parser);
   const PhSystemData data = file_system_data(parser, *system, cell.n_train);
   std::cout << "phnn train: " << system->name() << " (" << counted(system->n_x(), "state") << ", "
             << counted(system->n_w(), "port") << ", " << counted(system->n_u(), "input") << ") "
@@ -284,6 +283,7 @@ int run_train(int argc, char** argv, int first) {
   declare_train_options(&parser);
   if (!parser.parse(argc, argv, first)) return 0;
   const CellSpec cell = cell_from_options(parser);
+  if (parser.has("out")) require_new_output(parser);  // before any output or work
   torch::set_num_threads(parser.get_int_in("threads", 1, 4096));
   if (is_system_file_argument(parser.get("system"))) return run_train_file_system(parser, cell, argc, argv);
   const SystemKind system = parse_system(parser.get("system"));
@@ -294,7 +294,6 @@ int run_train(int argc, char** argv, int first) {
             << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
             << " steps=" << cell.training.steps << std::endl;
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  if (parser.has("out")) require_new_output(parser);
   print_estimate(cell_sweep_text(cell, data), {});
   const auto results = train_cell(cell, data, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);

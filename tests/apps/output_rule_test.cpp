@@ -5,6 +5,7 @@
 // checks the refused file is left byte for byte as it was.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -124,6 +125,7 @@ TEST_F(OutputRuleTest, AnEmptyOutputPathIsRefusedAndWritesNothing) {
         << args << ": " << log;
     EXPECT_THAT(log, ::testing::AnyOf(HasSubstr("empty path"), HasSubstr("names no file")))
         << args;
+    EXPECT_EQ(std::count(log.begin(), log.end(), '\n'), 1) << "one line, before any work: " << log;
     std::string listing;
     ASSERT_EQ(testing_util::run_shell("ls -A " + work, &listing), 0);
     EXPECT_EQ(listing, "") << args << " left files behind";
