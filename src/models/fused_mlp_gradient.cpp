@@ -19,6 +19,7 @@
 #include <algorithm>
 
 #include "models/fused_mlp_plan.h"
+#include "models/jet_kernels.h"
 
 namespace phnn {
 namespace internal {
@@ -74,9 +75,9 @@ Tensor fused_mlp_taped_vjp(const FusedMlpTape& tape, const std::vector<Tensor>& 
   gemm_nn(E, as_int(B), as_int(p.widths[L]), as_int(p.widths[L - 1]), t->c.data_ptr<double>(),
           weights[L - 1].data_ptr<double>(), w + t->s[L - 1], /*transpose_b=*/true);
   for (int64_t l = L - 1; l >= 1; --l) {
-    const double *a = ws + p.act[l], *s = w + t->s[l];
+    const double* a = ws + p.act[l];  // A_l = tanh(Z_{l-1}): U_{l-1} is tanh's backward of S_l
     double* u = w + t->u[l - 1];
-    for (int64_t k = 0; k < E * B * p.widths[l]; ++k) u[k] = s[k] * (1.0 - a[k] * a[k]);
+    tanh_jet_backward(0, 0, E, B * p.widths[l], a, a, w + t->s[l], u);
     gemm_nn(E, as_int(B), as_int(p.widths[l]), as_int(p.widths[l - 1]), u,
             weights[l - 1].data_ptr<double>(), w + t->s[l - 1], /*transpose_b=*/true);
   }
@@ -112,10 +113,8 @@ Tensor fused_mlp_taped_vjp_backward(FusedMlpVjpTape& vjp, const FusedMlpTape& ta
             /*transpose_b=*/false);
     const double *a = ws + p.act[l], *s = w + vjp.s[l];
     double* extra = w + vjp.extra[l];
-    for (int64_t k = 0; k < E * B * n_out; ++k) {
-      extra[k] = ((ub[k] * s[k]) * a[k]) * -2.0;
-      sb[k] = ub[k] * (1.0 - a[k] * a[k]);
-    }
+    for (int64_t k = 0; k < E * B * n_out; ++k) extra[k] = ((ub[k] * s[k]) * a[k]) * -2.0;
+    tanh_jet_backward(0, 0, E, B * n_out, a, a, ub, sb);  // S~_l = U~ (.) (1 - A_l^2)
   }
   const int n_last = as_int(p.widths[L - 1]), n_out = as_int(p.widths[L]);
   gemm_tn(E, as_int(B), n_last, n_out, sb, vjp.c.data_ptr<double>(),

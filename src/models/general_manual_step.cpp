@@ -6,7 +6,7 @@
 // forms (general_heads.h) in the order autograd takes the model's graph:
 // NODE's loss and gradients are bitwise those of loss.sum().backward(); the
 // PH models' equal them to round-off, since gradH is a vector-Jacobian
-// product of L_H (manual_step.cpp's TapedGradient) where autograd's graph
+// product of L_H (manual_step.h's TapedGradient) where autograd's graph
 // carries L_H's forward jet, and with a penalty the field jet at x runs
 // through general_jet_heads.h (the curvature of H and the field jet heads)
 // (tests/models/general_manual_step_test.cpp, manual_step_test.cpp). The

@@ -173,12 +173,10 @@ torch::Tensor PortHamiltonianModel::hamiltonian(const torch::Tensor& x) const {
 HamiltonianAndGradient PortHamiltonianModel::energy_and_gradient(
     const torch::Tensor& x) const {
   if (l_h().options().fused && !torch::GradMode::is_enabled()) {
-    // No graph to keep (rollouts): gradH in reverse mode, the hand-written
-    // steps' arithmetic (manual_step.cpp), two passes through L_H for any n_x.
-    internal::manual::TapedNet net{l_h(), nullptr};
-    internal::HamiltonianTape tape;
-    const auto h = internal::general_hamiltonian_cotangent(net.forward(x, 0, 0).v, x, &tape);
-    return {h.h, h.l_t_v + net.vjp(h.c)};
+    // No graph to keep (rollouts): gradH in reverse mode through the
+    // hand-written steps' own TapedGradient, two passes through L_H for any n_x.
+    const internal::manual::TapedGradient g(l_h(), x);
+    return {g.h, g.grad};
   }
   if (l_h().options().fused) {
     const Jet o = l_h().forward_input(x, static_cast<int>(x.size(-1)), /*order=*/1);

@@ -70,28 +70,6 @@ Tensor add_penalty(const Tensor& loss, const JacobianPenalty& penalty, const Ten
   return penalty ? loss + penalty(dfdx, dfdx_bar) : loss;
 }
 
-// gradH(y) in reverse mode (general_heads.h): L_H's value, the head's
-// cotangent c, then gradH = L^T v + J^T c; kept for its backward.
-struct TapedGradient {
-  TapedNet l_h;
-  HamiltonianTape head;
-  Tensor grad;
-  TapedGradient(const StackedMlp& net, const Tensor& y) : l_h{net, nullptr} {
-    const auto h = general_hamiltonian_cotangent(l_h.forward(y, 0, 0).v, y, &head);
-    grad = h.l_t_v + l_h.vjp(h.c);
-  }
-  // y~ = (c + the head's x adjoint b) + L_H's input adjoint a, autograd's
-  // order; c (another node's adjoint of y, created after these) may be
-  // undefined. The product's backward gives the head's c~ first.
-  Tensor backward(const Tensor& grad_bar, bool input, const Tensor& c = Tensor()) const {
-    const Tensor c_bar = l_h.vjp_backward(grad_bar);
-    const auto adj = general_hamiltonian_cotangent_backward(head, Tensor(), grad_bar, c_bar);
-    const Tensor a = l_h.backward_after_vjp(adj.o, input);
-    if (!input) return Tensor();
-    return (c.defined() ? c + adj.x : adj.x) + a;
-  }
-};
-
 }  // namespace
 
 Tensor cat_rows(const Tensor& x, const Tensor& u) {
@@ -142,6 +120,20 @@ Tensor TapedNet::vjp_backward(const Tensor& s_bar) const {
 Tensor TapedNet::backward_after_vjp(const Tensor& v_bar, bool input) const {
   return fused_mlp_vjp_value_backward(*vjp_tape, *tape, net.weights(), net.gradient_sinks(), v_bar,
                                       input);
+}
+
+TapedGradient::TapedGradient(const StackedMlp& net, const Tensor& y) : l_h{net, nullptr} {
+  const auto head_out = general_hamiltonian_cotangent(l_h.forward(y, 0, 0).v, y, &head);
+  h = head_out.h;
+  grad = head_out.l_t_v + l_h.vjp(head_out.c);
+}
+
+Tensor TapedGradient::backward(const Tensor& grad_bar, bool input, const Tensor& c) const {
+  const Tensor c_bar = l_h.vjp_backward(grad_bar);
+  const auto adj = general_hamiltonian_cotangent_backward(head, Tensor(), grad_bar, c_bar);
+  const Tensor a = l_h.backward_after_vjp(adj.o, input);
+  if (!input) return Tensor();
+  return (c.defined() ? c + adj.x : adj.x) + a;
 }
 
 FusedMlpJet TapedNet::forward_jet(const Tensor& v, const Tensor& g) {

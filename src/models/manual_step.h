@@ -79,6 +79,20 @@ struct TapedNet {
   std::pair<Tensor, Tensor> backward_jet(const std::vector<Tensor>& grads) const;
 };
 
+/// H(y) and gradH(y) in reverse mode (general_heads.h): L_H's value, the
+/// head's cotangent c, then gradH = L^T v + J^T c; kept for its backward
+/// (unused without one: rollouts take the same path, the same bits).
+struct TapedGradient {
+  TapedNet l_h;
+  HamiltonianTape head;
+  Tensor h, grad;
+  TapedGradient(const StackedMlp& net, const Tensor& y);
+  /// y~ = (c + the head's x adjoint b) + L_H's input adjoint a, autograd's
+  /// order; c (another node's adjoint of y, created after these) may be
+  /// undefined. The product's backward gives the head's c~ first.
+  Tensor backward(const Tensor& grad_bar, bool input, const Tensor& c = Tensor()) const;
+};
+
 /// gradH(x) and its Hessian from L_H's order-2 jet in the x.size(-1) state
 /// directions, kept for the backward from (gradH~, Hessian~): the head, then L_H.
 struct TapedCurvature {
