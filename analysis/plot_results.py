@@ -158,12 +158,15 @@ def load(path, round_k=None):
 
 
 def system_states(f, name):
-    """A system's state names, units, phase pairs (indices) and whether it is a system file:
-    from /data/<name> (a system file's group has state_names and its text with [plots] phase);
-    the built-in systems' q [m], p [kg m/s] otherwise."""
+    """A system's state names, units, phase pairs (indices), whether it is a system file and the
+    initial energies of its figure trajectories: from /data/<name> (a group of format_version 2
+    has state_names and its system file's text with [plots] phase and energies; the paper's three
+    have energies 0.5 and 0.75 J); a group of format_version 1 (files written before 2026-11-28)
+    is a built-in system: q [m], p [kg m/s], 0.5 and 0.75 J."""
     group = f["data"][name] if "data" in f and name in f["data"] else None
     if group is None or "state_names" not in group.attrs:
-        return {"names": ["q", "p"], "units": ["m", "kg m/s"], "pairs": [(0, 1)], "file": False}
+        return {"names": ["q", "p"], "units": ["m", "kg m/s"], "pairs": [(0, 1)], "file": False,
+                "energies": [0.5, 0.75]}
     names = text([group.attrs["state_names"]])[0].split(",")
     units = text([group.attrs["state_units"]])[0].split(",")
     pairs = [(i, i + 1 if i + 1 < len(names) else 0) for i in range(0, len(names), 2)]
@@ -172,7 +175,8 @@ def system_states(f, name):
     plots = parse_sweep(text([group.attrs.get("system_file", b"")])[0]).get("plots", {})
     if plots.get("phase"):
         pairs = [(names.index(a), names.index(b)) for a, b in plots["phase"]]
-    return {"names": names, "units": units, "pairs": pairs, "file": True}
+    return {"names": names, "units": units, "pairs": pairs, "file": True,
+            "energies": list(plots.get("energies", []))}
 
 
 def state_label(states, k):
@@ -184,10 +188,11 @@ def state_label(states, k):
 
 
 def figure_label(states, energy):
-    """Row label of a figure trajectory: its initial energy, or a system file's trajectory."""
-    if states["file"]:
-        return f"inference trajectory {0 if energy == '05' else 1}"
-    return f"$H(x_0)$ = {0.5 if energy == '05' else 0.75} J"
+    """Row label of a figure trajectory: its initial energy, or the inference trajectory."""
+    k = 0 if energy == "05" else 1
+    if not states["energies"]:
+        return f"inference trajectory {k}"
+    return f"$H(x_0)$ = {states['energies'][min(k, len(states['energies']) - 1)]:g} J"
 
 
 def parse_sweep(sweep_text):
@@ -616,9 +621,10 @@ def energies(runs, path, name, out):
         fig, axes = plt.subplots(1, 2, figsize=(12, 4.2), sharey=False)
         states = runs["states"][system]
         for ax, energy in zip(axes, ("05", "075")):
-            # The CSV's first column: h0 (built-in) or the inference trajectory (system file).
-            rows = (data[data["trajectory"] == (0 if energy == "05" else 1)] if states["file"]
-                    else data[np.isclose(data["h0"], 0.5 if energy == "05" else 0.75)])
+            # The CSV's first column: h0 (figure energies) or the inference trajectory.
+            k = 0 if energy == "05" else 1
+            rows = (data[np.isclose(data["h0"], states["energies"][min(k, len(states["energies"]) - 1)])]
+                    if states["energies"] else data[data["trajectory"] == k])
             c = colour(picks[0])
             ax.plot(rows["t"], rows["H_true_ref"], color="black", lw=2.2,
                     label="H along the reference")

@@ -1,10 +1,9 @@
 // bench/bench_system_data.cpp — cost of generating a data set (the paper's
 // splits: 400 train pairs, 2500 validation pairs, 100 inference trajectories
-// of 2000 DG steps) for the built-in systems and for system files.
+// of 2000 DG steps) for the shipped system files (the paper's three are the
+// built-in names).
 // Usage: bench_system_data [repeats=5] [sweeps/systems] [only=NAME] (NAME: one
-// system file's name, or generic-harmonic / generic-self-sustained for a
-// built-in through the general step, for profiling; the built-ins' own
-// path is skipped). Prints CSV:
+// system file's name). Prints CSV:
 // system,source,n_x,median_s,min_s,steps,us_per_dg_step.
 #include <algorithm>
 #include <chrono>
@@ -14,7 +13,6 @@
 #include <vector>
 
 #include "phnn/data/ph_dataset.h"
-#include "phnn/store/dataset_file.h"
 #include "phnn/systems/system_file.h"
 
 namespace {
@@ -54,28 +52,6 @@ int main(int argc, char** argv) {
     std::cout << name << "," << source << "," << nx << "," << median << "," << s.front() << ","
               << steps << "," << 1e6 * median / static_cast<double>(steps) << "\n";
   };
-  for (SystemKind kind : all_systems()) {
-    if (!only.empty()) break;
-    SystemData data;
-    const auto s = time_runs(repeats, [&] {
-      data = make_system_data(OscillatorOptions::defaults(kind), options, 400);
-    });
-    const long steps = pair_steps(data.train, options.stride()) +
-                       pair_steps(data.validation, options.stride()) + 100L * 2000;
-    report(to_string(kind), "built-in", 2, s, steps);
-  }
-  // Closed forms through the general n-dimensional step (the PhSystem
-  // interface, VecX): that step's own cost. (Built-in Duffing has no box for
-  // the general rejection sampler; only its file does.)
-  for (SystemKind kind : {SystemKind::kHarmonic, SystemKind::kSelfSustained}) {
-    if (!only.empty() && "generic-" + to_string(kind) != only) continue;
-    const auto system = make_system(to_string(kind));
-    PhSystemData data;
-    const auto s = time_runs(repeats, [&] { data = make_ph_system_data(*system, options, 400); });
-    const long steps = pair_steps(data.train, options.stride()) +
-                       pair_steps(data.validation, options.stride()) + 100L * 2000;
-    report(to_string(kind), "built-in/general", 2, s, steps);
-  }
   for (const std::string name : {"harmonic", "duffing", "self-sustained", "pendulum",
                                  "coupled-duffing", "mass-chain"}) {
     if (!only.empty() && name != only) continue;

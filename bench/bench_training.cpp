@@ -42,7 +42,7 @@
 #include <torch/torch.h>
 
 #include "models/member_gemm.h"
-#include "phnn/store/dataset_file.h"
+#include "phnn/data/ph_dataset.h"
 #include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"
 
@@ -61,13 +61,27 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-const phnn::SystemData& bench_data() {
-  static const phnn::SystemData data = [] {
+// A built-in system's data set with its system (the shipped file).
+struct BuiltinData {
+  std::shared_ptr<const phnn::PhSystem> system;
+  phnn::PhSystemData data;
+};
+BuiltinData builtin_data(phnn::SystemKind kind, const phnn::DatasetOptions& options, int n_train) {
+  BuiltinData d;
+  d.system = phnn::builtin_system(phnn::OscillatorOptions::defaults(kind), options);
+  d.data = phnn::make_ph_system_data(*d.system, options, n_train);
+  return d;
+}
+std::vector<phnn::RunResult> train_cell(const CellSpec& cell, const BuiltinData& d) {
+  return phnn::train_cell(cell, d.data, *d.system);
+}
+
+const BuiltinData& bench_data() {
+  static const BuiltinData data = [] {
     phnn::DatasetOptions options;
     options.num_validation = 64;
     options.num_inference = 1;
-    return phnn::make_system_data(phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing),
-                                  options, 100);
+    return builtin_data(phnn::SystemKind::kDuffing, options, 100);
   }();
   return data;
 }
@@ -76,7 +90,7 @@ double time_cell(CellSpec cell, int steps) {
   cell.training.steps = steps;
   cell.training.eval_every = 1000000;
   const auto t0 = Clock::now();
-  phnn::train_cell(cell, bench_data());
+  train_cell(cell, bench_data());
   return seconds_since(t0);
 }
 
@@ -233,13 +247,13 @@ struct BaselinePhnnJr {
 
 int baseline(int repeats) {
   torch::manual_seed(0);
-  const auto& data = bench_data();
+  const auto& data = bench_data().data;
   auto X = torch::empty({64, 2}, torch::kFloat64), Xn = torch::empty({64, 2}, torch::kFloat64),
        U = torch::empty({64, 1}, torch::kFloat64);
   for (int i = 0; i < 64; ++i) {
     X[i][0] = data.train.x[i](0); X[i][1] = data.train.x[i](1);
     Xn[i][0] = data.train.x_next[i](0); Xn[i][1] = data.train.x_next[i](1);
-    U[i][0] = data.train.u[i];
+    U[i][0] = data.train.u[i](0);
   }
   std::vector<double> samples;
   for (int r = 0; r < repeats; ++r) {
@@ -270,8 +284,7 @@ int baseline(int repeats) {
 
 int full_cell() {
   phnn::DatasetOptions options;
-  const auto data = phnn::make_system_data(
-      phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing), options, 25);
+  const auto data = builtin_data(phnn::SystemKind::kDuffing, options, 25);
   CellSpec cell;
   cell.model = phnn::ModelKind::kPhnnJr;
   cell.integrator = phnn::IntegratorKind::kRk2;
@@ -279,7 +292,7 @@ int full_cell() {
   cell.training.steps = 50000;
   cell.seeds = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
   const auto t0 = Clock::now();
-  const auto results = phnn::train_cell(cell, data);
+  const auto results = train_cell(cell, data);
   std::printf("full cell (Duffing, small PHNN-JR-RK2, N_train 25, E = 10, 50 000 steps, "
               "101 validations, inference): %.1f s\n", seconds_since(t0));
   return 0;
@@ -347,8 +360,7 @@ int general(int repeats) {
     options.num_inference = 1;
     options.beta = 0.4;  // 40-step rollouts: T(700) - T(100) is the training steps alone
     const phnn::PhSystemData data = phnn::make_ph_system_data(*system, options, 100);
-    const phnn::SystemData builtin = phnn::make_system_data(
-        phnn::OscillatorOptions::defaults(phnn::SystemKind::kHarmonic), options, 100);
+    const BuiltinData builtin = builtin_data(phnn::SystemKind::kHarmonic, options, 100);
     for (const auto& [model, integrator] : kModels) {
       CellSpec cell;
       cell.model = model;
@@ -369,11 +381,11 @@ int general(int repeats) {
           cell.training.eval_every = 1000000;
           cell.training.steps = 100;
           auto t0 = Clock::now();
-          phnn::train_cell(cell, builtin);
+          train_cell(cell, builtin);
           const double c = seconds_since(t0);
           cell.training.steps = 700;
           t0 = Clock::now();
-          phnn::train_cell(cell, builtin);
+          train_cell(cell, builtin);
           fused_us.push_back((seconds_since(t0) - c) / 6000.0 * 1e6);
         }
       }
@@ -394,8 +406,7 @@ int main(int argc, char** argv) {
   const int repeats = argc > 2 ? std::atoi(argv[2]) : 3;
   if (mode == "inference") {  // inference [MODEL] [INTEGRATOR]: a small cell's rollouts
     phnn::DatasetOptions options;  // 100 inference trajectories x 500 steps (+ 2 figure ones)
-    const auto data = phnn::make_system_data(
-        phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing), options, 25);
+    const auto data = builtin_data(phnn::SystemKind::kDuffing, options, 25);
     CellSpec cell;
     cell.model = phnn::parse_model(argc > 2 ? argv[2] : "phnn-jr");
     cell.integrator = phnn::parse_integrator(argc > 3 ? argv[3] : "dg");
@@ -404,7 +415,7 @@ int main(int argc, char** argv) {
     cell.training.steps = 1;  // two validations on 2 500 pairs, then inference
     cell.training.eval_every = 1000000;
     const auto t0 = Clock::now();
-    phnn::train_cell(cell, data);
+    train_cell(cell, data);
     std::printf("%.3f s\n", seconds_since(t0));
     return 0;
   }

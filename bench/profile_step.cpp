@@ -7,7 +7,7 @@
 #include <torch/csrc/autograd/profiler_legacy.h>
 #include <torch/torch.h>
 
-#include "phnn/store/dataset_file.h"
+#include "phnn/data/ph_dataset.h"
 #include "phnn/training/trainer.h"
 
 int main(int argc, char** argv) {
@@ -16,8 +16,9 @@ int main(int argc, char** argv) {
   phnn::DatasetOptions options;
   options.num_validation = 64;
   options.num_inference = 1;
-  const auto data = phnn::make_system_data(
-      phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing), options, 64);
+  const auto system =
+      phnn::builtin_system(phnn::OscillatorOptions::defaults(phnn::SystemKind::kDuffing), options);
+  const auto data = phnn::make_ph_system_data(*system, options, 64);
   phnn::CellSpec cell;
   cell.model = phnn::parse_model(argv[1]);
   cell.integrator = phnn::parse_integrator(argv[2]);
@@ -28,6 +29,6 @@ int main(int argc, char** argv) {
   cell.training.eval_every = 1000000;
   if (argc > 6 && std::string(argv[6]) == "float32") cell.training.precision = phnn::Precision::kFloat32;
   torch::autograd::profiler::RecordProfile guard(argv[5]);
-  phnn::train_cell(cell, data);
+  phnn::train_cell(cell, data, *system);
   return 0;
 }

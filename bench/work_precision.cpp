@@ -196,6 +196,12 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
+// A trajectory's initial state and input for the 2-state integrators.
+struct Spec2 {
+  Vec2 x0;
+  double u = 0.0;
+};
+
 template <class System, class Spec>
 void run_system(const std::string& name, const System& osc, const std::vector<Spec>& specs,
                 const Options& o) {
@@ -255,10 +261,13 @@ int main(int argc, char** argv) {
   const phnn::DatasetOptions data;
   if (o.systems.empty()) {
     for (phnn::SystemKind kind : phnn::all_systems()) {
+      // The closed-form 2-state integrators from the shipped file's draws.
       const phnn::Oscillator osc(phnn::OscillatorOptions::defaults(kind));
-      std::vector<phnn::TrajectorySpec> specs;
+      const auto sys = phnn::builtin_system(osc.options(), data);
+      std::vector<phnn::Spec2> specs;
       for (int i = 0; i < o.trajectories; ++i) {
-        specs.push_back(phnn::trajectory_spec(osc, data, data.inference_begin() + i));
+        const auto spec = phnn::ph_trajectory_spec(*sys, data, data.inference_begin() + i);
+        specs.push_back({phnn::Vec2(spec.x0(0), spec.x0(1)), spec.u(0)});
       }
       phnn::run_system(phnn::to_string(kind), osc, specs, o);
     }

@@ -10,8 +10,11 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
+#include "phnn/data/ph_dataset.h"
 #include "phnn/integrators/discrete_gradient.h"
 #include "phnn/integrators/explicit_midpoint.h"
 #include "phnn/systems/oscillators.h"
@@ -90,6 +93,33 @@ inline std::unique_ptr<PhSystem> shipped_system(const std::string& name) {
   return load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/" + name + ".toml");
 }
 #endif
+
+/// Trajectory `index` of the paper's system `kind` as the 2-state closed
+/// forms see it: the initial state and constant input its shipped file
+/// draws, and `steps` closed-form DG steps at options.generation_step
+/// (states[0] = x0).
+struct PaperTrajectory {
+  double u = 0.0;
+  std::vector<Vec2> states;
+};
+inline PaperTrajectory paper_trajectory(SystemKind kind, const DatasetOptions& options,
+                                        std::int64_t index, int steps) {
+  const auto system = builtin_system(OscillatorOptions::defaults(kind), options);
+  const PhTrajectorySpec spec = ph_trajectory_spec(*system, options, index);
+  const Oscillator osc(OscillatorOptions::defaults(kind));
+  PaperTrajectory t;
+  t.u = spec.u(0);
+  t.states.push_back(Vec2(spec.x0(0), spec.x0(1)));
+  for (int n = 0; n < steps; ++n) {
+    const DiscreteGradientStep step =
+        discrete_gradient_step(osc, t.states.back(), t.u, options.generation_step, options.newton);
+    if (step.status != StepStatus::kConverged) {
+      throw std::runtime_error("paper_trajectory: Newton failed at step " + std::to_string(n));
+    }
+    t.states.push_back(step.x_next);
+  }
+  return t;
+}
 
 }  // namespace testing_util
 }  // namespace phnn

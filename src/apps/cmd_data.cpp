@@ -11,7 +11,6 @@
 #include "apps/commands.h"
 #include "phnn/common/counted.h"
 #include "phnn/data/measured.h"
-#include "phnn/store/dataset_file.h"
 #include "phnn/store/output_path.h"
 #include "phnn/store/scratch_file.h"
 #include "phnn/store/ph_dataset_file.h"
@@ -52,10 +51,10 @@ NoiseOptions noise_options(const cli::Parser& parser, int n_x) {
   return o;
 }
 
-int write_file_system_data(const std::string& path, const DatasetOptions& options, int n_train,
-                           const std::string& out, const std::string& csv,
-                           const cli::Parser& parser, std::chrono::steady_clock::time_point start) {
-  const std::unique_ptr<PhSystem> system = load_system_file(system_file_path(path));
+int write_system_data(const std::unique_ptr<PhSystem>& system, const std::string& path,
+                      const DatasetOptions& options, int n_train, const std::string& out,
+                      const std::string& csv, const cli::Parser& parser,
+                      std::chrono::steady_clock::time_point start) {
   PhSystemData data = make_ph_system_data(*system, options, n_train);
   add_measurement_noise(&data, system->rng_id(), noise_options(parser, system->n_x()));
   if (!csv.empty()) {
@@ -86,19 +85,14 @@ int write_file_system_data(const std::string& path, const DatasetOptions& option
   return 0;
 }
 
-// --csv: with a system file only, not with --noise, never over --out or the
-// system file.
+// --csv: not with --noise, never over --out or the system file.
 void check_csv_option(const cli::Parser& parser, const std::string& csv, const std::string& out,
-                      const std::string& system_arg, bool from_file) {
+                      const std::string& system_arg) {
   if (parser.has("noise") && parser.has("csv")) {
     throw cli::UsageError{"phnn data: --csv writes the clean trajectories, --noise perturbs only "
                           "the pairs: use one of them (add noise to a recording before importing it)"};
   }
   if (parser.has("csv")) {
-    if (!from_file) {
-      throw cli::UsageError{"phnn data: --csv needs a system file: use --system "
-                            "sweeps/systems/" + system_arg + ".toml (the same system)"};
-    }
     const std::string bad = output_problem("data", csv, OutputKind::kTrajectoryCsv, {system_arg, out});
     if (!bad.empty()) throw cli::UsageError{"phnn data: --csv " + bad};
     // Neither exists yet, so compare the paths themselves.
@@ -123,10 +117,10 @@ int run_data(int argc, char** argv, int first) {
   parser.option("damping", "c of z(w) = c w [N s/m] (harmonic, duffing)", "0.14737");
   parser.option("mass", "m [kg]", "0.16");
   parser.option("csv", "also write the trajectories behind the splits to this CSV "
-                       "(`phnn import`'s format; system files only)");
+                       "(`phnn import`'s format)");
   parser.option("noise", "measurement noise on the training and validation pairs: one level for "
                          "all states (0.01) or one per state (0.01,0.02), relative to each "
-                         "state's spread (system files only)");
+                         "state's spread");
   parser.flag("noise-absolute", "--noise levels are absolute standard deviations");
   if (!parser.parse(argc, argv, first)) return 0;
 
@@ -136,12 +130,12 @@ int run_data(int argc, char** argv, int first) {
     throw cli::UsageError{"phnn data: --damping and --mass set the built-in systems' parameters; "
                           "a system file sets its own under [parameters]: edit " + system_arg};
   }
-  OscillatorOptions system;
+  OscillatorOptions physics;
   if (!from_file) {
-    system = OscillatorOptions::defaults(parse_system(system_arg));
-    if (parser.has("damping")) system.damping = parser.get_double("damping");
-    system.mass = parser.get_double("mass");
-    system.validate();
+    physics = OscillatorOptions::defaults(parse_system(system_arg));
+    if (parser.has("damping")) physics.damping = parser.get_double("damping");
+    physics.mass = parser.get_double("mass");
+    physics.validate();
   }
   DatasetOptions options;
   const std::int64_t seed = parser.get_int("data-seed");
@@ -156,29 +150,15 @@ int run_data(int argc, char** argv, int first) {
   const std::string problem = output_problem("data", out, OutputKind::kDataSet, {system_arg});
   if (!problem.empty()) throw cli::UsageError{"phnn data: --out " + problem};
   const std::string csv = parser.get("csv");
-  if ((parser.has("noise") || parser.flag_set("noise-absolute")) && !from_file) {
-    throw cli::UsageError{"phnn data: --noise needs a system file: use --system sweeps/systems/" +
-                          system_arg + ".toml (the same system)"};
-  }
   if (parser.flag_set("noise-absolute") && !parser.has("noise")) {
     throw cli::UsageError{"phnn data: --noise-absolute without --noise; give the levels"};
   }
-  check_csv_option(parser, csv, out, system_arg, from_file);
+  check_csv_option(parser, csv, out, system_arg);
   const auto start = std::chrono::steady_clock::now();
-  if (from_file) {
-    return write_file_system_data(system_arg, options, static_cast<int>(n_train), out, csv, parser,
-                                  start);
-  }
-  const SystemData data = make_system_data(system, options, static_cast<int>(n_train));
-  write_atomically(out, "writing", [&](const std::string& path) { write_dataset_file(path, data); });
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << "phnn data: " << to_string(system.kind) << ": " << data.train.size()
-            << " train pairs, " << data.validation.size() << " validation pairs, "
-            << data.inference.size() << " inference trajectories x "
-            << (data.inference.size() ? data.inference.states[0].size() : 0)
-            << " samples -> " << parser.get("out") << " (" << seconds << " s)\n";
-  return 0;
+  const std::unique_ptr<PhSystem> system = from_file ? load_system_file(system_file_path(system_arg))
+                                                     : builtin_system(physics, options);
+  return write_system_data(system, system_arg, options, static_cast<int>(n_train), out, csv, parser,
+                           start);
 }
 
 }  // namespace apps

@@ -74,10 +74,7 @@ RunConfig stored_config(const ResultsFile& results, const std::string& id) {
 Evaluation evaluate(const ResultsFile& results, const RunConfig& run,
                     const std::vector<double>& weights) {
   const CellSpec cell = cell_spec_for(run, {run.seed});
-  if (!run.has_system_file()) {
-    return evaluate_stored_run(cell, results.read_system_data(run.system_name()), weights);
-  }
-  const PhSystemData data = results.read_file_system_data(run.system_name());
+  const PhSystemData data = results.read_system_data(run.system_name());
   const auto system =
       compile_system(data.system_text, results.path() + "@/data/" + run.system_name());
   return evaluate_stored_run(cell, data, *system, weights);
@@ -120,17 +117,23 @@ std::pair<std::string, bool> mse_verdict(double recomputed, double stored,
   return {text, close};
 }
 
-// First column: the figure's initial energy h0 (0.5, 0.75 J) for a built-in
-// system, the inference trajectory (0, 1) for a system file.
-void write_energy_csv(const std::string& path, const Evaluation& e, bool system_file) {
+// First column: the figure's initial energy h0 [J] (0.5, 0.75 for the
+// paper's systems) where the system has figure energies, else the inference
+// trajectory (0, 1).
+void write_energy_csv(const std::string& path, const Evaluation& e) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot write the CSV; is the directory writable?");
-  out << (system_file ? "trajectory," : "h0,") << e.energy_05.columns << "\n";
+  const bool energies = !e.figure_energies.empty();
+  out << (energies ? "h0," : "trajectory,") << e.energy_05.columns << "\n";
   char buf[32];
-  for (const auto& [h0, trace] : {std::make_pair(system_file ? "0" : "0.5", &e.energy_05),
-                                  std::make_pair(system_file ? "1" : "0.75", &e.energy_075)}) {
-    for (const auto& row : trace->rows) {
-      out << h0;
+  for (std::size_t k = 0; k < 2; ++k) {
+    std::string label = std::to_string(k);
+    if (energies) {
+      std::snprintf(buf, sizeof buf, "%.17g", e.figure_energies[std::min(k, e.figure_energies.size() - 1)]);
+      label = buf;
+    }
+    for (const auto& row : (k == 0 ? e.energy_05 : e.energy_075).rows) {
+      out << label;
       for (double v : row) {
         std::snprintf(buf, sizeof buf, "%.17g", v);
         out << "," << buf;
@@ -186,7 +189,7 @@ int run_eval(int argc, char** argv, int first) {
               stored.mse, verdict.c_str());
   if (!parser.get("out").empty()) {
     write_atomically(parser.get("out"), "writing",
-                     [&](const std::string& path) { write_energy_csv(path, e, run.has_system_file()); });
+                     [&](const std::string& path) { write_energy_csv(path, e); });
     std::printf("phnn eval: energies along the figure trajectories -> %s\n",
                 parser.get("out").c_str());
   }

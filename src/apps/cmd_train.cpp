@@ -22,7 +22,6 @@
 #include "phnn/common/closest_name.h"
 #include "phnn/common/utc_time.h"
 #include "phnn/report/tables.h"
-#include "phnn/store/dataset_file.h"
 #include "phnn/store/ph_dataset_file.h"
 #include "phnn/store/output_path.h"
 #include "phnn/store/results_file.h"
@@ -147,22 +146,6 @@ DatasetOptions generation_options(const cli::Parser& parser, int n_train) {
   return options;
 }
 
-// The data set: read from --data, or generated for the cell's N_train.
-SystemData data_from_options(const cli::Parser& parser, SystemKind system, int n_train) {
-  if (parser.has("data")) {
-    SystemData data = read_dataset_file(parser.get("data"));
-    if (data.system.kind != system) {
-      throw cli::UsageError{"phnn train: --data " + parser.get("data") + " holds system " +
-                            to_string(data.system.kind) + ", not " + to_string(system)};
-    }
-    return data;
-  }
-  OscillatorOptions physics = OscillatorOptions::defaults(system);
-  if (parser.has("damping")) physics.damping = parser.get_double("damping");
-  const DatasetOptions options = generation_options(parser, n_train);
-  return make_system_data(physics, options, n_train);
-}
-
 // The cost model's estimate of the cell (the one-cell sweep `text`, as
 // `phnn sweep --dry-run` would give it), on stdout; a note on stderr when it
 // is long for one command, which saves nothing until it ends.
@@ -217,61 +200,66 @@ void print_cell_results(const CellSpec& cell, const std::vector<RunResult>& resu
               q75 - q25, results.empty() ? 0L : results[0].parameter_count, wall);
 }
 
-// A system file's data set: read from --data (it must have been made from
-// the same file text) or generated for the cell's N_train.
-PhSystemData file_system_data(const cli::Parser& parser, const PhSystem& system, int n_train) {
-  if (parser.has("data")) {
-    PhSystemData data = read_ph_dataset_file(parser.get("data"));
-    if (data.system_text != system.source_text()) {
-      throw cli::UsageError{"phnn train: --data " + parser.get("data") + " was made from " +
-                            (data.system_text.empty() ? "the built-in system " + data.system_name
-                                                      : "another text of system " + data.system_name) +
-                            ", not from " + parser.get("system") +
-                            "; regenerate it with `phnn data --system " + parser.get("system") +
-                            "` (or, for recordings, `phnn import ... --system " + parser.get("system") +
-                            "`)"};
+// The system and its data set. From --data: a built-in system's data say
+// its physics (--damping is refused); a system file's data must have been
+// made from the same text. Else generated for the cell's N_train from the
+// system file, or the built-in system's shipped file with --damping.
+struct TrainData {
+  std::unique_ptr<PhSystem> system;
+  PhSystemData data;
+};
+
+TrainData read_train_data(const cli::Parser& parser, bool builtin) {
+  const std::string arg = parser.get("system"), path = parser.get("data");
+  TrainData d;
+  d.data = read_ph_dataset_file(path);
+  if (builtin) {
+    if (parser.has("damping")) {
+      throw cli::UsageError{"phnn train: --damping with --data: the data set " + path +
+                            " fixes the physics; drop --damping"};
     }
-    if (static_cast<std::size_t>(n_train) > data.train.size())
-      throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " exceeds the " +
-                            std::to_string(data.train.size()) + " training pairs of --data " +
-                            parser.get("data") + "; lower --n-train, or make a larger data set"};
-    return data;
+    if (d.data.system_name != arg) {
+      throw cli::UsageError{"phnn train: --data " + path + " holds system " + d.data.system_name +
+                            ", not " + arg};
+    }
+    d.system = compile_system(d.data.system_text, path + "@system_file");
+    return d;
   }
-  const DatasetOptions options = generation_options(parser, n_train);
-  return make_ph_system_data(system, options, n_train);
+  d.system = load_system_file(system_file_path(arg));
+  if (d.data.system_text != d.system->source_text()) {
+    throw cli::UsageError{"phnn train: --data " + path + " was made from another text of system " +
+                          d.data.system_name + ", not from " + arg +
+                          "; regenerate it with `phnn data --system " + arg +
+                          "` (or, for recordings, `phnn import ... --system " + arg + "`)"};
+  }
+  return d;
 }
 
-// `phnn train --system FILE`: the n-dimensional models on a system file.
-int run_train_file_system(const cli::Parser& parser, const CellSpec& cell, int argc, char** argv) {
-  const std::string path = parser.get("system");
-  if (parser.has("damping")) {
-    throw cli::UsageError{"phnn train: --damping sets the built-in systems' c; a system file sets "
-                          "its own under [parameters]: edit " + path};
+TrainData train_data(const cli::Parser& parser, bool builtin, int n_train) {
+  const std::string arg = parser.get("system");
+  if (parser.has("data")) {
+    TrainData d = read_train_data(parser, builtin);
+    if (static_cast<std::size_t>(n_train) > d.data.train.size())
+      throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " exceeds the " +
+                            std::to_string(d.data.train.size()) + " training pairs of --data " +
+                            parser.get("data") + "; lower --n-train, or make a larger data set"};
+    return d;
   }
-  const std::unique_ptr<PhSystem> system = load_system_file(system_file_path(path));
-  const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  const PhSystemData data = file_system_data(parser, *system, cell.n_train);
-  std::cout << "phnn train: " << system->name() << " (" << counted(system->n_x(), "state") << ", "
-            << counted(system->n_w(), "port") << ", " << counted(system->n_u(), "input") << ") "
-            << model_label(cell.model, cell.integrator) << " size=" << to_string(cell.size)
-            << " n_train=" << cell.n_train << " reg=" << to_string(cell.regularizer)
-            << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << std::endl;
-  // The data set is at hand (read or generated above): supplied, not to generate.
-  const SystemFileReader read = [&](const std::string&) {
-    return SystemFileText{path, system->source_text(), "", 0, /*data_supplied=*/true};
-  };
-  print_estimate(cell_sweep_text(cell, data, path), read);
-  const auto results = train_cell(cell, data, *system, progress_printer(parser.flag_set("quiet")));
-  print_cell_results(cell, results);
-  if (parser.has("out")) {
-    const std::string out = parser.get("out");
-    write_cell_file(
-        out, cell, cell_sweep_text(cell, data, path), read,
-        [&](ResultsFile* file) { file->store_file_system_data(data.system_name, data, path); },
-        results, provenance, provenance_value(provenance, "started"));
-    std::printf("runs written to %s\n", out.c_str());
+  const DatasetOptions options = generation_options(parser, n_train);
+  TrainData d;
+  if (builtin) {
+    OscillatorOptions physics = OscillatorOptions::defaults(parse_system(arg));
+    if (parser.has("damping")) physics.damping = parser.get_double("damping");
+    d.system = builtin_system(physics, options);
+  } else {
+    if (parser.has("damping")) {
+      throw cli::UsageError{"phnn train: --damping sets the built-in systems' c; a system file sets "
+                            "its own under [parameters]: edit " + arg};
+    }
+    d.system = load_system_file(system_file_path(arg));
   }
-  return 0;
+  d.data = make_ph_system_data(*d.system, options, n_train);
+  return d;
 }
 
 }  // namespace
@@ -285,22 +273,34 @@ int run_train(int argc, char** argv, int first) {
   const CellSpec cell = cell_from_options(parser);
   if (parser.has("out")) require_new_output(parser);  // before any output or work
   torch::set_num_threads(parser.get_int_in("threads", 1, 4096));
-  if (is_system_file_argument(parser.get("system"))) return run_train_file_system(parser, cell, argc, argv);
-  const SystemKind system = parse_system(parser.get("system"));
-  const SystemData data = data_from_options(parser, system, cell.n_train);
-  cell.validate(data);
-  std::cout << "phnn train: " << to_string(system) << " " << model_label(cell.model, cell.integrator)
-            << " size=" << to_string(cell.size) << " n_train=" << cell.n_train
-            << " reg=" << to_string(cell.regularizer) << " seeds=" << cell.seeds.size()
-            << " steps=" << cell.training.steps << std::endl;
+  const std::string arg = parser.get("system");
+  const bool builtin = !is_system_file_argument(arg);
+  if (builtin) parse_system(arg);  // an unknown name is an error before any work
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  print_estimate(cell_sweep_text(cell, data), {});
-  const auto results = train_cell(cell, data, progress_printer(parser.flag_set("quiet")));
+  const TrainData d = train_data(parser, builtin, cell.n_train);
+  cell.validate(d.data);
+  const PhSystem& system = *d.system;
+  std::cout << "phnn train: " << system.name() << " (" << counted(system.n_x(), "state") << ", "
+            << counted(system.n_w(), "port") << ", " << counted(system.n_u(), "input") << ") "
+            << model_label(cell.model, cell.integrator) << " size=" << to_string(cell.size)
+            << " n_train=" << cell.n_train << " reg=" << to_string(cell.regularizer)
+            << " seeds=" << cell.seeds.size() << " steps=" << cell.training.steps << std::endl;
+  // A system file's data set is at hand (read or generated above): supplied,
+  // not to generate. Built-in systems are not read through the reader.
+  SystemFileReader read;
+  if (!builtin) {
+    read = [&](const std::string&) {
+      return SystemFileText{arg, system.source_text(), "", 0, /*data_supplied=*/true};
+    };
+  }
+  const std::string text = cell_sweep_text(cell, d.data, arg);
+  print_estimate(text, read);
+  const auto results = train_cell(cell, d.data, system, progress_printer(parser.flag_set("quiet")));
   print_cell_results(cell, results);
   if (parser.has("out")) {
     write_cell_file(
-        parser.get("out"), cell, cell_sweep_text(cell, data), {},
-        [&](ResultsFile* file) { file->store_system_data(to_string(data.system.kind), data); },
+        parser.get("out"), cell, text, read,
+        [&](ResultsFile* file) { file->store_system_data(d.data.system_name, d.data, builtin ? "" : arg); },
         results, provenance, provenance_value(provenance, "started"));
     std::printf("runs written to %s\n", parser.get("out").c_str());
   }

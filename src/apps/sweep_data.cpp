@@ -23,17 +23,17 @@ void SweepDataSets::make(const std::string& system_name) {
   if (file && file->is_data()) {
     // A `data` file: its splits as they are (the [data] table does not apply).
     d.system = compile_system(file->text, file->path);
-    d.file = read_ph_dataset_file(file->path);
-    if (data_set_checksum(*d.file) != file->data_checksum) {
+    d.data = read_ph_dataset_file(file->path);
+    if (data_set_checksum(d.data) != file->data_checksum) {
       throw std::runtime_error("data-set file " + file->path + " changed while the sweep was "
                                "starting (its checksum differs); start the sweep again");
     }
   } else if (file) {
     d.system = compile_system(file->text, file->entry);
-    d.file = make_ph_system_data(*d.system, spec_.data, max_train);
+    d.data = make_ph_system_data(*d.system, spec_.data, max_train);
   } else {
-    const SystemKind kind = parse_system(system_name);
-    d.builtin = make_system_data(spec_.physics.at(kind), spec_.data, max_train);
+    d.system = builtin_system(spec_.physics.at(parse_system(system_name)), spec_.data);
+    d.data = make_ph_system_data(*d.system, spec_.data, max_train);
   }
   data_.emplace(system_name, std::move(d));
 }
@@ -47,31 +47,23 @@ const SweepDataSets::DataSet& SweepDataSets::at(const std::string& system_name) 
 }
 
 void SweepDataSets::store(const std::string& system_name, ResultsFile* results) const {
-  const DataSet& d = at(system_name);
-  if (d.builtin) {
-    results->store_system_data(system_name, *d.builtin);
-  } else {
-    results->store_file_system_data(system_name, *d.file,
-                                    spec_.system_file(system_name)->entry);
-  }
+  const SweepSystemFile* file = spec_.system_file(system_name);
+  results->store_system_data(system_name, at(system_name).data, file ? file->entry : "");
 }
 
 namespace {
 
-// Bitwise equality of two states (Vec2 or VecX) or inputs.
-template <class V>
-bool same_bits(const V& a, const V& b) {
+// Bitwise equality of two states or inputs.
+bool same_bits(const VecX& a, const VecX& b) {
   if (a.size() != b.size()) return false;
   for (Eigen::Index i = 0; i < a.size(); ++i) {
     if (std::memcmp(&a(i), &b(i), sizeof(double)) != 0) return false;
   }
   return true;
 }
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // The first of `count` pairs (or inference trajectories) where a and b differ, or -1.
-template <class Pairs>
-long first_different_pair(const Pairs& a, const Pairs& b, std::size_t count) {
+long first_different_pair(const PhPairSet& a, const PhPairSet& b, std::size_t count) {
   for (std::size_t i = 0; i < count; ++i) {
     if (!same_bits(a.x[i], b.x[i]) || !same_bits(a.x_next[i], b.x_next[i]) ||
         !same_bits(a.u[i], b.u[i])) {
@@ -80,8 +72,7 @@ long first_different_pair(const Pairs& a, const Pairs& b, std::size_t count) {
   }
   return -1;
 }
-template <class Inference>
-long first_different_trajectory(const Inference& a, const Inference& b) {
+long first_different_trajectory(const PhInferenceSet& a, const PhInferenceSet& b) {
   for (std::size_t i = 0; i < a.size(); ++i) {
     if (a.states[i].size() != b.states[i].size()) return static_cast<long>(i);
     for (std::size_t n = 0; n < a.states[i].size(); ++n) {
@@ -91,8 +82,7 @@ long first_different_trajectory(const Inference& a, const Inference& b) {
   return -1;
 }
 
-template <class Data>
-std::string data_difference(const Data& made, const Data& stored) {
+std::string data_difference(const PhSystemData& made, const PhSystemData& stored) {
   if (made.validation.size() != stored.validation.size() ||
       made.inference.size() != stored.inference.size()) {
     return "its validation or inference split has another size";
@@ -115,9 +105,7 @@ std::string data_difference(const Data& made, const Data& stored) {
 
 std::string SweepDataSets::stored_data_problem(const std::string& system_name,
                                                const ResultsFile& results) const {
-  const DataSet& d = at(system_name);
-  const std::string what = d.builtin ? data_difference(*d.builtin, results.read_system_data(system_name))
-                                     : data_difference(*d.file, results.read_file_system_data(system_name));
+  const std::string what = data_difference(at(system_name).data, results.read_system_data(system_name));
   if (what.empty()) return "";
   return "the data this binary generates for " + system_name + " differ from the data set stored in "
          "the file (" + what + "): another phnn version or another C library generated it, and runs "
@@ -129,8 +117,7 @@ std::vector<RunResult> SweepDataSets::train(const CellSpec& cell, const std::str
                                             const ProgressCallback& progress,
                                             const CellCheckpointing* checkpointing) const {
   const DataSet& d = at(system_name);
-  if (d.builtin) return train_cell(cell, *d.builtin, progress, nullptr, checkpointing);
-  return train_cell(cell, *d.file, *d.system, progress, nullptr, checkpointing);
+  return train_cell(cell, d.data, *d.system, progress, nullptr, checkpointing);
 }
 
 }  // namespace apps

@@ -1,16 +1,14 @@
-// src/apps/sweep_data.h — the data sets a sweep trains on, one per system:
-// a built-in system's (SystemData) or a system file's (PhSystemData, with the
-// compiled system its models take S and J from). Made on demand, the same on
+// src/apps/sweep_data.h — the data sets a sweep trains on, one per system
+// (a built-in system's shipped file, a system file, a `data` file), with the
+// compiled system its models take S and J from. Made on demand, the same on
 // every rank (deterministic); stored once in the results file's /data.
 #pragma once
 
 #include <map>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
-#include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
@@ -47,9 +45,8 @@ class SweepDataSets {
 
  private:
   struct DataSet {
-    std::optional<SystemData> builtin;
-    std::optional<PhSystemData> file;
-    std::unique_ptr<PhSystem> system;  // a system file's, compiled
+    PhSystemData data;
+    std::unique_ptr<PhSystem> system;
   };
   const DataSet& at(const std::string& system_name) const;
 

@@ -9,6 +9,7 @@
 #include "phnn/common/utc_time.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/version.h"
+#include "phnn/systems/builtin_systems.h"
 
 namespace phnn {
 namespace apps {
@@ -44,39 +45,36 @@ std::string training_text(const CellSpec& cell) {
   return s.str();
 }
 
-}  // namespace
-
-std::string cell_sweep_text(const CellSpec& cell, const SystemData& data) {
+// The [physics.NAME] table of a built-in system: every aliased key
+// (builtin_systems.h) that applies to it.
+std::string physics_text(const OscillatorOptions& physics) {
   std::ostringstream s;
-  const std::string system = to_string(data.system.kind);
-  s << "# written by `phnn train --out`\n"
-    << "name = \"train-" << system << "-" << to_string(cell.model) << "-"
-    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed;
-  if (data.options.energy_sampling != EnergySampling::kAlgorithm1) {  // a --data file's
-    s << "\nenergy_sampling = \"" << to_string(data.options.energy_sampling) << "\"";
+  s << "\n\n[physics." << to_string(physics.kind) << "]";
+  const auto& aliases = builtin_aliases(physics.kind);
+  std::vector<double> z;
+  for (const BuiltinAlias& a : aliases) {
+    if (a.field) s << "\n" << a.physics_key << " = " << g17(physics.*a.field);
+    if (!a.field) z.push_back(physics.z_coefficients[static_cast<std::size_t>(a.z_index)]);
   }
-  s << training_text(cell) << "\n\n[physics." << system << "]\n"
-    << "mass = " << g17(data.system.mass) << "\nstiffness = " << g17(data.system.stiffness) << "\n";
-  if (data.system.kind == SystemKind::kDuffing) {
-    s << "cubic_stiffness = " << g17(data.system.cubic_stiffness) << "\n";
-  }
-  if (data.system.kind == SystemKind::kSelfSustained) {
-    s << "z_coefficients = [" << g17(data.system.z_coefficients[0]) << ", "
-      << g17(data.system.z_coefficients[1]) << ", " << g17(data.system.z_coefficients[2]) << "]\n";
-  } else {
-    s << "damping = " << g17(data.system.damping) << "\n";
-  }
-  s << "\n" << grid_text(cell, system);
+  if (!z.empty()) s << "\nz_coefficients = [" << g17(z[0]) << ", " << g17(z[1]) << ", " << g17(z[2]) << "]";
   return s.str();
 }
+
+}  // namespace
 
 std::string cell_sweep_text(const CellSpec& cell, const PhSystemData& data,
                             const std::string& system_entry) {
   std::ostringstream s;
   s << "# written by `phnn train --out`\n"
     << "name = \"train-" << data.system_name << "-" << to_string(cell.model) << "-"
-    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed
-    << training_text(cell) << "\n\n" << grid_text(cell, system_entry);
+    << to_string(cell.integrator) << "\"\n\n[data]\nseed = " << data.options.data_seed;
+  const bool builtin = !is_system_file_argument(system_entry);
+  if (builtin && data.options.energy_sampling != EnergySampling::kAlgorithm1) {  // a --data file's
+    s << "\nenergy_sampling = \"" << to_string(data.options.energy_sampling) << "\"";
+  }
+  s << training_text(cell);
+  if (builtin) s << physics_text(builtin_physics(data.system_text, data.system_name + "@system_file"));
+  s << "\n\n" << grid_text(cell, system_entry);
   return s.str();
 }
 

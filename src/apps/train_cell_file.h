@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "apps/provenance.h"
-#include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/sweep_file.h"
@@ -17,11 +16,9 @@
 namespace phnn {
 namespace apps {
 
-/// The cell as a one-study sweep file on a built-in system (its physics
-/// constants written out).
-std::string cell_sweep_text(const CellSpec& cell, const SystemData& data);
-
-/// The same for a system file's cell (`system_entry`: its path as given).
+/// The cell as a one-study sweep file on `system_entry` (a built-in name,
+/// with its physics constants written out from the data's system text, or a
+/// system file's path as given).
 std::string cell_sweep_text(const CellSpec& cell, const PhSystemData& data,
                             const std::string& system_entry);
 

@@ -90,18 +90,19 @@ VecX initial_state(const PhSystem& system, const DatasetOptions& options, Counte
   throw std::invalid_argument(os.str());
 }
 
-// q* >= 0 with H(q*, 0) = e (H(s, 0) increasing in s >= 0): bisection to
-// the last bit after doubling.
-double equilibrium_offset(const PhSystem& system, double e) {
+// s >= 0 with H(s e_1) = e (H(s e_1) increasing in s >= 0): bisection to
+// the last bit after doubling. `what` names the design in the error.
+double offset_at_energy(const PhSystem& system, double e, const std::string& what,
+                        const std::string& where) {
   auto energy = [&](double s) {
-    VecX x(2);
-    x << s, 0.0;
+    VecX x = VecX::Zero(system.n_x());
+    x(0) = s;
     return system.hamiltonian(x);
   };
   double hi = 1e-3;
   for (int it = 0; energy(hi) < e; ++it) {
-    PHNN_REQUIRE(it < 60, system.initial_location() << ": energy-shaping control: H(q, 0) stays "
-                                                    "below E_eq = " << e << "; lower control.energy");
+    PHNN_REQUIRE(it < 60, where << ": " << what << ": H(" << system.state_names()[0]
+                                << ", 0) stays below " << e << " J; lower that energy");
     hi *= 2.0;
   }
   double lo = 0.0;
@@ -111,6 +112,10 @@ double equilibrium_offset(const PhSystem& system, double e) {
     (energy(mid) < e ? lo : hi) = mid;
   }
   return energy(hi) - e <= e - energy(lo) ? hi : lo;
+}
+
+double equilibrium_offset(const PhSystem& system, double e) {
+  return offset_at_energy(system, e, "energy-shaping control (E_eq)", system.control_location("energy"));
 }
 
 // u_i ~ U(range[i]) for each input, in order.
@@ -254,12 +259,14 @@ PhTrajectorySpec ph_trajectory_spec(const PhSystem& system, const DatasetOptions
   return spec;
 }
 
-PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions& options,
-                                    std::int64_t index, int num_steps) {
+namespace {
+
+// `num_steps` DG steps at h_gen from spec.x0 under spec's inputs; `label`
+// names the trajectory in the Newton failure.
+PhTrajectory generate_from(const PhSystem& system, const DatasetOptions& options,
+                           const PhTrajectorySpec& spec, const std::string& label, int num_steps) {
   PHNN_REQUIRE(num_steps >= 0, "ph_generate_trajectory: num_steps = " << num_steps << " must be >= 0");
-  const PhTrajectorySpec spec = ph_trajectory_spec(system, options, index);
   PhTrajectory traj;
-  traj.index = index;
   traj.u = spec.u;
   const int stride = options.stride();
   if (!spec.inputs.empty()) {
@@ -279,14 +286,32 @@ PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions
                                                           options.generation_step, options.newton);
     if (step.status != StepStatus::kConverged) {
       std::ostringstream msg;
-      msg << "data generation: Newton did not converge for system " << system.name()
-          << ", trajectory " << index << ", step " << n << " (" << to_string(step.status)
-          << " after " << step.newton_iterations << " iterations, residual " << step.residual
+      msg << "data generation: Newton did not converge for system " << system.name() << ", "
+          << label << ", step " << n << " (" << to_string(step.status) << " after "
+          << step.newton_iterations << " iterations, residual " << step.residual
           << "); loosen newton.tolerance, shorten generation_step or check the system's parameters";
       throw std::runtime_error(msg.str());
     }
     traj.states.push_back(step.x_next);
   }
+  return traj;
+}
+
+// The states of `traj` at sr_infer (every stride-th), n = 0..steps.
+std::vector<VecX> subsampled(const PhTrajectory& traj, int stride, int steps) {
+  std::vector<VecX> sub;
+  sub.reserve(static_cast<std::size_t>(steps) + 1);
+  for (int n = 0; n <= steps; ++n) sub.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
+  return sub;
+}
+
+}  // namespace
+
+PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions& options,
+                                    std::int64_t index, int num_steps) {
+  PhTrajectory traj = generate_from(system, options, ph_trajectory_spec(system, options, index),
+                                    "trajectory " + std::to_string(index), num_steps);
+  traj.index = index;
   return traj;
 }
 
@@ -320,13 +345,37 @@ PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& op
   for (int j = 0; j < options.num_inference; ++j) {
     const std::int64_t i = options.inference_begin() + j;
     const PhTrajectory traj = ph_generate_trajectory(system, options, i, steps * stride);
-    std::vector<VecX> sub;
-    sub.reserve(static_cast<std::size_t>(steps) + 1);
-    for (int n = 0; n <= steps; ++n) sub.push_back(traj.states[static_cast<std::size_t>(n * stride)]);
     set.trajectory.push_back(i);
     set.u.push_back(traj.u);
-    set.states.push_back(std::move(sub));
+    set.states.push_back(subsampled(traj, stride, steps));
     if (!traj.inputs.empty()) set.inputs.push_back(traj.inputs);
+  }
+  return set;
+}
+
+// x0 = s e_1 with H(x0) = E per figure energy; u: the control design's
+// central input (Algorithm 4's middle of I_w, u = -(w1 + w2) / 2), else 0.
+PhInferenceSet ph_figure_set(const PhSystem& system, const DatasetOptions& options) {
+  options.validate();
+  const int stride = options.stride();
+  const int steps = options.num_inference_steps();
+  PhInferenceSet set;
+  set.step = stride * options.generation_step;
+  PhTrajectorySpec spec;
+  spec.u = VecX::Zero(system.n_u());
+  if (system.control_design().design == ControlDesign::Design::kLimitCycle) {
+    const auto iw = system.self_oscillation_interval();
+    spec.u(0) = -0.5 * (iw[0] + iw[1]);
+  }
+  for (const double e : system.figure_energies()) {
+    spec.x0 = VecX::Zero(system.n_x());
+    spec.x0(0) = offset_at_energy(system, e, "plots.energies", system.energy_location());
+    std::ostringstream label;
+    label << "the figure trajectory at H = " << e << " J";
+    const PhTrajectory traj = generate_from(system, options, spec, label.str(), steps * stride);
+    set.trajectory.push_back(-1);
+    set.u.push_back(spec.u);
+    set.states.push_back(subsampled(traj, stride, steps));
   }
   return set;
 }

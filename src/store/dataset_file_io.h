@@ -6,19 +6,18 @@
 
 #include "h5/h5file.h"
 #include "phnn/data/ph_dataset.h"
-#include "phnn/store/dataset_file.h"
 
 namespace phnn {
 namespace internal {
 
-/// Writes the three splits and the attributes under `group` ("/" or
-/// "/data/duffing"). In a parallel file every rank calls it with the same data.
-void write_system_data(h5::File& file, const std::string& group,
-                       const SystemData& data);
-SystemData read_system_data(const h5::File& file, const std::string& group);
+/// A format_version 1 group (a built-in system's 2-state layout, written
+/// before 2026-11-28) as a data set of the built-in system's file.
+PhSystemData read_version1_data(const h5::File& file, const std::string& group);
 
-/// The same for any system (format_version 2 of data-set files: state
-/// names, units, the system file's text as attributes of `group`).
+/// Writes the three splits and the attributes under `group` ("/" or
+/// "/data/duffing"; format_version 2: state names, units, the system
+/// file's text as attributes of `group`). In a parallel file every rank
+/// calls it with the same data. read_ph_system_data reads either version.
 void write_ph_system_data(h5::File& file, const std::string& group, const PhSystemData& data);
 PhSystemData read_ph_system_data(const h5::File& file, const std::string& group);
 

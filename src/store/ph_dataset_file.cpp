@@ -1,6 +1,6 @@
-// src/store/ph_dataset_file.cpp — format_version 2 data-set files
-// (include/phnn/store/ph_dataset_file.h); version 1 (built-in systems) is
-// read through dataset_file.cpp and converted.
+// src/store/ph_dataset_file.cpp — data-set files and groups
+// (include/phnn/store/ph_dataset_file.h): format_version 2 written and read;
+// version 1 (built-in systems before 2026-11-28) read by dataset_file.cpp.
 #include "phnn/store/ph_dataset_file.h"
 
 #include <sstream>
@@ -133,40 +133,6 @@ DatasetOptions read_options(const h5::File& file, const std::string& g) {
   return o;
 }
 
-// A version-1 (built-in, 2-state) data set in the n-dimensional form.
-PhSystemData from_version1(const SystemData& v1) {
-  PhSystemData d;
-  d.system_name = to_string(v1.system.kind);
-  d.state_names = {"q", "p"};
-  d.state_units = {"m", "kg m/s"};
-  d.input_names = {"u"};
-  d.n_w = 1;
-  d.options = v1.options;
-  auto pairs = [](const PairSet& p) {
-    PhPairSet out;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      out.x.push_back(p.x[i]);
-      out.x_next.push_back(p.x_next[i]);
-      out.u.push_back(VecX::Constant(1, p.u[i]));
-    }
-    out.trajectory = p.trajectory;
-    out.position = p.position;
-    out.step = p.step;
-    return out;
-  };
-  d.train = pairs(v1.train);
-  d.validation = pairs(v1.validation);
-  d.inference.trajectory = v1.inference.trajectory;
-  d.inference.step = v1.inference.step;
-  for (std::size_t i = 0; i < v1.inference.size(); ++i) {
-    d.inference.u.push_back(VecX::Constant(1, v1.inference.u[i]));
-    std::vector<VecX> traj;
-    for (const Vec2& x : v1.inference.states[i]) traj.push_back(x);
-    d.inference.states.push_back(std::move(traj));
-  }
-  return d;
-}
-
 }  // namespace
 
 std::string data_set_checksum(const PhSystemData& data) {
@@ -256,6 +222,14 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
 }
 
 PhSystemData read_ph_system_data(const h5::File& file, const std::string& group) {
+  if (!file.has_attribute(group, "format_version") || file.int_attribute(group, "format_version") == 1) {
+    return read_version1_data(file, group);
+  }
+  if (file.int_attribute(group, "format_version") != 2) {
+    throw std::runtime_error(file.path() + ": " + group + " is a data set of format_version " +
+                             std::to_string(file.int_attribute(group, "format_version")) +
+                             "; this phnn reads versions 1 and 2: read it with a newer phnn");
+  }
   const std::string g = group;
   const std::string p = group == "/" ? "" : group;
   PhSystemData d;
@@ -317,9 +291,6 @@ PhSystemData read_ph_dataset_file(const std::string& path) {
   if (!file.has_attribute("/", "format") || file.string_attribute("/", "format") != "phnn-dataset") {
     throw std::runtime_error(path + ": not a phnn data set (no format = \"phnn-dataset\" "
                                     "attribute); write one with `phnn data`");
-  }
-  if (!file.has_attribute("/", "format_version") || file.int_attribute("/", "format_version") == 1) {
-    return from_version1(internal::read_system_data(file, "/"));
   }
   return internal::read_ph_system_data(file, "/");
 }

@@ -263,31 +263,20 @@ void ResultsFile::store_data_group(const std::string& system_name,
   });
 }
 
-void ResultsFile::store_system_data(const std::string& system_name, const SystemData& data) {
-  store_data_group(system_name, [&](const std::string& group) {
-    internal::write_system_data(impl_->file, group, data);
-  });
-}
-
 bool ResultsFile::has_system_data(const std::string& system_name) const {
   const std::string group = data_group(system_name);
   return impl_->independent([&] { return impl_->file.has_attribute(group, "complete"); });
 }
 
-SystemData ResultsFile::read_system_data(const std::string& system_name) const {
-  const std::string group = data_group(system_name);
-  return impl_->independent([&] { return internal::read_system_data(impl_->file, group); });
-}
-
-void ResultsFile::store_file_system_data(const std::string& system_name, const PhSystemData& data,
-                                         const std::string& sweep_entry) {
+void ResultsFile::store_system_data(const std::string& system_name, const PhSystemData& data,
+                                    const std::string& sweep_entry) {
   store_data_group(system_name, [&](const std::string& group) {
     internal::write_ph_system_data(impl_->file, group, data);
-    impl_->file.set_attribute(group, "sweep_entry", sweep_entry);
+    if (!sweep_entry.empty()) impl_->file.set_attribute(group, "sweep_entry", sweep_entry);
   });
 }
 
-PhSystemData ResultsFile::read_file_system_data(const std::string& system_name) const {
+PhSystemData ResultsFile::read_system_data(const std::string& system_name) const {
   const std::string group = data_group(system_name);
   return impl_->independent([&] { return internal::read_ph_system_data(impl_->file, group); });
 }

@@ -198,11 +198,7 @@ void copy_data_groups(const std::vector<ResultsFile>& files, const SweepSpec& sp
         continue;
       }
       damaged.clear();
-      if (system_file) {
-        to->store_file_system_data(name, file.read_file_system_data(name), system_file->entry);
-      } else {
-        to->store_system_data(name, file.read_system_data(name));
-      }
+      to->store_system_data(name, file.read_system_data(name), system_file ? system_file->entry : "");
       break;
     }
     if (!damaged.empty()) {

@@ -88,11 +88,6 @@ namespace {
 // its contents and its training pairs.
 SystemFileText read_data_file_entry(const std::string& file) {
   const PhSystemData data = read_ph_dataset_file(file);
-  if (data.system_text.empty()) {
-    throw std::runtime_error(file + " holds data of the built-in system " + data.system_name +
-                             " (a version-1 data set); make it from the system file, e.g. "
-                             "`phnn data --system sweeps/systems/" + data.system_name + ".toml`");
-  }
   SystemFileText t{file, data.system_text};
   t.data_checksum = data_set_checksum(data);
   t.data_train_pairs = static_cast<int>(data.train.size());

@@ -1,6 +1,7 @@
 // src/systems/ph_system.cpp — the PhSystem interface's shared parts (flows,
-// the generic Gonzalez discrete gradient), the built-in oscillators behind
-// it, and the registry make_system() (built-in names and system files).
+// the generic Gonzalez discrete gradient) and the registry make_system()
+// (built-in names, whose shipped files builtin_systems.h reads, and system
+// files).
 #include "phnn/systems/ph_system.h"
 
 #include <sys/stat.h>
@@ -11,7 +12,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include "phnn/systems/oscillators.h"
+#include "phnn/systems/builtin_systems.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {
@@ -160,71 +161,6 @@ int system_rng_id(const std::string& name) {
 
 namespace {
 
-Eigen::Vector2d as2(const VecX& x) { return Eigen::Vector2d(x(0), x(1)); }
-
-// A built-in oscillator behind PhSystem: its closed forms and the paper's
-// Algorithms 1-4 as designs.
-class BuiltinSystem : public PhSystem {
- public:
-  explicit BuiltinSystem(const OscillatorOptions& options)
-      : osc_(options), name_(to_string(options.kind)) {
-    states_ = {"q", "p"};
-    units_ = {"m", "kg m/s"};
-    inputs_ = {"u"};
-    S_ = osc_.S();
-    J_ = osc_.J();
-    initial_.method = options.kind == SystemKind::kDuffing
-                          ? InitialConditionDesign::Method::kEnergy
-                          : InitialConditionDesign::Method::kAlgorithm1;
-    control_.design = options.kind == SystemKind::kSelfSustained
-                          ? ControlDesign::Design::kLimitCycle
-                          : ControlDesign::Design::kEnergyShaping;
-  }
-  const std::string& name() const override { return name_; }
-  const std::vector<std::string>& state_names() const override { return states_; }
-  const std::vector<std::string>& state_units() const override { return units_; }
-  const std::vector<std::string>& input_names() const override { return inputs_; }
-  double hamiltonian(const VecX& x) const override { return osc_.hamiltonian(as2(x)); }
-  VecX grad_hamiltonian(const VecX& x) const override { return osc_.grad_hamiltonian(as2(x)); }
-  MatX hessian(const VecX& x) const override { return osc_.hessian(as2(x)); }
-  VecX dissipation(const VecX& w) const override {
-    return VecX::Constant(1, osc_.dissipation(w(0)));
-  }
-  MatX dissipation_jacobian(const VecX& w) const override {
-    return MatX::Constant(1, 1, osc_.dissipation_derivative(w(0)));
-  }
-  VecX dissipation_second(const VecX& w, const VecX& s) const override {
-    return VecX::Constant(1, osc_.dissipation_second_derivative(w(0)) * s(0) * s(0));
-  }
-  const MatX& S() const override { return S_; }
-  const MatX& J() const override { return J_; }
-  VecX discrete_gradient(const VecX& x, const VecX& dx) const override {
-    return osc_.discrete_gradient(as2(x), as2(dx));
-  }
-  MatX discrete_gradient_jacobian(const VecX& x, const VecX& dx) const override {
-    return osc_.discrete_gradient_jacobian(as2(x), as2(dx));
-  }
-  const InitialConditionDesign& initial_design() const override { return initial_; }
-  const ControlDesign& control_design() const override { return control_; }
-  int rng_id() const override { return static_cast<int>(osc_.kind()); }
-  const std::string& source_text() const override { return source_; }
-  std::array<double, 2> self_oscillation_interval() const override {
-    return osc_.self_oscillation_interval();
-  }
-
- private:
-  Oscillator osc_;
-  std::string name_, source_;
-  std::vector<std::string> states_, units_, inputs_;
-  MatX S_, J_;
-  InitialConditionDesign initial_;
-  ControlDesign control_;
-};
-
-}  // namespace
-
-namespace {
-
 bool is_path_argument(const std::string& s) {
   const std::string ext = ".toml";
   return s.find('/') != std::string::npos ||
@@ -286,13 +222,14 @@ std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
   const std::string shipped = shipped_system_path(name_or_path);
   if (!shipped.empty()) return load_system_file(shipped);
   if (!is_path_argument(name_or_path)) {
+    SystemKind kind;
     try {
-      return std::make_unique<BuiltinSystem>(
-          OscillatorOptions::defaults(parse_system(name_or_path)));
+      kind = parse_system(name_or_path);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(std::string(e.what()) + " (shipped system files are read from " +
                                   shipped_systems_dir() + ")");
     }
+    return builtin_system(OscillatorOptions::defaults(kind), BuiltinEnergies{});
   }
   std::string path = name_or_path;
   if (!base_dir.empty() && !path.empty() && path[0] != '/') path = base_dir + "/" + path;

@@ -172,6 +172,7 @@ class FileSystem : public PhSystem {
   std::vector<std::array<int, 2>> phase_pairs() const override {
     return def_.phase_pairs.empty() ? PhSystem::phase_pairs() : def_.phase_pairs;
   }
+  const std::vector<double>& figure_energies() const override { return def_.figure_energies; }
 
   /// Resolves the automatic box of initial.method = "energy" and checks H
   /// at the box's centre, axis ends and corners (finite, >= 0).

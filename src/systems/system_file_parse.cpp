@@ -425,6 +425,7 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
       const auto v = r.interval(*e, "control.energy");
       c.equilibrium_energy_min = v[0];
       c.equilibrium_energy_max = v[1];
+      def->lines["control.energy"] = Reader::line(*e);
     }
   } else if (design == "limit-cycle") {
     c.design = ControlDesign::Design::kLimitCycle;
@@ -443,12 +444,33 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
   }
 }
 
+// [plots] phase = [["q", "p"], ...] (state pairs of the phase plots);
+// energies = [E1, E2] (the figure trajectories start at x = s e_1 with
+// H(s e_1) = E_k, as the paper's Figures 4-6; needs H).
 void read_plots(const Reader& r, const toml::table& t, SystemDefinition* def) {
   const toml::node* n = r.get(t, "plots", false, "", 0);
   if (n == nullptr) return;
   const toml::table* pt = n->as_table();
   if (pt == nullptr) r.fail(Reader::line(*n), "[plots] must be a table");
-  const toml::node* phase = r.get(*pt, "phase", false, "", 0);
+  for (const auto& [key, value] : *pt) {
+    const std::string k(key.str());
+    if (k == "energies") {
+      const toml::array* a = value.as_array();
+      if (a == nullptr || a->empty() || a->size() > 2 || !def->has_energy()) {
+        r.fail(Reader::line(value), "plots.energies must be one or two energies [J] of the figure "
+                                    "trajectories, e.g. [0.5, 0.75], in a file that defines H");
+      }
+      for (const toml::node& e : *a) {
+        const double v = r.number(e, "plots.energies");
+        if (!(v > 0.0)) r.fail(Reader::line(e), "plots.energies must be > 0 J");
+        def->figure_energies.push_back(v);
+      }
+      def->lines["plots.energies"] = Reader::line(value);
+    } else if (k != "phase") {
+      r.fail(Reader::line(value), "unknown key plots." + k + "; [plots] knows phase and energies");
+    }
+  }
+  const toml::node* phase = pt->get("phase");
   if (phase == nullptr) return;
   const toml::array* a = phase->as_array();
   if (a == nullptr) r.fail(Reader::line(*phase), "plots.phase must be an array of state pairs");

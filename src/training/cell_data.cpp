@@ -1,4 +1,4 @@
-// src/training/cell_data.cpp — CellData from the two kinds of data sets.
+// src/training/cell_data.cpp — CellData from a data set and its system.
 #include "training/cell_data.h"
 
 #include "phnn/common/check.h"
@@ -7,23 +7,9 @@
 namespace phnn {
 namespace {
 
-Eigen::Matrix<double, 1, 1> as_vector(double u) { return Eigen::Matrix<double, 1, 1>(u); }
-const VecX& as_vector(const VecX& u) { return u; }
-
 template <class Vec>
 void append(const Vec& v, std::vector<double>* out) {
   for (int i = 0; i < static_cast<int>(v.size()); ++i) out->push_back(v(i));
-}
-
-FlatPairs flatten(const PairSet& p) {
-  FlatPairs out;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    append(p.x[i], &out.x);
-    append(p.x_next[i], &out.x_next);
-    out.u.push_back(p.u[i]);
-  }
-  out.count = p.size();
-  return out;
 }
 
 FlatPairs flatten(const PhPairSet& p) {
@@ -45,9 +31,8 @@ std::vector<double> row_major(const MatX& m) {
   return out;
 }
 
-// The split sizes, steps and inference trajectories of either data set.
-template <class Data>
-CellData common_cell_data(const Data& data) {
+// The split sizes, steps and inference trajectories.
+CellData common_cell_data(const PhSystemData& data) {
   CellData d;
   d.step = data.train.step;
   d.train = flatten(data.train);
@@ -58,9 +43,28 @@ CellData common_cell_data(const Data& data) {
   d.inference_step = data.inference.step;
   for (std::size_t i = 0; i < data.inference.size(); ++i) {
     for (const auto& x : data.inference.states[i]) append(x, &d.inference_states);
-    append(as_vector(data.inference.u[i]), &d.inference_u);
+    append(data.inference.u[i], &d.inference_u);
   }
   return d;
+}
+
+// The figure trajectories of `figures` (one is shown twice).
+void set_figures(const PhInferenceSet& figures, CellData* d) {
+  d->has_figures = true;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const std::size_t i = std::min(k, figures.size() - 1);
+    d->figure_references[k].clear();
+    for (const VecX& x : figures.states[i]) append(x, &d->figure_references[k]);
+    d->figure_x0[k].clear();
+    append(figures.states[i].front(), &d->figure_x0[k]);
+    d->figure_u[k].clear();
+    append(figures.u[i], &d->figure_u[k]);
+    // Time-varying inference inputs: the figures' constant u at every step.
+    d->figure_inputs[k].clear();
+    for (int n = 0; !d->inference_inputs.empty() && n < d->inference_steps; ++n) {
+      append(figures.u[i], &d->figure_inputs[k]);
+    }
+  }
 }
 
 }  // namespace
@@ -75,24 +79,10 @@ ModelStructure model_structure(const PhSystem& system) {
   return s;
 }
 
-CellData make_cell_data(const SystemData& data, bool with_figures) {
+CellData make_split_data(const PhSystemData& data) {
   CellData d = common_cell_data(data);
-  d.builtin = data.system.kind;
-  if (!with_figures) return d;
-  d.has_figures = true;
-  const FigureSetup fig = figure_setup(data.system);
-  d.figure_x0 = {std::vector<double>{fig.x0_05(0), fig.x0_05(1)},
-                 std::vector<double>{fig.x0_075(0), fig.x0_075(1)}};
-  d.figure_u = {std::vector<double>{fig.u}, std::vector<double>{fig.u}};
-  d.figure_references = {reference_trajectory(data.system, data.options, fig.x0_05, fig.u),
-                         reference_trajectory(data.system, data.options, fig.x0_075, fig.u)};
-  return d;
-}
-
-CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
-  CellData d = common_cell_data(data);
-  d.n_x = system.n_x();
-  d.n_u = system.n_u();
+  d.n_x = static_cast<int>(data.state_names.size());
+  d.n_u = static_cast<int>(data.input_names.size());
   // Time-varying inputs: u_n of steps 0..steps-1 (the last sample's input
   // moves no step).
   for (const auto& traj : data.inference.inputs) {
@@ -100,7 +90,20 @@ CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
                  "make_cell_data: " << traj.size() << " inputs for " << d.inference_steps << " steps");
     for (int n = 0; n < d.inference_steps; ++n) append(traj[static_cast<std::size_t>(n)], &d.inference_inputs);
   }
+  return d;
+}
+
+CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
+  CellData d = make_split_data(data);
+  PHNN_REQUIRE(d.n_x == system.n_x() && d.n_u == system.n_u(),
+               "make_cell_data: a data set of " << d.n_x << " states and " << d.n_u
+                                                 << " inputs for system " << system.name() << " of "
+                                                 << system.n_x() << " and " << system.n_u());
   d.general = std::make_shared<ModelStructure>(model_structure(system));
+  if (!system.figure_energies().empty() && system.has_energy()) {
+    set_figures(ph_figure_set(system, data.options), &d);
+    return d;
+  }
   if (d.inference_count == 0) return d;
   d.has_figures = true;
   const std::size_t nx = static_cast<std::size_t>(d.n_x), nu = static_cast<std::size_t>(d.n_u);

@@ -1,10 +1,7 @@
 // src/training/cell_data.h — what a cell trains and rolls out on, in any
 // dimension (private to src/training): the pairs and inference trajectories
-// as flat row-major arrays, the model structure (a built-in system's kind,
-// or a file-defined system's S and J), and the paper's figure trajectories
-// where the system has them (built-in systems). Made from a built-in
-// SystemData or from a file-defined system's PhSystemData; the same doubles
-// either way, so the paper path's tensors are bitwise what they were.
+// as flat row-major arrays, the model structure (the system's S and J), and
+// the two figure trajectories. Made from a data set and its system.
 #pragma once
 
 #include <array>
@@ -12,9 +9,7 @@
 #include <vector>
 
 #include "phnn/config/model_config.h"
-#include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
-#include "phnn/systems/oscillators.h"
 #include "phnn/systems/ph_system.h"
 
 namespace phnn {
@@ -37,16 +32,14 @@ struct CellData {
   std::size_t inference_count = 0;
   int inference_steps = 0;
   double inference_step = 0.01;
-  // The built-in system's kind (its models' structure: builtin_structure).
-  SystemKind builtin = SystemKind::kHarmonic;
   // The two figure trajectories: their x0 (n_x), input (n_u) and true
-  // trajectory ([steps + 1][n_x]). Built-in systems: the paper's, from
-  // H(x0) = 0.5 J and 0.75 J; system files: inference trajectories 0 and 1.
+  // trajectory ([steps + 1][n_x]): ph_figure_set's (the paper's three: from
+  // H(x0) = 0.5 J and 0.75 J), else inference trajectories 0 and 1.
   bool has_figures = false;
   std::array<std::vector<double>, 2> figure_x0, figure_u;
   std::array<std::vector<double>, 2> figure_inputs;  // [steps][n_u] as inference_inputs
   std::array<std::vector<double>, 2> figure_references;
-  // File-defined systems: the structure of the n-dimensional models.
+  // The structure of the models (the system's S and J).
   std::shared_ptr<const ModelStructure> general;
 };
 
@@ -56,12 +49,12 @@ struct CellSpec;  // phnn/training/trainer.h
 // finite data; std::invalid_argument naming the field and the fix.
 void validate_cell(const CellSpec& cell, const CellData& data);
 
-// A built-in system's data set, with its figure trajectories (two reference
-// integrations of the true system) unless `with_figures` is false (checks
-// that read the pairs and inference trajectories only).
-CellData make_cell_data(const SystemData& data, bool with_figures = true);
-// A file-defined (or any PhSystem's) data set; its figure trajectories are
-// inference trajectories 0 and 1 (the only one twice; none without any).
+// The splits of `data` alone (no structure, no figure trajectories): what
+// validate_cell reads.
+CellData make_split_data(const PhSystemData& data);
+// A data set of `system`. Its figure trajectories: ph_figure_set's when
+// the system has figure energies (generated here), else inference
+// trajectories 0 and 1 (the only one twice; none without any).
 CellData make_cell_data(const PhSystemData& data, const PhSystem& system);
 
 }  // namespace phnn

@@ -70,9 +70,7 @@ void require_finite_data(const CellData& data, int n_train) {
 
 }  // namespace
 
-void CellSpec::validate(const SystemData& data) const {
-  validate_cell(*this, make_cell_data(data, /*with_figures=*/false));
-}
+void CellSpec::validate(const PhSystemData& data) const { validate_cell(*this, make_split_data(data)); }
 
 void validate_cell(const CellSpec& cell, const CellData& data) {
   cell.training.validate();

@@ -8,7 +8,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "phnn/systems/oscillators.h"
 #include "training/rollout.h"
 
 namespace phnn {
@@ -112,26 +111,6 @@ Evaluation evaluate_on(const CellSpec& cell, const CellData& cell_data,
 
 }  // namespace
 
-std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemData& data,
-                                           const std::vector<double>& weights) {
-  return load_member(cell, make_cell_data(data, /*with_figures=*/false), weights);
-}
-
-Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
-                               const std::vector<double>& weights) {
-  std::unique_ptr<DynamicsModel> model;
-  Evaluation out = evaluate_on(cell, make_cell_data(data), weights, &model);
-  const RunResult& r = out.result;
-  const Oscillator system(data.system);
-  const auto energy = [&system](const VecX& x) { return system.hamiltonian(Vec2(x(0), x(1))); };
-  const std::vector<std::string> names = {"q", "p"};
-  out.energy_05 = energy_trace(*model, energy, data.inference.step, names,
-                               r.figure_prediction_05, r.figure_reference_05);
-  out.energy_075 = energy_trace(*model, energy, data.inference.step, names,
-                                r.figure_prediction_075, r.figure_reference_075);
-  return out;
-}
-
 Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
                                const PhSystem& system, const std::vector<double>& weights) {
   std::unique_ptr<DynamicsModel> model;
@@ -145,6 +124,7 @@ Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
                                r.figure_prediction_05, r.figure_reference_05);
   out.energy_075 = energy_trace(*model, energy, data.inference.step, data.state_names,
                                 r.figure_prediction_075, r.figure_reference_075);
+  if (system.has_energy()) out.figure_energies = system.figure_energies();
   return out;
 }
 

@@ -5,52 +5,13 @@
 
 #include "models/ordered_sum.h"
 #include "phnn/common/check.h"
-#include "phnn/integrators/discrete_gradient.h"
 
 #include "phnn/training/discrete_step.h"
 
 namespace phnn {
 
-FigureSetup figure_setup(const OscillatorOptions& system) {
-  auto q_at_energy = [&](double energy) {
-    const double b = 0.5 * system.stiffness;
-    const double a = system.kind == SystemKind::kDuffing ? 0.25 * system.cubic_stiffness : 0.0;
-    return std::sqrt(2.0 * energy / (b + std::sqrt(b * b + 4.0 * a * energy)));
-  };
-  FigureSetup setup;
-  setup.x0_05 = Vec2(q_at_energy(0.5), 0.0);
-  setup.x0_075 = Vec2(q_at_energy(0.75), 0.0);
-  if (system.kind == SystemKind::kSelfSustained) {
-    const auto iw = Oscillator(system).self_oscillation_interval();
-    setup.u = -0.5 * (iw[0] + iw[1]);
-  }
-  return setup;
-}
-
-std::vector<double> reference_trajectory(const OscillatorOptions& system,
-                                         const DatasetOptions& options, const Vec2& x0, double u) {
-  const Oscillator osc(system);
-  const int stride = options.stride();
-  const int steps = options.num_inference_steps();
-  std::vector<double> out;
-  out.reserve(2 * static_cast<std::size_t>(steps + 1));
-  Vec2 x = x0;
-  for (int n = 0; n <= steps; ++n) {
-    out.push_back(x(0));
-    out.push_back(x(1));
-    if (n == steps) break;
-    for (int k = 0; k < stride; ++k) {
-      const auto step = discrete_gradient_step(osc, x, u, options.generation_step, options.newton);
-      PHNN_REQUIRE(step.status == StepStatus::kConverged,
-                   "reference_trajectory: Newton failed at step " << n);
-      x = step.x_next;
-    }
-  }
-  return out;
-}
-
 ModelOptions inference_model_options(const CellSpec& cell, const CellData& data) {
-  return ModelOptions{cell.model, cell.size, data.builtin, cell.fused_networks,
+  return ModelOptions{cell.model, cell.size, SystemKind::kHarmonic, cell.fused_networks,
                       cell.training.dg_structure_point, torch::kFloat64, data.general};
 }
 

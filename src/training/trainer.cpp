@@ -401,11 +401,4 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const PhSystemData& data
   return train_cell_data(cell, make_cell_data(data, system), progress, trained, checkpointing);
 }
 
-std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
-                                  const ProgressCallback& progress,
-                                  std::unique_ptr<DynamicsModel>* trained,
-                                  const CellCheckpointing* checkpointing) {
-  return train_cell_data(cell, make_cell_data(data), progress, trained, checkpointing);
-}
-
 }  // namespace phnn

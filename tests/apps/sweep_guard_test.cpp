@@ -22,7 +22,8 @@
 
 #include "apps/provenance.h"
 #include "h5/h5file.h"
-#include "phnn/store/dataset_file.h"
+#include "phnn/store/ph_dataset_file.h"
+#include "phnn/systems/ph_system.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/writer_lock.h"
@@ -261,8 +262,7 @@ TEST(SweepGuardTest, OutputThatIsNotAResultsFileIsNeverReplaced) {
   const std::string text = write_file(dir + "/notes.txt", "my thesis\n");
   ASSERT_EQ(::mkdir((dir + "/adir").c_str(), 0755), 0);
   const std::string data = dir + "/data.h5";
-  write_dataset_file(data, make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic),
-                                            DatasetOptions{}, 2));
+  write_ph_dataset_file(data, make_ph_system_data(*make_system("harmonic"), DatasetOptions{}, 2));
   const std::string data_bytes = read_all(data);
   const std::vector<std::string> before = list_dir(dir);
   const std::pair<std::string, std::string> cases[] = {
@@ -311,14 +311,14 @@ TEST(SweepGuardTest, MissingDataGroupIsWrittenAgainOnResume) {
   const std::string sweep = write_file(dir + "/tiny.toml", kTinySweep);
   const std::string out = dir + "/out.h5";
   run_tiny(sweep, out, 1);
-  const SystemData expected = ResultsFile::open_read_only(out).read_system_data("harmonic");
+  const PhSystemData expected = ResultsFile::open_read_only(out).read_system_data("harmonic");
   {
     h5::File file = h5::File::open(out, h5::Access::kReadWrite);
     file.remove("/data/harmonic");
   }
   ASSERT_FALSE(ResultsFile::open_read_only(out).has_system_data("harmonic"));
   EXPECT_THAT(run_tiny(sweep, out, 2), HasSubstr("wrote the missing data group(s) /data/harmonic"));
-  const SystemData stored = ResultsFile::open_read_only(out).read_system_data("harmonic");
+  const PhSystemData stored = ResultsFile::open_read_only(out).read_system_data("harmonic");
   EXPECT_EQ(stored.train.u, expected.train.u);
   EXPECT_EQ(stored.validation.u, expected.validation.u);
   EXPECT_EQ(stored.inference.u, expected.inference.u);

@@ -1,7 +1,7 @@
-// tests/data/ph_dataset_test.cpp — data sets of file-defined systems: the
-// paper's three systems as files reproduce the built-in data, every stored
-// step of the new systems satisfies the discrete power balance, and the
-// version-2 data-set file round-trips.
+// tests/data/ph_dataset_test.cpp — data sets of system files: the paper's
+// three follow the closed-form discrete gradient, their figure trajectories
+// start at their energies, every stored step of the other systems satisfies
+// the discrete power balance, and the version-2 data-set file round-trips.
 #include "phnn/data/ph_dataset.h"
 
 #include <algorithm>
@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
+#include "phnn/integrators/discrete_gradient.h"
 #include "phnn/integrators/ph_steps.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/ph_dataset_file.h"
@@ -28,6 +29,21 @@ std::string shipped(const std::string& name) {
   return std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/" + name + ".toml";
 }
 
+// The closed-form 2-state discrete gradient (integrators/discrete_gradient.h,
+// the Oscillator class: an implementation independent of the system files'
+// compiled expressions and generic Gonzalez quotient) from x0 under u.
+std::vector<Vec2> closed_form_trajectory(SystemKind kind, const DatasetOptions& options,
+                                         const VecX& x0, double u, int steps) {
+  const Oscillator osc(OscillatorOptions::defaults(kind));
+  std::vector<Vec2> out = {Vec2(x0(0), x0(1))};
+  for (int n = 0; n < steps; ++n) {
+    const auto step = discrete_gradient_step(osc, out.back(), u, options.generation_step, options.newton);
+    EXPECT_EQ(step.status, StepStatus::kConverged);
+    out.push_back(step.x_next);
+  }
+  return out;
+}
+
 double max_diff(const std::vector<Vec2>& a, const std::vector<VecX>& b) {
   EXPECT_EQ(a.size(), b.size());
   double worst = 0.0;
@@ -37,45 +53,52 @@ double max_diff(const std::vector<Vec2>& a, const std::vector<VecX>& b) {
   return worst;
 }
 
-// Acceptance: `phnn data --system sweeps/systems/X.toml` equals `--system X`
-// to <= 1e-12 (the splits at reduced sizes, every index drawn as in the paper).
-TEST(PhDatasetTest, PaperSystemFilesReproduceTheBuiltInData) {
-  DatasetOptions options;
-  options.num_validation = 40;
-  options.num_inference = 3;
-  for (SystemKind kind : all_systems()) {
-    const std::string name = to_string(kind);
-    const SystemData builtin = make_system_data(OscillatorOptions::defaults(kind), options, 25);
-    const auto system = load_system_file(shipped(name));
-    const PhSystemData file = make_ph_system_data(*system, options, 25);
-    EXPECT_EQ(file.train.position, builtin.train.position) << name;
-    EXPECT_EQ(file.validation.position, builtin.validation.position) << name;
-    EXPECT_LE(max_diff(builtin.train.x, file.train.x), 1e-12) << name;
-    EXPECT_LE(max_diff(builtin.train.x_next, file.train.x_next), 1e-12) << name;
-    EXPECT_LE(max_diff(builtin.validation.x_next, file.validation.x_next), 1e-12) << name;
-    for (std::size_t i = 0; i < builtin.train.size(); ++i) {
-      EXPECT_NEAR(file.train.u[i](0), builtin.train.u[i], 1e-12) << name;
-    }
-    for (std::size_t i = 0; i < builtin.inference.size(); ++i) {
-      EXPECT_NEAR(file.inference.u[i](0), builtin.inference.u[i], 1e-12) << name;
-      EXPECT_LE(max_diff(builtin.inference.states[i], file.inference.states[i]), 1e-12) << name;
-    }
-  }
-}
-
-// A whole 2000-step trajectory of the paper's inference split, per system.
-TEST(PhDatasetTest, PaperSystemFilesReproduceAFullInferenceTrajectory) {
+// The paper's three systems, generated from their shipped files, follow the
+// closed-form discrete gradient to <= 1e-12 over whole 2000-step trajectories
+// (training, validation and inference indices).
+TEST(PhDatasetTest, BuiltInTrajectoriesFollowTheClosedFormDiscreteGradient) {
   const DatasetOptions options;
   for (SystemKind kind : all_systems()) {
-    const Oscillator osc(OscillatorOptions::defaults(kind));
-    const Trajectory builtin = generate_trajectory(osc, options, 2950, 2000);
-    const auto system = load_system_file(shipped(to_string(kind)));
-    const PhTrajectory file = ph_generate_trajectory(*system, options, 2950, 2000);
-    double worst = max_diff(builtin.states, file.states);
+    const auto system = make_system(to_string(kind));
+    double worst = 0.0;
+    for (std::int64_t index : {0, 401, 2950}) {
+      const PhTrajectory traj = ph_generate_trajectory(*system, options, index, 2000);
+      worst = std::max(worst, max_diff(closed_form_trajectory(kind, options, traj.states[0], traj.u(0), 2000),
+                                       traj.states));
+    }
     EXPECT_LE(worst, 1e-12) << to_string(kind);
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3e", worst);
-    RecordProperty("file_vs_builtin_" + to_string(kind), buf);
+    RecordProperty("file_vs_closed_form_" + to_string(kind), buf);
+  }
+}
+
+// The figure trajectories of the paper's systems: H(x0) = 0.5 and 0.75 J on
+// the q axis (closed form: k q^2 / 2 + k3 q^4 / 4 = E), u = 0 or the middle
+// of I_w, and the closed-form trajectory sub-sampled to sr_infer.
+TEST(PhDatasetTest, PaperFigureTrajectoriesStartAtTheirEnergies) {
+  DatasetOptions options;
+  for (SystemKind kind : all_systems()) {
+    const OscillatorOptions p = OscillatorOptions::defaults(kind);
+    const auto system = make_system(to_string(kind));
+    const PhInferenceSet figures = ph_figure_set(*system, options);
+    ASSERT_EQ(figures.size(), 2u);
+    const double u = kind == SystemKind::kSelfSustained
+                         ? -0.5 * (Oscillator(p).self_oscillation_interval()[0] +
+                                   Oscillator(p).self_oscillation_interval()[1])
+                         : 0.0;
+    for (std::size_t k = 0; k < 2; ++k) {
+      const double e = k == 0 ? 0.5 : 0.75;
+      const double b = 0.5 * p.stiffness, a = kind == SystemKind::kDuffing ? 0.25 * p.cubic_stiffness : 0.0;
+      const double q0 = std::sqrt(2.0 * e / (b + std::sqrt(b * b + 4.0 * a * e)));
+      EXPECT_NEAR(figures.states[k][0](0), q0, 2e-15 * q0) << to_string(kind);
+      EXPECT_EQ(figures.states[k][0](1), 0.0);
+      EXPECT_NEAR(figures.u[k](0), u, 1e-15);
+      const auto ref = closed_form_trajectory(kind, options, figures.states[k][0], figures.u[k](0), 2000);
+      std::vector<Vec2> sub;
+      for (std::size_t n = 0; n < ref.size(); n += 4) sub.push_back(ref[n]);
+      EXPECT_LE(max_diff(sub, figures.states[k]), 1e-12) << to_string(kind);
+    }
   }
 }
 
@@ -164,9 +187,10 @@ TEST(PhDatasetTest, VersionTwoFileRoundTripsWithNamesAndTheSystemText) {
   }
   EXPECT_EQ(back.inference.states[1], data.inference.states[1]);
   EXPECT_TRUE(is_dataset_file(path));
-  // The built-in reader names the version instead of failing on a missing attribute.
-  EXPECT_THAT([&] { read_dataset_file(path); },
-              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("format_version 2")));
+  // A version this phnn does not know is named, not misread.
+  h5::File::open(path, h5::Access::kReadWrite).set_attribute("/", "format_version", std::int64_t{3});
+  EXPECT_THAT([&] { read_ph_dataset_file(path); },
+              ::testing::ThrowsMessage<std::runtime_error>(HasSubstr("format_version 3")));
   std::remove(path.c_str());
 }
 

@@ -91,14 +91,14 @@ TEST(DiscreteGradient4Test, IsFourthOrderOnNonlinearSystems) {
   const DatasetOptions data;
   for (SystemKind kind : {SystemKind::kDuffing, SystemKind::kSelfSustained}) {
     const Oscillator osc(OscillatorOptions::defaults(kind));
-    const TrajectorySpec spec = trajectory_spec(osc, data, /*index=*/5);
+    const testing_util::PaperTrajectory spec = testing_util::paper_trajectory(kind, data, /*index=*/5, 0);
     const double T = 1.0;
     const Vec2 reference =
-        integrate_rk4(osc, spec.x0, spec.u, T / (200 * 64), 200 * 64);
+        integrate_rk4(osc, spec.states[0], spec.u, T / (200 * 64), 200 * 64);
     double previous = 0.0;
     for (int steps : {100, 200, 400}) {
       const double err =
-          (integrate_dg4(osc, spec.x0, spec.u, T / steps, steps) - reference)
+          (integrate_dg4(osc, spec.states[0], spec.u, T / steps, steps) - reference)
               .norm();
       if (previous > 0.0) {
         EXPECT_NEAR(std::log2(previous / err), 4.0, 0.15)
@@ -118,8 +118,8 @@ TEST(DiscreteGradient4Test, SatisfiesDiscretePowerBalance) {
   for (SystemKind kind : all_systems()) {
     const Oscillator osc(OscillatorOptions::defaults(kind));
     for (int index : {0, 1, 2}) {
-      const TrajectorySpec spec = trajectory_spec(osc, data, index);
-      Vec2 x = spec.x0;
+      const testing_util::PaperTrajectory spec = testing_util::paper_trajectory(kind, data, index, 0);
+      Vec2 x = spec.states[0];
       for (int n = 0; n < 300; ++n) {
         const DiscreteGradient4Step s =
             discrete_gradient4_step(osc, x, spec.u, h);

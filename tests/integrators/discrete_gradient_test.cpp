@@ -106,7 +106,7 @@ TEST(DiscreteGradientTest, GeneratedTrajectoriesSatisfyDiscretePowerBalance) {
     const Oscillator osc(OscillatorOptions::defaults(kind));
     double worst = 0.0;
     for (std::int64_t index : {0, 17, 401, 2950}) {
-      const Trajectory traj = generate_trajectory(osc, data, index, 2000);
+      const testing_util::PaperTrajectory traj = testing_util::paper_trajectory(kind, data, index, 2000);
       for (std::size_t n = 0; n + 1 < traj.states.size(); ++n) {
         const Vec2& x = traj.states[n];
         const DiscreteGradientStep step =

@@ -145,8 +145,9 @@ TEST_F(ResultsFileMpiTest, StoresSystemDataCollectively) {
   DatasetOptions options;
   options.num_validation = 10;
   options.num_inference = 2;
-  const SystemData data =
-      make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic), options, 25);
+  const PhSystemData data =
+      make_ph_system_data(*builtin_system(OscillatorOptions::defaults(SystemKind::kHarmonic), options),
+                          options, 25);
   ResultsFile file = create();
   file.store_system_data("harmonic", data);
   EXPECT_TRUE(file.has_system_data("harmonic"));
@@ -154,7 +155,7 @@ TEST_F(ResultsFileMpiTest, StoresSystemDataCollectively) {
   file.close();
   MPI_Barrier(MPI_COMM_WORLD);
   if (rank_ == 0) {
-    const SystemData back = ResultsFile::open_read_only(path_).read_system_data("harmonic");
+    const PhSystemData back = ResultsFile::open_read_only(path_).read_system_data("harmonic");
     ASSERT_EQ(back.train.size(), 25u);
     EXPECT_EQ(back.train.x_next[7], data.train.x_next[7]);
     EXPECT_EQ(back.inference.states[1][250], data.inference.states[1][250]);

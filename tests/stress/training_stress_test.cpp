@@ -15,19 +15,21 @@
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/discrete_step.h"
 #include "phnn/training/trainer.h"
+#include "training/small_data.h"
 
 namespace phnn {
 namespace {
 
-const SystemData& duffing_data() {
-  static const SystemData data = [] {
+const testing_util::SystemAndData& duffing_data() {
+  static const testing_util::SystemAndData data = [] {
     DatasetOptions options;
     options.num_validation = 200;
     options.num_inference = 100;
-    return make_system_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 25);
+    return testing_util::builtin_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 25);
   }();
   return data;
 }
+using testing_util::train_cell;
 
 // Guards: members whose rollouts diverge (learning rate 0.3) are reported
 // as diverged with +inf MSE, and the other members of their stack are

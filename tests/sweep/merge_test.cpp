@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
-#include "phnn/data/dataset.h"
+#include "phnn/data/ph_dataset.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
@@ -217,8 +217,9 @@ TEST_F(MergeShardsTest, DamagedDataOrSweepTextComesFromAnIntactShardOrIsRefused)
   options.num_train_max = 4;
   options.num_validation = 4;
   options.num_inference = 1;
-  const SystemData data =
-      make_system_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 4);
+  const PhSystemData data =
+      make_ph_system_data(*builtin_system(OscillatorOptions::defaults(SystemKind::kDuffing), options),
+                          options, 4);
   auto with_data = [&](const std::string& name, int row) {
     const std::string path = shard(name, {row});
     const std::string hash = parse_sweep_text(kSweep, "sweep.toml").text_hash;

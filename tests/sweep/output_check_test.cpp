@@ -13,7 +13,8 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
-#include "phnn/store/dataset_file.h"
+#include "phnn/store/ph_dataset_file.h"
+#include "phnn/systems/ph_system.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "sample_results.h"
@@ -77,8 +78,7 @@ TEST_F(OutputCheckTest, RefusesATextFileAndAnotherProgramsHdf5File) {
   EXPECT_EQ(check().state, OutputState::kRefused);
   EXPECT_THAT(check().message, HasSubstr("not an HDF5 file"));
   std::remove(out_.c_str());
-  write_dataset_file(out_, make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic),
-                                            DatasetOptions{}, 2));
+  write_ph_dataset_file(out_, make_ph_system_data(*make_system("harmonic"), DatasetOptions{}, 2));
   EXPECT_EQ(check().state, OutputState::kRefused);
   EXPECT_THAT(check().message, HasSubstr("not a phnn results file"));
 }

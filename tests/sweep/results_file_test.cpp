@@ -388,8 +388,9 @@ TEST_F(ResultsFileTest, StoresEachSystemsDataOnce) {
   DatasetOptions options;
   options.num_validation = 20;
   options.num_inference = 2;
-  const SystemData data =
-      make_system_data(OscillatorOptions::defaults(SystemKind::kDuffing), options, 25);
+  const PhSystemData data =
+      make_ph_system_data(*builtin_system(OscillatorOptions::defaults(SystemKind::kDuffing), options),
+                          options, 25);
   ResultsFile file = create();
   EXPECT_FALSE(file.has_system_data("duffing"));
   file.store_system_data("duffing", data);
@@ -397,8 +398,9 @@ TEST_F(ResultsFileTest, StoresEachSystemsDataOnce) {
   EXPECT_THAT([&] { file.store_system_data("duffing", data); },
               ThrowsMessage<std::invalid_argument>(HasSubstr("/data/duffing is already stored")));
   file.close();
-  const SystemData back = ResultsFile::open_read_only(path_).read_system_data("duffing");
-  EXPECT_EQ(back.system.kind, SystemKind::kDuffing);
+  const PhSystemData back = ResultsFile::open_read_only(path_).read_system_data("duffing");
+  EXPECT_EQ(back.system_name, "duffing");
+  EXPECT_EQ(back.system_text, data.system_text);
   ASSERT_EQ(back.train.size(), 25u);
   EXPECT_EQ(back.train.x[24], data.train.x[24]);
   EXPECT_EQ(back.inference.states[1][500], data.inference.states[1][500]);
@@ -441,7 +443,7 @@ TEST_F(ResultsFileTest, StoresFiguresOfAnyStateCountAndSystemFileData) {
                                            "name = demo\n", kSweepHash, "phnn-sweep 0.1.0", layout);
     file.write_run(0, two);
     file.write_run(1, four);
-    file.store_file_system_data("quad", data, "systems/quad.toml");
+    file.store_system_data("quad", data, "systems/quad.toml");
     file.close();
   }
   const ResultsFile file = ResultsFile::open_read_only(path_);
@@ -452,7 +454,7 @@ TEST_F(ResultsFileTest, StoresFiguresOfAnyStateCountAndSystemFileData) {
   const std::vector<double> column = file.read_double_column("figure/prediction_05");
   EXPECT_TRUE(std::isnan(column[2]) && std::isnan(column[3]));  // run 0, point 0, states 3-4
   EXPECT_EQ(bits(column[0]), bits(two.figure_prediction_05[0]));
-  const PhSystemData back = file.read_file_system_data("quad");
+  const PhSystemData back = file.read_system_data("quad");
   EXPECT_EQ(back.state_names, data.state_names);
   EXPECT_EQ(back.train.x_next[0], data.train.x_next[0]);
   const SystemFileText stored = file.stored_system_files()("systems/quad.toml");

@@ -120,17 +120,6 @@ TEST(SweepDataFilesTest, BadDataValuesFailAtTheirLineWithTheFix) {
   write_data(dir + "/d/duffing.h5", 0);
   EXPECT_THAT(error_in(dir, sweep("data = \"d/duffing.h5\"")),
               AllOf(HasSubstr("s.toml:6:"), HasSubstr("built-in system's name"), HasSubstr("rename")));
-  // A built-in system's (version 1) data set: no system file to name its states.
-  DatasetOptions o;
-  o.num_train_max = 4;
-  o.num_validation = 4;
-  o.num_inference = 1;
-  o.beta = 0.5;
-  write_dataset_file(dir + "/d/v1.h5",
-                     make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic), o, 4));
-  EXPECT_THAT(error_in(dir, sweep("data = \"d/v1.h5\"")),
-              AllOf(HasSubstr("s.toml:6:"), HasSubstr("built-in system harmonic"),
-                    HasSubstr("sweeps/systems/harmonic.toml")));
   // A structure-only system file (no H) as a system to generate: refused
   // at its line with the import route.
   EXPECT_THAT(error_in(dir, sweep("systems = [\"" + std::string(PHNN_SOURCE_DIR) +

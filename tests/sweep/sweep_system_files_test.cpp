@@ -203,7 +203,7 @@ TEST(SweepSystemFilesTest, SweepOfASystemFileFinishesResumesReducesAndEvaluates)
       EXPECT_EQ(x.trajectory_errors, y.trajectory_errors) << row;
       EXPECT_EQ(x.weights, y.weights) << row;
     }
-    const PhSystemData data = a.read_file_system_data("osc");
+    const PhSystemData data = a.read_system_data("osc");
     EXPECT_EQ(data.state_names, (std::vector<std::string>{"q", "p"}));
     EXPECT_THAT(data.system_text, HasSubstr("name = \"osc\""));
   }

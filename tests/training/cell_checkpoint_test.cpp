@@ -19,8 +19,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-const SystemData& duffing() { return testing_util::small_data(SystemKind::kDuffing); }
-const SystemData& harmonic() { return testing_util::small_data(SystemKind::kHarmonic); }
+const testing_util::SystemAndData& duffing() { return testing_util::small_data(SystemKind::kDuffing); }
+const testing_util::SystemAndData& harmonic() { return testing_util::small_data(SystemKind::kHarmonic); }
+using testing_util::train_cell;
 
 using Train = std::function<std::vector<RunResult>(const CellCheckpointing*)>;
 

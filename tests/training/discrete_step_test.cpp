@@ -7,6 +7,7 @@
 #include "phnn/models/general_ph.h"
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/trainer.h"
+#include "training/small_data.h"
 
 namespace phnn {
 namespace {
@@ -304,8 +305,8 @@ std::unique_ptr<DynamicsModel> learned_model(ModelKind kind) {
   DatasetOptions options;
   options.num_validation = 100;
   options.num_inference = 2;
-  static const SystemData data =
-      make_system_data(OscillatorOptions::defaults(SystemKind::kHarmonic), options, 100);
+  static const testing_util::SystemAndData data =
+      testing_util::builtin_data(OscillatorOptions::defaults(SystemKind::kHarmonic), options, 100);
   CellSpec cell;
   cell.model = kind;
   cell.integrator = IntegratorKind::kDg;
@@ -313,7 +314,7 @@ std::unique_ptr<DynamicsModel> learned_model(ModelKind kind) {
   cell.seeds = {0};
   cell.training.steps = 1000;
   std::unique_ptr<DynamicsModel> model;
-  const auto results = train_cell(cell, data, {}, &model);
+  const auto results = testing_util::train_cell(cell, data, {}, &model);
   EXPECT_LT(results[0].best_validation_loss, 0.2 * results[0].trace.front().validation_loss);
   return model;
 }

@@ -25,6 +25,8 @@ using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
 using testing_util::small_data;
+using testing_util::SystemAndData;
+using testing_util::train_cell;
 
 double rel(double a, double b) { return std::abs(a - b) / std::max(std::abs(b), 1e-300); }
 
@@ -237,23 +239,23 @@ TEST(TrainerTest, NonFiniteDataIsRefusedWithItsPlace) {
   cell.training.steps = 10;
   cell.seeds = {0};
   {
-    SystemData data = small_data(SystemKind::kHarmonic);
-    data.train.x_next[3](1) = std::numeric_limits<double>::quiet_NaN();
+    SystemAndData data = small_data(SystemKind::kHarmonic);
+    data.data.train.x_next[3](1) = std::numeric_limits<double>::quiet_NaN();
     EXPECT_THAT([&] { train_cell(cell, data); },
                 ThrowsMessage<std::invalid_argument>(HasSubstr("training pair 3 has a non-finite")));
-    data.train.x_next[3](1) = 0.0;
-    data.train.x[30](0) = std::numeric_limits<double>::infinity();  // beyond n_train: unused
+    data.data.train.x_next[3](1) = 0.0;
+    data.data.train.x[30](0) = std::numeric_limits<double>::infinity();  // beyond n_train: unused
     EXPECT_NO_THROW(train_cell(cell, data));
   }
   {
-    SystemData data = small_data(SystemKind::kHarmonic);
-    data.validation.u[7] = std::numeric_limits<double>::infinity();
+    SystemAndData data = small_data(SystemKind::kHarmonic);
+    data.data.validation.u[7](0) = std::numeric_limits<double>::infinity();
     EXPECT_THAT([&] { train_cell(cell, data); },
                 ThrowsMessage<std::invalid_argument>(HasSubstr("validation pair 7")));
   }
   {
-    SystemData data = small_data(SystemKind::kHarmonic);
-    data.inference.states[2][40](0) = std::numeric_limits<double>::quiet_NaN();
+    SystemAndData data = small_data(SystemKind::kHarmonic);
+    data.data.inference.states[2][40](0) = std::numeric_limits<double>::quiet_NaN();
     EXPECT_THAT([&] { train_cell(cell, data); },
                 ThrowsMessage<std::invalid_argument>(
                     HasSubstr("inference trajectory 2 has a non-finite value (input u or the state at step 40)")));
@@ -418,7 +420,7 @@ TEST(TrainerTest, InferenceWeightsFinalRollsOutTheLastWeights) {
   cell.training.eval_every = 100;
   cell.training.learning_rate = 3e-2;
   cell.seeds = {1, 2, 3};
-  const SystemData& data = small_data(SystemKind::kHarmonic);
+  const SystemAndData& data = small_data(SystemKind::kHarmonic);
   const auto best = train_cell(cell, data);
   cell.training.inference_weights = InferenceWeights::kFinal;
   const auto final = train_cell(cell, data);
@@ -450,15 +452,15 @@ TEST(CellSpecTest, RejectsNodeWithDgAndBadCounts) {
   CellSpec cell;
   cell.model = ModelKind::kNode;
   cell.integrator = IntegratorKind::kDg;
-  EXPECT_THAT([&] { cell.validate(small_data(SystemKind::kHarmonic)); },
+  EXPECT_THAT([&] { cell.validate(small_data(SystemKind::kHarmonic).data); },
               ThrowsMessage<std::invalid_argument>(HasSubstr("integrator = dg with model = node")));
   cell.integrator = IntegratorKind::kRk2;
   cell.n_train = 401;
-  EXPECT_THAT([&] { cell.validate(small_data(SystemKind::kHarmonic)); },
+  EXPECT_THAT([&] { cell.validate(small_data(SystemKind::kHarmonic).data); },
               ThrowsMessage<std::invalid_argument>(HasSubstr("n_train = 401")));
   cell.n_train = 25;
   cell.training.steps = -1;
-  EXPECT_THAT([&] { cell.validate(small_data(SystemKind::kHarmonic)); },
+  EXPECT_THAT([&] { cell.validate(small_data(SystemKind::kHarmonic).data); },
               ThrowsMessage<std::invalid_argument>(HasSubstr("steps = -1")));
 }
 
@@ -506,7 +508,7 @@ TEST(TrainerTest, ChunkedLossPassesAreOnePassToTheBit) {
     std::vector<std::vector<RunResult>> runs;
     for (const int64_t chunk : {int64_t{1} << 40, int64_t{500}, int64_t{333}}) {
       internal::set_step_chunk(chunk);
-      runs.push_back(c.general ? train_cell(cell, coupled_data, *coupled)
+      runs.push_back(c.general ? phnn::train_cell(cell, coupled_data, *coupled)
                                : train_cell(cell, small_data(SystemKind::kDuffing)));
     }
     internal::set_step_chunk(500);

@@ -1,12 +1,15 @@
-// include/phnn/data/dataset.h
+// include/phnn/data/dataset.h — the options of data sets (sizes, timing,
+// splits, energy intervals, the DG generator's Newton) and the built-in
+// systems they configure. Generation: ph_dataset.h.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "phnn/integrators/discrete_gradient.h"
-#include "phnn/systems/oscillators.h"
+#include "phnn/systems/builtin_systems.h"
 
 namespace phnn {
 
@@ -68,85 +71,13 @@ struct DatasetOptions {
   void validate() const;
 };
 
-/// What defines a trajectory: its initial state and constant input.
-struct TrajectorySpec {
-  Vec2 x0 = Vec2::Zero();
-  double u = 0.0;
-};
+/// The energy intervals options set in a built-in system's designs
+/// (I_E0 = [energy_min, energy_max], I_Eeq = [equilibrium_energy_min, max]).
+BuiltinEnergies builtin_energies(const DatasetOptions& options);
 
-/// Initial state by Algorithm 1 (harmonic, self-sustained; *as written*:
-/// r ~ U(E_min, E_max), E0 = sqrt(r), or E0 = r with EnergySampling::kDirect)
-/// or Algorithm 2 (Duffing: rejection in
-/// the box |q| <= q_max, |p| <= sqrt(2 m E_max), H(q_max, 0) = E_max), and
-/// input by Algorithm 3 (harmonic, Duffing: E_eq ~ U(I_Eeq), sign of q* +-1)
-/// or Algorithm 4 (self-sustained: w ~ U(I_w), u = -w). Depends only on
-/// (data_seed, system, index).
-TrajectorySpec trajectory_spec(const Oscillator& system,
-                               const DatasetOptions& options,
-                               std::int64_t index);
-
-/// A trajectory at the generation rate: states[n] = x(n h_gen), n = 0..steps.
-struct Trajectory {
-  std::int64_t index = 0;
-  double u = 0.0;
-  std::vector<Vec2> states;
-};
-
-/// Generates trajectory `index` for `num_steps` DG steps at h_gen. Throws
-/// std::runtime_error naming system, trajectory and step if Newton fails.
-Trajectory generate_trajectory(const Oscillator& system,
-                               const DatasetOptions& options,
-                               std::int64_t index, int num_steps);
-
-/// Training or validation pairs (x_n, u, x_{n+1}) at sr_train, one per
-/// trajectory, uniform over positions with t_{n+1} <= alpha T0.
-struct PairSet {
-  std::vector<Vec2> x;
-  std::vector<Vec2> x_next;
-  std::vector<double> u;
-  std::vector<std::int64_t> trajectory;  // index in [0, N_traj)
-  std::vector<int> position;             // n at sr_train
-  double step = 0.01;                    // h = 1 / sr_train
-  std::size_t size() const { return x.size(); }
-};
-
-/// Pairs from trajectories [first, first + count). The pair drawn from a
-/// trajectory depends only on (data_seed, system, index).
-PairSet make_pairs(const Oscillator& system, const DatasetOptions& options,
-                   std::int64_t first, int count);
-
-/// Training pairs: the first n_train trajectories of the train split.
-PairSet training_pairs(const Oscillator& system, const DatasetOptions& options,
-                       int n_train);
-/// The validation split's pairs.
-PairSet validation_pairs(const Oscillator& system,
-                         const DatasetOptions& options);
-
-/// Inference trajectories at sr_infer: states[i][n], n = 0..num_inference_steps.
-struct InferenceSet {
-  std::vector<std::int64_t> trajectory;
-  std::vector<double> u;
-  std::vector<std::vector<Vec2>> states;
-  double step = 0.01;
-  std::size_t size() const { return u.size(); }
-};
-InferenceSet inference_set(const Oscillator& system,
-                           const DatasetOptions& options);
-
-/// Everything one system contributes to an experiment: the training pairs
-/// (first n_train of them are used by a run), validation pairs and inference
-/// trajectories (docs/METHOD.md §2).
-struct SystemData {
-  OscillatorOptions system;
-  DatasetOptions options;
-  PairSet train;
-  PairSet validation;
-  InferenceSet inference;
-};
-
-/// Generates a system's splits. `num_train` pairs of the train split (at most
-/// options.num_train_max) are generated; only what is asked is computed.
-SystemData make_system_data(const OscillatorOptions& system,
-                            const DatasetOptions& options, int num_train);
+/// The built-in system `physics.kind` (its shipped system file,
+/// builtin_systems.h) with the energy intervals of `options`.
+std::unique_ptr<PhSystem> builtin_system(const OscillatorOptions& physics,
+                                         const DatasetOptions& options);
 
 }  // namespace phnn

@@ -72,6 +72,13 @@ struct PhInferenceSet {
 };
 PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& options);
 
+/// The figure trajectories of a system with figure energies
+/// (PhSystem::figure_energies; the paper's Figures 4-6): x0 = s e_1 with
+/// H(x0) = E, u the control design's central input (limit-cycle: -(w1 +
+/// w2) / 2, the middle of Algorithm 4's I_w; else 0), at sr_infer over D as
+/// the inference trajectories (trajectory index -1). Empty without energies.
+PhInferenceSet ph_figure_set(const PhSystem& system, const DatasetOptions& options);
+
 /// A system's three splits with what names them.
 struct PhSystemData {
   std::string system_name, system_text;  // text: the system file ("" built-in)

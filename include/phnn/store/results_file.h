@@ -15,7 +15,6 @@
 #include "phnn/config/run_result.h"
 #include "phnn/config/system_file_text.h"
 #include "phnn/data/ph_dataset.h"
-#include "phnn/store/dataset_file.h"
 
 namespace phnn {
 
@@ -206,22 +205,18 @@ class ResultsFile {
   std::vector<std::string> read_string_column(const std::string& column) const;
 
   /// Collective: stores one system's data set once under /data/<system_name>
-  /// (every rank passes identical data) and flushes the file.
-  void store_system_data(const std::string& system_name, const SystemData& data);
+  /// (every rank passes identical data; format_version 2 of data-set files,
+  /// with the system file's text) and flushes the file. A system file's
+  /// `sweep_entry` is the sweep file's `systems` value that named it, so that
+  /// the sweep can be parsed again from this file alone
+  /// (stored_system_files); "" for a built-in system.
+  void store_system_data(const std::string& system_name, const PhSystemData& data,
+                         const std::string& sweep_entry = "");
   /// True once store_system_data(system_name, ...) has completed.
   bool has_system_data(const std::string& system_name) const;
-  /// Reads a data set stored by store_system_data.
-  SystemData read_system_data(const std::string& system_name) const;
-
-  /// Collective: stores a system file's data set once under
-  /// /data/<system_name> (format_version 2 of data-set files, with the
-  /// system file's text) and `sweep_entry`, the sweep file's `systems`
-  /// value that named the file, so that the sweep can be parsed again from
-  /// this file alone (stored_system_files). Flushes the file.
-  void store_file_system_data(const std::string& system_name, const PhSystemData& data,
-                              const std::string& sweep_entry);
-  /// Reads a data set stored by store_file_system_data.
-  PhSystemData read_file_system_data(const std::string& system_name) const;
+  /// Reads a stored data set (format_version 2, or 1: the built-in systems'
+  /// layout before 2026-11-28, read as their system files' data).
+  PhSystemData read_system_data(const std::string& system_name) const;
   /// The system files stored with their data sets, as a reader for
   /// parse_sweep_text: the text stored for the `systems` value `entry`;
   /// throws std::runtime_error naming the file when none is stored.

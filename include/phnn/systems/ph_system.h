@@ -163,6 +163,13 @@ class PhSystem {
   /// Pairs of state indices for phase plots: a system file's [plots] phase,
   /// else (0,1), (2,3), ... (an odd last state paired with the first).
   virtual std::vector<std::array<int, 2>> phase_pairs() const;
+  /// H [J] of the initial states of the figure trajectories (a system
+  /// file's [plots] energies; the paper's 0.5 and 0.75 J for its three): x0 =
+  /// s e_1 with H(s e_1) = E. Empty: the figures are inference trajectories.
+  virtual const std::vector<double>& figure_energies() const {
+    static const std::vector<double> none;
+    return none;
+  }
 
   /// Flows at effort e (in place of gradH) and input u.
   PhFlows flows(const VecX& effort, const VecX& u) const;

@@ -50,6 +50,9 @@ struct SystemDefinition {
   /// Pairs of state indices for phase plots ([plots] phase = [["q","p"]]);
   /// default: consecutive pairs (0,1), (2,3), ...
   std::vector<std::array<int, 2>> phase_pairs;
+  /// [plots] energies: H of the figure trajectories' initial states
+  /// (PhSystem::figure_energies); empty: the first inference trajectories.
+  std::vector<double> figure_energies;
   std::map<std::string, int> lines;  // key ("H", "S", "initial", ...) -> line
   int line_of(const std::string& key) const;
   /// False for a structure-only file (no H, z, [initial], [control]): it

@@ -10,18 +10,11 @@
 #include <vector>
 
 #include "phnn/config/run_result.h"
-#include "phnn/data/dataset.h"
+#include "phnn/data/ph_dataset.h"
 #include "phnn/models/dynamics_model.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {
-
-/// The model of `cell` (one seed) with `weights` loaded: DynamicsModel::
-/// parameters() order, each tensor row-major without its member axis.
-/// Throws std::invalid_argument if the cell has not exactly one seed or the
-/// weight count is not the model's parameter count.
-std::unique_ptr<DynamicsModel> load_member(const CellSpec& cell, const SystemData& data,
-                                           const std::vector<double>& weights);
 
 /// Energies along one figure trajectory (paper Figures 7, 9; a system
 /// file's inference trajectories 0 and 1), one row per point: t [s], the
@@ -40,16 +33,17 @@ struct Evaluation {
   /// the figure trajectories, as the trainer computes them (bitwise, since
   /// stacking members is exact).
   RunResult result;
-  /// From H(x0) = 0.5 J and 0.75 J.
+  /// Along the two figure trajectories (from H(x0) = 0.5 J and 0.75 J for
+  /// the paper's systems).
   EnergyTrace energy_05, energy_075;
+  /// H(x0) of the figure trajectories (PhSystem::figure_energies); empty
+  /// when they are inference trajectories 0 and 1.
+  std::vector<double> figure_energies;
 };
 
-/// Evaluates the run of `cell` (one seed) with its stored weights.
-Evaluation evaluate_stored_run(const CellSpec& cell, const SystemData& data,
-                               const std::vector<double>& weights);
-
-/// The same for a system file's run (figure trajectories: inference
-/// trajectories 0 and 1).
+/// Evaluates the run of `cell` (one seed) with its stored weights on
+/// `data` of `system` (figure trajectories: ph_figure_set's, else
+/// inference trajectories 0 and 1).
 Evaluation evaluate_stored_run(const CellSpec& cell, const PhSystemData& data,
                                const PhSystem& system, const std::vector<double>& weights);
 

@@ -12,7 +12,6 @@
 #include "phnn/config/run_config.h"
 #include "phnn/config/run_result.h"
 #include "phnn/config/trainer_options.h"
-#include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
 
 namespace phnn {
@@ -35,8 +34,9 @@ struct CellSpec {
   /// then selects the path of its float64 inference only.
   bool fused_networks = true;
 
-  /// Throws std::invalid_argument naming the field (e.g. NODE with DG).
-  void validate(const SystemData& data) const;
+  /// Throws std::invalid_argument naming the field (e.g. NODE with DG, an
+  /// n_train above the data's training pairs, non-finite data).
+  void validate(const PhSystemData& data) const;
 };
 
 /// The cell of `run` (its model, size, N_train, regularizer and training
@@ -103,14 +103,6 @@ struct CellInterrupted : std::runtime_error {
 /// If `trained` is given it receives the (float64) model stack the rollouts
 /// used, with the best weights.
 /// With `checkpointing`, training states are saved and resumed as it says.
-std::vector<RunResult> train_cell(const CellSpec& cell, const SystemData& data,
-                                  const ProgressCallback& progress = {},
-                                  std::unique_ptr<DynamicsModel>* trained = nullptr,
-                                  const CellCheckpointing* checkpointing = nullptr);
-
-/// The same for a file-defined system's data set (any n_x, n_u): the
-/// n-dimensional models of general_ph.h on the system's S and J; no figure
-/// trajectories (RunResult's figure fields stay empty).
 std::vector<RunResult> train_cell(const CellSpec& cell, const PhSystemData& data,
                                   const PhSystem& system, const ProgressCallback& progress = {},
                                   std::unique_ptr<DynamicsModel>* trained = nullptr,
@@ -119,20 +111,5 @@ std::vector<RunResult> train_cell(const CellSpec& cell, const PhSystemData& data
 /// The structure the n-dimensional models of a system use (its S and J,
 /// row-major, and n_x, n_w, n_u).
 ModelStructure model_structure(const PhSystem& system);
-
-/// Initial states of the figure trajectories (paper Figures 7 and 9):
-/// (q0, 0) with H(q0, 0) = energy, q0 > 0; and their input: u = 0 for
-/// harmonic / Duffing, u = -(center of I_w) for self-sustained.
-struct FigureSetup {
-  Vec2 x0_05, x0_075;
-  double u = 0.0;
-};
-FigureSetup figure_setup(const OscillatorOptions& system);
-
-/// Reference trajectory of the true system from x0 under u: DG at the data
-/// set's generation step, sub-sampled to sr_infer, num_inference_steps + 1
-/// states flattened [n][2].
-std::vector<double> reference_trajectory(const OscillatorOptions& system,
-                                         const DatasetOptions& options, const Vec2& x0, double u);
 
 }  // namespace phnn
