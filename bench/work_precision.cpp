@@ -5,9 +5,9 @@
 //
 //   build/work_precision [--trajectories N] [--repeats R] [--system FILE]... > wp.csv
 //
-// Without --system: the three built-in oscillators (2-state closed forms).
-// With --system FILE (repeatable): those system files instead, through the
-// n-dimensional steps of include/phnn/integrators/ph_steps.h.
+// Without --system: the paper's three oscillators (their shipped files).
+// With --system FILE or NAME (repeatable): those systems instead. Every
+// system through the steps of include/phnn/integrators/ph_steps.h.
 //   python3 analysis/plot_work_precision.py wp.csv docs/figures/
 //
 // Error: RMS over trajectories and the sample times t_k = k / 12.5 s
@@ -34,10 +34,6 @@
 #include <vector>
 
 #include "phnn/data/dataset.h"
-#include "phnn/integrators/discrete_gradient.h"
-#include "phnn/integrators/discrete_gradient4.h"
-#include "phnn/integrators/explicit_midpoint.h"
-#include "phnn/integrators/runge_kutta4.h"
 #include "phnn/data/ph_dataset.h"
 #include "phnn/integrators/ph_steps.h"
 #include "phnn/systems/system_file.h"
@@ -61,12 +57,7 @@ const char* name_of(Method m) {
   return "?";
 }
 
-// Continuous port power p(x) = z(w) w + u y at the true effort gradH(x).
-double port_power(const Oscillator& osc, const Vec2& x, double u) {
-  const PortFlows f = osc.flows(osc.grad_hamiltonian(x), u);
-  return f.z * f.w + u * f.y;
-}
-
+// Continuous port power p(x) = z(w)^T w + u^T y at the true effort gradH(x).
 double port_power(const PhSystem& sys, const VecX& x, const VecX& u) {
   const PhFlows f = sys.flows(sys.grad_hamiltonian(x), u);
   return f.z.dot(f.w) + u.dot(f.y);
@@ -79,38 +70,8 @@ struct StepResult {
   bool newton_failed = false;
 };
 
-// One step; with `diagnostics`, also the balance residual (kept out of the
-// timed passes: for RK it costs two more flow evaluations than the step).
-StepResult<Vec2> step(Method m, const Oscillator& osc, const Vec2& x, double u,
-                      double h, bool diagnostics) {
-  StepResult<Vec2> r;
-  double power = 0.0;  // h times the discrete port power of the step
-  if (m == Method::kDg) {
-    const DiscreteGradientStep s = discrete_gradient_step(osc, x, u, h);
-    r.x_next = s.x_next;
-    r.newton_failed = s.status != StepStatus::kConverged;
-    power = -h * (s.flows.z * s.flows.w + u * s.flows.y);
-  } else if (m == Method::kDg4) {
-    const DiscreteGradient4Step s = discrete_gradient4_step(osc, x, u, h);
-    r.x_next = s.x_next;
-    r.newton_failed = s.status != StepStatus::kConverged;
-    power = -h * (s.flows.z * s.flows.w + u * s.flows.y) +
-            h * h * h * s.correction_power;
-  } else {
-    r.x_next = m == Method::kRk2 ? explicit_midpoint_step(osc, x, u, h)
-                                 : runge_kutta4_step(osc, x, u, h);
-    if (diagnostics) {
-      power = -0.5 * h * (port_power(osc, x, u) + port_power(osc, r.x_next, u));
-    }
-  }
-  if (!diagnostics) return r;
-  const double H0 = osc.hamiltonian(x);
-  const double dH = osc.hamiltonian(r.x_next) - H0;
-  r.balance_residual = std::abs(dH - power) / (std::abs(H0) + std::abs(power));
-  return r;
-}
-
-// The same for a PhSystem (ph_steps.h).
+// One step (ph_steps.h); with `diagnostics`, also the balance residual (kept
+// out of the timed passes: for RK it costs two more flow evaluations).
 StepResult<VecX> step(Method m, const PhSystem& sys, const VecX& x, const VecX& u, double h,
                       bool diagnostics) {
   StepResult<VecX> r;
@@ -196,12 +157,6 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
-// A trajectory's initial state and input for the 2-state integrators.
-struct Spec2 {
-  Vec2 x0;
-  double u = 0.0;
-};
-
 template <class System, class Spec>
 void run_system(const std::string& name, const System& osc, const std::vector<Spec>& specs,
                 const Options& o) {
@@ -259,21 +214,10 @@ int main(int argc, char** argv) {
       "system,method,h,steps,rms_error,max_error,seconds_per_trajectory,"
       "worst_balance_residual,newton_failures,diverged_trajectories\n");
   const phnn::DatasetOptions data;
-  if (o.systems.empty()) {
-    for (phnn::SystemKind kind : phnn::all_systems()) {
-      // The closed-form 2-state integrators from the shipped file's draws.
-      const phnn::Oscillator osc(phnn::OscillatorOptions::defaults(kind));
-      const auto sys = phnn::builtin_system(osc.options(), data);
-      std::vector<phnn::Spec2> specs;
-      for (int i = 0; i < o.trajectories; ++i) {
-        const auto spec = phnn::ph_trajectory_spec(*sys, data, data.inference_begin() + i);
-        specs.push_back({phnn::Vec2(spec.x0(0), spec.x0(1)), spec.u(0)});
-      }
-      phnn::run_system(phnn::to_string(kind), osc, specs, o);
-    }
-  }
-  for (const std::string& path : o.systems) {
-    const auto sys = phnn::load_system_file(path);
+  std::vector<std::string> systems = o.systems;
+  if (systems.empty()) systems = {"harmonic", "duffing", "self-sustained"};
+  for (const std::string& path : systems) {
+    const auto sys = phnn::make_system(path);
     if (!sys->has_energy()) {
       std::fprintf(stderr, "work_precision: %s defines no energy H (structure only); give a system "
                            "file that generates data\n", path.c_str());

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "phnn/data/ph_dataset.h"
-#include "phnn/integrators/discrete_gradient.h"
-#include "phnn/integrators/explicit_midpoint.h"
-#include "phnn/systems/oscillators.h"
+#include "reference/discrete_gradient.h"
+#include "reference/explicit_midpoint.h"
+#include "reference/oscillator.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {

@@ -4,7 +4,7 @@
 #include "phnn/common/check.h"
 #include "phnn/models/general_ph.h"
 #include "phnn/models/port_hamiltonian.h"
-#include "phnn/systems/oscillators.h"
+#include "phnn/systems/builtin_systems.h"
 
 namespace phnn {
 
@@ -104,13 +104,12 @@ const std::vector<const StackedMlp*> DynamicsModel::networks() const {
 }
 
 ModelStructure builtin_structure(SystemKind kind) {
-  const Oscillator system(OscillatorOptions::defaults(kind));
+  const auto system = builtin_system(OscillatorOptions::defaults(kind), BuiltinEnergies{});
   ModelStructure s{2, 1, 1, {}, {}};
   for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) s.S.push_back(system.S()(r, c));
-  const Eigen::Matrix3d J = system.J();
+    for (int c = 0; c < 4; ++c) s.S.push_back(system->S()(r, c));
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) s.J.push_back(J(r, c));
+    for (int c = 0; c < 3; ++c) s.J.push_back(system->J()(r, c));
   return s;
 }
 

@@ -126,7 +126,7 @@ torch::Tensor PortHamiltonianModel::average_vector_field_gradient(const torch::T
 }
 
 // (DG4) for a learned model, the same scheme as the true systems'
-// (include/phnn/integrators/discrete_gradient4.h) with F(m, e) the model's
+// (include/phnn/integrators/ph_steps.h) with F(m, e) the model's
 // field from an effort e and its dissipation evaluated at m. One order-2 jet
 // of phi(s) = F(m + s, e + Q s) in the two state directions s gives at once
 //   phi(0)          = F(m, e) = v,

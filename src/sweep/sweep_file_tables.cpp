@@ -183,7 +183,7 @@ class TableWalker {
           [&] {
             spec_.physics[kind].validate();
             if (kind == SystemKind::kSelfSustained) {
-              (void)Oscillator(spec_.physics[kind]).self_oscillation_interval();
+              (void)self_oscillation_interval(spec_.physics[kind].z_coefficients);
             }
           },
           label, physics_lines_[kind], header);

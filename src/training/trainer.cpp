@@ -18,7 +18,7 @@
 #include "models/ordered_sum.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
-#include "phnn/integrators/discrete_gradient.h"
+#include "phnn/integrators/step_options.h"
 #include "phnn/models/dynamics_model.h"
 #include "phnn/training/discrete_step.h"
 #include "phnn/training/flat_adam.h"

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "phnn/data/ph_dataset.h"
-#include "phnn/systems/oscillators.h"
+#include "reference/oscillator.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {

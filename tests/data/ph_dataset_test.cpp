@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
-#include "phnn/integrators/discrete_gradient.h"
+#include "reference/discrete_gradient.h"
 #include "phnn/integrators/ph_steps.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/ph_dataset_file.h"

@@ -1,5 +1,5 @@
 // tests/integrators/discrete_gradient4_test.cpp
-#include "phnn/integrators/discrete_gradient4.h"
+#include "reference/discrete_gradient4.h"
 
 #include <cmath>
 #include <random>
@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "phnn/data/dataset.h"
-#include "phnn/integrators/runge_kutta4.h"
+#include "reference/runge_kutta4.h"
 #include "test_util.h"
 
 namespace phnn {

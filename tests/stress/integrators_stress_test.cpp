@@ -10,10 +10,10 @@
 #include <gtest/gtest.h>
 
 #include "phnn/data/ph_dataset.h"
-#include "phnn/integrators/discrete_gradient.h"
-#include "phnn/integrators/discrete_gradient4.h"
-#include "phnn/integrators/explicit_midpoint.h"
-#include "phnn/integrators/runge_kutta4.h"
+#include "reference/discrete_gradient.h"
+#include "reference/discrete_gradient4.h"
+#include "reference/explicit_midpoint.h"
+#include "reference/runge_kutta4.h"
 
 namespace phnn {
 namespace {

@@ -1,5 +1,5 @@
 // tests/systems/oscillators_test.cpp
-#include "phnn/systems/oscillators.h"
+#include "reference/oscillator.h"
 
 #include <cmath>
 #include <random>

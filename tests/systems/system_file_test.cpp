@@ -11,7 +11,7 @@
 #include <random>
 #include <string>
 
-#include "phnn/systems/oscillators.h"
+#include "reference/oscillator.h"
 #include "phnn/common/counted.h"
 #include "phnn/systems/ph_system.h"
 #include "systems/expression_code.h"

@@ -7,6 +7,7 @@
 #include "phnn/models/general_ph.h"
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/trainer.h"
+#include "reference/oscillator.h"
 #include "training/small_data.h"
 
 namespace phnn {

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "phnn/data/ph_dataset.h"
-#include "phnn/systems/oscillators.h"
+#include "reference/oscillator.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {

@@ -2,6 +2,7 @@
 // freezing, the knobs), in float64 and float32 training.
 // Size: one test file per module.
 #include "phnn/training/trainer.h"
+#include "reference/oscillator.h"
 
 #include <algorithm>
 #include <cmath>

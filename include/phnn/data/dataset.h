@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "phnn/integrators/discrete_gradient.h"
+#include "phnn/integrators/step_options.h"
 #include "phnn/systems/builtin_systems.h"
 
 namespace phnn {

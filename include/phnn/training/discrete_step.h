@@ -15,7 +15,7 @@ namespace phnn {
 torch::Tensor rk2_step(const DynamicsModel& model, const torch::Tensor& x,
                        const torch::Tensor& u, double h, const torch::Tensor& k1 = {});
 
-/// Classical RK4 (include/phnn/integrators/runge_kutta4.h has the tableau):
+/// Classical RK4 (include/phnn/integrators/ph_steps.h has the tableau):
 ///   x_hat = x + h (k1 + 2 k2 + 2 k3 + k4) / 6, four evaluations of f.
 torch::Tensor rk4_step(const DynamicsModel& model, const torch::Tensor& x,
                        const torch::Tensor& u, double h, const torch::Tensor& k1 = {});

@@ -1,5 +1,5 @@
-// src/integrators/runge_kutta4.cpp
-#include "phnn/integrators/runge_kutta4.h"
+// tests/reference/runge_kutta4.cpp — reference/runge_kutta4.h.
+#include "reference/runge_kutta4.h"
 
 namespace phnn {
 

@@ -1,5 +1,5 @@
-// src/integrators/explicit_midpoint.cpp
-#include "phnn/integrators/explicit_midpoint.h"
+// tests/reference/explicit_midpoint.cpp — reference/explicit_midpoint.h.
+#include "reference/explicit_midpoint.h"
 
 namespace phnn {
 

@@ -1,10 +1,12 @@
-// include/phnn/integrators/runge_kutta4.h
+// tests/reference/runge_kutta4.h — the 2-state closed-form step of the paper's
+// oscillators (test code: the reference the n-dimensional steps of
+// ph_steps.h are compared with).
 // The classical fourth-order Runge-Kutta step: the explicit fourth-order
 // scheme of the integrator work-precision study and of the `rk4` discrete
 // models. Owns nothing but the step; touches no file.
 #pragma once
 
-#include "phnn/systems/oscillators.h"
+#include "reference/oscillator.h"
 
 namespace phnn {
 

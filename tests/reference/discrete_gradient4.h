@@ -1,4 +1,6 @@
-// include/phnn/integrators/discrete_gradient4.h
+// tests/reference/discrete_gradient4.h — the 2-state closed-form step of the paper's
+// oscillators (test code: the reference the n-dimensional steps of
+// ph_steps.h are compared with).
 // A fourth-order, energy-consistent discrete-gradient step for the
 // oscillators' PH-DAE: the implicit solve on the true systems (work-precision
 // study, stress suite). The same formula, with both end points known, is the
@@ -6,8 +8,8 @@
 // schemes", derives it).
 #pragma once
 
-#include "phnn/integrators/discrete_gradient.h"
-#include "phnn/systems/oscillators.h"
+#include "reference/discrete_gradient.h"
+#include "reference/oscillator.h"
 
 namespace phnn {
 

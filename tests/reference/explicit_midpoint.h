@@ -1,7 +1,9 @@
-// include/phnn/integrators/explicit_midpoint.h
+// tests/reference/explicit_midpoint.h — the 2-state closed-form step of the paper's
+// oscillators (test code: the reference the n-dimensional steps of
+// ph_steps.h are compared with).
 #pragma once
 
-#include "phnn/systems/oscillators.h"
+#include "reference/oscillator.h"
 
 namespace phnn {
 

@@ -1,5 +1,5 @@
-// src/integrators/discrete_gradient.cpp
-#include "phnn/integrators/discrete_gradient.h"
+// tests/reference/discrete_gradient.cpp — reference/discrete_gradient.h.
+#include "reference/discrete_gradient.h"
 
 #include <cmath>
 #include <limits>
@@ -7,33 +7,9 @@
 #include <Eigen/LU>
 
 #include "phnn/common/check.h"
-#include "phnn/integrators/explicit_midpoint.h"
+#include "reference/explicit_midpoint.h"
 
 namespace phnn {
-
-void DiscreteGradientOptions::validate() const {
-  PHNN_REQUIRE(std::isfinite(newton_tolerance) && newton_tolerance > 0.0,
-               "Invalid DiscreteGradientOptions: newton_tolerance = "
-                   << newton_tolerance
-                   << "; violated constraint: newton_tolerance > 0.");
-  PHNN_REQUIRE(max_newton_iterations >= 1,
-               "Invalid DiscreteGradientOptions: max_newton_iterations = "
-                   << max_newton_iterations
-                   << "; violated constraint: max_newton_iterations >= 1.");
-  PHNN_REQUIRE(std::isfinite(min_dx_norm) && min_dx_norm >= 0.0,
-               "Invalid DiscreteGradientOptions: min_dx_norm = "
-                   << min_dx_norm
-                   << "; violated constraint: min_dx_norm >= 0.");
-}
-
-std::string to_string(StepStatus status) {
-  switch (status) {
-    case StepStatus::kConverged: return "converged";
-    case StepStatus::kMaxIterations: return "max-iterations";
-    case StepStatus::kNonFinite: return "non-finite";
-  }
-  return "unknown";
-}
 
 Vec2 gonzalez_gradient(const std::function<double(const Vec2&)>& H,
                        const std::function<Vec2(const Vec2&)>& grad_H,

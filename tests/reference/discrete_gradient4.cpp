@@ -1,5 +1,5 @@
-// src/integrators/discrete_gradient4.cpp
-#include "phnn/integrators/discrete_gradient4.h"
+// tests/reference/discrete_gradient4.cpp — reference/discrete_gradient4.h.
+#include "reference/discrete_gradient4.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <Eigen/LU>
 
 #include "phnn/common/check.h"
-#include "phnn/integrators/runge_kutta4.h"
+#include "reference/runge_kutta4.h"
 
 namespace phnn {
 namespace {

@@ -1,28 +1,16 @@
-// include/phnn/integrators/discrete_gradient.h
+// tests/reference/discrete_gradient.h — the closed-form 2-state discrete
+// gradient step of the paper's oscillators (reference/oscillator.h): an
+// implementation independent of the system files' (ph_steps.h), which the
+// tests compare them with. Test code only.
 #pragma once
 
 #include <functional>
 #include <string>
 
-#include "phnn/systems/oscillators.h"
+#include "phnn/integrators/step_options.h"
+#include "reference/oscillator.h"
 
 namespace phnn {
-
-/// Options of the implicit discrete-gradient step. Defaults are docs/METHOD.md §2.
-struct DiscreteGradientOptions {
-  /// Newton stops when ||dx - h f_bar(dx)||_inf <= newton_tolerance. The
-  /// power-balance error of a step equals gradbar^T (residual), so this
-  /// tolerance shows up directly in the balance (docs/METHOD.md §2).
-  double newton_tolerance = 1e-14;
-  /// Reaching the cap is reported in DiscreteGradientStep::status.
-  int max_newton_iterations = 50;
-  /// Below this ||dx|| the generic Gonzalez quotient is 0/0-prone: use
-  /// gradH(x + dx/2) alone (docs/METHOD.md §4: tau = 6e-6, about cbrt(eps)).
-  double min_dx_norm = 6e-6;
-
-  /// Throws std::invalid_argument naming the field, value and constraint.
-  void validate() const;
-};
 
 /// Generic Gonzalez discrete gradient (eq: gonzalez-discrete-gradient;
 /// O. Gonzalez, J. Nonlinear Sci. 6:449-467, 1996):
@@ -37,9 +25,6 @@ Vec2 gonzalez_gradient(const std::function<double(const Vec2&)>& H,
                        const std::function<Vec2(const Vec2&)>& grad_H,
                        const Vec2& x, const Vec2& dx,
                        double min_dx_norm = 6e-6);
-
-enum class StepStatus { kConverged, kMaxIterations, kNonFinite };
-std::string to_string(StepStatus status);
 
 /// One implicit DG step of a PH-DAE and its port variables, evaluated at the
 /// discrete gradient: the power balance of the step reads
