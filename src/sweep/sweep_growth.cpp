@@ -188,7 +188,9 @@ CopiedRows copy_results(const ResultsFile& from, const std::string& out,
   std::vector<std::pair<int, int>> rows;  // (row, run)
   for (std::size_t run = 0; run < cmp.file_row_of_run.size(); ++run) {
     const int row = cmp.file_row_of_run[run];
-    if (row < 0 || status[row] == RunStatus::kPending) continue;
+    // A pending row with a checksum is a finished one whose status is
+    // damaged: copied (as damaged: repaired from the journal) like the rest.
+    if (row < 0 || (status[row] == RunStatus::kPending && !from.row_damaged(row))) continue;
     rows.emplace_back(row, static_cast<int>(run));
   }
   const std::vector<std::pair<int, int>> damaged = results_copy::copy_rows(from, rows, to);
