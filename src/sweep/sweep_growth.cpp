@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -169,6 +170,45 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
                 "unchanged";
 }
 
+// The canonical configuration of each row of the old version, checked
+// against the runs of the file's own sweep text (when that text hashes to
+// the file's sweep_hash): a row whose /runs/canonical differs is damaged
+// (its checksum fails too; named in *notes) and is compared by its run from
+// the text, so the damage is neither taken for a changed or dropped run nor
+// copied. With the text unusable too and the file digest finding the column
+// damaged, nothing tells the rows' runs: refused (the file is untouched).
+std::vector<std::string> checked_canonical(const ResultsFile& old, std::string* notes) {
+  std::vector<std::string> canonical = old.read_canonical();
+  std::optional<Grid> own;
+  try {
+    const SweepSpec spec = parse_sweep_text(old.sweep_text(), old.path() + "@sweep_text",
+                                            old.stored_system_files());
+    if (spec.text_hash == old.sweep_hash()) own = expand_grid(spec);
+  } catch (const std::exception&) {
+    // unusable: the digest below decides
+  }
+  if (!own || own->runs.size() != canonical.size()) {
+    for (const ResultsFile::Damage& d : old.file_damage()) {
+      if (d.object != "/runs/canonical") continue;
+      throw RunSetRefused(
+          old.path() + ": /runs/canonical is damaged (" + d.what + ") and so is the stored "
+          "sweep text (@sweep_text or @sweep_hash; `phnn verify` names them), so the runs of "
+          "its rows are unknown; the file is unchanged: move the file aside and run this sweep "
+          "again (it rebuilds the file from the journals in " + journal_directory(old.path()) +
+          "; runs they lack are trained again)");
+    }
+    return canonical;
+  }
+  for (std::size_t row = 0; row < canonical.size(); ++row) {
+    const std::string& expected = own->runs[row].canonical();
+    if (canonical[row] == expected) continue;
+    *notes += "; /runs/canonical[" + std::to_string(row) + "] is damaged (it differs from run " +
+              own->runs[row].id() + " of the file's own sweep text), compared as that run";
+    canonical[row] = expected;
+  }
+  return canonical;
+}
+
 // What became of the rows of the old version that hold a result, as
 // (sweep run, old row) pairs.
 struct CopiedRows {
@@ -254,12 +294,13 @@ std::string run_list(const std::vector<std::pair<int, int>>& pairs,
 std::string write_grown_results(const std::string& out, const SweepSpec& spec, const Grid& grid,
                                 const std::string& program_version) {
   CopiedRows copied;
+  std::string notes;  // damaged canonical cells
   std::vector<std::string> old_ids;
   std::string scratch;
   RunSetComparison cmp;
   {
     const ResultsFile old = ResultsFile::open_read_only(out);
-    const std::vector<std::string> canonical = old.read_canonical();
+    const std::vector<std::string> canonical = checked_canonical(old, &notes);
     cmp = compare_run_sets(canonical, old.read_statuses(), grid.runs);
     if (cmp.refused()) throw RunSetRefused(refusal_message(out, cmp, canonical));
     const std::vector<std::string> studies = results_copy::joined_studies(grid);
@@ -298,7 +339,7 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
                                     : "the sweep file lists the same runs in another order";
   }
   if (cmp.added && dropped) what += " and no longer has " + std::to_string(dropped) + " pending runs";
-  return out + ": " + what + "; new version of the file with " + kept;
+  return out + ": " + what + "; new version of the file with " + kept + notes;
 }
 
 }  // namespace phnn
