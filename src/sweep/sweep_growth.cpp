@@ -177,12 +177,15 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
 // the text, so the damage is neither taken for a changed or dropped run nor
 // copied. With the text unusable too and the file digest finding the column
 // damaged, nothing tells the rows' runs: refused (the file is untouched).
-std::vector<std::string> checked_canonical(const ResultsFile& old, std::string* notes) {
+// *text_hash: what the stored sweep text hashes to ("" if it does not parse).
+std::vector<std::string> checked_canonical(const ResultsFile& old, std::string* notes,
+                                           std::string* text_hash) {
   std::vector<std::string> canonical = old.read_canonical();
   std::optional<Grid> own;
   try {
     const SweepSpec spec = parse_sweep_text(old.sweep_text(), old.path() + "@sweep_text",
                                             old.stored_system_files());
+    *text_hash = spec.text_hash;
     if (spec.text_hash == old.sweep_hash()) own = expand_grid(spec);
   } catch (const std::exception&) {
     // unusable: the digest below decides
@@ -295,12 +298,14 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
                                 const std::string& program_version) {
   CopiedRows copied;
   std::string notes;  // damaged canonical cells
+  std::string stored_text_hash, stored_hash;
   std::vector<std::string> old_ids;
   std::string scratch;
   RunSetComparison cmp;
   {
     const ResultsFile old = ResultsFile::open_read_only(out);
-    const std::vector<std::string> canonical = checked_canonical(old, &notes);
+    const std::vector<std::string> canonical = checked_canonical(old, &notes, &stored_text_hash);
+    stored_hash = old.sweep_hash();
     cmp = compare_run_sets(canonical, old.read_statuses(), grid.runs);
     if (cmp.refused()) throw RunSetRefused(refusal_message(out, cmp, canonical));
     const std::vector<std::string> studies = results_copy::joined_studies(grid);
@@ -339,6 +344,12 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
                                     : "the sweep file lists the same runs in another order";
   }
   if (cmp.added && dropped) what += " and no longer has " + std::to_string(dropped) + " pending runs";
+  // The stored text is this sweep file's, only the attribute differs: it is
+  // damaged, not another sweep (written again like one, every result kept).
+  if (stored_text_hash == spec.text_hash && stored_hash != spec.text_hash) {
+    what = "damaged: @sweep_hash = " + stored_hash + ", but the stored sweep text hashes to " +
+           spec.text_hash + ", this sweep file's hash; written again from the sweep file";
+  }
   return out + ": " + what + "; new version of the file with " + kept + notes;
 }
 
