@@ -25,25 +25,52 @@ namespace phnn {
 namespace apps {
 namespace {
 
+// Why the file cannot be reduced as it stands, naming the damage: its
+// structure (a status out of range, an empty or repeated id), then (rule 2)
+// the objects its digests find damaged. "" if neither.
+std::string named_damage(const ResultsFile& file) {
+  const std::vector<std::string> problems = file.structure_problems();
+  if (!problems.empty()) return problems.front();
+  std::string objects;
+  for (const ResultsFile::Damage& d : file.file_damage()) {
+    if (d.object.rfind("/data/", 0) == 0) continue;  // the tables do not read /data
+    objects += (objects.empty() ? "" : "; ") + d.object + ": " + d.what;
+  }
+  return objects;
+}
+
+[[noreturn]] void refuse_damaged(const std::string& path, const std::string& what) {
+  throw std::runtime_error(path + ": damaged: " + what + "; `phnn verify " + path + "` names "
+                           "each damage and its repair, and `phnn sweep` with the file's sweep "
+                           "file repairs it");
+}
+
 // The grid of the file's sweep text, checked row by row against /runs/id.
+// A mismatch is damage (the stored text, its hash or the id column; rule 2's
+// digests say which), not another phnn version: ids are hashes of the runs'
+// configurations, the same in every version that reads the format.
 Grid checked_grid(const ResultsFile& file, const SweepSpec& spec) {
   const std::string& path = file.path();
   Grid grid = expand_grid(spec);
   const auto ids = file.read_run_ids();
+  std::string mismatch;
   if (ids.size() != grid.runs.size()) {
-    throw std::runtime_error(path + ": holds " + std::to_string(ids.size()) +
-                             " runs but its sweep text expands to " +
-                             std::to_string(grid.runs.size()) +
-                             "; was it written by another phnn version?");
+    mismatch = "/runs/id holds " + std::to_string(ids.size()) + " runs, the stored sweep text " +
+               "expands to " + std::to_string(grid.runs.size());
   }
-  for (std::size_t i = 0; i < ids.size(); ++i) {
+  for (std::size_t i = 0; mismatch.empty() && i < ids.size(); ++i) {
     if (ids[i] != grid.runs[i].id()) {
-      throw std::runtime_error(path + ": run " + std::to_string(i) + " has id " + ids[i] +
-                               " but the sweep text gives " + grid.runs[i].id() +
-                               "; was it written by another phnn version?");
+      mismatch = "/runs/id[" + std::to_string(i) + "] = " + ids[i] +
+                 ", the stored sweep text gives " + grid.runs[i].id();
     }
   }
-  return grid;
+  if (mismatch.empty()) return grid;
+  if (spec.text_hash != file.sweep_hash()) {
+    mismatch += "; the stored sweep text hashes to " + spec.text_hash + ", @sweep_hash says " +
+                file.sweep_hash();
+  }
+  const std::string named = named_damage(file);
+  refuse_damaged(path, named.empty() ? mismatch : named + " (" + mismatch + ")");
 }
 
 // RunRecord's trace summary from /runs/trace ([rows, trace_points, 7]:
@@ -135,8 +162,10 @@ std::vector<int> damaged_rows_named(const ResultsFile& file) {
   if (damaged.empty()) return damaged;
   const std::vector<std::string> ids = file.read_run_ids();
   std::cerr << "phnn reduce: warning: " << file.path() << ": " << damaged.size()
-            << " damaged rows (checksum mismatch) left out, counted as pending:";
-  for (int row : damaged) std::cerr << " " << ids[static_cast<std::size_t>(row)];
+            << " damaged rows left out, counted as pending:";
+  for (int row : damaged) {
+    std::cerr << " " << ids[static_cast<std::size_t>(row)] << " (row " << row << ")";
+  }
   std::cerr << "; `phnn verify` tells which the journals can repair, `phnn sweep` repairs them\n";
   return damaged;
 }
@@ -230,8 +259,13 @@ Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
   auto statuses = file.read_statuses();
   for (int row : in.damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
   auto mse = file.read_double_column("mse");
-  const SweepSpec own =
-      parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
+  SweepSpec own;
+  try {
+    own = parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
+  } catch (const std::exception& e) {
+    const std::string named = named_damage(file);
+    refuse_damaged(path, named.empty() ? e.what() : named + " (" + e.what() + ")");
+  }
   in.own_grid = checked_grid(file, own);
   if (!parser.has("rule")) {
     in.view.spec = own;
@@ -376,6 +410,9 @@ int run_reduce(int argc, char** argv, int first) {
   const TableFormat format = view.format;
   const std::string path = parser.get("FILE");
   const ResultsFile file = ResultsFile::open_read_only(path);
+  if (const auto problems = file.structure_problems(); !problems.empty()) {
+    refuse_damaged(path, problems.front());
+  }
   const Inputs in = read_inputs(file, parser);
   const SweepSpec& spec = in.view.spec;
   const Grid& grid = in.view.grid;

@@ -60,10 +60,10 @@ namespace mpi = boost::mpi;
 using Clock = std::chrono::steady_clock;
 
 // Set by SIGTERM / SIGUSR1 (Slurm's --signal before the time limit, or
-// scancel): save the training state of the item in hand (sweep_checkpoints.h),
-// take no new one, close the file cleanly.
+// scancel) once the sweep writes: save the training state of the item in
+// hand (sweep_checkpoints.h), take no new one, close the file cleanly.
+// Before that a stop ends the process at once (early_signals.h).
 volatile std::sig_atomic_t g_stop_signal = 0;
-extern "C" void request_stop(int signal) { g_stop_signal = signal; }
 
 // Exit status of a sweep stopped by a signal: EX_TEMPFAIL, "try again" — the
 // Slurm job script requeues on it.
@@ -188,6 +188,7 @@ class SweepRun {
     // Rank 0 alone creates or updates the file, serially; the other ranks open
     // it only to write their rows (docs/DECISIONS.md, "No rank waits forever").
     std::vector<int> status_codes;
+    end_setup_stops();  // from here on a stop is graceful: the lock, the file
     if (int status = agreed(world_, root_, [&] { status_codes = prepare_results(session); })) {
       return status;
     }
@@ -716,11 +717,12 @@ std::string SweepRun::adaptive_line() const {
 }  // namespace
 
 int run_sweep(int argc, char** argv, int first) {
-  // Before MPI_Init: a SIGTERM/SIGUSR1 while starting up is a clean stop too
-  // (exit 75), not 143/138; one caught before main (early_signals.h) counts.
-  std::signal(SIGTERM, request_stop);
-  std::signal(SIGUSR1, request_stop);
-  if (early_stop_signal() != 0) g_stop_signal = early_stop_signal();
+  // Before MPI_Init: a SIGTERM/SIGUSR1 while starting up, or during the
+  // symbolic work of a system file, is a clean stop too (exit 75, at once),
+  // not 143/138; one caught before main (early_signals.h) counts.
+  begin_setup_stops(&g_stop_signal, kExitStopped,
+                    "phnn sweep: stopped on a signal; run the same command again to resume "
+                    "(nothing was written yet)\n");
   mpi::environment env(argc, argv);
   return SweepRun(argc, argv, first).run();
 }

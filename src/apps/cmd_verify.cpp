@@ -70,6 +70,10 @@ std::string fix_of(const std::string& object) {
            "refuses: then move the file aside and run the sweep again (it rebuilds the file from "
            "the journals and the data from the sweep's systems, or their `phnn data` files)";
   }
+  if (object == "@sweep_hash") {
+    return "`phnn sweep` with the file's sweep file (the one whose text is the stored sweep "
+           "text) writes the file again from it, every result kept";
+  }
   return "`phnn sweep` with the file's sweep file (the one whose text hashes to the file's "
          "sweep_hash) rewrites it from that file";
 }

@@ -25,15 +25,20 @@ std::string g(double v) {
 
 // Shapes, finite values, >= 2 samples, increasing time.
 void check_trajectory(const MeasuredTrajectory& m, int nx, int nu) {
-  const std::size_t n = m.t.size();
-  PHNN_CHECK(m.x.size() == n && m.u.size() == n, "ragged trajectory from the reader");
+  const std::size_t n = m.size();
+  PHNN_CHECK(m.n_x == nx && m.n_u == nu && m.x.size() == n * static_cast<std::size_t>(nx) &&
+                 m.u.size() == n * static_cast<std::size_t>(nu),
+             "ragged trajectory from the reader");
   if (n < 2) {
     fail(m.where(0) + " has " + std::to_string(n) + " sample; a training pair (x_n, x_n+1) needs "
          "at least 2: drop it or record longer");
   }
+  const auto finite = [](const double* v, int count) {
+    return std::all_of(v, v + count, [](double a) { return std::isfinite(a); });
+  };
   for (std::size_t k = 0; k < n; ++k) {
-    PHNN_CHECK(m.x[k].size() == nx && m.u[k].size() == nu, "wrong width from the reader");
-    if (!std::isfinite(m.t[k]) || !m.x[k].allFinite() || !m.u[k].allFinite()) {
+    if (!std::isfinite(m.t[k]) || !finite(m.x.data() + k * static_cast<std::size_t>(nx), nx) ||
+        !finite(m.u.data() + k * static_cast<std::size_t>(nu), nu)) {
       fail(m.where(k) + ": a value is NaN or infinite; remove "
            "or repair the sample (phnn needs every state and input finite)");
     }
@@ -115,9 +120,9 @@ void draw_pair(const PhSystem& system, const MeasuredTrajectory& m, const Import
   CounterRng pick = CounterRng::for_trajectory(o.data_seed, system.rng_id(), m.id,
                                                CounterRng::kTrainingPair);
   const auto n = static_cast<std::size_t>(pick.below(static_cast<std::uint64_t>(positions)));
-  pairs->x.push_back(m.x[n]);
-  pairs->x_next.push_back(m.x[n + 1]);
-  pairs->u.push_back(m.u[n]);
+  pairs->x.push_back(m.state(n));
+  pairs->x_next.push_back(m.state(n + 1));
+  pairs->u.push_back(m.input(n));
   pairs->trajectory.push_back(m.id);
   pairs->position.push_back(static_cast<int>(n));
 }
@@ -142,6 +147,33 @@ void order_for_split(std::vector<MeasuredTrajectory>* all, const ImportOptions& 
 }
 
 }  // namespace
+
+void MeasuredTrajectory::add(double time, const double* state, const double* input) {
+  t.push_back(time);
+  x.insert(x.end(), state, state + n_x);
+  u.insert(u.end(), input, input + n_u);
+}
+
+VecX MeasuredTrajectory::state(std::size_t k) const {
+  return Eigen::Map<const VecX>(x.data() + k * static_cast<std::size_t>(n_x), n_x);
+}
+
+VecX MeasuredTrajectory::input(std::size_t k) const {
+  return Eigen::Map<const VecX>(u.data() + k * static_cast<std::size_t>(n_u), n_u);
+}
+
+bool MeasuredTrajectory::same_input(std::size_t k) const {
+  const auto w = static_cast<std::size_t>(n_u);
+  return std::equal(u.begin() + static_cast<long>(k * w), u.begin() + static_cast<long>((k + 1) * w),
+                    u.begin());
+}
+
+void MeasuredTrajectory::shrink() {
+  t.shrink_to_fit();
+  x.shrink_to_fit();
+  u.shrink_to_fit();
+  line.shrink_to_fit();
+}
 
 std::string MeasuredTrajectory::where(std::size_t k) const {
   if (k < line.size()) return source + ":" + std::to_string(line[k]) + ": trajectory " + std::to_string(id);
@@ -183,9 +215,9 @@ PhSystemData split_measured_data(const PhSystem& system,
   for (std::size_t i = 0; i < infer_begin; ++i) {
     draw_pair(system, trajectories[i], options, i < num_train ? &data.train : &data.validation);
   }
-  std::size_t samples = trajectories[infer_begin].t.size();
+  std::size_t samples = trajectories[infer_begin].size();
   for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    samples = std::min(samples, trajectories[i].t.size());
+    samples = std::min(samples, trajectories[i].size());
   }
   // Inputs that change within an inference trajectory are replayed sample
   // by sample at inference (zero-order hold); constant ones stay one per
@@ -193,14 +225,20 @@ PhSystemData split_measured_data(const PhSystem& system,
   bool varying = false;
   for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
     const MeasuredTrajectory& m = trajectories[i];
-    for (std::size_t k = 1; k < samples && !varying; ++k) varying = m.u[k] != m.u[0];
+    for (std::size_t k = 1; k < samples && !varying; ++k) varying = !m.same_input(k);
   }
   for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    const MeasuredTrajectory& m = trajectories[i];
+    MeasuredTrajectory& m = trajectories[i];
     data.inference.trajectory.push_back(m.id);
-    data.inference.u.push_back(m.u[0]);
-    data.inference.states.emplace_back(m.x.begin(), m.x.begin() + static_cast<long>(samples));
-    if (varying) data.inference.inputs.emplace_back(m.u.begin(), m.u.begin() + static_cast<long>(samples));
+    data.inference.u.push_back(m.input(0));
+    std::vector<VecX> states, inputs;
+    for (std::size_t k = 0; k < samples; ++k) states.push_back(m.state(k));
+    data.inference.states.push_back(std::move(states));
+    if (varying) {
+      for (std::size_t k = 0; k < samples; ++k) inputs.push_back(m.input(k));
+      data.inference.inputs.push_back(std::move(inputs));
+    }
+    m = MeasuredTrajectory();  // its numbers are in `data` now
   }
 
   // What the options record: the rate, the split sizes, the window and the
@@ -292,17 +330,13 @@ std::vector<MeasuredTrajectory> generated_trajectories(const PhSystem& system,
   std::vector<MeasuredTrajectory> out;
   // inputs: per sample (time-varying designs), else empty and u throughout.
   const auto add = [&](std::int64_t id, const VecX& u, const std::vector<VecX>& inputs,
-                       std::vector<VecX> states) {
-    MeasuredTrajectory m;
+                       const std::vector<VecX>& states) {
+    MeasuredTrajectory m(static_cast<int>(system.n_x()), static_cast<int>(u.size()));
     m.id = id;
     m.source = "generated";
-    for (std::size_t n = 0; n < states.size(); ++n) m.t.push_back(static_cast<double>(n) * h);
-    if (inputs.empty()) {
-      m.u.assign(states.size(), u);
-    } else {
-      m.u.assign(inputs.begin(), inputs.begin() + static_cast<long>(states.size()));
+    for (std::size_t n = 0; n < states.size(); ++n) {
+      m.add(static_cast<double>(n) * h, states[n].data(), (inputs.empty() ? u : inputs[n]).data());
     }
-    m.x = std::move(states);
     out.push_back(std::move(m));
   };
   for (const PhPairSet* pairs : {&data.train, &data.validation}) {
@@ -314,7 +348,7 @@ std::vector<MeasuredTrajectory> generated_trajectories(const PhSystem& system,
       const auto n = static_cast<std::size_t>(pairs->position[i]);
       PHNN_CHECK(sub[n] == pairs->x[i] && sub[n + 1] == pairs->x_next[i] && traj.input(n) == pairs->u[i],
                  "trajectory " << pairs->trajectory[i] << " regenerated differs from its pair");
-      add(pairs->trajectory[i], traj.u, traj.inputs, std::move(sub));
+      add(pairs->trajectory[i], traj.u, traj.inputs, sub);
     }
   }
   for (std::size_t i = 0; i < data.inference.size(); ++i) {

@@ -53,15 +53,24 @@ std::uint64_t ResultsFile::row_checksum(int row) const {
   });
 }
 
+// A pending row holds no checksum (create, requeue_run and write_run of a
+// pending result store 0): one that does had its status (or its checksum)
+// damaged, and is damaged itself — else a finished run whose status byte
+// turned 0 would read as pending and drop out of every check.
 std::string ResultsFile::row_damage(int row) const {
   const Impl& impl = *impl_;
   if (!impl.has_checksums) return "";
   const auto at = static_cast<std::uint64_t>(row);
   try {
     const std::int64_t code = impl.ints(kStatus, at, 1).at(0);
-    if (code == static_cast<std::int64_t>(RunStatus::kPending)) return "";
-    read_run(row);  // every value in range (rule 1 hashes what it returns)
     const std::int64_t stored = impl.ints(kChecksum, at, 1).at(0);
+    if (code == static_cast<std::int64_t>(RunStatus::kPending)) {
+      if (stored == 0) return "";
+      return kStatus + "[" + std::to_string(row) + "] = 0 (pending) but " + kChecksum + "[" +
+             std::to_string(row) + "] is set (only a row with a result has one): the status "
+             "or the checksum is damaged";
+    }
+    read_run(row);  // every value in range (rule 1 hashes what it returns)
     if (stored == 0) return "no checksum";
     if (static_cast<std::uint64_t>(stored) != row_checksum(row)) return "checksum mismatch";
   } catch (const std::exception& e) {
@@ -76,8 +85,10 @@ std::vector<int> ResultsFile::damaged_rows() const {
   std::vector<int> damaged;
   if (!impl_->has_checksums) return damaged;
   const std::vector<std::int64_t> codes = impl_->ints(kStatus);
+  const std::vector<std::int64_t> checksums = impl_->ints(kChecksum);
   for (int row = 0; row < impl_->num_runs; ++row) {
-    if (codes[static_cast<std::size_t>(row)] == static_cast<std::int64_t>(RunStatus::kPending)) {
+    const auto at = static_cast<std::size_t>(row);
+    if (codes[at] == static_cast<std::int64_t>(RunStatus::kPending) && checksums[at] == 0) {
       continue;
     }
     if (row_damaged(row)) damaged.push_back(row);

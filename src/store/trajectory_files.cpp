@@ -12,6 +12,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include "h5/h5file.h"
 
@@ -26,19 +27,22 @@ std::string list(const std::vector<std::string>& names) {
   return out;
 }
 
-std::string trim(const std::string& s) {
+std::string_view trim(std::string_view s) {
   const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
+  if (b == std::string_view::npos) return {};
   return s.substr(b, s.find_last_not_of(" \t") - b + 1);
 }
 
-std::vector<std::string> split_fields(const std::string& line) {
-  std::vector<std::string> out;
+// The fields of `line`, trimmed, into *out (views into `line`: no copies,
+// so a row costs no allocation once *out has grown to the header's width).
+void split_fields(std::string_view line, std::vector<std::string_view>* out) {
+  out->clear();
   std::size_t start = 0;
   for (;;) {
     const std::size_t comma = line.find(',', start);
-    out.push_back(trim(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
-    if (comma == std::string::npos) return out;
+    out->push_back(trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos
+                                                                           : comma - start)));
+    if (comma == std::string_view::npos) return;
     start = comma + 1;
   }
 }
@@ -70,31 +74,137 @@ std::vector<int> header_roles(const std::vector<std::string>& header, const Traj
   return roles;
 }
 
-double number(const std::string& field, const std::string& column, const std::string& at) {
+// `at` is called only to word an error ("a.csv:14").
+template <class Where>
+double number(std::string_view field, const std::string& column, const Where& at) {
   const char* b = field.data();
   const char* e = b + field.size();
   if (b != e && *b == '+') ++b;
   double v = 0;
   const auto r = std::from_chars(b, e, v);
   if (field.empty() || r.ec != std::errc() || r.ptr != e) {
-    fail(at + ": column " + column + ": \"" + field + "\" is not a number; write a decimal number "
-         "such as 0.25 or 1e-3");
+    fail(at() + ": column " + column + ": \"" + std::string(field) + "\" is not a number; write a "
+         "decimal number such as 0.25 or 1e-3");
   }
   if (!std::isfinite(v)) {
-    fail(at + ": column " + column + " is " + field + "; phnn needs finite values: remove or "
-         "repair the sample");
+    fail(at() + ": column " + column + " is " + std::string(field) + "; phnn needs finite values: "
+         "remove or repair the sample");
   }
   return v;
 }
 
-std::int64_t trajectory_id(const std::string& field, const std::string& at) {
+template <class Where>
+std::int64_t trajectory_id(std::string_view field, const Where& at) {
   std::int64_t id = -1;
   const auto r = std::from_chars(field.data(), field.data() + field.size(), id);
   if (field.empty() || r.ec != std::errc() || r.ptr != field.data() + field.size() || id < 0) {
-    fail(at + ": trajectory \"" + field + "\" is not a non-negative integer; number the "
-         "trajectories 0, 1, 2, ...");
+    fail(at() + ": trajectory \"" + std::string(field) + "\" is not a non-negative integer; number "
+         "the trajectories 0, 1, 2, ...");
   }
   return id;
+}
+
+}  // namespace
+
+namespace {
+
+// The rows of one CSV file into trajectories, one line at a time: fields
+// are views into the line and samples go straight into the trajectory's
+// flat arrays, so a row allocates nothing (a large file costs its numbers).
+class CsvTrajectories {
+ public:
+  CsvTrajectories(const std::string& path, const TrajectoryColumns& c)
+      : path_(path), columns_(c), nx_(static_cast<int>(c.states.size())),
+        nu_(static_cast<int>(c.inputs.size())), x_(c.states.size()), u_(c.inputs.size()) {}
+
+  void add_line(std::string_view text, int lineno);
+  std::vector<MeasuredTrajectory> finish();
+
+ private:
+  void add_sample(int lineno);
+  void start_trajectory(std::int64_t id, int lineno);
+
+  const std::string& path_;
+  const TrajectoryColumns& columns_;
+  const int nx_, nu_;
+  std::vector<MeasuredTrajectory> out_;
+  std::map<std::int64_t, int> first_line_;  // trajectory id -> line of its first row
+  std::vector<int> roles_;
+  std::vector<std::string> names_;
+  std::vector<std::string_view> fields_;
+  std::vector<double> x_, u_;
+};
+
+void CsvTrajectories::add_line(std::string_view text, int lineno) {
+  if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
+  if (lineno == 1 && text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 BOM
+  const std::string_view trimmed = trim(text);
+  if (trimmed.empty() || trimmed[0] == '#') return;
+  split_fields(text, &fields_);
+  if (!roles_.empty()) return add_sample(lineno);
+  names_.assign(fields_.begin(), fields_.end());
+  roles_ = header_roles(names_, columns_, path_ + ":" + std::to_string(lineno));
+}
+
+void CsvTrajectories::add_sample(int lineno) {
+  const auto at = [&] { return path_ + ":" + std::to_string(lineno); };
+  if (fields_.size() != roles_.size()) {
+    fail(at() + ": " + std::to_string(fields_.size()) + " fields where the header has " +
+         std::to_string(roles_.size()) + " (" + list(names_) + "); give every row one value "
+         "per column");
+  }
+  std::int64_t id = -1;
+  double t = 0;
+  for (std::size_t k = 0; k < fields_.size(); ++k) {
+    const int role = roles_[k];
+    if (role == -2) {
+      id = trajectory_id(fields_[k], at);
+      continue;
+    }
+    const double v = number(fields_[k], names_[k], at);
+    if (role == -1) {
+      t = v;
+    } else if (role < nx_) {
+      x_[static_cast<std::size_t>(role)] = v;
+    } else {
+      u_[static_cast<std::size_t>(role - nx_)] = v;
+    }
+  }
+  if (out_.empty() || out_.back().id != id) start_trajectory(id, lineno);
+  MeasuredTrajectory& m = out_.back();
+  if (m.size() > 0 && !(t > m.t.back())) {
+    std::ostringstream msg;
+    msg.precision(17);
+    msg << at() << ": trajectory " << id << ": t = " << t << " does not increase (the previous "
+        << "sample is at t = " << m.t.back() << "); sort each trajectory's rows by t";
+    fail(msg.str());
+  }
+  m.add(t, x_.data(), u_.data());
+  m.line.push_back(lineno);
+}
+
+void CsvTrajectories::start_trajectory(std::int64_t id, int lineno) {
+  const auto [it, fresh] = first_line_.emplace(id, lineno);
+  if (!fresh) {
+    fail(path_ + ":" + std::to_string(lineno) + ": trajectory " + std::to_string(id) +
+         " continues here after other rows (it started at line " + std::to_string(it->second) +
+         "); keep each trajectory's rows together, or give this one another id");
+  }
+  if (!out_.empty()) out_.back().shrink();
+  out_.emplace_back(nx_, nu_);
+  out_.back().id = id;
+  out_.back().source = path_;
+}
+
+std::vector<MeasuredTrajectory> CsvTrajectories::finish() {
+  if (roles_.empty()) {
+    fail(path_ + ": no header line (the file is empty); write the header trajectory,t," +
+         list(columns_.states) + (columns_.inputs.empty() ? "" : "," + list(columns_.inputs)) +
+         " and one row per sample");
+  }
+  if (out_.empty()) fail(path_ + ": a header and no samples; add one row per sample");
+  out_.back().shrink();
+  return std::move(out_);
 }
 
 }  // namespace
@@ -103,73 +213,11 @@ std::vector<MeasuredTrajectory> read_trajectory_csv(const std::string& path,
                                                     const TrajectoryColumns& c) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path + ": cannot open it (" + std::strerror(errno) + "); check the path");
-  const int nx = static_cast<int>(c.states.size()), nu = static_cast<int>(c.inputs.size());
-  std::vector<MeasuredTrajectory> out;
-  std::map<std::int64_t, int> first_line;  // trajectory id -> line of its first row
-  std::vector<int> roles;
-  std::vector<std::string> names;
+  CsvTrajectories reader(path, c);
   std::string line;
-  for (int lineno = 1; std::getline(in, line); ++lineno) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (lineno == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 BOM
-    if (trim(line).empty() || trim(line)[0] == '#') continue;
-    const std::string at = path + ":" + std::to_string(lineno);
-    const std::vector<std::string> fields = split_fields(line);
-    if (roles.empty()) {
-      roles = header_roles(fields, c, at);
-      names = fields;
-      continue;
-    }
-    if (fields.size() != roles.size()) {
-      fail(at + ": " + std::to_string(fields.size()) + " fields where the header has " +
-           std::to_string(roles.size()) + " (" + list(names) + "); give every row one value "
-           "per column");
-    }
-    std::int64_t id = -1;
-    double t = 0;
-    VecX x(nx), u(nu);
-    for (std::size_t k = 0; k < fields.size(); ++k) {
-      const int role = roles[k];
-      if (role == -2) {
-        id = trajectory_id(fields[k], at);
-      } else {
-        const double v = number(fields[k], names[k], at);
-        if (role == -1) t = v;
-        else if (role < nx) x(role) = v;
-        else u(role - nx) = v;
-      }
-    }
-    if (out.empty() || out.back().id != id) {
-      const auto [it, fresh] = first_line.emplace(id, lineno);
-      if (!fresh) {
-        fail(at + ": trajectory " + std::to_string(id) + " continues here after other rows "
-             "(it started at line " + std::to_string(it->second) + "); keep each trajectory's "
-             "rows together, or give this one another id");
-      }
-      out.emplace_back();
-      out.back().id = id;
-      out.back().source = path;
-    }
-    MeasuredTrajectory& m = out.back();
-    if (!m.t.empty() && !(t > m.t.back())) {
-      std::ostringstream msg;
-      msg.precision(17);
-      msg << at << ": trajectory " << id << ": t = " << t << " does not increase (the previous "
-          << "sample is at t = " << m.t.back() << "); sort each trajectory's rows by t";
-      fail(msg.str());
-    }
-    m.t.push_back(t);
-    m.x.push_back(x);
-    m.u.push_back(u);
-    m.line.push_back(lineno);
-  }
+  for (int lineno = 1; std::getline(in, line); ++lineno) reader.add_line(line, lineno);
   if (in.bad()) fail(path + ": read error (" + std::strerror(errno) + ")");
-  if (roles.empty()) {
-    fail(path + ": no header line (the file is empty); write the header trajectory,t," +
-         list(c.states) + (c.inputs.empty() ? "" : "," + list(c.inputs)) + " and one row per sample");
-  }
-  if (out.empty()) fail(path + ": a header and no samples; add one row per sample");
-  return out;
+  return reader.finish();
 }
 
 bool is_phnn_trajectory_csv(const std::string& path) {
@@ -192,11 +240,12 @@ void write_trajectory_csv(const std::string& path, const TrajectoryColumns& c,
     out.write(buf, r.ptr - buf);
   };
   for (const MeasuredTrajectory& m : trajectories) {
-    for (std::size_t k = 0; k < m.t.size(); ++k) {
+    const auto nx = static_cast<std::size_t>(m.n_x), nu = static_cast<std::size_t>(m.n_u);
+    for (std::size_t k = 0; k < m.size(); ++k) {
       out << m.id;
       put(m.t[k]);
-      for (Eigen::Index j = 0; j < m.x[k].size(); ++j) put(m.x[k](j));
-      for (Eigen::Index j = 0; j < m.u[k].size(); ++j) put(m.u[k](j));
+      for (std::size_t j = 0; j < nx; ++j) put(m.x[k * nx + j]);
+      for (std::size_t j = 0; j < nu; ++j) put(m.u[k * nu + j]);
       out << '\n';
     }
   }
@@ -223,8 +272,8 @@ std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
   std::vector<MeasuredTrajectory> out;
   for (const std::string& name : file.link_names(root)) {
     const std::string g = root + "/" + name, at = path + ":" + g;
-    MeasuredTrajectory m;
-    m.id = trajectory_id(name, at);
+    MeasuredTrajectory m(static_cast<int>(c.states.size()), static_cast<int>(c.inputs.size()));
+    m.id = trajectory_id(name, [&] { return at; });
     m.source = at;
     for (const char* d : {"t", "x"}) {
       if (!file.exists(g + "/" + d)) fail(at + ": no dataset " + d + fix);
@@ -239,20 +288,14 @@ std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
            "column per state (" + list(c.states) + ")" + fix);
     }
     m.t = file.read_doubles(g + "/t");
-    const std::vector<double> x = file.read_doubles(g + "/x");
-    std::vector<double> u;
+    m.x = file.read_doubles(g + "/x");  // row-major (N x n_x): the flat layout
     if (nu > 0) {
       const auto du = file.dims(g + "/u");
       if (du.size() != 2 || du[0] != n || du[1] != nu) {
         fail(at + ": u must be (N x " + std::to_string(nu) + "), one column per input (" +
              list(c.inputs) + ")" + fix);
       }
-      u = file.read_doubles(g + "/u");
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-      m.x.push_back(Eigen::Map<const VecX>(x.data() + k * nx, static_cast<Eigen::Index>(nx)));
-      m.u.push_back(nu ? VecX(Eigen::Map<const VecX>(u.data() + k * nu, static_cast<Eigen::Index>(nu)))
-                       : VecX(0));
+      m.u = file.read_doubles(g + "/u");
     }
     out.push_back(std::move(m));
   }

@@ -61,6 +61,14 @@ std::vector<ResultsFile> open_shards(const std::vector<std::string>& shards) {
                                "; phnn merge reads shard results files written by `phnn sweep "
                                "--shard I/N`");
     }
+    // Rows are matched by position: a shard whose ids repeat or whose
+    // statuses are out of range cannot say which run a row holds.
+    if (const auto problems = files.back().structure_problems(); !problems.empty()) {
+      throw std::runtime_error("shard " + path + ": damaged: " + problems.front() +
+                               "; nothing written: `phnn sweep` on its sweep file with the same "
+                               "--shard and --out moves it aside and rebuilds it from its "
+                               "journals, or leave the shard out of the merge");
+    }
     if (files.back().sweep_hash() != files.front().sweep_hash()) {
       throw std::invalid_argument(path + ": results of sweep '" + files.back().sweep_name() +
                                   "' (hash " + files.back().sweep_hash() + "), but " +
@@ -101,11 +109,12 @@ std::vector<int> result_sources(const std::vector<ResultsFile>& files,
     const std::vector<int> damaged_here = files[s].damaged_rows();
     int finished = 0, repeated = 0;
     for (std::size_t row = 0; row < source.size(); ++row) {
-      if (status[row] == RunStatus::kPending) continue;
+      // First: a damaged status can make a finished row read as pending.
       if (std::binary_search(damaged_here.begin(), damaged_here.end(), static_cast<int>(row))) {
         damaged.emplace_back(s, static_cast<int>(row));
         continue;
       }
+      if (status[row] == RunStatus::kPending) continue;
       ++finished;
       if (source[row] < 0) {
         source[row] = static_cast<int>(s);
@@ -132,7 +141,7 @@ std::vector<int> result_sources(const std::vector<ResultsFile>& files,
   for (const auto& [s, row] : damaged) {
     const std::string where = "shard " + shards[s] + " row " + std::to_string(row) + " (run " +
                               files[s].read_run_ids()[static_cast<std::size_t>(row)] +
-                              "): checksum mismatch";
+                              "): " + files[s].row_damage(row);
     if (source[static_cast<std::size_t>(row)] >= 0) {
       *notes += "\nphnn merge: note: " + where + "; took the good copy in " +
                 shards[static_cast<std::size_t>(source[static_cast<std::size_t>(row)])];

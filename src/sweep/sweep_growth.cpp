@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -169,6 +170,48 @@ std::string refusal_message(const std::string& out, const RunSetComparison& cmp,
                 "unchanged";
 }
 
+// The canonical configuration of each row of the old version, checked
+// against the runs of the file's own sweep text (when that text hashes to
+// the file's sweep_hash): a row whose /runs/canonical differs is damaged
+// (its checksum fails too; named in *notes) and is compared by its run from
+// the text, so the damage is neither taken for a changed or dropped run nor
+// copied. With the text unusable too and the file digest finding the column
+// damaged, nothing tells the rows' runs: refused (the file is untouched).
+// *text_hash: what the stored sweep text hashes to ("" if it does not parse).
+std::vector<std::string> checked_canonical(const ResultsFile& old, std::string* notes,
+                                           std::string* text_hash) {
+  std::vector<std::string> canonical = old.read_canonical();
+  std::optional<Grid> own;
+  try {
+    const SweepSpec spec = parse_sweep_text(old.sweep_text(), old.path() + "@sweep_text",
+                                            old.stored_system_files());
+    *text_hash = spec.text_hash;
+    if (spec.text_hash == old.sweep_hash()) own = expand_grid(spec);
+  } catch (const std::exception&) {
+    // unusable: the digest below decides
+  }
+  if (!own || own->runs.size() != canonical.size()) {
+    for (const ResultsFile::Damage& d : old.file_damage()) {
+      if (d.object != "/runs/canonical") continue;
+      throw RunSetRefused(
+          old.path() + ": /runs/canonical is damaged (" + d.what + ") and so is the stored "
+          "sweep text (@sweep_text or @sweep_hash; `phnn verify` names them), so the runs of "
+          "its rows are unknown; the file is unchanged: move the file aside and run this sweep "
+          "again (it rebuilds the file from the journals in " + journal_directory(old.path()) +
+          "; runs they lack are trained again)");
+    }
+    return canonical;
+  }
+  for (std::size_t row = 0; row < canonical.size(); ++row) {
+    const std::string& expected = own->runs[row].canonical();
+    if (canonical[row] == expected) continue;
+    *notes += "; /runs/canonical[" + std::to_string(row) + "] is damaged (it differs from run " +
+              own->runs[row].id() + " of the file's own sweep text), compared as that run";
+    canonical[row] = expected;
+  }
+  return canonical;
+}
+
 // What became of the rows of the old version that hold a result, as
 // (sweep run, old row) pairs.
 struct CopiedRows {
@@ -188,7 +231,9 @@ CopiedRows copy_results(const ResultsFile& from, const std::string& out,
   std::vector<std::pair<int, int>> rows;  // (row, run)
   for (std::size_t run = 0; run < cmp.file_row_of_run.size(); ++run) {
     const int row = cmp.file_row_of_run[run];
-    if (row < 0 || status[row] == RunStatus::kPending) continue;
+    // A pending row with a checksum is a finished one whose status is
+    // damaged: copied (as damaged: repaired from the journal) like the rest.
+    if (row < 0 || (status[row] == RunStatus::kPending && !from.row_damaged(row))) continue;
     rows.emplace_back(row, static_cast<int>(run));
   }
   const std::vector<std::pair<int, int>> damaged = results_copy::copy_rows(from, rows, to);
@@ -252,12 +297,15 @@ std::string run_list(const std::vector<std::pair<int, int>>& pairs,
 std::string write_grown_results(const std::string& out, const SweepSpec& spec, const Grid& grid,
                                 const std::string& program_version) {
   CopiedRows copied;
+  std::string notes;  // damaged canonical cells
+  std::string stored_text_hash, stored_hash;
   std::vector<std::string> old_ids;
   std::string scratch;
   RunSetComparison cmp;
   {
     const ResultsFile old = ResultsFile::open_read_only(out);
-    const std::vector<std::string> canonical = old.read_canonical();
+    const std::vector<std::string> canonical = checked_canonical(old, &notes, &stored_text_hash);
+    stored_hash = old.sweep_hash();
     cmp = compare_run_sets(canonical, old.read_statuses(), grid.runs);
     if (cmp.refused()) throw RunSetRefused(refusal_message(out, cmp, canonical));
     const std::vector<std::string> studies = results_copy::joined_studies(grid);
@@ -296,7 +344,13 @@ std::string write_grown_results(const std::string& out, const SweepSpec& spec, c
                                     : "the sweep file lists the same runs in another order";
   }
   if (cmp.added && dropped) what += " and no longer has " + std::to_string(dropped) + " pending runs";
-  return out + ": " + what + "; new version of the file with " + kept;
+  // The stored text is this sweep file's, only the attribute differs: it is
+  // damaged, not another sweep (written again like one, every result kept).
+  if (stored_text_hash == spec.text_hash && stored_hash != spec.text_hash) {
+    what = "damaged: @sweep_hash = " + stored_hash + ", but the stored sweep text hashes to " +
+           spec.text_hash + ", this sweep file's hash; written again from the sweep file";
+  }
+  return out + ": " + what + "; new version of the file with " + kept + notes;
 }
 
 }  // namespace phnn

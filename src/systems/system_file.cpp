@@ -256,10 +256,15 @@ std::unique_ptr<CompiledExpressions> FileSystem::make(const std::vector<GiNaC::e
   try {
     return std::make_unique<CompiledExpressions>(c, vars_.get(), syms_.names);
   } catch (const mu::Parser::exception_type& e) {
+    const bool long_text = e.GetCode() == mu::ecEXPRESSION_TOO_LONG;
     throw SystemFileError(def_.file, def_.line_of(key),
                           "cannot evaluate " + what + " (" + e.GetMsg() +
-                              "); use the functions sin, cos, tan, exp, log, sqrt, sinh, cosh, "
-                              "tanh, asin, acos, atan, abs");
+                              (long_text ? "): written out it exceeds muParser's " +
+                                               std::to_string(mu::MaxLenExpression) +
+                                               " characters; simplify " + key +
+                                               " (fewer nested functions or terms)"
+                                         : "); use the functions sin, cos, tan, exp, log, sqrt, "
+                                           "sinh, cosh, tanh, asin, acos, atan, abs"));
   }
 }
 

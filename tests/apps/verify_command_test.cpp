@@ -73,7 +73,7 @@ TEST_F(VerifyCommandTest, DamagedRowsAreFoundThenRepairedFromTheJournalOrTrained
   EXPECT_THAT(log,
               HasSubstr("damaged: run " + id + " (row 1): checksum mismatch; the journal holds it"));
   EXPECT_EQ(phnn("reduce " + out_, &log), 0) << log;
-  EXPECT_THAT(log, HasSubstr("1 damaged rows (checksum mismatch) left out, counted as pending: " + id));
+  EXPECT_THAT(log, HasSubstr("1 damaged rows left out, counted as pending: " + id + " (row 1)"));
   ASSERT_EQ(sweep(&log), 0) << log;
   EXPECT_THAT(log, HasSubstr("1 damaged rows (checksum mismatch) repaired from the journals: " + id));
   const double repaired = mse(1);
@@ -190,6 +190,48 @@ TEST_F(VerifyCommandTest, TheFixtureOfTheOldRuleVerifies) {
             0)
       << log;
   EXPECT_THAT(log, HasSubstr("checksums (rule 1): 4 finished rows checked, 0 damaged"));
+}
+
+
+// A damaged stored sweep text or sweep_hash is named as damage by verify,
+// reduce and the resume, which repairs it; never "written by another phnn
+// version", nor advice to pass --mix-kernels (2026-11-28).
+TEST_F(VerifyCommandTest, ADamagedSweepTextOrHashIsNamedAsDamageAndRepaired) {
+  std::string log;
+  ASSERT_EQ(sweep(&log), 0) << log;
+  const std::string original = testing_util::read_all(out_);
+  const std::string hash = ResultsFile::open_read_only(out_).sweep_hash();
+  struct Damage {
+    std::string object, text;
+    std::size_t offset;
+    char to;
+  };
+  for (const Damage& d : {Damage{"@sweep_text", "seeds = [0, 1, 2]", 12, '3'},
+                          Damage{"@sweep_hash", hash, 3, hash[3] == '7' ? '8' : '7'}}) {
+    SCOPED_TRACE(d.object);
+    std::string bytes = original;
+    std::size_t at = std::string::npos;  // the attribute: the last copy in the file
+    for (std::size_t k = bytes.find(d.text); k != std::string::npos; k = bytes.find(d.text, k + 1)) {
+      if (k == 0 || (bytes[k - 1] != '"' && bytes[k - 1] != ' ')) at = k;
+    }
+    ASSERT_NE(at, std::string::npos);
+    bytes[at + d.offset] = d.to;
+    std::ofstream(out_, std::ios::binary | std::ios::trunc) << bytes;
+    EXPECT_EQ(phnn("verify " + out_, &log), 1) << log;
+    EXPECT_THAT(log, HasSubstr("damaged: " + d.object + ":"));
+    const int reduced = phnn("reduce " + out_, &log);
+    if (d.object == "@sweep_text") {
+      EXPECT_EQ(reduced, 1) << log;
+      EXPECT_THAT(log, HasSubstr(out_ + ": damaged: @sweep_text:"));
+    }
+    EXPECT_THAT(log, Not(HasSubstr("another phnn version")));
+    ASSERT_EQ(sweep(&log), 0) << log;
+    EXPECT_THAT(log, HasSubstr(d.object));
+    EXPECT_THAT(log, Not(HasSubstr("text changed")));
+    EXPECT_THAT(log, Not(HasSubstr("--mix-kernels")));
+    EXPECT_THAT(log, Not(HasSubstr("another phnn version")));
+    EXPECT_EQ(phnn("verify " + out_, &log), 0) << log;
+  }
 }
 
 }  // namespace

@@ -80,16 +80,13 @@ TEST(MeasuredDataTest, AGeneratedSetWrittenAsCsvAndImportedIsTheSameSet) {
 std::vector<MeasuredTrajectory> recordings(int count, int samples) {
   std::vector<MeasuredTrajectory> all;
   for (int k = count - 1; k >= 0; --k) {  // out of order: the split sorts by id
-    MeasuredTrajectory m;
+    MeasuredTrajectory m(/*n_x=*/2, /*n_u=*/1);
     m.id = 10 * k;
     m.source = "rec.csv";
     for (int n = 0; n < samples + k % 3; ++n) {
       const double t = n / 50.0;
-      m.t.push_back(t);
-      VecX x(2);
-      x << k + t, -t;
-      m.x.push_back(x);
-      m.u.push_back(VecX::Constant(1, 0.1 * k));
+      const double x[2] = {k + t, -t}, u = 0.1 * k;
+      m.add(t, x, &u);
     }
     all.push_back(std::move(m));
   }

@@ -183,6 +183,32 @@ TEST(MeasuredDataTest, TrajectoriesAcrossFilesNeedTheirOwnIds) {
   std::remove(b.c_str());
 }
 
+// A CSV trajectory is its numbers, flat: 8 bytes a value, no room left
+// over once read (a 224 MB CSV peaked at 2.97 GB resident as one VecX per
+// state and input, 0.40 GB flat: docs/BENCHMARKS.md, 2026-11-28).
+TEST(MeasuredDataTest, CsvTrajectoriesAreReadIntoFlatArraysOfTheirSize) {
+  std::string text = kHeader;
+  for (int id = 0; id < 3; ++id) {
+    for (int k = 0; k < 100 + id; ++k) {
+      text += std::to_string(id) + "," + std::to_string(0.1 * k) + ",1," + std::to_string(k) +
+              ",0.5\n";
+    }
+  }
+  const std::string path = csv_file(text);
+  const std::vector<MeasuredTrajectory> all = read_trajectory_csv(path, kPendulum);
+  ASSERT_EQ(all.size(), 3u);
+  for (const MeasuredTrajectory& m : all) {
+    EXPECT_EQ(m.size(), static_cast<std::size_t>(100 + m.id));
+    EXPECT_EQ(m.x.size(), 2 * m.size());
+    EXPECT_EQ(m.u.size(), m.size());
+    EXPECT_EQ(m.x.capacity(), m.x.size());
+    EXPECT_EQ(m.t.capacity(), m.t.size());
+    EXPECT_EQ(m.state(7)(1), 7.0);
+    EXPECT_EQ(m.input(7)(0), 0.5);
+  }
+  std::remove(path.c_str());
+}
+
 // HDF5 trajectory files: the documented layout reads like the CSV.
 std::string h5_file(const std::function<void(h5::File&)>& fill) {
   static int counter = 0;
@@ -220,9 +246,9 @@ TEST(MeasuredDataTest, Hdf5TrajectoryFilesReadAndFailWithTheirPlace) {
   std::set<std::int64_t> got;
   for (const auto& m : read) {
     got.insert(m.id);
-    EXPECT_EQ(m.x.size(), m.t.size());
-    EXPECT_EQ(m.x[1](1), 2.0);
-    EXPECT_EQ(m.u[0](0), 0.5);
+    EXPECT_EQ(m.x.size(), 2 * m.t.size());
+    EXPECT_EQ(m.state(1)(1), 2.0);
+    EXPECT_EQ(m.input(0)(0), 0.5);
   }
   EXPECT_EQ(got, (std::set<std::int64_t>{3, 12}));
   // 21. no /trajectories group

@@ -5,11 +5,14 @@
 // numbers also a high bit; `phnn verify` must name the damage, and `phnn
 // sweep` on the file must either restore every stored byte (re-read, not
 // judged by the exit status) or refuse naming it and leave the file as it
-// was — never leave a file that verifies with the damage in it.
+// was — never leave a file that verifies with the damage in it. Damage that
+// leaves every value in range (a status turned pending or failed, two rows
+// with one id) is also given to `phnn reduce` and `phnn merge`.
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <utility>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -48,13 +51,15 @@ seeds = [0, 1, 2]
 )";
 constexpr int kRows = 6;
 
-// One damage: the byte at `at` of the file xor `mask`; `verify` must print
-// one of `named` (the dataset, attribute or row).
+// One damage: the byte at `at` of the file xor `mask`, or, when `bytes` is
+// not empty, the bytes from `at` replaced by it; `verify` must print one of
+// `named` (the dataset, attribute or row).
 struct Case {
   std::string label;
   std::uint64_t at = 0;
   unsigned char mask = 0;
   std::vector<std::string> named;
+  std::string bytes;
 };
 
 int run(const std::string& command, const std::string& log) {
@@ -101,6 +106,9 @@ class DamageMatrixTest : public ::testing::Test {
   void TearDown() override { std::system(("rm -rf " + dir_).c_str()); }
 
   std::vector<Case> cases() const;
+  std::vector<Case> status_and_id_cases(const h5::File& file) const;
+  std::string damaged_copy(const Case& c, const std::string& here) const;
+  std::string check_reduce_and_merge(const Case& c, int index) const;
   void add_column_cases(const h5::File& file, std::vector<Case>* cases) const;
   void add_text_case(const std::string& label, const std::string& text, std::size_t offset,
                      const std::string& named, std::vector<Case>* cases) const;
@@ -165,10 +173,31 @@ void DamageMatrixTest::add_text_case(const std::string& label, const std::string
   cases->push_back({label, found[0] + offset, 0x01, {"damaged: " + named + ":"}});
 }
 
+// Damage that leaves every value in range (2026-11-28): a finished row's
+// status turned pending (it would drop out of every check) or failed, and
+// one row's id replaced by another row's (two rows with one id).
+std::vector<Case> DamageMatrixTest::status_and_id_cases(const h5::File& file) const {
+  std::vector<Case> cases;
+  const std::uint64_t status = file.data_address("/runs/status");
+  for (const auto& [row, to] : {std::pair<int, std::int64_t>{2, 0}, {5, 3}}) {
+    const std::int64_t code = file.read_ints("/runs/status", static_cast<std::uint64_t>(row), 1).at(0);
+    const std::string r = std::to_string(row);
+    cases.push_back({"/runs/status[" + r + "] " + std::to_string(code) + " -> " + std::to_string(to),
+                     status + 8 * static_cast<std::uint64_t>(row),
+                     static_cast<unsigned char>(code ^ to), {"(row " + r + ")", "/runs/status[" + r + "]"}});
+  }
+  const std::uint64_t id_bytes = file.read_row_bytes("/runs/id", 0, 1).size();
+  const std::string first = file.read_row_bytes("/runs/id", 0, 1);
+  cases.push_back({"/runs/id[1] = /runs/id[0]", file.data_address("/runs/id") + id_bytes, 0,
+                   {"repeats (row 1)", "damaged: /runs/id:"}, first});
+  return cases;
+}
+
 std::vector<Case> DamageMatrixTest::cases() const {
   std::vector<Case> cases;
   const h5::File file = h5::File::open(original_, h5::Access::kReadOnly);
   add_column_cases(file, &cases);
+  for (Case& c : status_and_id_cases(file)) cases.push_back(std::move(c));
   const std::int64_t offset = file.read_ints("/runs/weights_offset", 4, 1).at(0);
   const std::uint64_t weights = file.data_address("/weights") + 8 * (offset + 3);
   cases.push_back({"/weights byte", weights, 0xff, {"(row 4)"}});
@@ -195,15 +224,26 @@ std::vector<Case> DamageMatrixTest::cases() const {
 
 // "" if case `c` passes: verify names the damage, and the resume restores
 // every byte or refuses naming it and leaves the file alone.
-std::string DamageMatrixTest::check(const Case& c, int index, bool* refused) const {
-  const std::string here = dir_ + "/case" + std::to_string(index);
-  const std::string path = here + "/r.h5";
+// The damaged file at here/r.h5, with the original's journals; returns its
+// bytes.
+std::string DamageMatrixTest::damaged_copy(const Case& c, const std::string& here) const {
   std::system(("rm -rf " + here + " && mkdir -p " + here + " && cp -a " + original_ + " " +
                original_ + ".journal " + here + "/")
                   .c_str());
   std::string damaged = bytes_;
-  damaged[c.at] = static_cast<char>(damaged[c.at] ^ c.mask);
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << damaged;
+  if (c.bytes.empty()) {
+    damaged[c.at] = static_cast<char>(damaged[c.at] ^ c.mask);
+  } else {
+    damaged.replace(c.at, c.bytes.size(), c.bytes);
+  }
+  std::ofstream(here + "/r.h5", std::ios::binary | std::ios::trunc) << damaged;
+  return damaged;
+}
+
+std::string DamageMatrixTest::check(const Case& c, int index, bool* refused) const {
+  const std::string here = dir_ + "/case" + std::to_string(index);
+  const std::string path = here + "/r.h5";
+  const std::string damaged = damaged_copy(c, here);
   auto names_it = [&](const std::string& log) {
     for (const std::string& n : c.named) {
       if (log.find(n) != std::string::npos) return true;
@@ -239,6 +279,43 @@ std::string DamageMatrixTest::check(const Case& c, int index, bool* refused) con
   }
   if (have.size() != want.size()) return "the resumed file has other objects";
   return "";
+}
+
+// "" if `phnn reduce` names the damage (on stderr, the run left out) or
+// refuses naming it, and `phnn merge` (the file as its one shard) refuses
+// naming it and writes nothing.
+std::string DamageMatrixTest::check_reduce_and_merge(const Case& c, int index) const {
+  const std::string here = dir_ + "/other" + std::to_string(index);
+  damaged_copy(c, here);
+  const std::string phnn = PHNN_BINARY;
+  auto names_it = [&](const std::string& log) {
+    return std::any_of(c.named.begin(), c.named.end(),
+                       [&](const std::string& n) { return log.find(n) != std::string::npos; }) ||
+           log.find("damaged rows") != std::string::npos;
+  };
+  run(phnn + " reduce " + here + "/r.h5", here + "/reduce.log");
+  std::string log = testing_util::read_all(here + "/reduce.log");
+  if (!names_it(log)) return "reduce did not name it:\n" + log;
+  const int status = run(phnn + " merge " + here + "/m.h5 " + here + "/r.h5", here + "/merge.log");
+  log = testing_util::read_all(here + "/merge.log");
+  if (status == 0) return "merge wrote a file from it:\n" + log;
+  if (!names_it(log) && log.find("row ") == std::string::npos) {
+    return "merge refused without naming it:\n" + log;
+  }
+  if (::access((here + "/m.h5").c_str(), F_OK) == 0) return "the refusing merge wrote m.h5";
+  return "";
+}
+
+// Reduce and merge on the damage that leaves every value in range.
+TEST_F(DamageMatrixTest, StatusAndIdDamageIsNamedByReduceAndRefusedByMerge) {
+  std::vector<Case> all;
+  {
+    const h5::File file = h5::File::open(original_, h5::Access::kReadOnly);
+    all = status_and_id_cases(file);
+  }
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    EXPECT_EQ(check_reduce_and_merge(all[k], static_cast<int>(k)), "") << all[k].label;
+  }
 }
 
 TEST_F(DamageMatrixTest, EveryDamageIsNamedThenRepairedBitwiseOrRefused) {

@@ -18,6 +18,7 @@
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "sample_results.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -239,6 +240,67 @@ TEST_F(WriteGrownResultsTest, DamagedRowsAreRepairedFromTheJournalOrLeftToTrainA
       EXPECT_EQ(status[run], RunStatus::kPending) << run;  // new, or row 3 to train again
     }
   }
+}
+
+
+// A damaged /runs/canonical cell must not read as a changed or dropped run
+// (refused with a misleading list) nor be copied: the column is checked
+// against the runs of the file's own sweep text, the row compared by its
+// run from the text and repaired from the journal (2026-11-28).
+TEST_F(WriteGrownResultsTest, ADamagedCanonicalCellIsNamedAndItsRowRepaired) {
+  create_original();
+  const Grid old_grid = grid_of(kSweep);
+  {
+    Journal journal(out_, /*rank=*/0);
+    journal.append(old_grid.runs[0].id(), original_[old_grid.runs[0].canonical()]);
+  }
+  {
+    std::string text = old_grid.runs[0].canonical();
+    text[text.find("steps=30") + 6] = '7';  // steps=70: a "changed" run
+    h5::File file = h5::File::open(out_, h5::Access::kReadWrite);
+    file.write_string_rows("/runs/canonical", 0, {text});
+  }
+  const SweepSpec grown =
+      parse_sweep_text(edited(kSweep, "seeds = [0, 1]", "seeds = [0, 1, 2]"), "sweep.toml");
+  const Grid grid = expand_grid(grown);
+  const std::string message = write_grown_results(out_, grown, grid, "v2");
+  EXPECT_THAT(message, HasSubstr("/runs/canonical[0] is damaged"));
+  EXPECT_THAT(message, HasSubstr("2 runs with results kept bitwise"));
+  EXPECT_THAT(message, HasSubstr("repaired from the journals: " + old_grid.runs[0].id()));
+  const ResultsFile file = ResultsFile::open_read_only(out_);
+  EXPECT_TRUE(file.damaged_rows().empty());
+  EXPECT_TRUE(file.file_damage().empty());
+  for (int run = 0; run < file.num_runs(); ++run) {
+    const auto it = original_.find(grid.runs[run].canonical());
+    if (it != original_.end()) testing_util::expect_bit_equal(it->second, file.read_run(run));
+  }
+}
+
+// With the stored sweep text damaged as well, nothing tells the row's run:
+// refused naming both, the file untouched.
+TEST_F(WriteGrownResultsTest, ADamagedCanonicalCellWithADamagedSweepTextIsRefused) {
+  create_original();
+  {
+    h5::File file = h5::File::open(out_, h5::Access::kReadWrite);
+    std::string text = file.string_attribute("/", "sweep_text");
+    text[text.find("steps = 30") + 8] = '7';
+    file.set_attribute("/", "sweep_text", text);
+    std::string canonical = grid_of(kSweep).runs[1].canonical();
+    canonical[canonical.find("steps=30") + 6] = '7';
+    file.write_string_rows("/runs/canonical", 1, {canonical});
+  }
+  const std::string before = testing_util::read_all(out_);
+  const SweepSpec grown =
+      parse_sweep_text(edited(kSweep, "seeds = [0, 1]", "seeds = [0, 1, 2]"), "sweep.toml");
+  try {
+    write_grown_results(out_, grown, expand_grid(grown), "v2");
+    FAIL() << "a damaged canonical column was used";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/runs/canonical"));
+    EXPECT_THAT(e.what(), HasSubstr("@sweep_text"));
+    EXPECT_THAT(e.what(), HasSubstr("move the file aside"));
+  }
+  EXPECT_EQ(testing_util::read_all(out_), before);
 }
 
 }  // namespace

@@ -9,9 +9,11 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "phnn/systems/system_file.h"
 #include "systems/toy_system.h"
@@ -72,6 +74,65 @@ TEST(ExpressionBoundsTest, ASweepOfSuchASystemFileEndsWithinTwoSeconds) {
   std::system(("rm -rf " + dir).c_str());
 }
 
+// `phnn data` too: (q^2)^1000000 in H and w^(10^4) in z end with the
+// refusal (exit 2), its file, line and rule, within 2 s.
+TEST(ExpressionBoundsTest, DataOfSuchASystemFileIsRefusedWithinTwoSeconds) {
+  const std::string dir = ::testing::TempDir() + "phnn_bounds_data_" + std::to_string(::getpid());
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  std::ofstream(dir + "/h.toml") << with("k*q^2/2\"", "k*q^2/2 + (q^2)^1000000\"");
+  std::ofstream(dir + "/z.toml") << with("z = [\"c*w\"]", "z = [\"c*w^(10^4)\"]");
+  for (const auto& [name, line] : {std::pair<std::string, std::string>{"h", ":5: H = "},
+                                   {"z", ":6: z = "}}) {
+    std::string log;
+    const auto start = std::chrono::steady_clock::now();
+    const int status = testing_util::run_shell("timeout -k 1 60 " + std::string(PHNN_BINARY) +
+                                                   " data --system " + dir + "/" + name +
+                                                   ".toml --out " + dir + "/" + name + ".h5",
+                                               &log);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(status, 2) << log;
+    EXPECT_THAT(log, AllOf(HasSubstr(name + ".toml" + line), HasSubstr("|exponent| <= 100")));
+    EXPECT_LT(seconds, 2.0) << log;
+  }
+  std::system(("rm -rf " + dir).c_str());
+}
+
+// H = tanh(tanh(...tanh(q*p)...)) nested 190 deep is within the size limits,
+// yet GiNaC differentiates it for ~9 s (2026-11-28, this machine) before
+// muParser refuses the result. A SIGTERM then must still end `phnn sweep`
+// at once: before the sweep takes its lock or writes anything, a stop
+// exits with 75 right away (nothing to save). Bound: 2 s, the stop rule;
+// the handler exits within milliseconds, the rest is margin for a loaded
+// machine. Measured from the signal to the exit seen by the shell.
+TEST(ExpressionBoundsTest, ASweepStoppedDuringLongSymbolicWorkEndsWithinTwoSeconds) {
+  const std::string dir = ::testing::TempDir() + "phnn_bounds_stop_" + std::to_string(::getpid());
+  std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str());
+  std::string nest = "q*p";
+  for (int i = 0; i < 190; ++i) nest = "tanh(" + nest + ")";
+  std::ofstream(dir + "/deep.toml") << with("p^2/(2*m) + k*q^2/2", nest + " + p^2/(2*m)");
+  std::ofstream(dir + "/s.toml") << "name = \"s\"\n[grid]\nsystems = [\"deep.toml\"]\n"
+                                    "models = [\"node-rk2\"]\nn_train = [25]\nseeds = [0]\n";
+  // Started in the background; SIGTERM 1.5 s later (LibTorch's start-up
+  // takes ~0.5 s, the symbolic work ~9 s); prints the exit status and the
+  // seconds from the signal to the exit.
+  const std::string script =
+      "cd " + dir + " && (" + PHNN_BINARY + " sweep s.toml --out r.h5 > sweep.log 2>&1 & pid=$!; "
+      "sleep 1.5; kill -0 $pid || exit 3; s=$(date +%s.%N); kill -TERM $pid; wait $pid; "
+      "status=$?; e=$(date +%s.%N); echo \"$status $(echo \"$e - $s\" | bc)\")";
+  std::string log;
+  ASSERT_EQ(testing_util::run_shell("timeout -k 1 60 bash -c '" + script + "'", &log), 0) << log;
+  int status = -1;
+  double seconds = 1e9;
+  std::sscanf(log.c_str(), "%d %lf", &status, &seconds);
+  const std::string sweep_log = testing_util::read_all(dir + "/sweep.log");
+  EXPECT_EQ(status, 75) << log << sweep_log;
+  EXPECT_LT(seconds, 2.0) << log << sweep_log;
+  EXPECT_THAT(sweep_log, HasSubstr("stopped on a signal; run the same command again"));
+  EXPECT_NE(::access((dir + "/r.h5").c_str(), F_OK), 0) << "the stopped sweep wrote its file";
+  std::system(("rm -rf " + dir).c_str());
+}
+
 TEST(ExpressionBoundsTest, ExponentsMadeOfParametersAndNumbersCountToo) {
   EXPECT_THAT(bound("q^n"), HasSubstr("the exponent 1000000 in \"q^n\""));
   EXPECT_THAT(bound("q^(2*60)"), HasSubstr("the exponent 120"));
@@ -101,6 +162,15 @@ TEST(ExpressionBoundsTest, TheShippedSystemFilesAreWithinTheLimits) {
     EXPECT_NO_THROW(
         load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/" + name + ".toml"));
   }
+}
+
+// Within the size limits but longer than muParser compiles once expanded:
+// the rule and the fix, not a list of functions (2026-11-28).
+TEST(SystemFileMessagesTest, AnExpressionTooLongForMuParserNamesItsLimit) {
+  const std::string error = error_of(with("p^2/(2*m) + k*q^2/2", "(q + p + 1)^12"));
+  EXPECT_THAT(error, AllOf(HasSubstr("toy.toml:5: cannot evaluate the Gonzalez defect of H"),
+                           HasSubstr("exceeds muParser's 20000 characters; simplify H"),
+                           Not(HasSubstr("use the functions"))));
 }
 
 TEST(SystemFileMessagesTest, ANonZeroDiagonalOfSNamesOneEntry) {

@@ -16,18 +16,39 @@
 namespace phnn {
 
 /// One recorded trajectory: samples (t_k, x_k, u_k), k = 0 .. N-1, with u_k
-/// held over [t_k, t_k+1) (zero-order hold).
+/// held over [t_k, t_k+1) (zero-order hold). Stored flat, sample after
+/// sample, 8 bytes a value (and 4 for a text file's line): a large
+/// recording costs its numbers, not an object per value.
+///
+///   MeasuredTrajectory m(/*n_x=*/2, /*n_u=*/1);
+///   m.add(/*t=*/0.0, x0.data(), u0.data());
+///   const VecX x0_again = m.state(0);
 struct MeasuredTrajectory {
+  MeasuredTrajectory() = default;
+  MeasuredTrajectory(int states, int inputs) : n_x(states), n_u(inputs) {}
+
   /// The `trajectory` column: a non-negative integer, unique in a data set.
   /// It orders the trajectories and keys the draw of its training pair.
   std::int64_t id = 0;
-  std::vector<double> t;  // [s]
-  std::vector<VecX> x;    // n_x each
-  std::vector<VecX> u;    // n_u each
+  /// Widths of a sample's state and input.
+  int n_x = 0, n_u = 0;
+  std::vector<double> t;  // [s], N
+  std::vector<double> x;  // x_k = x[k n_x .. (k+1) n_x), N n_x
+  std::vector<double> u;  // u_k = u[k n_u .. (k+1) n_u), N n_u
   /// Where it was read ("a.csv", "b.h5:/trajectories/7"), for errors, and
   /// the line of each sample in a text file (empty otherwise).
   std::string source;
   std::vector<int> line;
+
+  std::size_t size() const { return t.size(); }
+  /// Appends sample (t, x, u): n_x and n_u values.
+  void add(double time, const double* state, const double* input);
+  VecX state(std::size_t k) const;
+  VecX input(std::size_t k) const;
+  /// u_k == u_0, value by value.
+  bool same_input(std::size_t k) const;
+  /// Frees the room the arrays grew beyond their samples (call once read).
+  void shrink();
 
   /// "a.csv:14: trajectory 7" (sample k's line) or "b.h5:/trajectories/7,
   /// sample 3".

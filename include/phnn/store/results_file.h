@@ -238,16 +238,18 @@ class ResultsFile {
   /// write_run carries a checksum of what it stores, by the file's rule
   /// (checksum_version()). The rows with a result (not pending) whose
   /// checksum is missing or wrong, or that cannot be read (a value out of
-  /// range: read_run's message); empty for a file written before checksums
-  /// (has_checksums()).
+  /// range: read_run's message), and the pending rows that hold a checksum
+  /// (a damaged status: only a row with a result has one); empty for a file
+  /// written before checksums (has_checksums()).
   std::vector<int> damaged_rows() const;
   /// The same check for one row: true if it holds a result (not pending)
-  /// whose checksum is missing or wrong, or if it cannot be read; false in a
-  /// file written before checksums. Every copy of a row into another file
+  /// whose checksum is missing or wrong, if it cannot be read, or if it is
+  /// pending but holds a checksum; false in a file written before checksums. Every copy of a row into another file
   /// (merge, a grown sweep) asks this first (src/sweep/results_copy.h).
   bool row_damaged(int row) const;
-  /// Why row `row` is damaged ("" if it is not): "checksum mismatch", or
-  /// read_run's message for a value out of range.
+  /// Why row `row` is damaged ("" if it is not): "checksum mismatch",
+  /// read_run's message for a value out of range, or `/runs/status[r] = 0
+  /// (pending) but /runs/checksum[r] is set ...`.
   std::string row_damage(int row) const;
   /// What makes the file unusable as a whole: an empty or repeated run id, a
   /// status outside 0..3, an unreadable column ("" entries none).

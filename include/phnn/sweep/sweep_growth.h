@@ -62,7 +62,11 @@ class RunSetRefused : public std::invalid_argument {
 /// reading it back) with its run times. A row whose checksum fails is never
 /// copied as it stands: it is written from the journals' record of its run
 /// (`out`'s journal directory), or, if they lack the run, left pending to be
-/// trained again; both are named in the account. /data is left to the caller (the
+/// trained again; both are named in the account. The old rows' runs are
+/// read from /runs/canonical checked against the file's own sweep text: a
+/// damaged cell is named and its row compared as the text's run (and
+/// repaired as damaged); with the text damaged too, RunSetRefused (nothing
+/// written). /data is left to the caller (the
 /// sweep writes missing data groups on resume). The new file replaces `out`
 /// by an atomic rename, so a crash leaves either version whole. Throws
 /// RunSetRefused (nothing written) when compare_run_sets() refuses, and
