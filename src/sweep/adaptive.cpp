@@ -1,7 +1,8 @@
 // src/sweep/adaptive.cpp — adaptive seeds: the rounds replayed from finished
 // results, and the two rules that name the cells of the next round
 // (column-best: the reducer's (tie) cells; comparisons: both sides of every
-// comparison whose intervals overlap, or with grow = "one" the side that
+// comparison whose intervals overlap — or, with reading = "four-way", that
+// compare_cells leaves undecided — or with grow = "one" the side that
 // closes the gap more cheaply). Reads the report's statistics
 // (phnn/report/tables.h) and the grid's cost model; writes nothing.
 #include "phnn/sweep/adaptive.h"
@@ -13,6 +14,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "phnn/report/comparison.h"
 #include "phnn/report/tables.h"
 
 namespace phnn {
@@ -74,6 +76,7 @@ class ComparisonRule {
   void name_cells(const SeedComparison& c, std::vector<int>* cells) {
     const int a = pick(c.a), b = pick(c.b);
     if (a < 0 || b < 0) return;
+    if (adaptive_.four_way) return name_four_way(a, b, cells);
     if (resolved(summary(a, stop_, &stop_summaries_), summary(b, stop_, &stop_summaries_))) return;
     const CellSummary& sa = summary(a);
     const CellSummary& sb = summary(b);
@@ -90,6 +93,48 @@ class ComparisonRule {
   }
 
  private:
+  // reading = "four-way": compare_cells on the two cells' finished seeds
+  // (paired when cells_are_paired), at the stop confidence; anything but
+  // undecided stops the comparison. An undecided one names both cells, or
+  // with grow = "one" and unpaired cells the side that closes more of the
+  // gap per core-second (as the intervals reading does).
+  void name_four_way(int a, int b, std::vector<int>* cells) {
+    const RunConfig& ra = grid_.runs[static_cast<std::size_t>(grid_.cells[static_cast<std::size_t>(a)].runs.front())];
+    const RunConfig& rb = grid_.runs[static_cast<std::size_t>(grid_.cells[static_cast<std::size_t>(b)].runs.front())];
+    const bool paired = cells_are_paired(ra, rb);
+    ComparisonOptions options;
+    options.delta = adaptive_.delta;
+    options.confidence = stop_.confidence;
+    const SeedResults sa = seed_results(a), sb = seed_results(b);
+    if (!sa.empty() && !sb.empty() &&
+        compare_cells(sa, sb, paired, options).reading != ComparisonReading::kUndecided) {
+      return;
+    }
+    const CellSummary& ca = summary(a);
+    const CellSummary& cb = summary(b);
+    if (!paired && adaptive_.grow_one && ca.has_interval() && cb.has_interval() &&
+        ca.median != cb.median) {
+      const double ga = gain_per_second(a, ca, cb), gb = gain_per_second(b, cb, ca);
+      if (ga > gb) return cells->push_back(a);
+      if (gb > ga) return cells->push_back(b);
+    }
+    cells->push_back(a);
+    cells->push_back(b);
+  }
+
+  // Seed -> MSE of the cell's finished runs among those asked for (a
+  // diverged run's MSE is +inf).
+  SeedResults seed_results(int cell) const {
+    SeedResults out;
+    for (int r : grid_.cells[static_cast<std::size_t>(cell)].runs) {
+      const auto i = static_cast<std::size_t>(r);
+      if (!active_[i]) continue;
+      if (status_[i] == RunStatus::kDone) out[grid_.runs[i].seed] = mse_[i];
+      if (status_[i] == RunStatus::kDiverged) out[grid_.runs[i].seed] = std::numeric_limits<double>::infinity();
+    }
+    return out;
+  }
+
   // The smallest-median cell of a selector with a finished run, or -1.
   int pick(const CellSelector& s) {
     int best = -1;

@@ -167,7 +167,7 @@ void check_selectors(const SweepSpec& spec, const ValueReader& reader) {
 AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
   AdaptiveSpec a;
   a.enabled = true;
-  bool has_max = false, has_batch = false;
+  bool has_max = false, has_batch = false, has_delta = false;
   const toml::table& table = values.table(e, "[adaptive]");
   for (const Entry& k : entries_in_file_order(table)) {
     if (k.key == "max_seeds") {
@@ -189,6 +189,15 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
       a.futility = *k.value->value<bool>();
     } else if (k.key == "grow") {
       a.grow_one = values.choice_index(k, {"both", "one"}) == 1;
+    } else if (k.key == "reading") {
+      a.four_way = values.choice_index(k, {"intervals", "four-way"}) == 1;
+    } else if (k.key == "delta") {
+      a.delta = values.number(k, *k.value);
+      has_delta = true;
+      if (!(a.delta > 1.0 && a.delta <= 100.0)) {
+        values.fail(k.line, "delta expects a factor in (1, 100] (e.g. 1.5: medians within x1.5 "
+                            "are equivalent); got " + values.describe(*k.value));
+      }
     } else if (k.key == "stop_confidence") {
       a.stop_confidence = values.number(k, *k.value);
       if (!(a.stop_confidence >= 0.5 && a.stop_confidence <= 0.999)) {
@@ -196,8 +205,8 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
                             "early resolution must hold at 99 %); got " + values.describe(*k.value));
       }
     } else {
-      const std::vector<std::string> keys = {"max_seeds", "batch", "rule", "comparisons",
-                                             "futility", "grow", "stop_confidence"};
+      const std::vector<std::string> keys = {"max_seeds", "batch", "rule", "comparisons", "futility",
+                                             "grow", "stop_confidence", "reading", "delta"};
       values.fail(k.line, "unknown key " + quoted(k.key) + " in [adaptive]" +
                               did_you_mean(k.key, keys) + "; expected one of: " + join(keys));
     }
@@ -214,6 +223,18 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
   if (a.rule != AdaptiveRule::kComparisons && a.futility) {
     values.fail(e.line, "futility applies to rule = \"comparisons\" only; set that rule or "
                         "remove futility");
+  }
+  if (a.rule != AdaptiveRule::kComparisons && a.four_way) {
+    values.fail(e.line, "reading = \"four-way\" applies to rule = \"comparisons\" only; set that "
+                        "rule or remove reading");
+  }
+  if (has_delta && !a.four_way) {
+    values.fail(e.line, "delta is the margin of reading = \"four-way\"; set that reading or "
+                        "remove delta");
+  }
+  if (a.four_way && a.futility) {
+    values.fail(e.line, "futility and reading = \"four-way\" do not combine: the four-way "
+                        "reading stops ties by equivalence within x delta; remove futility");
   }
   if (a.rule != AdaptiveRule::kComparisons && a.grow_one) {
     values.fail(e.line, "grow = \"one\" applies to rule = \"comparisons\" only; set that rule "

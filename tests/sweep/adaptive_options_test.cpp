@@ -246,3 +246,69 @@ TEST(AdaptiveRoundsTest, GrowOneCostsOfThePaperGridArePinned) {
 
 }  // namespace
 }  // namespace phnn
+
+namespace phnn {
+namespace {
+
+// reading = "four-way" (paired here: PHNN-JR with RK2 and with RK4 share
+// their seeds' initial weights and batches): a pair whose per-seed ratio is
+// ~1.01 is equivalent within x1.5 and a pair 1.8x apart is decided, so
+// neither grows — although the second pair's median intervals overlap,
+// which keeps the intervals reading growing it; a pair whose ratio swings
+// between x3 and x1/3 by seed is undecided and grows both cells to max_seeds.
+TEST(AdaptiveRoundsTest, FourWayReadingStopsEquivalentAndDecidedPairsAndGrowsUndecidedOnes) {
+  const auto text = [](const std::string& reading) {
+    return "name = \"a\"\n[grid]\nsystems = [\"harmonic\"]\nmodels = [\"phnn-jr-rk2\", "
+           "\"phnn-jr-rk4\"]\nseeds = \"0-9\"\n[adaptive]\nmax_seeds = 20\nbatch = 5\n"
+           "rule = \"comparisons\"\ncomparisons = [[\"harmonic/phnn-jr-rk2/25/small/none\", "
+           "\"harmonic/phnn-jr-rk4/25/small/none\"]]\n" + reading;
+  };
+  const SweepSpec four_way = parse_sweep_text(text("reading = \"four-way\"\n"), "x.toml");
+  const SweepSpec intervals = parse_sweep_text(text(""), "x.toml");
+  EXPECT_TRUE(four_way.adaptive.four_way);
+  EXPECT_EQ(four_way.adaptive.delta, 1.5);
+  const Grid grid = expand_grid(four_way);
+  const auto with_ratio = [&](const std::function<double(int)>& ratio) {
+    return adaptive_test::results_of(grid, [&](const RunConfig& run) {
+      const double v = 1e-3 * (1.0 + run.seed);
+      return run.integrator == IntegratorKind::kRk4 ? v * ratio(run.seed) : v;
+    });
+  };
+  const auto equivalent = with_ratio([](int) { return 1.01; });
+  const auto decided = with_ratio([](int) { return 1.8; });
+  const auto undecided = with_ratio([](int seed) { return seed % 2 ? 3.0 : 1.0 / 3.0; });
+  for (const auto* r : {&equivalent, &decided}) {
+    const AdaptiveState s = replay_adaptive_rounds(four_way, grid, r->status, r->mse);
+    EXPECT_TRUE(s.complete);
+    EXPECT_TRUE(s.cells_grown.empty());
+    EXPECT_EQ(adaptive_test::seeds_of(s, grid, IntegratorKind::kRk4), 10);
+  }
+  const AdaptiveState by_intervals = replay_adaptive_rounds(intervals, grid, decided.status, decided.mse);
+  EXPECT_FALSE(by_intervals.cells_grown.empty()) << "the intervals reading should not decide 1.8x at 10 seeds";
+  const AdaptiveState grown = replay_adaptive_rounds(four_way, grid, undecided.status, undecided.mse);
+  EXPECT_EQ(adaptive_test::seeds_of(grown, grid, IntegratorKind::kRk2), 20);
+  EXPECT_EQ(adaptive_test::seeds_of(grown, grid, IntegratorKind::kRk4), 20);
+}
+
+TEST(AdaptiveSweepFileTest, FourWayReadingOptionsAreCheckedAtTheirTable) {
+  const std::string base =
+      "max_seeds = 8\nbatch = 3\nrule = \"comparisons\"\n"
+      "comparisons = [[\"harmonic/phnn-jr-rk2/25/small/none\", \"harmonic/phnn-jr-rk4/25/small/none\"]]\n";
+  using adaptive_test::error_of;
+  using adaptive_test::kTwoModels;
+  using adaptive_test::sweep_text;
+  EXPECT_THAT(error_of(sweep_text(kTwoModels, base + "reading = \"four-way\"\nfutility = true\n")),
+              AllOf(HasSubstr("x.toml:6:"), HasSubstr("remove futility")));
+  EXPECT_THAT(error_of(sweep_text(kTwoModels, base + "delta = 2.0\n")),
+              HasSubstr("delta is the margin of reading = \"four-way\""));
+  EXPECT_THAT(error_of(sweep_text(kTwoModels, base + "reading = \"four-way\"\ndelta = 1.0\n")),
+              HasSubstr("delta expects a factor in (1, 100]"));
+  EXPECT_THAT(error_of(sweep_text(kTwoModels, base + "reading = \"fourway\"\n")),
+              HasSubstr("four-way"));
+  EXPECT_EQ(parse_sweep_text(sweep_text(kTwoModels, base + "reading = \"four-way\"\ndelta = 2\n"), "x.toml")
+                .adaptive.delta,
+            2.0);
+}
+
+}  // namespace
+}  // namespace phnn

@@ -147,6 +147,17 @@ struct AdaptiveSpec {
   /// stricter than the final one, docs/METHOD.md "Adaptive seeds"). 0: the
   /// reducer's confidence.
   double stop_confidence = 0;
+  /// `reading`, rule comparisons only: false ("intervals"): a comparison
+  /// stops when the bootstrap intervals of its two medians are disjoint;
+  /// true ("four-way"): when compare_cells (phnn/report/comparison.h) reads
+  /// it as A better, B better or equivalent within x delta; an undecided
+  /// comparison names both cells (a paired one needs both for its pairs;
+  /// grow = "one" still picks one side of an unpaired one). Equivalence
+  /// stops the ties futility stopped, so the two are not combined.
+  bool four_way = false;
+  /// `delta`: the equivalence margin of the four-way reading, a factor on
+  /// the MSE (> 1; ComparisonOptions::delta).
+  double delta = 1.5;
   /// The studies' `seeds` as written (every study has the same): round 0.
   /// With [adaptive], StudySpec::seeds holds these and then the
   /// max_seeds - initial_seeds.size() next seed numbers (the runs a cell may get).
