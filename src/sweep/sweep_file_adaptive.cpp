@@ -162,6 +162,40 @@ void check_selectors(const SweepSpec& spec, const ValueReader& reader) {
   }
 }
 
+// Keys that only some rules or readings read: refused where they would be
+// ignored, at the [adaptive] header.
+void check_rule_keys(const AdaptiveSpec& a, bool has_delta, const Entry& e,
+                     const ValueReader& values) {
+  if (a.rule == AdaptiveRule::kComparisons && a.comparisons.empty()) {
+    values.fail(e.line, "rule = \"comparisons\" needs `comparisons = [[\"A\", \"B\"], ...]` in "
+                        "[adaptive]: the pairs of cells whose medians a question compares");
+  }
+  if (a.rule != AdaptiveRule::kComparisons && a.futility) {
+    values.fail(e.line, "futility applies to rule = \"comparisons\" only; set that rule or "
+                        "remove futility");
+  }
+  if (a.rule != AdaptiveRule::kComparisons && a.four_way) {
+    values.fail(e.line, "reading = \"four-way\" applies to rule = \"comparisons\" only; set that "
+                        "rule or remove reading");
+  }
+  if (has_delta && !a.four_way) {
+    values.fail(e.line, "delta is the margin of reading = \"four-way\"; set that reading or "
+                        "remove delta");
+  }
+  if (a.four_way && a.futility) {
+    values.fail(e.line, "futility and reading = \"four-way\" do not combine: the four-way "
+                        "reading stops ties by equivalence within x delta; remove futility");
+  }
+  if (a.rule != AdaptiveRule::kComparisons && a.grow_one) {
+    values.fail(e.line, "grow = \"one\" applies to rule = \"comparisons\" only; set that rule "
+                        "or remove grow");
+  }
+  if (a.rule != AdaptiveRule::kComparisons && !a.comparisons.empty()) {
+    values.fail(e.line, "comparisons are read by rule = \"comparisons\" only; set that rule or "
+                        "remove them");
+  }
+}
+
 }  // namespace
 
 AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
@@ -216,34 +250,7 @@ AdaptiveSpec read_adaptive_table(const Entry& e, const ValueReader& values) {
                             (!has_max && !has_batch ? " and " : "") + (has_batch ? "" : "batch") +
                             ", e.g. max_seeds = 40 and batch = 10 (seeds added to a cell per round)");
   }
-  if (a.rule == AdaptiveRule::kComparisons && a.comparisons.empty()) {
-    values.fail(e.line, "rule = \"comparisons\" needs `comparisons = [[\"A\", \"B\"], ...]` in "
-                        "[adaptive]: the pairs of cells whose medians a question compares");
-  }
-  if (a.rule != AdaptiveRule::kComparisons && a.futility) {
-    values.fail(e.line, "futility applies to rule = \"comparisons\" only; set that rule or "
-                        "remove futility");
-  }
-  if (a.rule != AdaptiveRule::kComparisons && a.four_way) {
-    values.fail(e.line, "reading = \"four-way\" applies to rule = \"comparisons\" only; set that "
-                        "rule or remove reading");
-  }
-  if (has_delta && !a.four_way) {
-    values.fail(e.line, "delta is the margin of reading = \"four-way\"; set that reading or "
-                        "remove delta");
-  }
-  if (a.four_way && a.futility) {
-    values.fail(e.line, "futility and reading = \"four-way\" do not combine: the four-way "
-                        "reading stops ties by equivalence within x delta; remove futility");
-  }
-  if (a.rule != AdaptiveRule::kComparisons && a.grow_one) {
-    values.fail(e.line, "grow = \"one\" applies to rule = \"comparisons\" only; set that rule "
-                        "or remove grow");
-  }
-  if (a.rule != AdaptiveRule::kComparisons && !a.comparisons.empty()) {
-    values.fail(e.line, "comparisons are read by rule = \"comparisons\" only; set that rule or "
-                        "remove them");
-  }
+  check_rule_keys(a, has_delta, e, values);
   return a;
 }
 
