@@ -9,6 +9,8 @@
 #include <iterator>
 #include <string>
 
+#include <unistd.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -42,7 +44,7 @@ std::vector<double> mses(const std::string& results) {
 TEST(ImportCommandTest, AGeneratedSetThroughCsvTrainsToTheSameMsesBitForBit) {
   for (const std::string name : {"pendulum", "pendulum-forced"}) {
     const std::string system = std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/" + name + ".toml";
-    const std::string dir = ::testing::TempDir() + "phnn_import_rt/";
+    const std::string dir = ::testing::TempDir() + "phnn_import_rt_" + std::to_string(::getpid()) + "/";
     ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
     std::string log;
     ASSERT_EQ(phnn("data --system " + system + " --n-train 25 --out " + dir + "a.h5 --csv " + dir +
@@ -74,7 +76,7 @@ TEST(ImportCommandTest, AGeneratedSetThroughCsvTrainsToTheSameMsesBitForBit) {
 // (same name, so the same pair draws; same S, so the same models). It
 // generates nothing: `phnn data` refuses it at its name, exit 2.
 TEST(ImportCommandTest, AStructureOnlySystemFileIsEnoughForMeasuredData) {
-  const std::string dir = ::testing::TempDir() + "phnn_import_structure/";
+  const std::string dir = ::testing::TempDir() + "phnn_import_structure_" + std::to_string(::getpid()) + "/";
   ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
   std::ifstream in(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum-structure.toml");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -104,7 +106,7 @@ TEST(ImportCommandTest, AStructureOnlySystemFileIsEnoughForMeasuredData) {
 }
 
 TEST(ImportCommandTest, BadInputExitsTwoAndWritesNoDataSet) {
-  const std::string dir = ::testing::TempDir() + "phnn_import_bad/";
+  const std::string dir = ::testing::TempDir() + "phnn_import_bad_" + std::to_string(::getpid()) + "/";
   ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
   std::ofstream(dir + "bad.csv") << "trajectory,t,q,p,u\n0,0,1,0,0\n0,0.1,1,0\n";
   std::string log;
@@ -131,7 +133,7 @@ TEST(ImportCommandTest, BadInputExitsTwoAndWritesNoDataSet) {
 }
 
 TEST(ImportCommandTest, DataNoiseIsRecordedAndItsMisusesRefused) {
-  const std::string dir = ::testing::TempDir() + "phnn_noise_cli/";
+  const std::string dir = ::testing::TempDir() + "phnn_noise_cli_" + std::to_string(::getpid()) + "/";
   ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
   std::string log;
   ASSERT_EQ(phnn("data --system " + kPendulum + " --n-train 5 --noise 0.01 --out " + dir + "n.h5", &log), 0)
