@@ -123,8 +123,14 @@ std::string g17(double v) {
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // Line `line` (1-based) of `text`, `key = old  # note`, with `value` in
-// place of old (the note kept).
-void set_value(std::string* text, int line, const std::string& value) {
+// place of old (the note kept). `key` (e.g. "control.energy") names a key
+// the shipped file `path` must have for the value to be written.
+void set_value(std::string* text, int line, const std::string& value, const std::string& key,
+               const std::string& path) {
+  if (line <= 0) {
+    throw SystemFileError(path, 0, "the shipped system file has no " + key + " to set to " + value +
+                                       "; restore it from the source tree (sweeps/systems/)");
+  }
   std::size_t begin = 0;
   for (int l = 1; l < line; ++l) begin = text->find('\n', begin) + 1;
   const std::size_t end = std::min(text->find('\n', begin), text->size());
@@ -137,6 +143,31 @@ void set_value(std::string* text, int line, const std::string& value) {
 }
 
 std::string interval_text(const std::array<double, 2>& v) { return "[" + g17(v[0]) + ", " + g17(v[1]) + "]"; }
+
+// The rewritten text reads back as the values asked for (a line rewritten
+// in place cannot have hit another key), else the shipped file's layout is
+// not one this rewriting handles.
+void check_written(const std::string& text, const OscillatorOptions& physics,
+                   const BuiltinEnergies& energies, const std::string& path) {
+  const SystemDefinition def = parse_system_definition(text, path);
+  OscillatorOptions values = physics;
+  bool same = same_bits(def.initial.energy_min, energies.initial[0]) &&
+              same_bits(def.initial.energy_max, energies.initial[1]);
+  if (def.control.design == ControlDesign::Design::kEnergyShaping) {
+    same = same && same_bits(def.control.equilibrium_energy_min, energies.equilibrium[0]) &&
+           same_bits(def.control.equilibrium_energy_max, energies.equilibrium[1]);
+  }
+  for (const BuiltinAlias& a : aliases_of(physics.kind)) {
+    for (const auto& [name, stored] : def.parameters) {
+      if (name == a.parameter) same = same && same_bits(stored, value_of(values, a));
+    }
+  }
+  if (!same) {
+    throw SystemFileError(path, 0, "the shipped system file does not take the built-in system's "
+                                   "physics (a parameter or energy written on a shared line?); "
+                                   "restore it from the source tree (sweeps/systems/)");
+  }
+}
 
 }  // namespace
 
@@ -153,20 +184,22 @@ std::string builtin_system_text(const OscillatorOptions& physics, const BuiltinE
     for (const auto& [name, stored] : def.parameters) {
       const double wanted = value_of(values, a);
       if (name == a.parameter && !same_bits(stored, wanted)) {
-        set_value(&text, def.line_of("parameters." + name), g17(wanted));
+        set_value(&text, def.line_of("parameters." + name), g17(wanted), "parameters." + name, path);
       }
     }
   }
   const InitialConditionDesign& d = def.initial;
   if (!same_bits(d.energy_min, energies.initial[0]) || !same_bits(d.energy_max, energies.initial[1])) {
-    set_value(&text, def.line_of("initial.energy"), interval_text(energies.initial));
+    set_value(&text, def.line_of("initial.energy"), interval_text(energies.initial), "initial.energy", path);
   }
   const ControlDesign& c = def.control;
   if (c.design == ControlDesign::Design::kEnergyShaping &&
       (!same_bits(c.equilibrium_energy_min, energies.equilibrium[0]) ||
        !same_bits(c.equilibrium_energy_max, energies.equilibrium[1]))) {
-    set_value(&text, def.line_of("control.energy"), interval_text(energies.equilibrium));
+    set_value(&text, def.line_of("control.energy"), interval_text(energies.equilibrium),
+              "control.energy", path);
   }
+  check_written(text, physics, energies, path);
   return text;
 }
 

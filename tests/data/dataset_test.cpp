@@ -245,6 +245,17 @@ TEST(BuiltinSystemsTest, AChangedShippedFileIsRefused) {
   EXPECT_THAT([] { make_system("duffing"); },
               ThrowsMessage<SystemFileError>(AllOf(HasSubstr(dir + "/duffing.toml"), HasSubstr("H or z"),
                                                    HasSubstr("restore it"))));
+  // A file without the key a sweep's value goes to: refused, not written
+  // over another line.
+  text = read_system_file_text(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/duffing.toml");
+  const std::string control_energy = "design = \"energy-shaping\"\nenergy = [0.1, 1.0]";
+  ASSERT_NE(text.find(control_energy), std::string::npos);
+  text.replace(text.find(control_energy), control_energy.size(), "design = \"energy-shaping\"");
+  std::ofstream(dir + "/duffing.toml") << text;
+  BuiltinEnergies e;
+  e.equilibrium = {0.3, 0.6};
+  EXPECT_THAT([&] { builtin_system(OscillatorOptions::defaults(SystemKind::kDuffing), e); },
+              ThrowsMessage<SystemFileError>(AllOf(HasSubstr("no control.energy"), HasSubstr("restore it"))));
   ::unsetenv("PHNN_SYSTEMS_DIR");
   std::filesystem::remove_all(dir);
 }
