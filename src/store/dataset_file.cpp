@@ -67,24 +67,15 @@ OscillatorOptions read_physics(const h5::File& file, const std::string& group) {
   return s;
 }
 
+// Version 1 also stores the energy intervals (version 2 keeps them in the
+// system file's text).
 DatasetOptions read_options(const h5::File& file, const std::string& group) {
-  DatasetOptions o;
-  o.data_seed = static_cast<std::uint64_t>(file.int_attribute(group, "data_seed"));
-  o.generation_step = file.double_attribute(group, "generation_step_s");
-  o.period = file.double_attribute(group, "period_s");
-  o.alpha = file.double_attribute(group, "alpha");
-  o.beta = file.double_attribute(group, "beta");
-  o.sample_rate = file.double_attribute(group, "sample_rate_Hz");
+  DatasetOptions o = read_dataset_timing(file, group);
   o.energy_min = file.double_attribute(group, "energy_min_J");
   o.energy_max = file.double_attribute(group, "energy_max_J");
   o.energy_sampling = read_energy_sampling(file, group);
   o.equilibrium_energy_min = file.double_attribute(group, "equilibrium_energy_min_J");
   o.equilibrium_energy_max = file.double_attribute(group, "equilibrium_energy_max_J");
-  o.num_trajectories = static_cast<int>(file.int_attribute(group, "num_trajectories"));
-  o.num_train_max = static_cast<int>(file.int_attribute(group, "num_train_max"));
-  o.num_validation = static_cast<int>(file.int_attribute(group, "num_validation"));
-  o.num_inference = static_cast<int>(file.int_attribute(group, "num_inference"));
-  o.newton.newton_tolerance = file.double_attribute(group, "newton_tolerance");
   return o;
 }
 

@@ -10,6 +10,11 @@
 namespace phnn {
 namespace internal {
 
+/// The options every data-set version stores alike under `group`: seed,
+/// timing, split sizes and the Newton tolerance (not the energy sampling,
+/// which the versions read differently, nor version 1's energy intervals).
+DatasetOptions read_dataset_timing(const h5::File& file, const std::string& group);
+
 /// A format_version 1 group (a built-in system's 2-state layout, written
 /// before 2026-11-28) as a data set of the built-in system's file.
 PhSystemData read_version1_data(const h5::File& file, const std::string& group);

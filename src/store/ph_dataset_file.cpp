@@ -115,6 +115,18 @@ void write_options(h5::File& file, const std::string& g, const DatasetOptions& o
 }
 
 DatasetOptions read_options(const h5::File& file, const std::string& g) {
+  DatasetOptions o = internal::read_dataset_timing(file, g);
+  o.energy_sampling = file.string_attribute(g, "energy_sampling") == "direct"
+                          ? EnergySampling::kDirect
+                          : EnergySampling::kAlgorithm1;
+  return o;
+}
+
+}  // namespace
+
+namespace internal {
+
+DatasetOptions read_dataset_timing(const h5::File& file, const std::string& g) {
   DatasetOptions o;
   o.data_seed = static_cast<std::uint64_t>(file.int_attribute(g, "data_seed"));
   o.generation_step = file.double_attribute(g, "generation_step_s");
@@ -122,9 +134,6 @@ DatasetOptions read_options(const h5::File& file, const std::string& g) {
   o.alpha = file.double_attribute(g, "alpha");
   o.beta = file.double_attribute(g, "beta");
   o.sample_rate = file.double_attribute(g, "sample_rate_Hz");
-  o.energy_sampling = file.string_attribute(g, "energy_sampling") == "direct"
-                          ? EnergySampling::kDirect
-                          : EnergySampling::kAlgorithm1;
   o.num_trajectories = static_cast<int>(file.int_attribute(g, "num_trajectories"));
   o.num_train_max = static_cast<int>(file.int_attribute(g, "num_train_max"));
   o.num_validation = static_cast<int>(file.int_attribute(g, "num_validation"));
@@ -133,7 +142,7 @@ DatasetOptions read_options(const h5::File& file, const std::string& g) {
   return o;
 }
 
-}  // namespace
+}  // namespace internal
 
 std::string data_set_checksum(const PhSystemData& data) {
   // The bytes hashed, field by field: sizes as uint64, doubles as stored.

@@ -3,12 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <map>
 #include <queue>
 #include <stdexcept>
+
+#include "phnn/common/number_text.h"
 
 namespace phnn {
 
@@ -66,17 +66,6 @@ double estimate_group_cost_s(const RunConfig& run, int members, const CostModel&
 }
 
 namespace {
-
-// Shortest "%g" spelling that reads back as `value` (1e-05, 0.0001, 2.5e-06):
-// distinct weights never share a column label.
-std::string shortest_number(double value) {
-  char buf[32];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-    if (std::strtod(buf, nullptr) == value) break;
-  }
-  return buf;
-}
 
 // Varied axes of a study, in nesting order, and the label of a run's column.
 // The regularizer weight is a column part of regularized runs only

@@ -4,11 +4,10 @@
 // parameter and energy lines.
 #include "phnn/systems/builtin_systems.h"
 
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <sstream>
 
+#include "phnn/common/number_text.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {
@@ -110,16 +109,6 @@ void check_definition(const SystemDefinition& def, SystemKind kind) {
   }
 }
 
-// The shortest decimal that reads back as v (0.9, not 0.90000000000000002).
-std::string g17(double v) {
-  char buf[40];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  return buf;
-}
-
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // Line `line` (1-based) of `text`, `key = old  # note`, with `value` in
@@ -142,7 +131,7 @@ void set_value(std::string* text, int line, const std::string& value, const std:
   text->replace(begin, end - begin, updated);
 }
 
-std::string interval_text(const std::array<double, 2>& v) { return "[" + g17(v[0]) + ", " + g17(v[1]) + "]"; }
+std::string interval_text(const std::array<double, 2>& v) { return "[" + shortest_number(v[0]) + ", " + shortest_number(v[1]) + "]"; }
 
 // The rewritten text reads back as the values asked for (a line rewritten
 // in place cannot have hit another key), else the shipped file's layout is
@@ -184,7 +173,7 @@ std::string builtin_system_text(const OscillatorOptions& physics, const BuiltinE
     for (const auto& [name, stored] : def.parameters) {
       const double wanted = value_of(values, a);
       if (name == a.parameter && !same_bits(stored, wanted)) {
-        set_value(&text, def.line_of("parameters." + name), g17(wanted), "parameters." + name, path);
+        set_value(&text, def.line_of("parameters." + name), shortest_number(wanted), "parameters." + name, path);
       }
     }
   }

@@ -48,7 +48,10 @@ CellData common_cell_data(const PhSystemData& data) {
   return d;
 }
 
-// The figure trajectories of `figures` (one is shown twice).
+// The two figure trajectories from `figures` (ph_figure_set's, or the
+// inference set; one trajectory is shown twice). With time-varying
+// inference inputs they need u at every step: the set's own (inference), or
+// its constant u repeated (figure energies).
 void set_figures(const PhInferenceSet& figures, CellData* d) {
   d->has_figures = true;
   for (std::size_t k = 0; k < 2; ++k) {
@@ -59,10 +62,10 @@ void set_figures(const PhInferenceSet& figures, CellData* d) {
     append(figures.states[i].front(), &d->figure_x0[k]);
     d->figure_u[k].clear();
     append(figures.u[i], &d->figure_u[k]);
-    // Time-varying inference inputs: the figures' constant u at every step.
     d->figure_inputs[k].clear();
     for (int n = 0; !d->inference_inputs.empty() && n < d->inference_steps; ++n) {
-      append(figures.u[i], &d->figure_inputs[k]);
+      append(figures.inputs.empty() ? figures.u[i] : figures.inputs[i][static_cast<std::size_t>(n)],
+             &d->figure_inputs[k]);
     }
   }
 }
@@ -104,23 +107,7 @@ CellData make_cell_data(const PhSystemData& data, const PhSystem& system) {
     set_figures(ph_figure_set(system, data.options), &d);
     return d;
   }
-  if (d.inference_count == 0) return d;
-  d.has_figures = true;
-  const std::size_t nx = static_cast<std::size_t>(d.n_x), nu = static_cast<std::size_t>(d.n_u);
-  const std::size_t points = static_cast<std::size_t>(d.inference_steps) + 1;
-  for (std::size_t k = 0; k < 2; ++k) {
-    const std::size_t i = std::min(k, d.inference_count - 1);
-    const auto states = d.inference_states.begin() + static_cast<long>(i * points * nx);
-    d.figure_references[k].assign(states, states + static_cast<long>(points * nx));
-    d.figure_x0[k].assign(states, states + static_cast<long>(nx));
-    const auto u = d.inference_u.begin() + static_cast<long>(i * nu);
-    d.figure_u[k].assign(u, u + static_cast<long>(nu));
-    if (!d.inference_inputs.empty()) {
-      const std::size_t per = static_cast<std::size_t>(d.inference_steps) * nu;
-      const auto in = d.inference_inputs.begin() + static_cast<long>(i * per);
-      d.figure_inputs[k].assign(in, in + static_cast<long>(per));
-    }
-  }
+  if (d.inference_count > 0) set_figures(data.inference, &d);
   return d;
 }
 
