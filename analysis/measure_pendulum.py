@@ -6,7 +6,7 @@ sub-sampled to 100 Hz, with Gaussian noise on the states, written as the CSV tha
 
     analysis/measure_pendulum.py --out results/pendulum-measured.csv
     build/phnn import results/pendulum-measured.csv --system sweeps/systems/pendulum.toml \\
-        --num-validation 500 --num-inference 50 --pair-window 0.31 \\
+        --split trajectories --num-validation 500 --num-inference 50 --pair-window 0.31 \\
         --out results/pendulum-measured.h5
     mpirun -np 2 build/phnn sweep sweeps/examples/pendulum-measured.toml
 

@@ -1,11 +1,13 @@
 // src/apps/cmd_import.cpp — `phnn import`: recorded trajectories (CSV or
 // HDF5) into a data-set file, split as docs/METHOD.md "Measured data" says.
 #include <chrono>
+#include <cstdlib>
 #include <iostream>
 
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "h5/h5file.h"
+#include "phnn/common/counted.h"
 #include "phnn/data/measured.h"
 #include "phnn/store/output_path.h"
 #include "phnn/store/ph_dataset_file.h"
@@ -29,8 +31,46 @@ std::vector<MeasuredTrajectory> read_inputs(const std::vector<std::string>& file
   return all;
 }
 
+// --blocks "0.6,0.2": the training and validation shares of each recording.
+void parse_blocks(const std::string& text, ImportOptions* o) {
+  const std::size_t comma = text.find(',');
+  char* end_a = nullptr;
+  char* end_b = nullptr;
+  const std::string a = text.substr(0, comma);
+  const std::string b = comma == std::string::npos ? "" : text.substr(comma + 1);
+  o->train_fraction = std::strtod(a.c_str(), &end_a);
+  o->validation_fraction = std::strtod(b.c_str(), &end_b);
+  const bool numbers = !a.empty() && !b.empty() && *end_a == '\0' && *end_b == '\0';
+  if (!numbers || !(o->train_fraction > 0) || !(o->validation_fraction > 0) ||
+      !(o->train_fraction + o->validation_fraction < 1)) {
+    throw cli::UsageError{"phnn import: --blocks " + text + ": give the training and validation "
+                          "shares of each recording, both > 0 with a sum < 1 (the inference block "
+                          "is the rest), e.g. --blocks 0.6,0.2"};
+  }
+}
+
 ImportOptions import_options(const cli::Parser& parser) {
   ImportOptions o;
+  const std::string split = parser.get("split");
+  if (split != "blocks" && split != "trajectories") {
+    throw cli::UsageError{"phnn import: --split " + split + ": give blocks (a few long recordings, "
+                          "cut in time) or trajectories (one pair per trajectory)"};
+  }
+  o.split = split == "blocks" ? ImportSplit::kBlocks : ImportSplit::kTrajectories;
+  const bool blocks = o.split == ImportSplit::kBlocks;
+  for (const char* name : {"pair-window", "split-seed"}) {
+    if (blocks && parser.has(name)) {
+      throw cli::UsageError{std::string("phnn import: --") + name + " belongs to --split "
+                            "trajectories; blocks use every pair of a block, in time order"};
+    }
+  }
+  for (const char* name : {"blocks", "window"}) {
+    if (!blocks && parser.has(name)) {
+      throw cli::UsageError{std::string("phnn import: --") + name + " belongs to --split blocks"};
+    }
+  }
+  parse_blocks(parser.get("blocks"), &o);
+  o.window = parser.get_double_in("window", 0.0, 1e12);
   o.data_seed = static_cast<std::uint64_t>(parser.get_int_in("data-seed", 0, 2147483647));
   o.num_validation = parser.get_int_in("num-validation", 1, 100000000);
   o.num_inference = parser.get_int_in("num-inference", 1, 100000000);
@@ -46,19 +86,29 @@ int run_import(int argc, char** argv, int first) {
   cli::Parser parser("import",
                      "Reads recorded trajectories (CSV: trajectory,t,<states>,<inputs>; or HDF5:\n"
                      "/trajectories/<id>/{t,x,u}) and writes a data-set file that `phnn train\n"
-                     "--data` and sweeps read: training and validation pairs, one per trajectory,\n"
-                     "and inference trajectories, each from different trajectories\n"
-                     "(docs/METHOD.md, \"Measured data\").");
+                     "--data` and sweeps read (docs/METHOD.md, \"Measured data\"). --split blocks\n"
+                     "(a few long recordings): each recording is cut in time into a training, a\n"
+                     "validation and an inference block; every pair inside a block is a pair, and\n"
+                     "inference windows lie in the last block. --split trajectories (many short\n"
+                     "ones, as `phnn data --csv` writes): one pair per trajectory, each trajectory\n"
+                     "in one role.\n\n"
+                     "Example: phnn import rec.csv --system pendulum.toml --blocks 0.6,0.2 --window 10 --out rec.h5");
   parser.positional_rest("FILE", "CSV or HDF5 trajectory files (their trajectories are joined)");
   parser.option("system", "a system file (.toml) or built-in name: the state and input names", "",
                 true);
   parser.option("out", "output data-set file (HDF5)", "", true);
-  parser.option("num-validation", "trajectories for validation pairs", "2500");
-  parser.option("num-inference", "trajectories for inference (the last ones after the split)", "100");
-  parser.option("pair-window", "draw pairs with t_n+1 - t_0 <= this [s]; 0: anywhere", "0");
+  parser.option("split", "blocks | trajectories (see above)", "blocks");
+  parser.option("blocks", "blocks: training and validation shares of each recording's samples "
+                          "(inference: the rest)", "0.6,0.2");
+  parser.option("window", "blocks: inference windows of this duration [s]; 0: the whole block", "0");
+  parser.option("num-validation", "trajectories: trajectories for validation pairs; blocks: at most "
+                                  "this many validation pairs", "2500");
+  parser.option("num-inference", "trajectories: trajectories for inference (the last ones after "
+                                 "the split); blocks: at most this many windows", "100");
+  parser.option("pair-window", "trajectories: draw pairs with t_n+1 - t_0 <= this [s]; 0: anywhere", "0");
   parser.option("sample-rate", "sampling rate [Hz] (checked against t); 0: from t", "0");
   parser.option("data-seed", "seed of the pair draws (as `phnn data --data-seed`)", "0");
-  parser.option("split-seed", "shuffle the trajectories by this seed before the split "
+  parser.option("split-seed", "trajectories: shuffle them by this seed before the split "
                               "(default: in the order of their ids)");
   if (!parser.parse(argc, argv, first)) return 0;
 
@@ -87,10 +137,14 @@ int run_import(int argc, char** argv, int first) {
   write_atomically(out, "writing", [&](const std::string& path) { write_ph_dataset_file(path, data); });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << summary << "phnn import: " << system->name() << ": " << data.train.size()
-            << " train pairs, " << data.validation.size() << " validation pairs, "
-            << data.inference.size() << " inference trajectories -> " << out << " (" << seconds
-            << " s)\n";
+  const bool blocks = options.split == ImportSplit::kBlocks;
+  std::cout << summary << "phnn import: " << system->name() << ": "
+            << counted(static_cast<long long>(data.train.size()), "training pair") << ", "
+            << counted(static_cast<long long>(data.validation.size()), "validation pair") << ", "
+            << (blocks ? counted(static_cast<long long>(data.inference.size()), "inference window")
+                       : std::to_string(data.inference.size()) +
+                             (data.inference.size() == 1 ? " inference trajectory" : " inference trajectories"))
+            << " -> " << out << " (" << seconds << " s)\n";
   return 0;
 }
 

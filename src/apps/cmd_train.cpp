@@ -28,6 +28,7 @@
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/sweep/version.h"
+#include "phnn/systems/builtin_systems.h"
 #include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"
 
@@ -45,14 +46,16 @@ std::string provenance_value(const Provenance& provenance, const std::string& ke
 // --out is checked before training, not after (store/output_path.h): a new
 // results file, not an input, in a writable directory.
 void require_new_output(const cli::Parser& parser) {
-  std::vector<std::string> inputs = {parser.get("system")};
+  std::vector<std::string> inputs;
+  if (parser.has("system")) inputs.push_back(parser.get("system"));
   if (parser.has("data")) inputs.push_back(parser.get("data"));
   const std::string problem = output_problem("train", parser.get("out"), OutputKind::kResults, inputs);
   if (!problem.empty()) throw cli::UsageError{"phnn train: --out " + problem};
 }
 
 void declare_train_options(cli::Parser* parser) {
-  parser->option("system", "harmonic | duffing | self-sustained | a system file (.toml)", "", true);
+  parser->option("system", "harmonic | duffing | self-sustained | a system file (.toml); with "
+                           "--data: optional (the data set names its system)");
   parser->option("model",
                  "formulation-integrator as in sweep files: node-rk2, node-rk4, phnn-s-rk2, "
                  "phnn-s-dg, phnn-s-rk4, phnn-s-dg4, phnn-jr-rk2, phnn-jr-dg, phnn-jr-rk4, "
@@ -202,49 +205,76 @@ void print_cell_results(const CellSpec& cell, const std::vector<RunResult>& resu
 
 // The system and its data set. From --data: a built-in system's data say
 // its physics (--damping is refused); a system file's data must have been
-// made from the same text. Else generated for the cell's N_train from the
-// system file, or the built-in system's shipped file with --damping.
+// made from the same text, and without --system the data set's own text is
+// the system. Else generated for the cell's N_train from the system file,
+// or the built-in system's shipped file with --damping.
 struct TrainData {
   std::unique_ptr<PhSystem> system;
   PhSystemData data;
 };
 
-TrainData read_train_data(const cli::Parser& parser, bool builtin) {
-  const std::string arg = parser.get("system"), path = parser.get("data");
+// --data without --system: the system entry the data set stands for — a
+// built-in's name when its text is a built-in's, else "<name>.toml", a
+// system file whose text the data set supplies.
+std::string stored_system_entry(const PhSystemData& data, const std::string& path) {
+  try {
+    parse_system(data.system_name);
+    builtin_physics(data.system_text, path + "@system_file");
+    return data.system_name;
+  } catch (const std::exception&) {
+    return data.system_name + ".toml";
+  }
+}
+
+TrainData read_train_data(const cli::Parser& parser, std::string* arg) {
+  const std::string path = parser.get("data");
+  const bool given = !arg->empty();
   TrainData d;
   d.data = read_ph_dataset_file(path);
-  if (builtin) {
+  if (!given) *arg = stored_system_entry(d.data, path);
+  if (!is_system_file_argument(*arg)) {
     if (parser.has("damping")) {
       throw cli::UsageError{"phnn train: --damping with --data: the data set " + path +
                             " fixes the physics; drop --damping"};
     }
-    if (d.data.system_name != arg) {
+    if (d.data.system_name != *arg) {
       throw cli::UsageError{"phnn train: --data " + path + " holds system " + d.data.system_name +
-                            ", not " + arg};
+                            ", not " + *arg + "; drop --system (the data set names its system)"};
     }
     d.system = compile_system(d.data.system_text, path + "@system_file");
     return d;
   }
-  d.system = load_system_file(system_file_path(arg));
+  if (!given) {
+    d.system = compile_system(d.data.system_text, path + "@system_file");
+    return d;
+  }
+  d.system = load_system_file(system_file_path(*arg));
   if (d.data.system_text != d.system->source_text()) {
     throw cli::UsageError{"phnn train: --data " + path + " was made from another text of system " +
-                          d.data.system_name + ", not from " + arg +
-                          "; regenerate it with `phnn data --system " + arg +
-                          "` (or, for recordings, `phnn import ... --system " + arg + "`)"};
+                          d.data.system_name + ", not from " + *arg +
+                          "; drop --system (the data set holds its system's text), or regenerate "
+                          "it with `phnn data --system " + *arg +
+                          "` (for recordings, `phnn import ... --system " + *arg + "`)"};
   }
   return d;
 }
 
-TrainData train_data(const cli::Parser& parser, bool builtin, int n_train) {
-  const std::string arg = parser.get("system");
+// *arg: --system, or "" (then --data's own system, set here).
+TrainData train_data(const cli::Parser& parser, std::string* arg_in, int n_train) {
   if (parser.has("data")) {
-    TrainData d = read_train_data(parser, builtin);
+    TrainData d = read_train_data(parser, arg_in);
     if (static_cast<std::size_t>(n_train) > d.data.train.size())
       throw cli::UsageError{"phnn train: --n-train = " + std::to_string(n_train) + " exceeds the " +
                             std::to_string(d.data.train.size()) + " training pairs of --data " +
                             parser.get("data") + "; lower --n-train, or make a larger data set"};
     return d;
   }
+  const std::string arg = *arg_in;
+  if (arg.empty()) {
+    throw cli::UsageError{"phnn train: give --system (a built-in name or a system file), or --data "
+                          "FILE (a data set names its system)"};
+  }
+  const bool builtin = !is_system_file_argument(arg);
   const DatasetOptions options = generation_options(parser, n_train);
   TrainData d;
   if (builtin) {
@@ -273,11 +303,11 @@ int run_train(int argc, char** argv, int first) {
   const CellSpec cell = cell_from_options(parser);
   if (parser.has("out")) require_new_output(parser);  // before any output or work
   torch::set_num_threads(parser.get_int_in("threads", 1, 4096));
-  const std::string arg = parser.get("system");
-  const bool builtin = !is_system_file_argument(arg);
-  if (builtin) parse_system(arg);  // an unknown name is an error before any work
+  std::string arg = parser.get("system");
+  if (!arg.empty() && !is_system_file_argument(arg)) parse_system(arg);  // unknown: an error before any work
   const Provenance provenance = session_provenance(MPI_COMM_NULL, argc, argv);
-  const TrainData d = train_data(parser, builtin, cell.n_train);
+  const TrainData d = train_data(parser, &arg, cell.n_train);
+  const bool builtin = !is_system_file_argument(arg);
   cell.validate(d.data);
   const PhSystem& system = *d.system;
   std::cout << "phnn train: " << system.name() << " (" << counted(system.n_x(), "state") << ", "

@@ -9,12 +9,13 @@
 
 #include "phnn/common/check.h"
 #include "phnn/common/cr_math.h"
+#include "data/measured_checks.h"
 #include "phnn/data/counter_rng.h"
 
 namespace phnn {
-namespace {
+namespace internal {
 
-[[noreturn]] void fail(const std::string& message) { throw MeasuredDataError(message); }
+void fail(const std::string& message) { throw MeasuredDataError(message); }
 
 std::string g(double v) {
   std::ostringstream s;
@@ -49,6 +50,8 @@ void check_trajectory(const MeasuredTrajectory& m, int nx, int nu) {
   }
 }
 
+namespace {
+
 // h of one trajectory, checked uniform: every step within tol h of the
 // median step (a gap or one bad stamp cannot shift the reference), then h =
 // (t_N-1 - t_0) / (N - 1), the most accurate estimate once uniform.
@@ -68,6 +71,8 @@ double uniform_step(const MeasuredTrajectory& m, double tolerance) {
   }
   return (m.t.back() - m.t.front()) / static_cast<double>(m.t.size() - 1);
 }
+
+}  // namespace
 
 // The common step h = 1 / rate: given, or from the time columns (snapped
 // to an integer rate within 1e-9).
@@ -101,6 +106,26 @@ double common_step(const std::vector<MeasuredTrajectory>& all, const ImportOptio
   return h0;
 }
 
+// Sorted by id, ids unique.
+void sort_by_id(std::vector<MeasuredTrajectory>* all) {
+  std::stable_sort(all->begin(), all->end(),
+                   [](const MeasuredTrajectory& a, const MeasuredTrajectory& b) { return a.id < b.id; });
+  for (std::size_t i = 1; i < all->size(); ++i) {
+    if ((*all)[i].id == (*all)[i - 1].id) {
+      fail((*all)[i].where(0) + " was already read at " + (*all)[i - 1].where(0) +
+           " (a trajectory's rows must be contiguous and its id unique); give each trajectory "
+           "its own id");
+    }
+  }
+}
+
+}  // namespace internal
+
+namespace {
+
+using internal::fail;
+using internal::g;
+
 // The pair (x_n, x_n+1) of a trajectory: n uniform among the positions
 // with t_n+1 - t_0 <= window (all when window = 0), keyed by its id.
 void draw_pair(const PhSystem& system, const MeasuredTrajectory& m, const ImportOptions& o,
@@ -130,15 +155,7 @@ void draw_pair(const PhSystem& system, const MeasuredTrajectory& m, const Import
 // Sorted by id; unique ids; shuffled by split_seed (Fisher-Yates on one
 // counter stream) when it is >= 0.
 void order_for_split(std::vector<MeasuredTrajectory>* all, const ImportOptions& o) {
-  std::stable_sort(all->begin(), all->end(),
-                   [](const MeasuredTrajectory& a, const MeasuredTrajectory& b) { return a.id < b.id; });
-  for (std::size_t i = 1; i < all->size(); ++i) {
-    if ((*all)[i].id == (*all)[i - 1].id) {
-      fail((*all)[i].where(0) + " was already read at " + (*all)[i - 1].where(0) +
-           " (a trajectory's rows must be contiguous and its id unique); give each trajectory "
-           "its own id");
-    }
-  }
+  internal::sort_by_id(all);
   if (o.split_seed < 0) return;
   CounterRng rng(mix64(static_cast<std::uint64_t>(o.split_seed) ^ 0x73706c6974ULL));  // "split"
   for (std::size_t i = all->size(); i > 1; --i) {
@@ -189,12 +206,24 @@ void ImportOptions::validate() const {
                "sample_rate = " << sample_rate << " must be >= 0 (0: from the time column)");
   PHNN_REQUIRE(time_tolerance > 0 && time_tolerance < 0.5,
                "time_tolerance = " << time_tolerance << " must be in (0, 0.5)");
+  if (split != ImportSplit::kBlocks) return;
+  PHNN_REQUIRE(train_fraction > 0 && validation_fraction > 0 &&
+                   train_fraction + validation_fraction < 1,
+               "blocks " << train_fraction << ", " << validation_fraction << ": the training and "
+               "validation shares must be > 0 and leave an inference block (sum < 1)");
+  PHNN_REQUIRE(std::isfinite(window) && window >= 0,
+               "window = " << window << " must be >= 0 (0: the whole inference block)");
+  PHNN_REQUIRE(pair_window == 0 && split_seed < 0,
+               "pair_window and split_seed belong to the split by trajectories; blocks use every "
+               "pair of a block, in time order");
 }
 
-PhSystemData split_measured_data(const PhSystem& system,
-                                 std::vector<MeasuredTrajectory> trajectories,
-                                 const ImportOptions& options, std::string* summary) {
-  options.validate();
+namespace {
+
+// ImportSplit::kTrajectories (split_measured_data's step 2).
+PhSystemData split_by_trajectories(const PhSystem& system,
+                                   std::vector<MeasuredTrajectory> trajectories,
+                                   const ImportOptions& options, std::string* summary) {
   const long total = static_cast<long>(trajectories.size());
   const long held = static_cast<long>(options.num_validation) + options.num_inference;
   if (total < held + 1) {
@@ -204,9 +233,11 @@ PhSystemData split_measured_data(const PhSystem& system,
          "need " + std::to_string(held + 1) + ": lower --num-validation / --num-inference or "
          "record more trajectories");
   }
-  for (const MeasuredTrajectory& m : trajectories) check_trajectory(m, system.n_x(), system.n_u());
+  for (const MeasuredTrajectory& m : trajectories) {
+    internal::check_trajectory(m, system.n_x(), system.n_u());
+  }
   order_for_split(&trajectories, options);
-  const double h = common_step(trajectories, options, summary);
+  const double h = internal::common_step(trajectories, options, summary);
   const std::size_t num_train = static_cast<std::size_t>(total - held);
   const std::size_t infer_begin = num_train + static_cast<std::size_t>(options.num_validation);
 
@@ -270,56 +301,15 @@ PhSystemData split_measured_data(const PhSystem& system,
   return data;
 }
 
-void NoiseOptions::validate(int n_x) const {
-  PHNN_REQUIRE(levels.empty() || static_cast<int>(levels.size()) == n_x,
-               "noise: " << levels.size() << " levels for " << n_x << " states; give one per state "
-               "(or one for all)");
-  for (double l : levels) {
-    PHNN_REQUIRE(std::isfinite(l) && l >= 0, "noise level " << l << " must be finite and >= 0");
-  }
-}
+}  // namespace
 
-std::vector<double> add_measurement_noise(PhSystemData* data, int rng_id,
-                                          const NoiseOptions& options) {
-  const int nx = static_cast<int>(data->state_names.size());
-  options.validate(nx);
-  if (options.levels.empty()) return {};
-  // spread_j: standard deviation (two passes) of x_j over the clean
-  // validation pairs' x — a fixed split, so sigma does not depend on n_train.
-  std::vector<double> sigma(static_cast<std::size_t>(nx));
-  const std::vector<VecX>& xs = data->validation.x;
-  for (int j = 0; j < nx; ++j) {
-    const double n = static_cast<double>(xs.size());
-    double mean = 0, var = 0;
-    for (const VecX& x : xs) mean += x(j) / n;
-    for (const VecX& x : xs) var += (x(j) - mean) * (x(j) - mean) / (n - 1);
-    const double spread = xs.size() > 1 ? std::sqrt(var) : 0.0;
-    const double level = options.levels[static_cast<std::size_t>(j)];
-    sigma[static_cast<std::size_t>(j)] = options.relative ? level * spread : level;
-  }
-  // Box-Muller: z = sqrt(-2 ln(1 - u1)) cos(2 pi u2), u in [0, 1).
-  const auto normal = [](CounterRng* rng) {
-    const double u1 = rng->uniform(), u2 = rng->uniform();
-    return std::sqrt(-2.0 * cr::log(1.0 - u1)) * cr::cos(2.0 * M_PI * u2);
-  };
-  for (PhPairSet* p : {&data->train, &data->validation}) {
-    for (std::size_t i = 0; i < p->size(); ++i) {
-      CounterRng rng = CounterRng::for_trajectory(data->options.data_seed, rng_id, p->trajectory[i],
-                                                  CounterRng::kMeasurementNoise);
-      for (VecX* x : {&p->x[i], &p->x_next[i]}) {
-        for (int j = 0; j < nx; ++j) (*x)(j) += sigma[static_cast<std::size_t>(j)] * normal(&rng);
-      }
-    }
-  }
-  std::ostringstream note;
-  note.precision(6);
-  note << (options.relative ? "relative" : "absolute") << " levels";
-  for (double l : options.levels) note << " " << l;
-  note << ": sigma";
-  for (int j = 0; j < nx; ++j) note << " " << data->state_names[static_cast<std::size_t>(j)] << "=" << sigma[static_cast<std::size_t>(j)];
-  note << " (training and validation pairs; inference clean)";
-  data->noise = note.str();
-  return sigma;
+PhSystemData split_measured_data(const PhSystem& system,
+                                 std::vector<MeasuredTrajectory> trajectories,
+                                 const ImportOptions& options, std::string* summary) {
+  options.validate();
+  return options.split == ImportSplit::kBlocks
+             ? split_in_blocks(system, std::move(trajectories), options, summary)
+             : split_by_trajectories(system, std::move(trajectories), options, summary);
 }
 
 std::vector<MeasuredTrajectory> generated_trajectories(const PhSystem& system,

@@ -204,6 +204,7 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
   file.set_attribute(g, "input_names", join(data.input_names));
   file.set_attribute(g, "time_units", std::string("s"));
   if (!data.noise.empty()) file.set_attribute(g, "noise", data.noise);
+  if (!data.split.empty()) file.set_attribute(g, "split", data.split);
   write_options(file, g, data.options);
   write_pairs(file, p + "/train", data.train, nx, nu);
   write_pairs(file, p + "/validation", data.validation, nx, nu);
@@ -227,6 +228,11 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
                flatten_trajectories(data.inference.inputs));
   }
   file.write(p + "/inference/trajectory", {m}, data.inference.trajectory);
+  if (!data.inference.position.empty()) {
+    PHNN_REQUIRE(data.inference.position.size() == m, "write_ph_system_data: "
+                     << data.inference.position.size() << " start samples for " << m << " windows");
+    file.write(p + "/inference/position", {m}, data.inference.position);
+  }
   file.set_attribute(p + "/inference", "step_s", data.inference.step);
 }
 
@@ -249,6 +255,7 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
   d.input_names = split(file.string_attribute(g, "input_names"));
   d.n_w = static_cast<int>(file.int_attribute(g, "n_w"));
   if (file.has_attribute(g, "noise")) d.noise = file.string_attribute(g, "noise");
+  if (file.has_attribute(g, "split")) d.split = file.string_attribute(g, "split");
   const int nx = static_cast<int>(d.state_names.size());
   const int nu = static_cast<int>(d.input_names.size());
   if (nx < 1 || d.n_w < 0 || nx + d.n_w + nu > kMaxDimension) {
@@ -263,6 +270,14 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
   d.inference.trajectory = file.read_ints(p + "/inference/trajectory");
   d.inference.step = file.double_attribute(p + "/inference", "step_s");
   const std::size_t m = d.inference.trajectory.size();
+  if (file.exists(p + "/inference/position")) {
+    d.inference.position = file.read_ints(p + "/inference/position");
+    if (d.inference.position.size() != m) {
+      throw std::runtime_error(p + "/inference/position: " + std::to_string(d.inference.position.size()) +
+                               " start samples for " + std::to_string(m) + " windows; the file is "
+                               "damaged or was not written by phnn");
+    }
+  }
   const auto dims = file.dims(p + "/inference/states");
   const auto flat = file.read_doubles(p + "/inference/states");
   const std::size_t steps = dims.size() == 3 ? dims[1] : 0;

@@ -4,6 +4,7 @@
 // and files that are not phnn's never overwritten.
 #include <sys/stat.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -52,9 +53,9 @@ TEST(ImportCommandTest, AGeneratedSetThroughCsvTrainsToTheSameMsesBitForBit) {
                    &log),
               0)
         << log;
-    ASSERT_EQ(phnn("import " + dir + "a.csv --system " + system + " --out " + dir + "b.h5", &log), 0)
+    ASSERT_EQ(phnn("import " + dir + "a.csv --split trajectories --system " + system + " --out " + dir + "b.h5", &log), 0)
         << log;
-    EXPECT_THAT(log, AllOf(HasSubstr("sample rate 100 Hz"), HasSubstr("25 train pairs")));
+    EXPECT_THAT(log, AllOf(HasSubstr("sample rate 100 Hz"), HasSubstr("25 training pairs")));
     for (const char* d : {"a", "b"}) {
       ASSERT_EQ(phnn("train --system " + system + " --model phnn-s-dg --n-train 25 --seeds 0-1 "
                      "--steps 200 --eval-every 100 --quiet --data " + dir + d + ".h5 --out " + dir +
@@ -89,7 +90,7 @@ TEST(ImportCommandTest, AStructureOnlySystemFileIsEnoughForMeasuredData) {
   std::vector<double> mse[2];
   int k = 0;
   for (const std::string& system : {kPendulum, dir + "structure.toml"}) {
-    ASSERT_EQ(phnn("import " + dir + "a.csv --system " + system + " --out " + dir + "b.h5", &log), 0) << log;
+    ASSERT_EQ(phnn("import " + dir + "a.csv --split trajectories --system " + system + " --out " + dir + "b.h5", &log), 0) << log;
     ASSERT_EQ(phnn("train --system " + system + " --model phnn-jr-rk2 --n-train 25 --seeds 0-1 "
                    "--steps 100 --eval-every 50 --quiet --data " + dir + "b.h5 --out " + dir + "r.h5", &log),
               0) << log;
@@ -102,6 +103,43 @@ TEST(ImportCommandTest, AStructureOnlySystemFileIsEnoughForMeasuredData) {
   EXPECT_EQ(phnn("data --system " + dir + "structure.toml --out " + dir + "c.h5", &log), 2);
   EXPECT_THAT(log, AllOf(HasSubstr("structure.toml:7:"), HasSubstr("defines no energy H")));
   EXPECT_FALSE(exists(dir + "c.h5"));
+  std::system(("rm -rf " + dir).c_str());
+}
+
+// One long recording (20 s at 100 Hz, a decaying oscillation under a
+// changing torque) imported by time blocks, then trained from the data set
+// alone: `phnn train --data` takes the system the file stores.
+TEST(ImportCommandTest, ALongRecordingByBlocksTrainsWithoutSystem) {
+  const std::string dir = ::testing::TempDir() + "phnn_import_blocks_" + std::to_string(::getpid()) + "/";
+  ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
+  {
+    std::ofstream csv(dir + "rec.csv");
+    csv.precision(17);
+    csv << "trajectory,t,q,p,u\n";
+    for (int k = 0; k < 2000; ++k) {
+      const double t = k / 100.0, decay = std::exp(-0.1 * t);
+      csv << 0 << "," << t << "," << 0.5 * decay * std::cos(4.4 * t) << "," << -0.1 * decay * std::sin(4.4 * t)
+          << "," << 0.05 * std::sin(0.7 * t) << "\n";
+    }
+  }
+  std::string log;
+  ASSERT_EQ(phnn("import " + dir + "rec.csv --system " + kPendulum + " --window 2 --out " + dir + "rec.h5", &log), 0)
+      << log;
+  EXPECT_THAT(log, AllOf(HasSubstr("1 recording cut in time"), HasSubstr("1199 training pairs"),
+                         HasSubstr("1 inference window of 2 s")));
+  ASSERT_EQ(phnn("train --data " + dir + "rec.h5 --model phnn-s-dg --n-train 25 --steps 20 --eval-every 10 "
+                 "--seeds 0-1 --quiet --out " + dir + "r.h5", &log), 0)
+      << log;
+  const std::vector<double> mse = mses(dir + "r.h5");
+  ASSERT_EQ(mse.size(), 2u);
+  EXPECT_TRUE(std::isfinite(mse[0]) && std::isfinite(mse[1]));
+  EXPECT_EQ(phnn("train --data " + dir + "rec.h5 --system harmonic --model phnn-s-dg --steps 2", &log), 2);
+  EXPECT_THAT(log, AllOf(HasSubstr("holds system pendulum"), HasSubstr("drop --system")));
+  EXPECT_EQ(phnn("import " + dir + "rec.csv --system " + kPendulum + " --pair-window 0.3 --out " + dir + "x.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("--pair-window belongs to --split trajectories"));
+  EXPECT_EQ(phnn("import " + dir + "rec.csv --system " + kPendulum + " --blocks 0.9,0.2 --out " + dir + "x.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("sum < 1"));
+  EXPECT_FALSE(exists(dir + "x.h5"));
   std::system(("rm -rf " + dir).c_str());
 }
 

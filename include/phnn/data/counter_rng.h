@@ -24,6 +24,8 @@ class CounterRng {
     kControl = 2,
     kTrainingPair = 3,
     kMeasurementNoise = 4,
+    kBlockPairOrder = 5,   // recordings split in time blocks (data/measured.h)
+    kBlockValidation = 6,
   };
 
   static CounterRng for_trajectory(std::uint64_t data_seed, int system_id,

@@ -62,15 +62,35 @@ class MeasuredDataError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// How recorded trajectories become pairs (docs/METHOD.md "Measured data").
+enum class ImportSplit {
+  /// Each trajectory serves one role and gives one pair (or inference
+  /// trajectory): many short trajectories, as generated data are.
+  kTrajectories,
+  /// Each recording is cut in time into a training, a validation and an
+  /// inference block; every sample pair inside a block is a pair, inference
+  /// windows lie inside the inference block: a few long recordings.
+  kBlocks,
+};
+
 /// How recorded trajectories become a data set.
 struct ImportOptions {
+  ImportSplit split = ImportSplit::kTrajectories;
+  /// kBlocks: the training and validation blocks' shares of each
+  /// recording's samples, in this order; the inference block is the rest.
+  double train_fraction = 0.6, validation_fraction = 0.2;
+  /// kBlocks: inference windows of this duration [s], consecutive and
+  /// disjoint inside each inference block (0: the whole block).
+  double window = 0.0;
   /// Keys the draw of each training / validation trajectory's pair position:
   /// CounterRng::for_trajectory(data_seed, system.rng_id(), id,
   /// kTrainingPair).below(positions), as for generated data, so a generated
   /// set written to CSV and imported gives back the same pairs.
   std::uint64_t data_seed = 0;
-  /// Trajectories for the validation pairs and for inference; the others
-  /// (at least one) give the training pairs.
+  /// kTrajectories: trajectories for the validation pairs and for
+  /// inference; the others (at least one) give the training pairs.
+  /// kBlocks: at most this many validation pairs (a uniform draw among the
+  /// validation blocks' pairs when they are more) and inference windows.
   int num_validation = 2500;
   int num_inference = 100;
   /// Pairs (x_n, x_n+1) are drawn among n with t_n+1 - t_0 <= pair_window
@@ -91,17 +111,33 @@ struct ImportOptions {
 
 /// The data set of `trajectories` for `system` (its names, rng_id and text):
 ///   1. ids unique; every trajectory has >= 2 samples and finite values,
-///      constant inputs (phnn trains with one input per trajectory), and
-///      steps equal to one h within time_tolerance, the same h for all;
-///   2. sorted by id (then shuffled by split_seed when >= 0): the last
-///      num_inference are the inference trajectories (cut to the shortest),
-///      the num_validation before them give validation pairs, the rest
-///      training pairs, one pair per trajectory at the drawn position.
+///      and steps equal to one h within time_tolerance, the same h for all;
+///   2. kTrajectories: sorted by id (then shuffled by split_seed when >= 0):
+///      the last num_inference are the inference trajectories (cut to the
+///      shortest), the num_validation before them give validation pairs,
+///      the rest training pairs, one pair per trajectory at the drawn
+///      position; kBlocks: split_in_blocks below.
 /// `summary` (optional) gets one line per decision (rate, split, cuts).
 /// Throws MeasuredDataError.
 PhSystemData split_measured_data(const PhSystem& system,
                                  std::vector<MeasuredTrajectory> trajectories,
                                  const ImportOptions& options, std::string* summary = nullptr);
+
+/// kBlocks (docs/METHOD.md "Measured data"): recording r of N samples
+/// (sorted by id) is cut at b1 = round(train_fraction N) and b2 = b1 +
+/// round(validation_fraction N) into the sample ranges [0, b1), [b1, b2),
+/// [b2, N), each of >= 2 samples. Training pairs: every (x_n, u_n, x_n+1)
+/// with n, n+1 in the first range, of every recording, in an order drawn by
+/// CounterRng stream kBlockPairOrder of the data seed (so a run's first
+/// n_train pairs are a uniform draw, nested in n_train). Validation pairs:
+/// likewise in the second range, at most num_validation (a uniform draw,
+/// stream kBlockValidation, kept in time order). Inference: windows of
+/// round(window / h) + 1 samples (window 0: the shortest inference block)
+/// starting at b2, b2 + W, ... inside [b2, N), taken round-robin over the
+/// recordings up to num_inference, each with its start sample in
+/// inference.position. No pair or window crosses a block boundary.
+PhSystemData split_in_blocks(const PhSystem& system, std::vector<MeasuredTrajectory> recordings,
+                             const ImportOptions& options, std::string* summary = nullptr);
 
 /// Measurement noise on a generated data set (docs/METHOD.md "Measured
 /// data"): sigma_j = level_j (absolute) or level_j * spread_j (relative;

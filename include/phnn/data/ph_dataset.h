@@ -67,6 +67,9 @@ struct PhInferenceSet {
   /// trajectory's input is constant.
   std::vector<std::vector<VecX>> inputs;
   std::vector<std::vector<VecX>> states;  // [trajectory][n], n = 0..steps at sr_infer
+  /// Windows of recordings (split_in_blocks, data/measured.h): the sample of
+  /// its recording each starts at; empty when every trajectory starts at 0.
+  std::vector<std::int64_t> position;
   double step = 0.01;
   std::size_t size() const { return u.size(); }
 };
@@ -90,6 +93,10 @@ struct PhSystemData {
   /// Measurement noise added to the pairs ("" = none), e.g. "relative 0.01:
   /// sigma q=0.0021 p=0.0034" (add_measurement_noise, data/measured.h).
   std::string noise;
+  /// How recordings were split when not one pair per trajectory, e.g.
+  /// "blocks: train 0.6, validation 0.2, inference 0.2 of each recording;
+  /// windows of 10 s" ("" = one pair per trajectory).
+  std::string split;
 };
 
 /// A data set of `system` with no splits yet: its name, text, state and
