@@ -13,6 +13,7 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
+#include "apps/eval_on_data.h"
 #include "apps/provenance.h"
 #include "phnn/store/output_path.h"
 #include "phnn/store/results_file.h"
@@ -144,6 +145,25 @@ void write_energy_csv(const std::string& path, const Evaluation& e) {
   if (!out.flush()) throw std::runtime_error(path + ": write failed; is the disk full?");
 }
 
+// --data FILE: the run of --run (or every finished run) on another data set.
+int eval_on_data(const cli::Parser& parser) {
+  if (parser.has("out")) throw cli::UsageError{"phnn eval: --out (the energy traces) goes without --data"};
+  std::vector<std::string> inputs = {parser.get("RESULTS"), parser.get("data")};
+  if (!parser.get("errors").empty()) {
+    const std::string problem = output_problem("eval", parser.get("errors"), OutputKind::kEvalCsv, inputs);
+    if (!problem.empty()) throw cli::UsageError{"phnn eval: --errors " + problem};
+  }
+  const ResultsFile results = ResultsFile::open_read_only(parser.get("RESULTS"));
+  EvalOnDataOptions o;
+  o.data_path = parser.get("data");
+  o.errors_path = parser.get("errors");
+  if (!parser.get("run").empty()) {
+    o.rows = {find_row(results, results.read_run_ids(), parser.get("run"),
+                       parser.has("seed") ? parser.get_int_in("seed", 0, 1 << 30) : -1)};
+  }
+  return apps::eval_on_data(results, o);
+}
+
 }  // namespace
 
 int run_eval(int argc, char** argv, int first) {
@@ -154,14 +174,24 @@ int run_eval(int argc, char** argv, int first) {
       "the figure trajectories: from H(x0) = 0.5 J and 0.75 J for a built-in system,\n"
       "inference trajectories 0 and 1 for a system file), checks the MSE against the\n"
       "stored one (exit 1 if it differs), and writes the states and the true and\n"
-      "learned energy along the figure trajectories to --out (CSV).");
+      "learned energy along the figure trajectories to --out (CSV). With --data FILE\n"
+      "it rolls the run (or every finished run) out on another data set or imported\n"
+      "recording of the same states and inputs instead, and prints each run's MSE there.\n\n"
+      "Example: phnn eval sines.h5 --data chirp.h5 --errors chirp-errors.csv");
   parser.positional("RESULTS", "results file of `phnn sweep` or `phnn train --out`");
   parser.option("run", "run id (or a unique prefix of it), as in `phnn reduce --per-run`", "");
   parser.option("seed", "with --run PREFIX: the run of this seed among those it matches (the "
                 "seeds of one cell share their ids' first digits)", "");
   parser.option("out", "CSV of t, states and energies along the figure trajectories", "");
+  parser.option("data", "roll the run (without --run: every finished run of its system) out on "
+                "this data set or imported recording instead of the stored data", "");
+  parser.option("errors", "with --data: CSV of the error of every run on every inference trajectory", "");
   if (!parser.parse(argc, argv, first)) return 0;
-  if (parser.get("run").empty()) throw cli::UsageError{"phnn eval: --run ID is required"};
+  if (parser.has("data")) return eval_on_data(parser);
+  if (parser.has("errors")) throw cli::UsageError{"phnn eval: --errors goes with --data FILE"};
+  if (parser.get("run").empty()) {
+    throw cli::UsageError{"phnn eval: --run ID is required (or --data FILE: every run on another data set)"};
+  }
   if (parser.has("out")) {  // given, even empty: checked
     const std::string problem =
         output_problem("eval", parser.get("out"), OutputKind::kEvalCsv, {parser.get("RESULTS")});

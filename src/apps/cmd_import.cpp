@@ -142,8 +142,8 @@ int run_import(int argc, char** argv, int first) {
             << counted(static_cast<long long>(data.train.size()), "training pair") << ", "
             << counted(static_cast<long long>(data.validation.size()), "validation pair") << ", "
             << (blocks ? counted(static_cast<long long>(data.inference.size()), "inference window")
-                       : std::to_string(data.inference.size()) +
-                             (data.inference.size() == 1 ? " inference trajectory" : " inference trajectories"))
+                       : counted(static_cast<long long>(data.inference.size()), "inference trajectory",
+                                 "inference trajectories"))
             << " -> " << out << " (" << seconds << " s)\n";
   return 0;
 }

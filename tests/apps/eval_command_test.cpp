@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -215,6 +216,61 @@ TEST_F(EvalCommandTest, UnknownOrMissingRunIsAUsageError) {
   EXPECT_THAT(log, HasSubstr("--per-run"));
   EXPECT_EQ(run("eval " + out_, &log), 2);
   EXPECT_THAT(log, HasSubstr("--run ID is required"));
+}
+
+// --data: the runs of a file rolled out on another data set. On the data
+// they were trained on (a data-set file, trained with --data) each run's
+// MSE and errors per trajectory are its stored ones, bit for bit (the
+// trainer's inference and eval's are the same code from the same weights);
+// the CSV's MSE is the mean of its errors (Eq. 31); on a chirp-driven set
+// the MSE differs; a data set of other states is refused.
+TEST_F(EvalCommandTest, OnAnotherDataSetEveryRunRollsOutAndItsErrorsAreWritten) {
+  const std::string dir = out_ + ".d/";
+  ASSERT_EQ(std::system(("rm -rf " + dir + " && mkdir -p " + dir).c_str()), 0);
+  const std::string systems = std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/";
+  std::string log;
+  ASSERT_EQ(run("data --system " + systems + "pendulum-forced.toml --n-train 25 --out " + dir + "sines.h5", &log), 0) << log;
+  ASSERT_EQ(run("data --system " + systems + "pendulum-chirp.toml --n-train 1 --out " + dir + "chirp.h5", &log), 0) << log;
+  ASSERT_EQ(run("train --data " + dir + "sines.h5 --model phnn-s-dg --n-train 25 --seeds 0-1 --steps 40 "
+                "--eval-every 20 --quiet --out " + out_, &log), 0) << log;
+  ASSERT_EQ(run("eval " + out_ + " --data " + dir + "sines.h5 --errors " + dir + "own.csv", &log), 0) << log;
+  ASSERT_EQ(run("eval " + out_ + " --data " + dir + "chirp.h5 --errors " + dir + "chirp.csv", &log), 0) << log;
+  EXPECT_THAT(log, HasSubstr("on " + dir + "chirp.h5 (100 trajectories;"));
+  const ResultsFile file = ResultsFile::open_read_only(out_);
+  const std::vector<std::string> ids = file.read_run_ids();
+  // Per run: the CSV's (error per trajectory, MSE), in file order.
+  const auto read_csv = [&](const std::string& path) {
+    std::map<std::string, std::pair<std::vector<double>, double>> rows;
+    std::ifstream in(path);
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "run_id,system,model,integrator,size,n_train,regularizer,seed,trajectory,position,error,mse");
+    while (std::getline(in, line)) {
+      const auto f = split(line);
+      rows[f[0]].first.push_back(std::stod(f[10]));
+      rows[f[0]].second = std::stod(f[11]);
+    }
+    return rows;
+  };
+  const auto own = read_csv(dir + "own.csv"), chirp = read_csv(dir + "chirp.csv");
+  ASSERT_EQ(own.size(), 2u);
+  for (std::size_t row = 0; row < ids.size(); ++row) {
+    const RunResult stored = file.read_run(static_cast<int>(row));
+    const auto& [errors, mse] = own.at(ids[row]);
+    EXPECT_EQ(mse, stored.mse);  // %.17g round-trips a double
+    EXPECT_EQ(errors, stored.trajectory_errors);
+    double mean = 0;
+    for (double e : chirp.at(ids[row]).first) mean += e;
+    mean /= static_cast<double>(chirp.at(ids[row]).first.size());
+    EXPECT_NEAR(mean, chirp.at(ids[row]).second, 1e-13 * mean);
+    EXPECT_NE(chirp.at(ids[row]).second, stored.mse);
+  }
+  ASSERT_EQ(run("data --system " + systems + "coupled-duffing.toml --n-train 1 --out " + dir + "four.h5", &log), 0);
+  EXPECT_EQ(run("eval " + out_ + " --data " + dir + "four.h5", &log), 2);
+  EXPECT_THAT(log, HasSubstr("no finished run of " + out_ + " fits --data " + dir + "four.h5: it has states [q1,"));
+  EXPECT_EQ(run("eval " + out_ + " --errors " + dir + "x.csv --run " + ids[0], &log), 2);
+  EXPECT_THAT(log, HasSubstr("--errors goes with --data FILE"));
+  std::system(("rm -rf " + dir).c_str());
 }
 
 }  // namespace

@@ -11,4 +11,9 @@ inline std::string counted(long long n, const std::string& noun) {
   return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
 }
 
+/// "1 trajectory", "2 trajectories": nouns whose plural is not noun + "s".
+inline std::string counted(long long n, const std::string& singular, const std::string& plural) {
+  return std::to_string(n) + " " + (n == 1 ? singular : plural);
+}
+
 }  // namespace phnn
