@@ -109,7 +109,8 @@ int run_data(int argc, char** argv, int first) {
   cli::Parser parser("data",
                      "Generates the train / validation / inference splits of one "
                      "system (docs/METHOD.md §2)\nwith the Gonzalez discrete gradient and "
-                     "writes them to an HDF5 file.");
+                     "writes them to an HDF5 file.\n\n"
+                     "Example: phnn data --system duffing --n-train 100 --out duffing.h5 --csv duffing.csv");
   parser.option("system", "harmonic | duffing | self-sustained | a system file (.toml)", "", true);
   parser.option("out", "output HDF5 file", "", true);
   parser.option("n-train", "training pairs to generate (<= 400)", "400");

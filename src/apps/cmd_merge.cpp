@@ -18,7 +18,8 @@ int run_merge(int argc, char** argv, int first) {
       "one per Slurm array task) into a new results file OUT: every run gets the result\n"
       "of the shard that trained it (a run finished in two shards must be bitwise equal\n"
       "in both), the data groups and every shard's provenance. Missing shards leave\n"
-      "their runs pending; `phnn sweep FILE --out OUT` then trains just those.");
+      "their runs pending; `phnn sweep FILE --out OUT` then trains just those.\n\n"
+      "Example: phnn merge results/paper.h5 results/paper.shard-0-of-2.h5 results/paper.shard-1-of-2.h5");
   parser.positional("OUT", "new results file (must not exist)");
   parser.positional_rest("SHARD", "shard results files of one sweep file");
   parser.flag("mix-kernels", "merge shards computed with different kernel sets (their results "

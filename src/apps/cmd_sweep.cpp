@@ -148,7 +148,8 @@ class SweepRun {
                 "Runs a sweep file over the MPI ranks (mpirun -np N phnn sweep FILE):\n"
                 "work items (cells, or member groups of a cell) largest first from a shared\n"
                 "counter, one parallel HDF5 results file, resume by running the same command\n"
-                "again. One sweep at a time writes a results file (<results>.lock).") {
+                "again. One sweep at a time writes a results file (<results>.lock).\n\n"
+                "Example: mpirun -np 2 phnn sweep sweeps/demo.toml   (then: phnn reduce results/demo.h5)") {
     declare_options(&parser_);
   }
 

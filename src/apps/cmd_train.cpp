@@ -297,7 +297,8 @@ TrainData train_data(const cli::Parser& parser, std::string* arg_in, int n_train
 int run_train(int argc, char** argv, int first) {
   cli::Parser parser("train",
                      "Trains one cell (all seeds of one configuration) as one stacked model,\n"
-                     "then rolls every member out over the inference set (docs/METHOD.md §3-§5).");
+                     "then rolls every member out over the inference set (docs/METHOD.md §3-§5).\n\n"
+                     "Example: phnn train --system duffing --model phnn-s-dg --seeds 0-9 --out cell.h5");
   declare_train_options(&parser);
   if (!parser.parse(argc, argv, first)) return 0;
   const CellSpec cell = cell_from_options(parser);

@@ -136,7 +136,8 @@ int run_verify(int argc, char** argv, int first) {
       "the digests of its sweep text, configuration columns and data sets, every finished\n"
       "row against the checksum written with it, and, for each damage, what `phnn sweep`\n"
       "on the file will do (rewrite it from the sweep file or the journals, or train the\n"
-      "run again). Exit 0 if nothing is damaged, 1 otherwise.");
+      "run again). Exit 0 if nothing is damaged, 1 otherwise.\n\n"
+      "Example: phnn verify results/paper.h5");
   parser.positional("RESULTS", "results file of `phnn sweep` or `phnn train --out`");
   if (!parser.parse(argc, argv, first)) return 0;
   const std::string path = parser.get("RESULTS");

@@ -38,9 +38,12 @@ double checked_energy(const PhSystem& system, const VecX& x) {
   if (!std::isfinite(h) || h < 0.0) {
     std::ostringstream os;
     os << system.energy_location() << ": H = " << h << " at the drawn initial state x = "
-       << vec_text(x) << (std::isfinite(h) ? " is negative" : " is not finite")
-       << "; an energy must be finite and >= 0 where initial states are drawn: fix H or "
-          "shrink initial.box";
+       << vec_text(x) << (std::isfinite(h) ? " is negative" : " is not finite");
+    if (std::isfinite(h)) {
+      os << negative_energy_advice(system, system.initial_design().box, h);
+    } else {
+      os << "; an energy must be finite where initial states are drawn: fix H or shrink initial.box";
+    }
     throw std::invalid_argument(os.str());
   }
   return h;

@@ -7,9 +7,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
+#include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "phnn/systems/builtin_systems.h"
@@ -211,6 +215,46 @@ std::string shipped_system_path(const std::string& name) {
 std::string system_file_path(const std::string& name_or_path) {
   const std::string shipped = shipped_system_path(name_or_path);
   return shipped.empty() ? name_or_path : shipped;
+}
+
+namespace {
+
+// min H on a grid of k^n <= 4096 points of `box` (n <= 12; else +inf).
+double grid_minimum(const PhSystem& system, const std::vector<std::array<double, 2>>& box) {
+  const int n = static_cast<int>(box.size());
+  if (n == 0 || n > 12) return std::numeric_limits<double>::infinity();
+  int k = 2;
+  while (std::pow(k + 1, n) <= 4096) ++k;
+  long total = 1;
+  for (int i = 0; i < n; ++i) total *= k;
+  double lowest = std::numeric_limits<double>::infinity();
+  VecX x(n);
+  for (long c = 0; c < total; ++c) {
+    long rest = c;
+    for (int i = 0; i < n; ++i, rest /= k) {
+      const auto& [lo, hi] = box[static_cast<std::size_t>(i)];
+      x(i) = lo + (hi - lo) * static_cast<double>(rest % k) / (k - 1);
+    }
+    const double h = system.hamiltonian(x);
+    if (std::isfinite(h)) lowest = std::min(lowest, h);
+  }
+  return lowest;
+}
+
+}  // namespace
+
+std::string negative_energy_advice(const PhSystem& system,
+                                   const std::vector<std::array<double, 2>>& box, double found) {
+  const double lowest = std::min(found, grid_minimum(system, box));
+  const double unit = std::pow(10.0, std::floor(std::log10(-lowest)) - 1);
+  const double c = std::ceil(-lowest / unit) * unit;
+  std::ostringstream os;
+  os << "; phnn draws initial states by their energy in [E_min, E_max] >= 0 and reads energies "
+        "from 0, so H must be >= 0 where states are drawn. A constant changes no trajectory (only "
+        "grad H enters the dynamics): add a constant C >= "
+     << std::setprecision(2) << c << " to H (the smallest H on a grid of the initial box is "
+     << std::setprecision(6) << lowest << "), or shrink initial.box";
+  return os.str();
 }
 
 bool is_system_file_argument(const std::string& s) {

@@ -499,9 +499,12 @@ void FileSystem::check_energy_at(const std::vector<VecX>& points) const {
     const double h = hamiltonian(p);
     if (!std::isfinite(h) || h < 0.0) {
       std::ostringstream os;
-      os << "H = " << h << " at x = (" << p.transpose().format(kRow) << ")" << (std::isfinite(h) ? " is negative" : " is not finite")
-         << "; an energy must be finite and >= 0 wherever initial states are drawn: fix H or "
-            "shrink initial.box";
+      os << "H = " << h << " at x = (" << p.transpose().format(kRow) << ")" << (std::isfinite(h) ? " is negative" : " is not finite");
+      if (std::isfinite(h)) {
+        os << negative_energy_advice(*this, def_.initial.box, h);
+      } else {
+        os << "; an energy must be finite wherever initial states are drawn: fix H or shrink initial.box";
+      }
       throw SystemFileError(def_.file, def_.line_of("H"), os.str());
     }
   }

@@ -222,6 +222,17 @@ void read_names(const Reader& r, const toml::table& t, SystemDefinition* def) {
   }
 }
 
+// One z_k(w) per port; without ports, the ports to declare.
+void check_ports_for_z(const Reader& r, int line, std::size_t expressions, std::size_t ports) {
+  if (expressions == ports) return;
+  r.fail(line, "\"z\" has " + counted(static_cast<long long>(expressions), "expression") + " for " +
+                   counted(static_cast<long long>(ports), "port") +
+                   (ports == 0 ? "; z acts on ports: declare them, one name per z_k(w), e.g. ports = "
+                                 "[\"w\"], and give S their rows and columns (sweeps/FORMAT.md, "
+                                 "\"System files\")"
+                               : "; give one z_k(w) per port in \"ports\""));
+}
+
 void read_structure(const Reader& r, const toml::table& t, SystemDefinition* def) {
   const int nx = static_cast<int>(def->states.size());
   const int nw = static_cast<int>(def->ports.size());
@@ -235,6 +246,10 @@ void read_structure(const Reader& r, const toml::table& t, SystemDefinition* def
                                  " square; at most " + std::to_string(kMaxDimension) +
                                  " is supported: reduce the model or raise kMaxDimension "
                                  "(include/phnn/systems/ph_system.h) and rebuild");
+  }
+  // S's size follows from the ports: a z without its ports is named before S.
+  if (const toml::node* z = r.get(t, "z", false, "", 0); z != nullptr && z->is_array()) {
+    check_ports_for_z(r, Reader::line(*z), z->as_array()->size(), def->ports.size());
   }
   def->S = r.matrix(*s, "S", nx + nw + nu);
   check_skew(r, Reader::line(*s), def->S, "S");
@@ -284,12 +299,7 @@ void read_expressions(const Reader& r, const toml::table& t, SystemDefinition* d
   if (z != nullptr) {
     def->lines["z"] = Reader::line(*z);
     def->dissipation = r.strings(*z, "z");
-    if (def->dissipation.size() != def->ports.size()) {
-      r.fail(Reader::line(*z),
-             "\"z\" has " + counted(static_cast<long long>(def->dissipation.size()), "expression") +
-                 " for " + counted(static_cast<long long>(def->ports.size()), "port") +
-                 "; give one z_k(w) per port in \"ports\"");
-    }
+    check_ports_for_z(r, Reader::line(*z), def->dissipation.size(), def->ports.size());
   }
 }
 

@@ -236,9 +236,22 @@ TEST(SystemFileErrorTest, StructureOnlyFilesDescribeButDoNotGenerate) {
               HasSubstr("\"H\" is empty"));
 }
 
+// The message says why H >= 0 and the constant that fixes it: the
+// smallest H of the box (-0.5 at x = 0) rounded up to two digits.
 TEST(SystemFileErrorTest, EnergyNegativeAtASampledInitialState) {
   EXPECT_THAT(error_of(replaced("k*q^2/2\"", "k*q^2/2 - 0.5\"")),
-              AllOf(HasSubstr("toy.toml:5:"), HasSubstr("is negative"), HasSubstr("fix H")));
+              AllOf(HasSubstr("toy.toml:5:"), HasSubstr("is negative"),
+                    HasSubstr("H must be >= 0 where states are drawn"),
+                    HasSubstr("add a constant C >= 0.5 to H")));
+  EXPECT_THAT(error_of(replaced("k*q^2/2\"", "k*q^2/2 - 0.123456\"")),
+              HasSubstr("add a constant C >= 0.13 to H"));
+}
+
+// z without ports says to declare them.
+TEST(SystemFileErrorTest, DissipationWithoutPortsNamesThem) {
+  std::string text = kGood;
+  text.erase(text.find("ports = "), text.find('\n', text.find("ports = ")) - text.find("ports = ") + 1);
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("for 0 ports"), HasSubstr("ports = [\"w\"]")));
 }
 
 TEST(SystemFileErrorTest, EnergyNotFinite) {

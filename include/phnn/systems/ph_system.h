@@ -212,6 +212,14 @@ int system_rng_id(const std::string& name);
 /// std::invalid_argument for an unknown name.
 std::unique_ptr<PhSystem> make_system(const std::string& name_or_path,
                                       const std::string& base_dir = "");
+/// What to do about H = `found` < 0 at a drawn state, for the errors that
+/// find one: why phnn needs H >= 0 and the constant that lifts H above 0
+/// over `box` (H's smallest value on a grid of <= 4 096 points of it, and
+/// `found`, rounded up to two significant digits), e.g. "; phnn draws ...:
+/// add a constant C >= 0.16 to H (...), or shrink initial.box".
+std::string negative_energy_advice(const PhSystem& system,
+                                   const std::vector<std::array<double, 2>>& box, double found);
+
 /// True when make_system would read `name_or_path` as a file (a path, or
 /// a shipped system file's name).
 bool is_system_file_argument(const std::string& name_or_path);
