@@ -13,6 +13,7 @@
 #include "phnn/store/ph_dataset_file.h"
 #include "phnn/store/scratch_file.h"
 #include "phnn/store/trajectory_files.h"
+#include "phnn/systems/measurement_map.h"
 #include "phnn/systems/ph_system.h"
 
 namespace phnn {
@@ -29,6 +30,19 @@ std::vector<MeasuredTrajectory> read_inputs(const std::vector<std::string>& file
     for (auto& m : part) all.push_back(std::move(m));
   }
   return all;
+}
+
+// "a,b" -> {"a", "b"} (empty items dropped).
+std::vector<std::string> split_names(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', start);
+    std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (!item.empty()) out.push_back(std::move(item));
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
 }
 
 // --blocks "0.6,0.2": the training and validation shares of each recording.
@@ -106,6 +120,8 @@ int run_import(int argc, char** argv, int first) {
   parser.option("num-inference", "trajectories: trajectories for inference (the last ones after "
                                  "the split); blocks: at most this many windows", "100");
   parser.option("pair-window", "trajectories: draw pairs with t_n+1 - t_0 <= this [s]; 0: anywhere", "0");
+  parser.option("ignore-columns", "columns of the files to skip, e.g. temperature,t_ms (the system "
+                                  "file's [measurement] ignore lists more)");
   parser.option("sample-rate", "sampling rate [Hz] (checked against t); 0: from t", "0");
   parser.option("data-seed", "seed of the pair draws (as `phnn data --data-seed`)", "0");
   parser.option("split-seed", "trajectories: shuffle them by this seed before the split "
@@ -126,11 +142,19 @@ int run_import(int argc, char** argv, int first) {
   const std::string problem = output_problem("import", out, OutputKind::kDataSet, inputs);
   if (!problem.empty()) throw cli::UsageError{"phnn import: --out " + problem};
 
-  const TrajectoryColumns columns{system->state_names(), system->input_names()};
+  const MeasurementMap measurement =
+      MeasurementMap::of_system_text(system->source_text(), parser.get("system"));
+  TrajectoryColumns columns{measurement.recorded(), system->input_names(), measurement.ignored()};
+  if (parser.has("ignore-columns")) {
+    for (const std::string& name : split_names(parser.get("ignore-columns"))) columns.ignore.push_back(name);
+  }
   std::string summary;
+  if (!measurement.identity()) summary += "states from [measurement]: " + measurement.describe() + "\n";
   PhSystemData data;
   try {
-    data = split_measured_data(*system, read_inputs(parser.rest(), columns), options, &summary);
+    std::vector<MeasuredTrajectory> recorded = read_inputs(parser.rest(), columns);
+    apply_measurement(measurement, &recorded);
+    data = split_measured_data(*system, std::move(recorded), options, &summary);
   } catch (const MeasuredDataError& e) {
     throw cli::UsageError{std::string("phnn import: ") + e.what()};  // bad input: exit 2
   }

@@ -165,6 +165,26 @@ void order_for_split(std::vector<MeasuredTrajectory>* all, const ImportOptions& 
 
 }  // namespace
 
+void apply_measurement(const MeasurementMap& map, std::vector<MeasuredTrajectory>* trajectories) {
+  if (map.identity()) return;
+  const auto nr = map.recorded().size(), nx = static_cast<std::size_t>(map.n_x());
+  for (MeasuredTrajectory& m : *trajectories) {
+    PHNN_CHECK(static_cast<std::size_t>(m.n_x) == nr, "a recording of " << m.n_x << " columns for "
+                                                                        << nr << " recorded ones");
+    std::vector<double> x(m.size() * nx);
+    for (std::size_t k = 0; k < m.size(); ++k) {
+      map.states(m.x.data() + k * nr, x.data() + k * nx);
+      if (!std::all_of(x.begin() + static_cast<long>(k * nx), x.begin() + static_cast<long>((k + 1) * nx),
+                       [](double v) { return std::isfinite(v); })) {
+        internal::fail(m.where(k) + ": [measurement] (" + map.describe() + ") gives a state that "
+                       "is NaN or infinite; repair the sample or the expression");
+      }
+    }
+    m.x = std::move(x);
+    m.n_x = static_cast<int>(nx);
+  }
+}
+
 void MeasuredTrajectory::add(double time, const double* state, const double* input) {
   t.push_back(time);
   x.insert(x.end(), state, state + n_x);

@@ -47,7 +47,8 @@ void split_fields(std::string_view line, std::vector<std::string_view>* out) {
   }
 }
 
-// Column k of the header: -2 trajectory, -1 t, 0 .. n_x-1 states, then inputs.
+// Column k of the header: -3 skipped, -2 trajectory, -1 t, 0 .. n_x-1
+// states, then inputs.
 std::vector<int> header_roles(const std::vector<std::string>& header, const TrajectoryColumns& c,
                               const std::string& at) {
   std::vector<std::string> expected = {"trajectory", "t"};
@@ -55,10 +56,18 @@ std::vector<int> header_roles(const std::vector<std::string>& header, const Traj
   expected.insert(expected.end(), c.inputs.begin(), c.inputs.end());
   const std::string fix = "; the header must name trajectory, t, the states (" + list(c.states) +
                           ") and the inputs (" + (c.inputs.empty() ? "none" : list(c.inputs)) +
-                          "), e.g. " + list(expected);
+                          "), e.g. " + list(expected) + " (skip other columns with `phnn import "
+                          "--ignore-columns`; compute a state from others with [measurement] in "
+                          "the system file)";
   std::vector<int> roles;
   std::set<std::string> seen;
   for (const std::string& name : header) {
+    if (std::find(c.ignore.begin(), c.ignore.end(), name) != c.ignore.end() &&
+        std::find(expected.begin(), expected.end(), name) == expected.end()) {
+      if (!seen.insert(name).second) fail(at + ": column \"" + name + "\" appears twice" + fix);
+      roles.push_back(-3);
+      continue;
+    }
     const auto it = std::find(expected.begin(), expected.end(), name);
     if (it == expected.end()) fail(at + ": unknown column \"" + name + "\"" + fix);
     if (!seen.insert(name).second) fail(at + ": column \"" + name + "\" appears twice" + fix);
@@ -157,6 +166,7 @@ void CsvTrajectories::add_sample(int lineno) {
   double t = 0;
   for (std::size_t k = 0; k < fields_.size(); ++k) {
     const int role = roles_[k];
+    if (role == -3) continue;
     if (role == -2) {
       id = trajectory_id(fields_[k], at);
       continue;

@@ -5,8 +5,10 @@
 // Size: one reader per part of the format, each with the checks of its keys.
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -33,7 +35,7 @@ namespace {
 const std::vector<std::string> kTopKeys = {"name",   "description", "states", "units",
                                            "inputs", "input_units", "ports",  "H",
                                            "z",      "S",           "J",      "parameters",
-                                           "initial", "control",    "plots"};
+                                           "initial", "control",    "plots", "measurement"};
 
 // Names GiNaC or muParser read as functions or constants.
 const std::set<std::string> kReserved = {
@@ -454,6 +456,36 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
   }
 }
 
+// [measurement] p = "m*v" (a state from recorded columns and parameters;
+// systems/measurement_map.h compiles it), ignore = ["temperature"].
+void read_measurement(const Reader& r, const toml::table& t, SystemDefinition* def) {
+  const toml::node* n = r.get(t, "measurement", false, "", 0);
+  if (n == nullptr) return;
+  const toml::table* mt = n->as_table();
+  if (mt == nullptr) r.fail(Reader::line(*n), "[measurement] must be a table");
+  for (const auto& [key, value] : *mt) {
+    const std::string k(key.str());
+    def->lines["measurement." + k] = Reader::line(value);
+    if (k == "ignore") {
+      def->measurement_ignore = r.strings(value, "measurement.ignore");
+      continue;
+    }
+    if (std::find(def->states.begin(), def->states.end(), k) == def->states.end()) {
+      const std::string near = closest_name(k, def->states);
+      r.fail(Reader::line(value), "measurement." + k + ": \"" + k + "\" is not a state" +
+                                      (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
+                                      "; [measurement] computes states from recorded columns, e.g. "
+                                      "p = \"m*v\", and takes ignore = [\"column\", ...]");
+    }
+    const std::optional<std::string> text = value.value<std::string>();
+    if (!text || text->empty()) {
+      r.fail(Reader::line(value), "measurement." + k + " must be an expression in quotes, e.g. "
+                                  "\"m*v\" (of recorded columns and parameters)");
+    }
+    def->measurement.emplace_back(k, *text);
+  }
+}
+
 // [plots] phase = [["q", "p"], ...] (state pairs of the phase plots);
 // energies = [E1, E2] (the figure trajectories start at x = s e_1 with
 // H(s e_1) = E_k, as the paper's Figures 4-6; needs H).
@@ -522,7 +554,7 @@ SystemDefinition parse_system_definition(const std::string& text, const std::str
                                       (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
                                       "; system files know: name, description, states, units, "
                                       "inputs, input_units, ports, H, z, S, J, [parameters], "
-                                      "[initial], [control], [plots]");
+                                      "[initial], [control], [plots], [measurement]");
     }
   }
   const toml::node* name = r.get(t, "name", true, " (the system's name)", 1);
@@ -545,6 +577,7 @@ SystemDefinition parse_system_definition(const std::string& text, const std::str
     read_control(r, t, &def);
   }
   read_plots(r, t, &def);
+  read_measurement(r, t, &def);
   return def;
 }
 

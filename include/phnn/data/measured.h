@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "phnn/data/ph_dataset.h"
+#include "phnn/systems/measurement_map.h"
 #include "phnn/systems/ph_system.h"
 
 namespace phnn {
@@ -54,6 +55,12 @@ struct MeasuredTrajectory {
   /// sample 3".
   std::string where(std::size_t k) const;
 };
+
+/// Recorded columns into states ([measurement] of the system file): each
+/// trajectory read with map.recorded() as its columns gets the system's
+/// n_x states per sample. Throws MeasuredDataError naming the sample where
+/// a computed state is not finite.
+void apply_measurement(const MeasurementMap& map, std::vector<MeasuredTrajectory>* trajectories);
 
 /// Bad measured data: the message names the file and line (or trajectory
 /// and sample) and the fix.

@@ -14,7 +14,10 @@ namespace phnn {
 /// The column names a trajectory file must hold: the system's state and
 /// input names.
 struct TrajectoryColumns {
-  std::vector<std::string> states, inputs;
+  /// `states`: the recorded columns that make the states (a system's states,
+  /// or MeasurementMap::recorded()); `ignore`: columns a file may hold that
+  /// are skipped.
+  std::vector<std::string> states, inputs, ignore;
 };
 
 /// CSV, one row per sample: a header naming the columns `trajectory`, `t`,

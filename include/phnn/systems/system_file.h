@@ -53,6 +53,11 @@ struct SystemDefinition {
   /// [plots] energies: H of the figure trajectories' initial states
   /// (PhSystem::figure_energies); empty: the first inference trajectories.
   std::vector<double> figure_energies;
+  /// [measurement]: states a recording does not hold, computed from its
+  /// columns (state name -> expression of recorded columns and parameters,
+  /// file order), and columns a recording may hold that phnn skips.
+  std::vector<std::pair<std::string, std::string>> measurement;
+  std::vector<std::string> measurement_ignore;
   std::map<std::string, int> lines;  // key ("H", "S", "initial", ...) -> line
   int line_of(const std::string& key) const;
   /// False for a structure-only file (no H, z, [initial], [control]): it
