@@ -214,6 +214,24 @@ TEST_F(ReduceCommandTest, ComparisonsAreOneCsvLinePerPairOfCells) {
   EXPECT_THAT(out, HasSubstr("exclude each other"));
 }
 
+// --stat: a checked set (median | iqm); iqm names the CSV column and the
+// Markdown text "IQM"; the views without cell statistics refuse it.
+TEST_F(ReduceCommandTest, StatIqmNamesItsStatisticAndIsACheckedSet) {
+  std::string out;
+  ASSERT_EQ(reduce("--format csv --stat iqm", &out), 0) << out;
+  EXPECT_THAT(out, StartsWith("study,system,model,axis,column,iqm,q25,"));
+  ASSERT_EQ(reduce("--format csv --stat median", &out), 0) << out;
+  EXPECT_THAT(out, StartsWith("study,system,model,axis,column,median,q25,"));
+  ASSERT_EQ(reduce("--stat iqm", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("Cells: IQM (interquartile mean"));
+  ASSERT_EQ(reduce("--format latex --stat iqm", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("IQM [IQR] (bootstrap 95~\\% interval of the IQM)"));
+  EXPECT_EQ(reduce("--stat mean", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--stat: unknown statistic \"mean\"; expected one of: median, iqm"));
+  EXPECT_EQ(reduce("--comparisons --stat iqm", &out), 2);
+  EXPECT_THAT(out, HasSubstr("drop --stat"));
+}
+
 // A sweep file given instead of its results file: named as such, and no
 // advice to delete it or to pass an --out that reduce does not have.
 TEST(ReduceCommandMissingFileTest, ASweepFileIsNamedWithoutDeleteAdvice) {
