@@ -3,7 +3,8 @@
 // bootstrap interval of the inference MSE over seeds), the seeds-per-mode view, or one CSV row per run, from a results
 // file, complete or partial; --round K and --rule SWEEP show an adaptive
 // sweep after round K or under another rule (apps/reduce_rule.h);
-// --comparisons the pairs of cells a table invites (report/table_comparisons.h).
+// --comparisons the pairs of cells a table invites (report/table_comparisons.h),
+// with --seed-lists on resamples of the seeds (apps/reduce_seed_lists.h).
 // Size: the views share the inputs read once (grid, statuses, MSEs, rounds).
 #include <algorithm>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/reduce_rule.h"
+#include "apps/reduce_seed_lists.h"
 #include "phnn/report/per_run.h"
 #include "phnn/report/table_comparisons.h"
 #include "phnn/report/tables.h"
@@ -364,6 +366,11 @@ void declare_options(cli::Parser* p) {
               "equivalent / undecided; docs/METHOD.md \"Comparisons\")");
   parser.option("delta", "--comparisons: the equivalence margin, a factor on the MSE (> 1)",
                 "1.5");
+  parser.option("seed-lists",
+                "--comparisons: a text file with one comma-separated list of seeds per line "
+                "(repeats allowed: a bootstrap resample of the seeds); prints the comparisons "
+                "of every list, slot j of a list holding its j-th seed in every cell (pairs "
+                "stay paired), with a first column `list` (1, 2, ...)");
 }
 
 // Which view reduce prints, checked: one of the tables (in `format`),
@@ -380,6 +387,10 @@ View read_view(const cli::Parser& parser) {
   v.per_run = parser.flag_set("per-run");
   v.seeds_summary = parser.flag_set("seeds-summary");
   v.comparisons = parser.flag_set("comparisons");
+  if (parser.has("seed-lists") && !v.comparisons) {
+    throw cli::UsageError{"phnn reduce: --seed-lists needs --comparisons (it resamples the "
+                          "seeds of the comparisons only)"};
+  }
   if (v.comparisons + v.per_run + v.seeds_summary > 1) {
     throw cli::UsageError{"phnn reduce: --comparisons, --per-run and --seeds-summary exclude "
                           "each other; pass one of them"};
@@ -454,6 +465,15 @@ int run_reduce(int argc, char** argv, int first) {
   }
   const auto entries =
       make_table_entries(grid, statuses, in.mse, adaptive ? &adaptive->active : nullptr);
+  if (view.comparisons && parser.has("seed-lists")) {
+    std::vector<int> seeds;
+    for (const TableEntry& e : entries) seeds.push_back(e.seed);
+    std::sort(seeds.begin(), seeds.end());
+    seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+    std::cout << render_seed_list_comparisons(
+        grid, entries, read_seed_lists(parser.get("seed-lists"), seeds), view.comparison);
+    return 0;
+  }
   if (view.comparisons) {
     std::cout << render_comparisons_csv(compare_table_cells(grid, entries, view.comparison),
                                         view.comparison.delta);
