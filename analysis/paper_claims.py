@@ -54,6 +54,7 @@ Cell = namedtuple("Cell", "median q25 q75 iqr lo hi done diverged expected key",
 # ok: the paper's direction; reading (four-way only): for, against, equivalent, undecided
 Comparison = namedtuple("Comparison", "label ok resolved reading", defaults=(None,))
 FOUR_WAY = None  # a four_way.FourWay while the statements are read four-way
+JOINT = False  # --resample joint (the report says how the seeds were resampled)
 
 DEFAULTS = {"n_train": "25", "size": "small", "regularizer": "none"}  # the shared column
 FAMILIES = {"PHNN-S": ("PHNN-S-DG", "PHNN-S-RK2"), "PHNN-JR": ("PHNN-JR-DG", "PHNN-JR-RK2")}
@@ -598,10 +599,13 @@ def run_value(r):
     return math.inf if math.isnan(v) else v
 
 
-def stability(stat_rows, run_rows, resamples, seed=0, inner=1000, judge=verdict_name):
+def stability(stat_rows, run_rows, resamples, seed=0, inner=1000, judge=verdict_name,
+              joint=False):
     """Per statement tag, the share of `resamples` bootstrap resamples of every cell's finished
     seeds (each cell resampled once per round, shared by every study that shows it) that give the
     verdict the file gives (judge: verdict_name, or decided for the resolved-only reading).
+    With `joint`, one draw of the seeds serves every cell (four_way.draw_seed_lists, the
+    four-way reading's resamples): runs of one seed stay together across cells.
     Per-run quantities (the Jacobian statement) use the same resample."""
     import numpy as np
     rng = np.random.default_rng(seed)
@@ -611,10 +615,15 @@ def stability(stat_rows, run_rows, resamples, seed=0, inner=1000, judge=verdict_
         if r["status"] in ("done", "diverged"):
             key = (r["system"], r["model_label"], r["n_train"], r["size"], r["regularizer"])
             cells.setdefault(key, []).append(r)
+    lists = four_way.draw_seed_lists(run_rows, resamples, seed) if joint else None
     same = {tag: 0 for tag in base}
-    for _ in range(resamples):
-        drawn = {key: [rows[i] for i in rng.integers(0, len(rows), len(rows))]
-                 for key, rows in cells.items()}
+    for b in range(resamples):
+        if joint:
+            by_seed = {key: {int(r["seed"]): r for r in rows} for key, rows in cells.items()}
+            drawn = {key: [rows[s] for s in lists[b] if s in rows] for key, rows in by_seed.items()}
+        else:
+            drawn = {key: [rows[i] for i in rng.integers(0, len(rows), len(rows))]
+                     for key, rows in cells.items()}
         new_stats = []
         for row in stat_rows:
             config = dict(DEFAULTS, **{row["axis"]: row["column"]})
@@ -680,9 +689,10 @@ def report(results, path, problems=(), stable=None):
                      f"that give the same verdict; below {100 * STABLE:.0f} % the verdict is "
                      "marked unstable (it rests on seeds at the margin).")
     elif stable is not None:
+        scheme = " (drawn jointly: one draw of seeds for every cell)" if JOINT else ""
         lines.append(f"\nLast column: the share of bootstrap resamples of every cell's finished "
-                     f"seeds that give the same verdict; below {100 * STABLE:.0f} % the verdict "
-                     "is marked unstable (it rests on seeds at the margin).")
+                     f"seeds{scheme} that give the same verdict; below {100 * STABLE:.0f} % the "
+                     "verdict is marked unstable (it rests on seeds at the margin).")
     missing = [s for s in ("I", "II", "III") if not results.has(s)]
     if missing:
         lines.append(f"\nNot in the file (statements skipped): Study {', '.join(missing)}.")
@@ -727,6 +737,10 @@ def main(argv=None):
                         "intervals do not overlap; four-way: each comparison's reading from "
                         "`phnn reduce --comparisons` (A better / B better / equivalent / "
                         "undecided) and the verdicts of the docstring")
+    parser.add_argument("--resample", choices=("cell", "joint"), default=None,
+                        help="--stability: resample each cell's seeds on its own (cell, the "
+                        "overlap reading's default) or draw the seeds once for every cell "
+                        "(joint, the four-way reading's only scheme: paired runs stay paired)")
     parser.add_argument("--strict", action="store_true",
                         help="exit 1 without verdicts if the steps or seeds differ from the paper's")
     parser.add_argument("--write-comparisons", action="store_true",
@@ -759,10 +773,16 @@ def main(argv=None):
     if args.stability < 0:
         parser.error("--stability N needs N >= 0")
     stat_rows = reduce_csv(args.results, *extra)
+    if args.reading == "four-way" and args.resample == "cell":
+        parser.error("--reading four-way resamples the seeds jointly (its comparisons pair runs "
+                     "by seed); drop --resample cell")
+    global JOINT
+    JOINT = args.resample == "joint"
     if args.reading == "four-way":
         stable = read_four_way(args.results, stat_rows, run_rows, args.stability, extra)
     else:
-        stable = stability(stat_rows, run_rows, args.stability) if args.stability else None
+        stable = (stability(stat_rows, run_rows, args.stability, joint=JOINT)
+                  if args.stability else None)
     results = Results(stat_rows, run_rows)
     title = args.results + (f" replaying {args.rule}" if args.rule else "") + (
         f" after round {args.round}" if args.round is not None else "")
