@@ -41,7 +41,7 @@ class FourWay:
 
     @staticmethod
     def of_rows(comparison_rows, stat_rows):
-        readings, delta = {}, None
+        readings, delta = {}, 1.5  # reduce's default, for a file without comparisons
         for r in comparison_rows:
             if r["reading"] not in READINGS:
                 raise ValueError(f"phnn reduce --comparisons: unknown reading {r['reading']!r} "

@@ -725,9 +725,10 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         description="The paper's statements (§6 and conclusion) checked on a results file of "
         "sweeps/paper.toml: comparisons with intervals and a verdict per statement, as Markdown.",
-        epilog="Verdicts: holds, same direction, partly, not supported, contradicted / mixed "
-        "(the module's docstring says when). A file trained with fewer steps or seeds than the "
-        "paper's is flagged at the top; --strict refuses it.")
+        epilog="Verdicts: holds, same direction, partly, not supported, contradicted / mixed; "
+        "with --reading four-way supported, contradicted / mixed, equivalent within x1.5, "
+        "partly, undecided (the module's docstring says when). A file trained with fewer "
+        "steps or seeds than the paper's is flagged at the top; --strict refuses it.")
     parser.add_argument("results", help="results file written by `phnn sweep sweeps/paper.toml`")
     parser.add_argument("--stability", type=int, default=0, metavar="N",
                         help="recompute every verdict on N bootstrap resamples of each cell's "

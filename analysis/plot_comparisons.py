@@ -45,12 +45,14 @@ def improvement_matrices(comparison_rows):
     return out
 
 
-def improvement_figures(pr, path, name, out):
-    """pimprove_<st>_<sys>.png per (study, system) with a panel per column."""
+def improvement_figures(pr, path, name, out, round_k=None):
+    """pimprove_<st>_<sys>.png per (study, system) with a panel per column; of an adaptive sweep
+    the runs of rounds 0..round_k when given (reduce --round), as the other figures."""
     import matplotlib.pyplot as plt
     from phnn_tool import run_csv
+    extra = ("--round", str(round_k)) if round_k is not None else ()
     try:
-        rows = run_csv("reduce", path, "--comparisons")
+        rows = run_csv("reduce", path, "--comparisons", *extra)
     except (OSError, subprocess.CalledProcessError) as e:
         print(f"  P(improvement) matrices skipped: phnn reduce --comparisons failed ({e})")
         return []

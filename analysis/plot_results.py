@@ -809,7 +809,8 @@ def main():
     written += energies(runs, path, name, out)
     import plot_comparisons  # the P(improvement) matrices and the performance profiles
     written += plot_comparisons.profile_figures(sys.modules[__name__], runs, name, out)
-    written += plot_comparisons.improvement_figures(sys.modules[__name__], path, name, out)
+    written += plot_comparisons.improvement_figures(sys.modules[__name__], path, name, out,
+                                                    args.round)
     c = Counter(int(s) for s in runs["status"])
     print(f"{len(written)} figures written to {out}/ ({c[DONE]} done, {c[DIVERGED]} diverged, "
           f"{c[FAILED]} failed, {c[PENDING]} pending of {len(runs['status'])} runs)")
