@@ -23,6 +23,21 @@ by direction only: a tie cannot prove an absence, so such a statement is at best
 Medians, IQRs and intervals come from `phnn reduce --format csv` (the reducer's own statistics),
 the per-run Jacobian quantities from `phnn reduce --format csv --per-run`.  The phnn binary: $PHNN,
 else build/phnn.  A study or cell missing from the file is skipped and said so.
+
+--reading four-way (default: overlap, the rules above): each comparison takes its reading from
+`phnn reduce --comparisons` (analysis/four_way.py; paired by seed where the runs share weights,
+batches and data): A better / B better / equivalent within x1.5 / undecided, turned into the
+claim's terms -- for (the paper's direction), against, equivalent, undecided.  A statement that
+something does not happen counts its occurrence (the claimed direction; for "about constant",
+either direction) as against, and equivalent or the other direction as for.  Verdicts:
+
+  supported                 every reading for the paper (and every by-direction one agrees)
+  contradicted / mixed      some reading against the paper (mixed: some for it too)
+  equivalent within x1.5    every reading equivalent
+  partly                    some for, none against, the rest equivalent or undecided
+  undecided                 none for or against, not all equivalent
+
+Statements without readings (dispersion, per-run quantities) keep their by-direction verdict.
 """
 import argparse
 import math
@@ -31,10 +46,15 @@ import statistics
 import sys
 from collections import namedtuple
 
+import four_way
 from phnn_tool import run_csv
 
-Cell = namedtuple("Cell", "median q25 q75 iqr lo hi done diverged expected")
-Comparison = namedtuple("Comparison", "label ok resolved")  # ok: the paper's direction
+# key: (system, model, n_train, size, regularizer), for the four-way reading's look-up
+Cell = namedtuple("Cell", "median q25 q75 iqr lo hi done diverged expected key", defaults=(None,))
+# ok: the paper's direction; reading (four-way only): for, against, equivalent, undecided
+Comparison = namedtuple("Comparison", "label ok resolved reading", defaults=(None,))
+FOUR_WAY = None  # a four_way.FourWay while the statements are read four-way
+JOINT = False  # --resample joint (the report says how the seeds were resampled)
 
 DEFAULTS = {"n_train": "25", "size": "small", "regularizer": "none"}  # the shared column
 FAMILIES = {"PHNN-S": ("PHNN-S-DG", "PHNN-S-RK2"), "PHNN-JR": ("PHNN-JR-DG", "PHNN-JR-RK2")}
@@ -54,8 +74,8 @@ class Probe(namedtuple("Probe", Cell._fields + ("system", "models", "n_train", "
 
     @staticmethod
     def of(system, model, config):
-        return Probe(1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0, 0, 0, system, (model,), config["n_train"],
-                     config["size"], config["regularizer"])
+        return Probe(1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0, 0, 0, None, system, (model,),
+                     config["n_train"], config["size"], config["regularizer"])
 
     @staticmethod
     def merge(probes):
@@ -79,12 +99,12 @@ class Results:
         for r in stat_rows:
             f = lambda k: float(r[k]) if r[k] not in ("", "nan") else math.nan  # noqa: E731
             config = dict(DEFAULTS, **{r["axis"]: r["column"]})
+            key = (r["system"], r["model"], config["n_train"], config["size"], config["regularizer"])
             cell = Cell(f("median"), f("q25"), f("q75"), f("iqr"), f("ci_low"), f("ci_high"),
-                        int(r["done"]), int(r["diverged"]), int(r["expected"]))
+                        int(r["done"]), int(r["diverged"]), int(r["expected"]), key)
             if probes:
                 cell = Probe.of(r["system"], r["model"], config)
             self.cells[(r["study"], r["system"], r["model"], r["column"])] = cell
-            key = (r["system"], r["model"], config["n_train"], config["size"], config["regularizer"])
             self.by_config[key] = cell
         for r in run_rows:
             if r["status"] != "done":
@@ -119,6 +139,8 @@ def compare(label, a, b, paper_says_lower=True):
     if isinstance(a, Probe):  # --write-comparisons: record the two cells, decide nothing
         RECORDED.append((a.selector(), b.selector()))
         return Comparison(label, True, False)
+    if FOUR_WAY is not None:
+        return compare_four_way(label, a, b, paper_says_lower)
     lower = a.median < b.median
     resolved = a.hi < b.lo if lower else a.lo > b.hi
     if a.median == b.median:
@@ -127,6 +149,21 @@ def compare(label, a, b, paper_says_lower=True):
     sign = "<" if lower else ">="
     mark = "resolved" if resolved else "tie"
     return Comparison(f"{label}: {fmt(a)} {sign} {fmt(b)} [{mark}]", ok, resolved)
+
+
+FOUR_WAY_MARKS = {"A better": "first better", "B better": "second better",
+                  "undecided": "undecided"}
+
+
+def compare_four_way(label, a, b, paper_says_lower):
+    """compare() under --reading four-way: the reducer's reading of a against b."""
+    raw = FOUR_WAY.reading(a.key, b.key)
+    reading = four_way.claim_reading(raw, paper_says_lower)
+    lower = a.median < b.median
+    mark = FOUR_WAY_MARKS.get(raw, f"equivalent within x{FOUR_WAY.delta:g}")
+    return Comparison(f"{label}: {fmt(a)} {'<' if lower else '>='} {fmt(b)} [{mark}]",
+                      lower if paper_says_lower else not lower, reading in ("for", "against"),
+                      reading)
 
 
 def by_direction(label, ok):
@@ -138,6 +175,10 @@ def absence(c, happens=None):
     """The paper says what comparison c shows does *not* happen (by default: c's direction,
     resolved). Only a resolved occurrence counts (against the paper); anything else is
     consistent with it, by direction only (a tie cannot prove an absence)."""
+    if c.reading is not None:  # four-way: c.resolved = read either way
+        occurs = c.reading == "for" if happens is None else happens
+        kept = "undecided" if c.reading == "undecided" and not occurs else "for"
+        return Comparison(c.label, not occurs, occurs, "against" if occurs else kept)
     occurs = (c.ok and c.resolved) if happens is None else happens
     return Comparison(c.label, not occurs, True if occurs else None)
 
@@ -158,6 +199,8 @@ def best_of(results, study, system, models, column):
 
 
 def verdict(comparisons):
+    if FOUR_WAY is not None:
+        return four_way.verdict(comparisons, FOUR_WAY.delta)
     n = len(comparisons)
     if n == 0:
         return "no data", ""
@@ -484,8 +527,14 @@ PAPER_STEPS, PAPER_SEEDS = 50000, 10
 STABLE = 0.9  # share of resamples with the same verdict below which a verdict is unstable
 
 
+READING_WORDS = {"for": "for the paper", "against": "against the paper",
+                 "equivalent": "equivalent", "undecided": "undecided"}
+
+
 def detail_line(c):
     """One comparison as a Markdown bullet that does not nest ("- - x" would)."""
+    if c.reading is not None:  # four-way: the reading, not the medians' direction
+        return f"- {READING_WORDS[c.reading]}: {c.label}"
     return f"- {'for' if c.ok else 'against'} the paper: {c.label}"
 
 
@@ -550,10 +599,13 @@ def run_value(r):
     return math.inf if math.isnan(v) else v
 
 
-def stability(stat_rows, run_rows, resamples, seed=0, inner=1000, judge=verdict_name):
+def stability(stat_rows, run_rows, resamples, seed=0, inner=1000, judge=verdict_name,
+              joint=False):
     """Per statement tag, the share of `resamples` bootstrap resamples of every cell's finished
     seeds (each cell resampled once per round, shared by every study that shows it) that give the
     verdict the file gives (judge: verdict_name, or decided for the resolved-only reading).
+    With `joint`, one draw of the seeds serves every cell (four_way.draw_seed_lists, the
+    four-way reading's resamples): runs of one seed stay together across cells.
     Per-run quantities (the Jacobian statement) use the same resample."""
     import numpy as np
     rng = np.random.default_rng(seed)
@@ -563,10 +615,15 @@ def stability(stat_rows, run_rows, resamples, seed=0, inner=1000, judge=verdict_
         if r["status"] in ("done", "diverged"):
             key = (r["system"], r["model_label"], r["n_train"], r["size"], r["regularizer"])
             cells.setdefault(key, []).append(r)
+    lists = four_way.draw_seed_lists(run_rows, resamples, seed) if joint else None
     same = {tag: 0 for tag in base}
-    for _ in range(resamples):
-        drawn = {key: [rows[i] for i in rng.integers(0, len(rows), len(rows))]
-                 for key, rows in cells.items()}
+    for b in range(resamples):
+        if joint:
+            by_seed = {key: {int(r["seed"]): r for r in rows} for key, rows in cells.items()}
+            drawn = {key: [rows[s] for s in lists[b] if s in rows] for key, rows in by_seed.items()}
+        else:
+            drawn = {key: [rows[i] for i in rng.integers(0, len(rows), len(rows))]
+                     for key, rows in cells.items()}
         new_stats = []
         for row in stat_rows:
             config = dict(DEFAULTS, **{row["axis"]: row["column"]})
@@ -599,6 +656,10 @@ def comparisons_toml(stat_rows):
 def report(results, path, problems=(), stable=None):
     claims = all_claims(results)
     lines = [f"# The paper's statements checked on {os.path.basename(path)}", ""]
+    if FOUR_WAY is not None:
+        lines += [f"Reading: four-way (`phnn reduce --comparisons`, equivalence margin "
+                  f"x{FOUR_WAY.delta:g}); verdicts supported / contradicted / mixed / equivalent "
+                  "/ partly / undecided (analysis/paper_claims.py's docstring).", ""]
     if problems:
         lines += [f"**Not the paper's settings: {'; '.join(problems)}.** The verdicts below describe "
                   "this file only; they do not confirm or contradict the paper.", ""]
@@ -621,27 +682,66 @@ def report(results, path, problems=(), stable=None):
         details.append(f"**{tag}** {text}: {v}")
         details.extend(detail_line(c) for c in comps)
         details.append("")
-    if stable is not None:
+    if stable is not None and FOUR_WAY is not None:
+        lines.append(f"\nLast column: the share of bootstrap resamples of the seeds (drawn "
+                     "jointly: one draw of seeds for every cell, so paired runs stay paired; "
+                     "each resample's readings from `phnn reduce --comparisons --seed-lists`) "
+                     f"that give the same verdict; below {100 * STABLE:.0f} % the verdict is "
+                     "marked unstable (it rests on seeds at the margin).")
+    elif stable is not None:
+        scheme = " (drawn jointly: one draw of seeds for every cell)" if JOINT else ""
         lines.append(f"\nLast column: the share of bootstrap resamples of every cell's finished "
-                     f"seeds that give the same verdict; below {100 * STABLE:.0f} % the verdict "
-                     "is marked unstable (it rests on seeds at the margin).")
+                     f"seeds{scheme} that give the same verdict; below {100 * STABLE:.0f} % the "
+                     "verdict is marked unstable (it rests on seeds at the margin).")
     missing = [s for s in ("I", "II", "III") if not results.has(s)]
     if missing:
         lines.append(f"\nNot in the file (statements skipped): Study {', '.join(missing)}.")
     return "\n".join(lines + details)
 
 
+def four_way_verdicts(stat_rows, run_rows, readings):
+    """{tag: four-way verdict} of every statement, the reducer's readings given."""
+    global FOUR_WAY
+    FOUR_WAY = readings
+    return {tag: verdict_name(comps) for tag, _, comps in all_claims(Results(stat_rows, run_rows))}
+
+
+def read_four_way(path, stat_rows, run_rows, resamples, extra=()):
+    """Sets FOUR_WAY from `phnn reduce --comparisons`; with resamples > 0 returns the stability
+    shares (four_way.stability: joint seed resamples, one reduce call for all of them)."""
+    global FOUR_WAY
+    comparison_rows = run_csv("reduce", path, "--comparisons", *extra)
+    stable = None
+    if resamples:
+        stable = four_way.stability(
+            stat_rows, run_rows, comparison_rows, four_way_verdicts,
+            lambda lists: four_way.reduce_seed_lists(run_csv, path, lists, extra), resamples,
+            run_value=run_value)
+    FOUR_WAY = four_way.FourWay.of_rows(comparison_rows, stat_rows)
+    return stable
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(
         description="The paper's statements (§6 and conclusion) checked on a results file of "
         "sweeps/paper.toml: comparisons with intervals and a verdict per statement, as Markdown.",
-        epilog="Verdicts: holds, same direction, partly, not supported, contradicted / mixed "
-        "(the module's docstring says when). A file trained with fewer steps or seeds than the "
-        "paper's is flagged at the top; --strict refuses it.")
+        epilog="Verdicts: holds, same direction, partly, not supported, contradicted / mixed; "
+        "with --reading four-way supported, contradicted / mixed, equivalent within x1.5, "
+        "partly, undecided (the module's docstring says when). A file trained with fewer "
+        "steps or seeds than the paper's is flagged at the top; --strict refuses it.")
     parser.add_argument("results", help="results file written by `phnn sweep sweeps/paper.toml`")
     parser.add_argument("--stability", type=int, default=0, metavar="N",
                         help="recompute every verdict on N bootstrap resamples of each cell's "
                         "seeds and show the share that agrees (below 90 %%: unstable)")
+    parser.add_argument("--reading", choices=("overlap", "four-way"), default="overlap",
+                        help="overlap (default): a comparison is resolved when the two median "
+                        "intervals do not overlap; four-way: each comparison's reading from "
+                        "`phnn reduce --comparisons` (A better / B better / equivalent / "
+                        "undecided) and the verdicts of the docstring")
+    parser.add_argument("--resample", choices=("cell", "joint"), default=None,
+                        help="--stability: resample each cell's seeds on its own (cell, the "
+                        "overlap reading's default) or draw the seeds once for every cell "
+                        "(joint, the four-way reading's only scheme: paired runs stay paired)")
     parser.add_argument("--strict", action="store_true",
                         help="exit 1 without verdicts if the steps or seeds differ from the paper's")
     parser.add_argument("--write-comparisons", action="store_true",
@@ -674,8 +774,17 @@ def main(argv=None):
     if args.stability < 0:
         parser.error("--stability N needs N >= 0")
     stat_rows = reduce_csv(args.results, *extra)
+    if args.reading == "four-way" and args.resample == "cell":
+        parser.error("--reading four-way resamples the seeds jointly (its comparisons pair runs "
+                     "by seed); drop --resample cell")
+    global JOINT
+    JOINT = args.resample == "joint"
+    if args.reading == "four-way":
+        stable = read_four_way(args.results, stat_rows, run_rows, args.stability, extra)
+    else:
+        stable = (stability(stat_rows, run_rows, args.stability, joint=JOINT)
+                  if args.stability else None)
     results = Results(stat_rows, run_rows)
-    stable = stability(stat_rows, run_rows, args.stability) if args.stability else None
     title = args.results + (f" replaying {args.rule}" if args.rule else "") + (
         f" after round {args.round}" if args.round is not None else "")
     print(report(results, title, problems, stable))

@@ -58,6 +58,14 @@ tests/analysis/test_plot_results.py.
                               (the binary: $PHNN, else build/phnn next to analysis/); files
                               written before weights were stored get none, and the script says so.
 
+  profile_<sys>.png           performance profiles: per model, the share of its runs on the system
+                              with inference MSE <= tau over a log grid of tau, with a 95 %
+                              bootstrap band over seeds; values in profile_<sys>.csv
+                              (analysis/plot_comparisons.py).
+  pimprove_<st>_<sys>.png     per column of the study, the matrix P(row model < column model)
+                              from `phnn reduce --comparisons` (needs the binary; skipped without
+                              it) (analysis/plot_comparisons.py).
+
 The integrator work-precision figure comes from bench/ via analysis/plot_work_precision.py, not
 from a results file.
 """
@@ -799,6 +807,10 @@ def main():
     for make in (trajectories, size_trajectories, jacobian_traces, loss_curves, time_vs_error):
         written += make(runs, name, out)
     written += energies(runs, path, name, out)
+    import plot_comparisons  # the P(improvement) matrices and the performance profiles
+    written += plot_comparisons.profile_figures(sys.modules[__name__], runs, name, out)
+    written += plot_comparisons.improvement_figures(sys.modules[__name__], path, name, out,
+                                                    args.round)
     c = Counter(int(s) for s in runs["status"])
     print(f"{len(written)} figures written to {out}/ ({c[DONE]} done, {c[DIVERGED]} diverged, "
           f"{c[FAILED]} failed, {c[PENDING]} pending of {len(runs['status'])} runs)")

@@ -1,9 +1,10 @@
 // src/apps/cmd_reduce.cpp — `phnn reduce results.h5`: the paper's Appendix-F
-// tables (median [IQR] and bootstrap interval of the inference MSE over
-// seeds), the seeds-per-mode view, or one CSV row per run, from a results
+// tables (median, or with --stat iqm the interquartile mean, [IQR] and
+// bootstrap interval of the inference MSE over seeds), the seeds-per-mode view, or one CSV row per run, from a results
 // file, complete or partial; --round K and --rule SWEEP show an adaptive
 // sweep after round K or under another rule (apps/reduce_rule.h);
-// --comparisons the pairs of cells a table invites (report/table_comparisons.h).
+// --comparisons the pairs of cells a table invites (report/table_comparisons.h),
+// with --seed-lists on resamples of the seeds (apps/reduce_seed_lists.h).
 // Size: the views share the inputs read once (grid, statuses, MSEs, rounds).
 #include <algorithm>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/reduce_rule.h"
+#include "apps/reduce_seed_lists.h"
 #include "phnn/report/per_run.h"
 #include "phnn/report/table_comparisons.h"
 #include "phnn/report/tables.h"
@@ -173,7 +175,8 @@ std::vector<int> damaged_rows_named(const ResultsFile& file) {
 // `statuses`: of the runs the tables cover (an adaptive sweep's: those its
 // rounds asked for).
 void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
-                             const std::vector<RunStatus>& statuses, bool seeds_summary) {
+                             const std::vector<RunStatus>& statuses, bool seeds_summary,
+                             CellStatistic statistic) {
   int counts[4] = {0, 0, 0, 0};
   for (RunStatus s : statuses) ++counts[static_cast<int>(s)];
   std::cout << "# " << spec.name << " — " << file.path() << "\n\n"
@@ -186,11 +189,14 @@ void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
                  "of expected.\n\n";
     return;
   }
-  std::cout << "Cells: median [IQR] (bootstrap 95 % interval of the median) of the inference "
-               "MSE (Eq. 31) over seeds; **bold** = best median of its column, its interval "
-               "overlapping no other; (tie) = best median whose interval overlaps others', and "
-               "those others; (d=k) diverged runs (MSE +inf, included), (n=k/N) finished of "
-               "expected.\n\n";
+  const std::string m = statistic == CellStatistic::kIqm ? "IQM" : "median";
+  std::cout << "Cells: " << (statistic == CellStatistic::kIqm ? "IQM (interquartile mean: the "
+                             "mean of the middle half of the sorted seeds)" : "median")
+            << " [IQR] (bootstrap 95 % interval of the " << m << ") of the inference MSE (Eq. 31) "
+            << "over seeds; **bold** = best " << m << " of its column, its interval overlapping "
+            << "no other; (tie) = best " << m << " whose interval overlaps others', and those "
+            << "others; (d=k) diverged runs (MSE +inf, included), (n=k/N) finished of "
+            << "expected.\n\n";
 }
 
 // An adaptive sweep's rounds (up to --round K): the runs they asked for,
@@ -334,6 +340,11 @@ std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
 void declare_options(cli::Parser* p) {
   cli::Parser& parser = *p;
   parser.option("format", "markdown | latex | csv", "markdown");
+  parser.option("stat",
+                "median | iqm: what the tables' cells show and rank by, the median or the "
+                "interquartile mean (25 % trimmed mean; a cell with more than a quarter of its "
+                "seeds diverged has IQM inf), each with its bootstrap 95 % interval",
+                "median");
   parser.flag("seeds-summary",
               "instead of the statistics, count per cell the seeds below / above the column's "
               "geometric midpoint of the MSE (shows bimodal cells)");
@@ -355,6 +366,11 @@ void declare_options(cli::Parser* p) {
               "equivalent / undecided; docs/METHOD.md \"Comparisons\")");
   parser.option("delta", "--comparisons: the equivalence margin, a factor on the MSE (> 1)",
                 "1.5");
+  parser.option("seed-lists",
+                "--comparisons: a text file with one comma-separated list of seeds per line "
+                "(repeats allowed: a bootstrap resample of the seeds); prints the comparisons "
+                "of every list, slot j of a list holding its j-th seed in every cell (pairs "
+                "stay paired), with a first column `list` (1, 2, ...)");
 }
 
 // Which view reduce prints, checked: one of the tables (in `format`),
@@ -362,6 +378,7 @@ void declare_options(cli::Parser* p) {
 struct View {
   bool per_run = false, seeds_summary = false, comparisons = false;
   TableFormat format = TableFormat::kMarkdown;
+  CellStatistic statistic = CellStatistic::kMedian;
   ComparisonOptions comparison;
 };
 
@@ -370,9 +387,22 @@ View read_view(const cli::Parser& parser) {
   v.per_run = parser.flag_set("per-run");
   v.seeds_summary = parser.flag_set("seeds-summary");
   v.comparisons = parser.flag_set("comparisons");
+  if (parser.has("seed-lists") && !v.comparisons) {
+    throw cli::UsageError{"phnn reduce: --seed-lists needs --comparisons (it resamples the "
+                          "seeds of the comparisons only)"};
+  }
   if (v.comparisons + v.per_run + v.seeds_summary > 1) {
     throw cli::UsageError{"phnn reduce: --comparisons, --per-run and --seeds-summary exclude "
                           "each other; pass one of them"};
+  }
+  try {
+    v.statistic = parse_cell_statistic(parser.get("stat"));
+  } catch (const std::invalid_argument& e) {
+    throw cli::UsageError{std::string("phnn reduce: --stat: ") + e.what()};
+  }
+  if (parser.has("stat") && (v.per_run || v.seeds_summary || v.comparisons)) {
+    throw cli::UsageError{"phnn reduce: --stat chooses the tables' statistic; --per-run, "
+                          "--seeds-summary and --comparisons do not use it: drop --stat"};
   }
   v.comparison.delta = parser.get_double("delta");
   if (!(v.comparison.delta > 1.0)) {
@@ -401,7 +431,8 @@ int run_reduce(int argc, char** argv, int first) {
       "interpolation, (low, high) a percentile-bootstrap 95 % interval of the median\n"
       "(100 000 resamples, fixed seed). The best median of a column is bold only if its\n"
       "interval overlaps no other cell's; otherwise the overlapping cells are marked\n"
-      "(tie). Works on partial files: missing and diverged runs are counted.");
+      "(tie). --stat iqm: the interquartile mean in place of the median. Works on\n"
+      "partial files: missing and diverged runs are counted.");
   parser.positional("FILE", "results file written by `phnn sweep`");
   declare_options(&parser);
   if (!parser.parse(argc, argv, first)) return 0;
@@ -434,6 +465,15 @@ int run_reduce(int argc, char** argv, int first) {
   }
   const auto entries =
       make_table_entries(grid, statuses, in.mse, adaptive ? &adaptive->active : nullptr);
+  if (view.comparisons && parser.has("seed-lists")) {
+    std::vector<int> seeds;
+    for (const TableEntry& e : entries) seeds.push_back(e.seed);
+    std::sort(seeds.begin(), seeds.end());
+    seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+    std::cout << render_seed_list_comparisons(
+        grid, entries, read_seed_lists(parser.get("seed-lists"), seeds), view.comparison);
+    return 0;
+  }
   if (view.comparisons) {
     std::cout << render_comparisons_csv(compare_table_cells(grid, entries, view.comparison),
                                         view.comparison.delta);
@@ -447,14 +487,15 @@ int run_reduce(int argc, char** argv, int first) {
     for (std::size_t i = 0; i < statuses.size(); ++i) {
       if (!adaptive || adaptive->active[i]) covered.push_back(statuses[i]);
     }
-    print_markdown_preamble(file, spec, covered, seeds_summary);
+    print_markdown_preamble(file, spec, covered, seeds_summary, view.statistic);
     if (adaptive) {
       print_adaptive_preamble(spec, *adaptive, parser.has("rule") ? parser.get("rule") : "");
     }
   }
   const int expected = static_cast<int>(expected_seeds);
   std::cout << (seeds_summary ? render_seeds_summary(grid.studies, entries, format, expected)
-                              : render_tables(grid.studies, entries, format, expected));
+                              : render_tables(grid.studies, entries, format, expected,
+                                              BootstrapOptions{}, view.statistic));
   return 0;
 }
 

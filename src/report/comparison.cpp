@@ -107,13 +107,15 @@ std::string csv_text(const std::string& text) {
 
 }  // namespace
 
-std::string render_comparisons_csv(const std::vector<NamedComparison>& comparisons, double delta) {
-  std::string out =
-      "a,b,paired,n_a,n_b,n_pairs,diverged_a,diverged_b,effect,effect_low,effect_high,"
-      "effect_coverage,p_a_less,p_low,p_high,delta,reading\n";
+std::string render_comparisons_csv(const std::vector<NamedComparison>& comparisons, double delta,
+                                   int list) {
+  const std::string lead = list > 0 ? std::to_string(list) + "," : "";
+  std::string out = std::string(list > 0 ? "list," : "") +
+                    "a,b,paired,n_a,n_b,n_pairs,diverged_a,diverged_b,effect,effect_low,"
+                    "effect_high,effect_coverage,p_a_less,p_low,p_high,delta,reading\n";
   for (const NamedComparison& named : comparisons) {
     const Comparison& c = named.comparison;
-    out += csv_text(named.a) + "," + csv_text(named.b) + "," + (c.paired ? "1" : "0");
+    out += lead + csv_text(named.a) + "," + csv_text(named.b) + "," + (c.paired ? "1" : "0");
     for (int count : {c.n_a, c.n_b, c.n_pairs, c.diverged_a, c.diverged_b}) {
       out += "," + std::to_string(count);
     }

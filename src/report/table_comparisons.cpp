@@ -1,5 +1,5 @@
-// src/report/table_comparisons.cpp — compare_table_cells
-// (phnn/report/table_comparisons.h).
+// src/report/table_comparisons.cpp — compare_table_cells and
+// entries_for_seeds (phnn/report/table_comparisons.h).
 #include "phnn/report/table_comparisons.h"
 
 #include <cmath>
@@ -58,9 +58,29 @@ std::vector<NamedComparison> compare_table_cells(const Grid& grid,
         for (std::size_t i = 0; i < t.rows.size(); ++i)
           for (std::size_t j = i + 1; j < t.rows.size(); ++j)
             compare({t.name, system, t.rows[i], column}, {t.name, system, t.rows[j], column});
-      for (const std::string& row : t.rows)
+      for (const std::string& row : t.rows) {
         for (std::size_t k = 1; k < t.columns.size(); ++k)
           compare({t.name, system, row, t.columns[k]}, {t.name, system, row, t.columns[0]});
+        for (std::size_t l = 1; l < t.columns.size(); ++l)
+          for (std::size_t k = l + 1; k < t.columns.size(); ++k)
+            compare({t.name, system, row, t.columns[k]}, {t.name, system, row, t.columns[l]});
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<TableEntry> entries_for_seeds(const std::vector<TableEntry>& entries,
+                                          const std::vector<int>& seeds) {
+  std::map<int, std::vector<const TableEntry*>> by_seed;
+  for (const TableEntry& e : entries) by_seed[e.seed].push_back(&e);
+  std::vector<TableEntry> out;
+  for (std::size_t j = 0; j < seeds.size(); ++j) {
+    const auto it = by_seed.find(seeds[j]);
+    if (it == by_seed.end()) continue;
+    for (const TableEntry* e : it->second) {
+      out.push_back(*e);
+      out.back().seed = static_cast<int>(j);
     }
   }
   return out;

@@ -1,5 +1,5 @@
-// src/report/tables.cpp — median [IQR] (bootstrap interval) tables of the
-// inference MSE with best/tie marks. The seeds-per-mode view:
+// src/report/tables.cpp — median or IQM [IQR] (bootstrap interval) tables
+// of the inference MSE with best/tie marks. The seeds-per-mode view:
 // seeds_summary.cpp; the shared text layout: table_text.cpp.
 #include "phnn/report/tables.h"
 
@@ -69,14 +69,28 @@ std::string to_string(TableFormat format) {
   return "unknown";
 }
 
+CellStatistic parse_cell_statistic(const std::string& name) {
+  if (name == "median") return CellStatistic::kMedian;
+  if (name == "iqm") return CellStatistic::kIqm;
+  throw std::invalid_argument("unknown statistic \"" + name + "\"; expected one of: median, iqm");
+}
+
+std::string to_string(CellStatistic statistic) {
+  return statistic == CellStatistic::kIqm ? "iqm" : "median";
+}
+
 double CellSummary::iqr() const {
   if (std::isinf(q75) && q75 > 0) return q75;
   return q75 - q25;
 }
 
 CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_seeds,
-                           const BootstrapOptions& bootstrap) {
+                           const BootstrapOptions& bootstrap, CellStatistic statistic) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   CellSummary s;
+  s.statistic = statistic;
+  s.iqm = nan;
+  s.iqm_interval = Interval{nan, nan};
   std::vector<double> values;
   for (const TableEntry& e : entries) {
     if (counts_as_diverged(e)) {
@@ -90,7 +104,6 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
   s.expected = std::max(expected_seeds, static_cast<int>(entries.size()));
   s.missing = std::max(0, s.expected - s.finished());
   if (values.empty()) {
-    const double nan = std::numeric_limits<double>::quiet_NaN();
     s.median = s.q25 = s.q75 = nan;
     s.median_interval = Interval{nan, nan};
     return s;
@@ -100,6 +113,10 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
   s.q25 = quantile_linear_sorted(values, 0.25);
   s.q75 = quantile_linear_sorted(values, 0.75);
   s.median_interval = bootstrap_median_interval(values, bootstrap);
+  if (statistic == CellStatistic::kIqm) {
+    s.iqm = interquartile_mean_sorted(values);
+    s.iqm_interval = bootstrap_iqm_interval(values, bootstrap);
+  }
   return s;
 }
 
@@ -107,13 +124,21 @@ bool CellSummary::has_interval() const { return finished() >= kMinSeedsForInterv
 
 namespace {
 
-const char* const kTieNote =
-    "(tie): no clear best in this column: the bootstrap 95 % interval of its smallest median "
-    "overlaps the intervals of the other cells marked (tie), so none is bold.";
+// "median" or "IQM", as the table text names the statistic.
+std::string statistic_name(CellStatistic statistic) {
+  return statistic == CellStatistic::kIqm ? "IQM" : "median";
+}
 
-const std::string kFewSeedsNote =
-    "Cells with fewer than " + std::to_string(kMinSeedsForInterval) +
-    " finished seeds show median [IQR] without an interval.";
+std::string tie_note(CellStatistic statistic) {
+  return "(tie): no clear best in this column: the bootstrap 95 % interval of its smallest " +
+         statistic_name(statistic) +
+         " overlaps the intervals of the other cells marked (tie), so none is bold.";
+}
+
+std::string few_seeds_note(CellStatistic statistic) {
+  return "Cells with fewer than " + std::to_string(kMinSeedsForInterval) + " finished seeds show " +
+         statistic_name(statistic) + " [IQR] without an interval.";
+}
 
 std::string annotations(const CellSummary& s) {
   return table_text::annotations(s.finished(), s.diverged, s.missing, s.expected);
@@ -137,17 +162,17 @@ std::string unmarkable(const std::vector<CellSummary>& column, const std::vector
 }
 
 // Best of one column (CellSummary order = rows), if unmarkable() allows: the
-// smallest finite median is best if its interval overlaps no other cell's
-// interval; else it and every cell overlapping it (or with an equal median)
-// are a tie. A cell whose interval is [+inf, +inf] (all or nearly all runs
+// smallest finite center() (median or IQM) is best if its interval overlaps
+// no other cell's interval; else it and every cell overlapping it (or with
+// an equal center) are a tie. A cell whose interval is [+inf, +inf] (all or nearly all runs
 // diverged) cannot be smaller than anything: sharing the point +inf is no tie.
 std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   std::vector<Mark> marks(column.size(), Mark::kNone);
   int best = -1;
   for (std::size_t r = 0; r < column.size(); ++r) {
     const CellSummary& s = column[r];
-    if (!std::isfinite(s.median)) continue;
-    if (best < 0 || s.median < column[best].median) best = static_cast<int>(r);
+    if (!std::isfinite(s.center())) continue;
+    if (best < 0 || s.center() < column[best].center()) best = static_cast<int>(r);
   }
   if (best < 0) return marks;
   const CellSummary& b = column[best];
@@ -155,8 +180,8 @@ std::vector<Mark> mark_column(const std::vector<CellSummary>& column) {
   for (std::size_t r = 0; r < column.size(); ++r) {
     const CellSummary& s = column[r];
     if (static_cast<int>(r) == best) continue;
-    if (std::isinf(s.median_interval.low)) continue;
-    if (s.median_interval.overlaps(b.median_interval) || s.median == b.median) {
+    if (std::isinf(s.center_interval().low)) continue;
+    if (s.center_interval().overlaps(b.center_interval()) || s.center() == b.center()) {
       marks[r] = Mark::kTie;
       tied = true;
     }
@@ -174,12 +199,12 @@ struct ColumnJudgement {
 };
 
 ColumnJudgement judge_column(const TableEntries& t, std::size_t c, int expected_seeds,
-                             const BootstrapOptions& bootstrap) {
+                             const BootstrapOptions& bootstrap, CellStatistic statistic) {
   const std::size_t rows = t.study->rows.size();
   ColumnJudgement j;
   j.cells.resize(rows);
   for (std::size_t r = 0; r < rows; ++r) {
-    j.cells[r] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap);
+    j.cells[r] = summarize_cell(t.cells[r][c], expected_seeds, bootstrap, statistic);
   }
   j.unmarkable = unmarkable(j.cells, t.study->rows);
   j.marks = j.unmarkable.empty() ? mark_column(j.cells) : std::vector<Mark>(rows, Mark::kNone);
@@ -197,14 +222,15 @@ std::string own_count(const CellSummary& s, bool counts) {
 std::string summary_cell_text(const CellSummary& s, Mark mark, TableFormat format, bool counts) {
   const std::string none = format == TableFormat::kMarkdown ? "—" : "--";
   if (s.finished() == 0) return none;                        // all missing
-  // All diverged at +inf: median and interval say nothing more than the count.
-  if (s.done == 0 && std::isinf(s.median) && std::isinf(s.median_interval.low)) {
+  // All diverged at +inf: median (IQM) and interval say nothing more than the count.
+  if (s.done == 0 && std::isinf(s.center()) && std::isinf(s.center_interval().low)) {
     return "inf" + own_count(s, counts) + annotations(s);
   }
-  std::string value = format_number("%.2e", s.median) + " [" + format_number("%.2e", s.iqr()) + "]";
+  std::string value =
+      format_number("%.2e", s.center()) + " [" + format_number("%.2e", s.iqr()) + "]";
   if (s.has_interval()) {
-    value += " (" + format_number("%.2e", s.median_interval.low) + ", " +
-             format_number("%.2e", s.median_interval.high) + ")";
+    value += " (" + format_number("%.2e", s.center_interval().low) + ", " +
+             format_number("%.2e", s.center_interval().high) + ")";
   }
   if (mark == Mark::kBest) {
     value = format == TableFormat::kMarkdown ? "**" + value + "**" : "\\textbf{" + value + "}";
@@ -224,9 +250,9 @@ void render_summary_csv(const TableEntries& t, const std::vector<std::vector<Cel
       const auto bound = [&](double v) { return s.has_interval() ? number(v) : std::string(); };
       out << csv_field(t.study->name) << "," << t.system << ","
           << csv_field(t.study->rows[r]) << "," << csv_field(t.study->varied_axis) << ","
-          << csv_field(t.study->columns[c]) << "," << number(s.median) << "," << number(s.q25)
-          << "," << number(s.q75) << "," << number(s.iqr()) << ","
-          << bound(s.median_interval.low) << "," << bound(s.median_interval.high) << ","
+          << csv_field(t.study->columns[c]) << "," << number(s.center()) << ","
+          << number(s.q25) << "," << number(s.q75) << "," << number(s.iqr()) << ","
+          << bound(s.center_interval().low) << "," << bound(s.center_interval().high) << ","
           << s.done << "," << s.diverged << "," << s.missing << "," << s.expected << ","
           << (marks[r][c] == Mark::kBest ? 1 : 0) << "," << (marks[r][c] == Mark::kTie ? 1 : 0)
           << "\n";
@@ -235,13 +261,14 @@ void render_summary_csv(const TableEntries& t, const std::vector<std::vector<Cel
 }
 
 void render_summary_table(const TableEntries& t, TableFormat format, int expected_seeds,
-                          const BootstrapOptions& bootstrap, std::ostringstream& out) {
+                          const BootstrapOptions& bootstrap, CellStatistic statistic,
+                          std::ostringstream& out) {
   const std::size_t rows = t.study->rows.size(), cols = t.study->columns.size();
   std::vector<std::vector<CellSummary>> cells(rows, std::vector<CellSummary>(cols));
   std::vector<std::vector<Mark>> marks(rows, std::vector<Mark>(cols, Mark::kNone));
   std::vector<std::string> unmarked;  // "column: why", for the note under the table
   for (std::size_t c = 0; c < cols; ++c) {
-    const ColumnJudgement j = judge_column(t, c, expected_seeds, bootstrap);
+    const ColumnJudgement j = judge_column(t, c, expected_seeds, bootstrap, statistic);
     for (std::size_t r = 0; r < rows; ++r) {
       cells[r][c] = j.cells[r];
       marks[r][c] = j.marks[r];
@@ -252,8 +279,10 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
   }
   if (format == TableFormat::kCsv) return render_summary_csv(t, cells, marks, out);
   TextTable text{t.study, t.system, t.study->columns, {}, {}, {}};
-  text.caption_tail =
-      "Median [IQR] (bootstrap 95~\\% interval of the median) of the inference MSE over seeds.";
+  const std::string name = statistic_name(statistic);
+  text.caption_tail = (statistic == CellStatistic::kIqm ? "IQM" : "Median") +
+                      std::string(" [IQR] (bootstrap 95~\\% interval of the ") + name +
+                      ") of the inference MSE over seeds.";
   std::set<int> seed_counts;
   for (const auto& row : cells) {
     for (const CellSummary& s : row) {
@@ -269,10 +298,10 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
       any_tie = any_tie || marks[r][c] == Mark::kTie;
     }
   }
-  if (any_tie) text.notes.push_back(kTieNote);
+  if (any_tie) text.notes.push_back(tie_note(statistic));
   if (counts) {
-    text.notes.push_back("Cells hold different numbers of seeds: (n=k) gives each cell's; its "
-                         "median, IQR and interval use every one of them.");
+    text.notes.push_back("Cells hold different numbers of seeds: (n=k) gives each cell's; its " +
+                         name + ", IQR and interval use every one of them.");
   }
   if (!unmarked.empty()) {
     std::string note = "No best marked where a row has fewer than " +
@@ -284,7 +313,7 @@ void render_summary_table(const TableEntries& t, TableFormat format, int expecte
   for (const auto& row : cells) {
     for (const CellSummary& s : row) few = few || (s.finished() > 0 && !s.has_interval());
   }
-  if (few) text.notes.push_back(kFewSeedsNote);
+  if (few) text.notes.push_back(few_seeds_note(statistic));
   render_text(text, format, out);
 }
 
@@ -300,7 +329,8 @@ std::vector<TableCellName> undecided_cells(const std::vector<StudyTable>& studie
     for (const std::string& system : study.systems) {
       const TableEntries t = gather_table(study, system, by_cell);
       for (std::size_t c = 0; c < study.columns.size(); ++c) {
-        const ColumnJudgement j = judge_column(t, c, expected_seeds, bootstrap);
+        const ColumnJudgement j =
+            judge_column(t, c, expected_seeds, bootstrap, CellStatistic::kMedian);
         for (std::size_t r = 0; r < study.rows.size(); ++r) {
           // Unmarkable: no intervals to compare, the cells without one are undecided.
           const bool undecided = j.unmarkable.empty() ? j.marks[r] == Mark::kTie
@@ -315,18 +345,19 @@ std::vector<TableCellName> undecided_cells(const std::vector<StudyTable>& studie
 
 std::string render_tables(const std::vector<StudyTable>& studies,
                           const std::vector<TableEntry>& entries, TableFormat format,
-                          int expected_seeds, const BootstrapOptions& bootstrap) {
+                          int expected_seeds, const BootstrapOptions& bootstrap,
+                          CellStatistic statistic) {
   bootstrap.validate();
   const CellIndex by_cell = index_cells(entries);
   std::ostringstream out;
   if (format == TableFormat::kCsv) {
-    out << "study,system,model,axis,column,median,q25,q75,iqr,ci_low,ci_high,done,diverged,"
-           "missing,expected,best,tie\n";
+    out << "study,system,model,axis,column," << to_string(statistic)
+        << ",q25,q75,iqr,ci_low,ci_high,done,diverged,missing,expected,best,tie\n";
   }
   for (const StudyTable& study : studies) {
     for (const std::string& system : study.systems) {
       render_summary_table(gather_table(study, system, by_cell), format, expected_seeds,
-                           bootstrap, out);
+                           bootstrap, statistic, out);
     }
   }
   return out.str();

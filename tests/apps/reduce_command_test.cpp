@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -212,6 +213,53 @@ TEST_F(ReduceCommandTest, ComparisonsAreOneCsvLinePerPairOfCells) {
   EXPECT_THAT(out, HasSubstr("--delta 1 must be greater than 1"));
   EXPECT_EQ(reduce("--comparisons --per-run", &out), 2);
   EXPECT_THAT(out, HasSubstr("exclude each other"));
+}
+
+// --stat: a checked set (median | iqm); iqm names the CSV column and the
+// Markdown text "IQM"; the views without cell statistics refuse it.
+TEST_F(ReduceCommandTest, StatIqmNamesItsStatisticAndIsACheckedSet) {
+  std::string out;
+  ASSERT_EQ(reduce("--format csv --stat iqm", &out), 0) << out;
+  EXPECT_THAT(out, StartsWith("study,system,model,axis,column,iqm,q25,"));
+  ASSERT_EQ(reduce("--format csv --stat median", &out), 0) << out;
+  EXPECT_THAT(out, StartsWith("study,system,model,axis,column,median,q25,"));
+  ASSERT_EQ(reduce("--stat iqm", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("Cells: IQM (interquartile mean"));
+  ASSERT_EQ(reduce("--format latex --stat iqm", &out), 0) << out;
+  EXPECT_THAT(out, HasSubstr("IQM [IQR] (bootstrap 95~\\% interval of the IQM)"));
+  EXPECT_EQ(reduce("--stat mean", &out), 2);
+  EXPECT_THAT(out, HasSubstr("--stat: unknown statistic \"mean\"; expected one of: median, iqm"));
+  EXPECT_EQ(reduce("--comparisons --stat iqm", &out), 2);
+  EXPECT_THAT(out, HasSubstr("drop --stat"));
+}
+
+// --seed-lists: one block of comparisons per list, led by its number; the
+// first list repeats the file's own seeds (the same comparisons as without
+// it); a seed no run has, a token that is no seed, or no --comparisons are
+// refused naming the place.
+TEST_F(ReduceCommandTest, SeedListsPrintTheComparisonsOfEachList) {
+  std::string plain, out;
+  ASSERT_EQ(reduce("--comparisons", &plain), 0) << plain;
+  const std::string lists = path_ + ".lists";
+  std::ofstream(lists) << "# resamples\n0,1,2\n2,2,0\n";
+  ASSERT_EQ(reduce("--comparisons --seed-lists " + lists, &out), 0) << out;
+  const auto rows = parse_csv(out), own = parse_csv(plain);
+  ASSERT_EQ(rows.size(), 1 + 2 * (own.size() - 1)) << out;
+  EXPECT_EQ(rows[0][0], "list");
+  for (std::size_t r = 1; r < own.size(); ++r) {
+    EXPECT_EQ(rows[r][0], "1");
+    EXPECT_EQ(std::vector<std::string>(rows[r].begin() + 1, rows[r].end()), own[r]);
+    EXPECT_EQ(rows[r + own.size() - 1][0], "2");
+  }
+  std::ofstream(lists) << "0,1\n0,7\n";
+  EXPECT_EQ(reduce("--comparisons --seed-lists " + lists, &out), 2);
+  EXPECT_THAT(out, HasSubstr(lists + ":2: seed 7 has no run in the tables (their seeds: 0,1,2)"));
+  std::ofstream(lists) << "0,x\n";
+  EXPECT_EQ(reduce("--comparisons --seed-lists " + lists, &out), 2);
+  EXPECT_THAT(out, HasSubstr(lists + ":1: \"x\" is not a seed"));
+  EXPECT_EQ(reduce("--seed-lists " + lists, &out), 2);
+  EXPECT_THAT(out, HasSubstr("--seed-lists needs --comparisons"));
+  std::remove(lists.c_str());
 }
 
 // A sweep file given instead of its results file: named as such, and no

@@ -1,10 +1,10 @@
 // tests/report/table_comparisons_test.cpp — compare_table_cells on a grid
 // expanded from a sweep text: which comparisons a table makes (every pair of
-// models in a column, every column against the first in a row), that each is
+// models in a column, every pair of columns in a row), that each is
 // compare_cells of the two cells' seeds, paired exactly where the runs share
 // weights, batches and data (models of one kind, another integrator or
 // regularizer: paired; another kind: unpaired), and that unfinished runs stay
-// out.
+// out; entries_for_seeds' slots.
 #include "phnn/report/table_comparisons.h"
 
 #include <gtest/gtest.h>
@@ -78,6 +78,70 @@ TEST(TableComparisonsTest, PairsOfModelsAndColumnsPairedWhereTheRunsShareTheirSe
   EXPECT_NEAR(out[0].comparison.effect, std::log10(2.0), 1e-12);
   EXPECT_LE(out[0].comparison.n_pairs, 6);
   EXPECT_GE(out[0].comparison.n_pairs, 5);
+}
+
+const char* kThreeColumns = R"(name = "cmp3"
+[training]
+steps = 10
+[grid]
+systems = ["duffing"]
+models = ["phnn-s-rk2", "phnn-s-dg"]
+seeds = "0-5"
+[study.I]
+n_train = [25, 100, 400]
+)";
+
+// Three columns: per column 1 pair of rows (3), per row the columns against
+// the first, (100, 25) and (400, 25), then (400, 100) (2 rows x 3).
+TEST(TableComparisonsTest, EveryPairOfColumnsOfARow) {
+  const Grid grid = expand_grid(parse_sweep_text(kThreeColumns, "cmp3.toml"));
+  std::vector<RunStatus> status(grid.runs.size(), RunStatus::kDone);
+  std::vector<double> mse;
+  for (const RunConfig& run : grid.runs) mse.push_back(mse_of(run) / run.n_train);
+  const std::vector<NamedComparison> out =
+      compare_table_cells(grid, make_table_entries(grid, status, mse));
+  ASSERT_EQ(out.size(), 9u);
+  EXPECT_EQ(out[3].a, "I/duffing/PHNN-S-RK2/100");
+  EXPECT_EQ(out[3].b, "I/duffing/PHNN-S-RK2/25");
+  EXPECT_EQ(out[5].a, "I/duffing/PHNN-S-RK2/400");
+  EXPECT_EQ(out[5].b, "I/duffing/PHNN-S-RK2/100");
+  EXPECT_EQ(out[8].a, "I/duffing/PHNN-S-DG/400");
+  EXPECT_EQ(out[8].b, "I/duffing/PHNN-S-DG/100");
+  // Every seed's error falls 4x from 100 to 400 points: A better (unpaired:
+  // another N_train is other data; the two columns do not overlap).
+  EXPECT_FALSE(out[5].comparison.paired);
+  EXPECT_EQ(out[5].comparison.reading, ComparisonReading::kABetter);
+}
+
+// Slots: {3, 3, 0} gives slots 0 and 1 seed 3's runs, slot 2 seed 0's, in
+// every cell; unlisted seeds drop out; pairs of slots compare as pairs.
+TEST(EntriesForSeedsTest, SlotsHoldTheListedSeedsInEveryCell) {
+  const Grid grid = expand_grid(parse_sweep_text(kSweep, "cmp.toml"));
+  std::vector<RunStatus> status(grid.runs.size(), RunStatus::kDone);
+  std::vector<double> mse;
+  for (const RunConfig& run : grid.runs) mse.push_back(mse_of(run));
+  const std::vector<TableEntry> entries = make_table_entries(grid, status, mse);
+  const std::vector<TableEntry> slots = entries_for_seeds(entries, {3, 3, 0});
+  std::size_t seed3 = 0, seed0 = 0;
+  for (const TableEntry& e : entries) {
+    if (e.seed == 3) ++seed3;
+    if (e.seed == 0) ++seed0;
+  }
+  ASSERT_EQ(slots.size(), 2 * seed3 + seed0);
+  for (const TableEntry& e : slots) {
+    ASSERT_GE(e.seed, 0);
+    ASSERT_LE(e.seed, 2);
+    const int original = e.seed == 2 ? 0 : 3;
+    EXPECT_EQ(grid.runs[static_cast<std::size_t>(e.run)].seed, original);
+    EXPECT_EQ(e.mse, mse_of(grid.runs[static_cast<std::size_t>(e.run)]));
+  }
+  ComparisonOptions one_pair;
+  one_pair.min_seeds = 1;
+  const std::vector<NamedComparison> out = compare_table_cells(grid, slots, one_pair);
+  ASSERT_FALSE(out.empty());
+  EXPECT_TRUE(out[0].comparison.paired);
+  EXPECT_EQ(out[0].comparison.n_pairs, 3);  // a seed drawn twice is two pairs
+  EXPECT_TRUE(entries_for_seeds(entries, {99}).empty());
 }
 
 }  // namespace

@@ -1,4 +1,6 @@
-// tests/report/tables_test.cpp
+// tests/report/tables_test.cpp — the tables (median or IQM), their marks,
+// the seeds summary and the cell summaries.
+// Size: one fixture (TableTest) serves every table test, the IQM ones too.
 #include "phnn/report/tables.h"
 
 #include <gmock/gmock.h>
@@ -151,6 +153,59 @@ TEST_F(TableTest, CsvHasOneLinePerCellWithIntervalBestAndTieColumns) {
   EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,100,,,,,,,0,0,5,5,0,0\n"));
   // Header + 4 cells.
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
+}
+
+TEST(CellStatisticTest, ParsesMedianAndIqmAndListsThemOnError) {
+  EXPECT_EQ(parse_cell_statistic("median"), CellStatistic::kMedian);
+  EXPECT_EQ(parse_cell_statistic("iqm"), CellStatistic::kIqm);
+  EXPECT_EQ(to_string(CellStatistic::kIqm), "iqm");
+  EXPECT_THAT([] { parse_cell_statistic("mean"); },
+              testing::ThrowsMessage<std::invalid_argument>(
+                  HasSubstr("\"mean\"; expected one of: median, iqm")));
+}
+
+// --stat iqm: NODE-RK2/25 {1..5}e-3 has IQM (2 + 3 + 4) / 3 e-3 = 3e-3;
+// PHNN-JR-DG/25 {1, 2, 3}e-4 + 2 x inf keeps 2e-4, 3e-4 and one inf: IQM inf
+// (two of five diverged, only floor(5/4) = 1 trimmed). The CSV names the
+// column iqm; the text says IQM.
+TEST_F(TableTest, IqmCellsNameTheirStatisticAndKeepUntrimmedDivergedRuns) {
+  const std::string csv = render_tables({study_}, entries_, TableFormat::kCsv, 5, {},
+                                        CellStatistic::kIqm);
+  EXPECT_THAT(csv, StartsWith("study,system,model,axis,column,iqm,q25,q75,iqr,ci_low,ci_high,"));
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,25,3.000000e-03,2.000000e-03,"
+                             "4.000000e-03,2.000000e-03,"));
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,PHNN-JR-DG,n_train,25,inf,2.000000e-04,inf,inf,"));
+  // 3 finished seeds in NODE-RK2/100: g = 0, the mean of {5, 6, 7}e-3.
+  EXPECT_THAT(csv, HasSubstr("\nI,harmonic,NODE-RK2,n_train,100,6.000000e-03,"));
+  const std::string markdown = render_tables({study_}, entries_, TableFormat::kMarkdown, 5, {},
+                                             CellStatistic::kIqm);
+  EXPECT_THAT(markdown, HasSubstr("| PHNN-JR-DG | inf [inf] ("));
+  EXPECT_THAT(markdown, HasSubstr("show IQM [IQR] without an interval"));
+  EXPECT_THAT(render_tables({study_}, entries_, TableFormat::kLatex, 5, {}, CellStatistic::kIqm),
+              HasSubstr("IQM [IQR] (bootstrap 95~\\% interval of the IQM)"));
+}
+
+// Best and tie by the IQM's interval, not the median's: NODE-RK2
+// {2, 2}e-4 + 5 x 1e-2 has median 1e-2 with interval [2e-4, 1e-2]
+// (P(bootstrap median = 2e-4) = P(>= 4 of 7 draws small) = 0.108), touching
+// PHNN-JR-DG's constant 2e-4: a tie by the median. Its IQM (2e-4 + 4 x
+// 1e-2) / 5 = 8.04e-3 is 2e-4 in a resample only with >= 6 small draws
+// (P = 0.0029 < 2.5 %), so its IQM interval starts at 2.16e-3 or above:
+// PHNN-JR-DG is bold by the IQM.
+TEST_F(TableTest, IqmMarksTheBestByTheIqmInterval) {
+  entries_.clear();
+  for (double mse : {2e-4, 2e-4, 1e-2, 1e-2, 1e-2, 1e-2, 1e-2}) {
+    add("NODE-RK2", "25", RunStatus::kDone, mse);
+  }
+  for (int seed = 0; seed < 5; ++seed) add("PHNN-JR-DG", "25", RunStatus::kDone, 2e-4);
+  const std::string iqm = render_tables({study_}, entries_, TableFormat::kMarkdown, 5, {},
+                                        CellStatistic::kIqm);
+  EXPECT_THAT(iqm, HasSubstr("| NODE-RK2 | 8.04e-03 [4.90e-03] ("));
+  EXPECT_THAT(iqm, HasSubstr("| PHNN-JR-DG | **2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04)**"));
+  EXPECT_THAT(iqm, Not(HasSubstr("(tie)")));
+  const std::string median = render(TableFormat::kMarkdown);
+  EXPECT_THAT(median, HasSubstr("| NODE-RK2 | 1.00e-02 [4.90e-03] (2.00e-04, 1.00e-02) (tie)"));
+  EXPECT_THAT(median, HasSubstr("| PHNN-JR-DG | 2.00e-04 [0.00e+00] (2.00e-04, 2.00e-04) (tie)"));
 }
 
 TEST_F(TableTest, AllDivergedCellShowsInfinityAndCountNeverNan) {

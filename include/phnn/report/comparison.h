@@ -111,7 +111,10 @@ struct NamedComparison {
 ///   effect_high,effect_coverage,p_a_less,p_low,p_high,delta,reading
 /// paired 0/1; numbers "%.6e", "inf" / "-inf" for infinities, empty for
 /// NaN; reading as to_string(); names quoted when they hold , or ".
-std::string render_comparisons_csv(const std::vector<NamedComparison>& comparisons, double delta);
+/// With list > 0 (one of several seed lists, `phnn reduce --seed-lists`) the
+/// header starts with a column `list` and every record with the number.
+std::string render_comparisons_csv(const std::vector<NamedComparison>& comparisons, double delta,
+                                   int list = 0);
 
 /// Whether runs of the cells of `a` and `b` with equal seeds share their
 /// seed effect (docs/METHOD.md "Comparisons"): the same initial weights (same

@@ -1,5 +1,6 @@
-// include/phnn/report/statistics.h — quantiles and the percentile-bootstrap
-// interval of a median, for the reducer's tables. Pure functions: no HDF5, no
+// include/phnn/report/statistics.h — quantiles, the interquartile mean and
+// the percentile-bootstrap intervals of a median or an IQM, for the
+// reducer's tables. Pure functions: no HDF5, no
 // MPI, no std:: random distributions (their output differs between standard
 // libraries), so every number printed is the same on every machine.
 #pragma once
@@ -28,7 +29,24 @@ double quantile_linear(std::vector<double> values, double q);
 /// checking them (the bootstrap's inner loop). `sorted` must not be empty.
 double quantile_linear_sorted(const std::vector<double>& sorted, double q);
 
-/// Options of the percentile bootstrap of a median.
+/// The interquartile mean (IQM) of values sorted ascending: the 25 % trimmed
+/// mean of Agarwal et al. (NeurIPS 2021, rliable), scipy.stats.trim_mean(x,
+/// 0.25):
+///
+///   g = floor(n / 4),   IQM = (s[g] + ... + s[n - 1 - g]) / (n - 2 g)
+///
+/// (summed in ascending order). E.g. {1, 2, 3, 4, 100}: g = 1, (2 + 3 + 4) / 3
+/// = 3; n <= 3 keeps every value (the mean). +inf (a diverged run) sorts to
+/// the top: dropped while at most g values are +inf, else the IQM is +inf.
+/// `sorted` must not be empty and hold no NaN (not checked: the bootstrap's
+/// inner loop).
+double interquartile_mean_sorted(const std::vector<double>& sorted);
+
+/// interquartile_mean_sorted of `values` in any order. Throws
+/// std::invalid_argument if `values` is empty or contains a NaN.
+double interquartile_mean(std::vector<double> values);
+
+/// Options of the percentile bootstrap of a median or an IQM.
 struct BootstrapOptions {
   /// Resamples B. The empirical 2.5 % point is off by about
   /// sqrt(0.025 * 0.975 / B) in probability: 0.16 % at B = 10 000, 0.05 % at
@@ -69,6 +87,18 @@ struct Interval {
 std::vector<double> bootstrap_medians(const std::vector<double>& values,
                                       const BootstrapOptions& options = {});
 
+/// The B bootstrap statistics of `values`: the resamples of
+/// bootstrap_medians (same stream, same draws), each sorted and passed to
+/// `statistic` (e.g. quantile_linear_sorted at 0.5, interquartile_mean_sorted).
+/// Same errors as bootstrap_medians.
+std::vector<double> bootstrap_statistics(const std::vector<double>& values,
+                                         const BootstrapOptions& options,
+                                         double (*statistic)(const std::vector<double>& sorted));
+
+/// The percentile interval of bootstrap draws: [Q((1 - c)/2), Q((1 + c)/2)]
+/// (quantile_linear) of `draws`, c = `confidence`. `draws` must not be empty.
+Interval percentile_interval(std::vector<double> draws, double confidence);
+
 /// Percentile-bootstrap confidence interval of the median of `values`:
 ///   [Q((1 - c)/2), Q((1 + c)/2)] of bootstrap_medians(values, options).
 /// A constant sample gives [v, v]; n = 1 gives [v, v]; n = 3 with
@@ -76,5 +106,16 @@ std::vector<double> bootstrap_medians(const std::vector<double>& values,
 /// with probability 7/27). Same errors as bootstrap_medians.
 Interval bootstrap_median_interval(const std::vector<double>& values,
                                    const BootstrapOptions& options = {});
+
+/// Percentile-bootstrap confidence interval of the IQM of `values`, the
+/// median's interval with interquartile_mean_sorted in place of the median
+/// (same resamples, same key; rliable's stratified bootstrap of one stratum):
+///   [Q((1 - c)/2), Q((1 + c)/2)] of bootstrap_statistics(values, options,
+///                                    interquartile_mean_sorted).
+/// A resample whose +inf values outnumber its trimming has IQM +inf, so the
+/// upper end is +inf when such resamples pass (1 - c)/2. Same errors as
+/// bootstrap_medians.
+Interval bootstrap_iqm_interval(const std::vector<double>& values,
+                                const BootstrapOptions& options = {});
 
 }  // namespace phnn

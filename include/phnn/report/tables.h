@@ -1,5 +1,6 @@
 // include/phnn/report/tables.h — the paper's result tables (Appendix F) from
-// run results: median [IQR] (bootstrap interval of the median) per cell, the
+// run results: median (or IQM) [IQR] (bootstrap interval of the median or
+// IQM) per cell, the
 // best of a column only when the intervals separate it, and the seeds-per-mode
 // view. Pure functions: no HDF5, no MPI.
 #pragma once
@@ -46,12 +47,21 @@ TableFormat parse_table_format(const std::string& name);
 /// "markdown", "latex", "csv".
 std::string to_string(TableFormat format);
 
-/// Statistics of one table cell.
+/// The statistic a table's cells show and rank by (`phnn reduce --stat`):
+/// the median (the paper's), or the interquartile mean (interquartile_mean,
+/// statistics.h) with its bootstrap interval.
+enum class CellStatistic { kMedian, kIqm };
+/// "median", "iqm"; throws std::invalid_argument listing them.
+CellStatistic parse_cell_statistic(const std::string& name);
+/// "median", "iqm".
+std::string to_string(CellStatistic statistic);
+
 /// Fewest finished seeds for which a table prints a cell's bootstrap
 /// interval; a column marks a best (or a tie) only if every row has as
 /// many. A bootstrap interval of 1-4 values says little (of 1: zero width).
 constexpr int kMinSeedsForInterval = 5;
 
+/// Statistics of one table cell.
 struct CellSummary {
   /// Runs with status done (and a finite MSE).
   int done = 0;
@@ -69,7 +79,20 @@ struct CellSummary {
   /// Percentile-bootstrap interval of the median (bootstrap_median_interval
   /// over the done and diverged runs); NaN ends if done + diverged == 0.
   Interval median_interval;
+  /// Which statistic the cell shows; with kIqm, `iqm` is
+  /// interquartile_mean over the done and diverged runs (+inf when more
+  /// than floor(n / 4) of the n diverged) and `iqm_interval` its
+  /// bootstrap_iqm_interval; with kMedian both are NaN (not computed).
+  CellStatistic statistic = CellStatistic::kMedian;
+  double iqm = 0.0;
+  Interval iqm_interval;
 
+  /// The shown statistic: median or iqm.
+  double center() const { return statistic == CellStatistic::kIqm ? iqm : median; }
+  /// Its interval: median_interval or iqm_interval.
+  const Interval& center_interval() const {
+    return statistic == CellStatistic::kIqm ? iqm_interval : median_interval;
+  }
   /// Runs whose MSE enters the statistics.
   int finished() const { return done + diverged; }
   /// Whether the tables show the interval (and may mark a best): at least
@@ -80,9 +103,11 @@ struct CellSummary {
   double iqr() const;
 };
 
-/// Summarizes the MSEs of one cell's entries.
+/// Summarizes the MSEs of one cell's entries (the IQM and its interval only
+/// with `statistic` kIqm).
 CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_seeds,
-                           const BootstrapOptions& bootstrap = {});
+                           const BootstrapOptions& bootstrap = {},
+                           CellStatistic statistic = CellStatistic::kMedian);
 
 /// The paper's tables (Appendix F layout): for each study and each of its
 /// systems, rows = StudyTable::rows (models, in order), columns =
@@ -120,10 +145,19 @@ CellSummary summarize_cell(const std::vector<TableEntry>& entries, int expected_
 ///   diverged,missing,expected,best,tie
 /// numbers "%.6e" ("inf" for +inf; empty when the cell has no finished run).
 ///
+/// With `statistic` kIqm every "median" above reads "IQM" (the
+/// interquartile mean and bootstrap_iqm_interval): cells "IQM [IQR] (low,
+/// high)", best and tie by the IQMs and their intervals, the caption says
+/// "IQM", and the CSV header names the column `iqm` instead of `median`
+/// (ci_low, ci_high are then the IQM's interval). A cell with more diverged
+/// runs than floor(n / 4) has IQM +inf and prints as a cell whose median is
+/// +inf does.
+///
 /// Entries whose study, system, row or column is not in `studies` are ignored.
 std::string render_tables(const std::vector<StudyTable>& studies,
                           const std::vector<TableEntry>& entries, TableFormat format,
-                          int expected_seeds, const BootstrapOptions& bootstrap = {});
+                          int expected_seeds, const BootstrapOptions& bootstrap = {},
+                          CellStatistic statistic = CellStatistic::kMedian);
 
 /// A cell of a study table, by name.
 struct TableCellName {
