@@ -73,6 +73,7 @@ import argparse
 import os
 import subprocess
 import sys
+import textwrap
 import warnings
 from collections import Counter
 
@@ -166,25 +167,34 @@ def load(path, round_k=None):
 
 
 def system_states(f, name):
-    """A system's state names, units, phase pairs (indices), whether it is a system file and the
-    initial energies of its figure trajectories: from /data/<name> (a group of format_version 2
-    has state_names and its system file's text with [plots] phase and energies; the paper's three
-    have energies 0.5 and 0.75 J); a group of format_version 1 (files written before 2026-11-28)
-    is a built-in system: q [m], p [kg m/s], 0.5 and 0.75 J."""
+    """A system's state names, units, phase pairs (indices), whether it is a system file, the
+    initial energies of its figure trajectories, whether its data are recorded (`phnn import`:
+    a data set with a `split` attribute, or a structure-only system file without H) and, for
+    recorded or generated time-varying inputs on inference trajectories 0 and 1 (no figure
+    energies), those inputs: from /data/<name> (a group of format_version 2 has state_names and
+    its system file's text with [plots] phase and energies; the paper's three have energies 0.5
+    and 0.75 J); a group of format_version 1 (files written before 2026-11-28) is a built-in
+    system: q [m], p [kg m/s], 0.5 and 0.75 J."""
     group = f["data"][name] if "data" in f and name in f["data"] else None
     if group is None or "state_names" not in group.attrs:
         return {"names": ["q", "p"], "units": ["m", "kg m/s"], "pairs": [(0, 1)], "file": False,
-                "energies": [0.5, 0.75]}
+                "energies": [0.5, 0.75], "recorded": False, "inputs": None}
     names = text([group.attrs["state_names"]])[0].split(",")
     units = text([group.attrs["state_units"]])[0].split(",")
     pairs = [(i, i + 1 if i + 1 < len(names) else 0) for i in range(0, len(names), 2)]
     if len(names) == 1:
         pairs = []
-    plots = parse_sweep(text([group.attrs.get("system_file", b"")])[0]).get("plots", {})
+    system_file = parse_sweep(text([group.attrs.get("system_file", b"")])[0])
+    plots = system_file.get("plots", {})
     if plots.get("phase"):
         pairs = [(names.index(a), names.index(b)) for a, b in plots["phase"]]
-    return {"names": names, "units": units, "pairs": pairs, "file": True,
-            "energies": list(plots.get("energies", []))}
+    energies = list(plots.get("energies", []))
+    inputs = None
+    if not energies and "inference" in group and "inputs" in group["inference"]:
+        input_names = text([group.attrs.get("input_names", b"")])[0].split(",")
+        inputs = {"names": input_names, "values": np.asarray(group["inference"]["inputs"][:2])}
+    return {"names": names, "units": units, "pairs": pairs, "file": True, "energies": energies,
+            "recorded": "split" in group.attrs or "H" not in system_file, "inputs": inputs}
 
 
 def state_label(states, k):
@@ -319,8 +329,9 @@ def save(fig, out, filename):
 
 
 def suptitle(fig, *lines):
-    """A one-line title (the first line); every line goes to the caption file save() writes."""
-    fig.suptitle(lines[0], fontsize=10)
+    """A title (the first line, wrapped to the figure's width); every line goes to the caption
+    file save() writes."""
+    fig.suptitle(textwrap.fill(lines[0], width=max(60, int(fig.get_figwidth() * 13))), fontsize=10)
     fig.phnn_caption = "\n".join(lines)
 
 
@@ -464,7 +475,7 @@ def trajectories(runs, name, out):
                 i = median_seed_row(runs, [j for j in cell if runs["model"][j] == m])
                 draw_prediction(runs, axes[r], i, energy, m, medians[m])
             axes[r, 0].set_ylabel(f"{figure_label(states, energy)}\n{state_label(states, 0)}")
-        axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+        figure_legend(axes)
         seeds = seeds_per_cell(runs, cell)
         note = "" if n_train == target else f" (paper: {target}, not in this file)"
         suptitle(fig, f"{name}: {system}, {study_names(runs, cell)}, {runs['size'][cell[0]]}, "
@@ -515,7 +526,7 @@ def size_trajectories(runs, name, out):
                 draw_prediction(runs, axes[r], i, energy, model, median,
                                 label_prefix=f"{size}: ", linestyle=SIZE_STYLES.get(size, "--"))
             axes[r, 0].set_ylabel(f"{figure_label(states, energy)}\n{state_label(states, 0)}")
-        axes[0, -1].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+        figure_legend(axes)
         rows = [i for r in groups.values() for i in r]
         suptitle(fig, f"{name}: {system}, {model} at each model size, no regularizer, "
                  f"N_train = {n_train} (paper Fig. 9); n = {seeds_per_cell(runs, rows)} seeds per size",
@@ -534,7 +545,7 @@ def trajectory(runs, i, key, column):
 def trajectory_axes(states):
     """Two rows (the figure trajectories); a column per state against t, then one per phase
     pair: q(t), p(t), (q, p) for the built-in systems."""
-    columns = len(states["names"]) + len(states["pairs"])
+    columns = len(states["names"]) + len(states["pairs"]) + (1 if states.get("inputs") else 0)
     return plt.subplots(2, columns, figsize=(max(13, 3.3 * columns), 7), squeeze=False)
 
 
@@ -548,15 +559,34 @@ def plot_states(runs, axes, i, data, t, style):
         axes[n + c].plot(data[:, a], data[:, b], **style)
 
 
+def figure_legend(axes):
+    """The trajectories' legend (first axis: recording or reference, the rollouts; then the
+    inputs' lines of an input column) right of the first row's last axis."""
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if axes.shape[1] > 1:
+        more = axes[0, -1].get_legend_handles_labels()
+        handles += [h for h, lab in zip(*more) if lab not in labels]
+        labels += [lab for lab in more[1] if lab not in labels]
+    axes[0, -1].legend(handles, labels, fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+
+
 def draw_reference(runs, axes, i, energy):
     """Reference states against t and phase portraits of row i (energy '05' or '075'), axis
     labels."""
     ref = trajectory(runs, i, "reference_" + energy, 2 if energy == "05" else 3)
     t = np.arange(len(ref)) / float(canonical_value(runs, i, "sample_rate", 100))
-    style = {"color": "black", "lw": 2.2, "label": "reference (data generator)"}
-    plot_states(runs, axes, i, ref, t, style)
     states = runs["states"][runs["system"][i]]
+    style = {"color": "black", "lw": 2.2,
+             "label": "recording" if states.get("recorded") else "reference (data generator)"}
+    plot_states(runs, axes, i, ref, t, style)
     n = len(states["names"])
+    if states.get("inputs"):  # the input held over each sample, in the last column
+        u = states["inputs"]["values"][0 if energy == "05" else 1][:len(t)]
+        for k, input_name in enumerate(states["inputs"]["names"]):
+            axes[-1].step(t[:len(u)], u[:, k], where="post", lw=1.2, label=f"input {input_name}")
+        axes[-1].set_xlabel("t [s]")
+        axes[-1].set_ylabel("input u(t)")
+        axes[-1].grid(alpha=0.3)
     labels = [("t [s]", None if k == 0 else state_label(states, k)) for k in range(n)]
     labels += [(state_label(states, a), state_label(states, b)) for a, b in states["pairs"]]
     for ax, (xl, yl) in zip(axes, labels):
@@ -634,14 +664,16 @@ def energies(runs, path, name, out):
             rows = (data[np.isclose(data["h0"], states["energies"][min(k, len(states["energies"]) - 1)])]
                     if states["energies"] else data[data["trajectory"] == k])
             c = colour(picks[0])
-            ax.plot(rows["t"], rows["H_true_ref"], color="black", lw=2.2,
-                    label="H along the reference")
-            ax.plot(rows["t"], rows["H_model_ref"], color="grey", lw=1.3, ls=":",
-                    label=r"$H_\theta$ along the reference")
-            ax.plot(rows["t"], rows["H_true"], color=c, lw=1.3, ls="--",
-                    label=f"H along the {picks[0]} rollout")
-            ax.plot(rows["t"], rows["H_model"], color=c, lw=1.3, ls=":",
-                    label=rf"$H_\theta$ along the {picks[0]} rollout")
+            reference = "recording" if states.get("recorded") else "reference"
+            lines = [("H_true_ref", {"color": "black", "lw": 2.2}, f"H along the {reference}"),
+                     ("H_model_ref", {"color": "grey", "lw": 1.3, "ls": ":"},
+                      rf"$H_\theta$ along the {reference}"),
+                     ("H_true", {"color": c, "lw": 1.3, "ls": "--"}, f"H along the {picks[0]} rollout"),
+                     ("H_model", {"color": c, "lw": 1.3, "ls": ":"},
+                      rf"$H_\theta$ along the {picks[0]} rollout")]
+            for column, style, label in lines:  # a structure-only system has no true H: not drawn
+                if np.isfinite(rows[column]).any():
+                    ax.plot(rows["t"], rows[column], label=label, **style)
             ax.set_title(figure_label(states, energy))
             ax.set_xlabel("t [s]")
             ax.set_ylabel(r"energy $H$, $H_\theta$ [J]")
@@ -711,6 +743,8 @@ def trace_figure(runs, name, system, out, panels, stem, what):
             ax = axes[row, col]
             lo, hi = ax.dataLim.y0, ax.dataLim.y1
             ax.set_yscale("log" if log and lo > 0 and hi / lo > 30 else "linear")
+            if ax.get_yscale() == "log":
+                label_minor_log_ticks(ax.yaxis)
             ax.set_ylabel(ylabel, fontsize=8)
             ax.set_title(f"regularizer: {reg}", fontsize=8)
             ax.grid(alpha=0.3)

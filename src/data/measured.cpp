@@ -309,6 +309,10 @@ PhSystemData split_by_trajectories(const PhSystem& system,
   o.num_train_max = static_cast<int>(num_train);
   o.num_validation = options.num_validation;
   o.num_inference = options.num_inference;
+  data.split = "trajectories: one pair per training or validation trajectory, the last " +
+               std::to_string(options.num_inference) + " for inference, " +
+               (options.split_seed >= 0 ? "shuffled by split seed " + std::to_string(options.split_seed)
+                                        : std::string("in the order of their ids"));
   if (summary) {
     *summary += std::to_string(num_train) + " training, " + std::to_string(options.num_validation) +
                 " validation, " + std::to_string(options.num_inference) + " inference trajectories" +

@@ -77,5 +77,45 @@ class SizeTrajectories(unittest.TestCase):
         self.assertEqual(pr.size_trajectory_rows(runs, "self-sustained"), ({}, None))
 
 
+class RecordedData(unittest.TestCase):
+    """system_states reads whether a data set is recorded and its figure inputs; the legend
+    gathers the recording, the rollouts and the inputs."""
+
+    def data_file(self, split, with_h, inputs):
+        import h5py
+        f = h5py.File("recorded.h5", "w", driver="core", backing_store=False)
+        g = f.create_group("data/pend")
+        g.attrs["state_names"], g.attrs["state_units"], g.attrs["input_names"] = "q,p", "rad,x", "u"
+        g.attrs["system_file"] = 'states = ["q", "p"]\n' + ('H = "p^2/2"\n' if with_h else "")
+        if split:
+            g.attrs["split"] = "blocks: ..."
+        if inputs:
+            g.create_dataset("inference/inputs", data=np.arange(3 * 5).reshape(3, 5, 1) * 1.0)
+        return f
+
+    def test_recorded_and_inputs(self):
+        with self.data_file(split=True, with_h=True, inputs=True) as f:
+            states = pr.system_states(f, "pend")
+            self.assertTrue(states["recorded"])
+            self.assertEqual(states["inputs"]["names"], ["u"])
+            self.assertEqual(states["inputs"]["values"].shape, (2, 5, 1))  # figures: trajectories 0, 1
+        with self.data_file(split=False, with_h=False, inputs=False) as f:
+            states = pr.system_states(f, "pend")
+            self.assertTrue(states["recorded"])  # structure only: a recording
+            self.assertIsNone(states["inputs"])
+        with self.data_file(split=False, with_h=True, inputs=False) as f:
+            self.assertFalse(pr.system_states(f, "pend")["recorded"])
+
+    def test_legend_gathers_the_lines_of_the_first_and_the_input_axes(self):
+        fig, axes = pr.plt.subplots(2, 3, squeeze=False)
+        axes[0, 0].plot([0, 1], [0, 1], label="recording")
+        axes[0, 0].plot([0, 1], [1, 0], label="PHNN-S-DG")
+        axes[0, 2].plot([0, 1], [0, 0], label="input u")
+        pr.figure_legend(axes)
+        texts = [t.get_text() for t in axes[0, -1].get_legend().get_texts()]
+        self.assertEqual(texts, ["recording", "PHNN-S-DG", "input u"])
+        pr.plt.close(fig)
+
+
 if __name__ == "__main__":
     unittest.main()
