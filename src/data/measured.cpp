@@ -240,6 +240,39 @@ void ImportOptions::validate() const {
 
 namespace {
 
+// Trajectories [first, end) of `all` as inference trajectories, cut to the
+// shortest; inputs that change within one are replayed sample by sample
+// (zero-order hold), constant ones stay one per trajectory. Frees them;
+// returns the samples kept.
+std::size_t add_inference_trajectories(std::vector<MeasuredTrajectory>* all,
+                                       std::size_t infer_begin, PhInferenceSet* out_set) {
+  std::vector<MeasuredTrajectory>& trajectories = *all;
+  PhInferenceSet& out = *out_set;
+  std::size_t samples = trajectories[infer_begin].size();
+  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
+    samples = std::min(samples, trajectories[i].size());
+  }
+  bool varying = false;
+  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
+    const MeasuredTrajectory& m = trajectories[i];
+    for (std::size_t k = 1; k < samples && !varying; ++k) varying = !m.same_input(k);
+  }
+  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
+    MeasuredTrajectory& m = trajectories[i];
+    out.trajectory.push_back(m.id);
+    out.u.push_back(m.input(0));
+    std::vector<VecX> states, inputs;
+    for (std::size_t k = 0; k < samples; ++k) states.push_back(m.state(k));
+    out.states.push_back(std::move(states));
+    if (varying) {
+      for (std::size_t k = 0; k < samples; ++k) inputs.push_back(m.input(k));
+      out.inputs.push_back(std::move(inputs));
+    }
+    m = MeasuredTrajectory();  // its numbers are in `out` now
+  }
+  return samples;
+}
+
 // ImportSplit::kTrajectories (split_measured_data's step 2).
 PhSystemData split_by_trajectories(const PhSystem& system,
                                    std::vector<MeasuredTrajectory> trajectories,
@@ -266,31 +299,7 @@ PhSystemData split_by_trajectories(const PhSystem& system,
   for (std::size_t i = 0; i < infer_begin; ++i) {
     draw_pair(system, trajectories[i], options, i < num_train ? &data.train : &data.validation);
   }
-  std::size_t samples = trajectories[infer_begin].size();
-  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    samples = std::min(samples, trajectories[i].size());
-  }
-  // Inputs that change within an inference trajectory are replayed sample
-  // by sample at inference (zero-order hold); constant ones stay one per
-  // trajectory.
-  bool varying = false;
-  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    const MeasuredTrajectory& m = trajectories[i];
-    for (std::size_t k = 1; k < samples && !varying; ++k) varying = !m.same_input(k);
-  }
-  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    MeasuredTrajectory& m = trajectories[i];
-    data.inference.trajectory.push_back(m.id);
-    data.inference.u.push_back(m.input(0));
-    std::vector<VecX> states, inputs;
-    for (std::size_t k = 0; k < samples; ++k) states.push_back(m.state(k));
-    data.inference.states.push_back(std::move(states));
-    if (varying) {
-      for (std::size_t k = 0; k < samples; ++k) inputs.push_back(m.input(k));
-      data.inference.inputs.push_back(std::move(inputs));
-    }
-    m = MeasuredTrajectory();  // its numbers are in `data` now
-  }
+  const std::size_t samples = add_inference_trajectories(&trajectories, infer_begin, &data.inference);
 
   // What the options record: the rate, the split sizes, the window and the
   // inference duration; no generation.
