@@ -50,6 +50,7 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
   std::string log;
   EXPECT_EQ(run("train --system harmonic --model node --integrator dg --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("integrator = dg with model = node"));
+  EXPECT_THAT(log, Not(HasSubstr("phnn train: phnn train")));  // no made-up FILE:LINE
   EXPECT_THAT(log, Not(HasSubstr("CellSpec")));  // no internal names in messages
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --steps -4", &log), 2);
   EXPECT_THAT(log, HasSubstr("--steps = -4 is outside [1, 2147483647]"));
@@ -70,6 +71,7 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
   EXPECT_THAT(log, HasSubstr("--model \"mlp\": expected formulation-integrator"));  // nothing near
   EXPECT_EQ(run("train --system harmonic --model node-dg --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("integrator = dg with model = node"));
+  EXPECT_THAT(log, Not(HasSubstr("phnn train: phnn train")));  // no made-up FILE:LINE
   EXPECT_EQ(run("train --system harmonic --model phnn-jr-rk2 --integrator dg --steps 1", &log), 2);
   EXPECT_THAT(log, HasSubstr("already names the integrator rk2"));
   // "Did you mean" for a system and a model a letter away.
