@@ -65,10 +65,6 @@ using Clock = std::chrono::steady_clock;
 // Before that a stop ends the process at once (early_signals.h).
 volatile std::sig_atomic_t g_stop_signal = 0;
 
-// Exit status of a sweep stopped by a signal: EX_TEMPFAIL, "try again" — the
-// Slurm job script requeues on it.
-constexpr int kExitStopped = 75;
-
 // --split and --max-group-size; throws cli::UsageError.
 SplitOptions split_options(const cli::Parser& parser) {
   SplitOptions options;
@@ -190,6 +186,7 @@ class SweepRun {
     // it only to write their rows (docs/DECISIONS.md, "No rank waits forever").
     std::vector<int> status_codes;
     end_setup_stops();  // from here on a stop is graceful: the lock, the file
+    data_.set_stop([] { return g_stop_signal != 0; });  // and a long data generation
     if (int status = agreed(world_, root_, [&] { status_codes = prepare_results(session); })) {
       return status;
     }
@@ -382,7 +379,8 @@ class SweepRun {
 
 // Trains one item's cell, from its saved state if it has one. A cell that
 // throws is a result too: every run failed, with the message. A cell stopped
-// by a signal returns no results (its state is saved; *interrupted).
+// by a signal returns no results (its state is saved; *interrupted), and so
+// does one whose data set a signal stopped while it was being generated.
 std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
                                   const std::string& system, const std::function<void()>& tick,
                                   ItemCheckpoints* checkpoints, const std::string& prefix,
@@ -418,6 +416,11 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
                        ? "its last saved state"
                        : "the start");
     }
+    return {};
+  } catch (const GenerationStopped&) {  // a signal while this rank made its data: nothing trained
+    *interrupted = true;
+    std::fprintf(stderr, "%sitem %d stopped while making its data set; it trains at the next run\n",
+                 prefix.c_str(), item_number);
     return {};
   } catch (const std::exception& e) {
     std::vector<RunResult> failed(cell.seeds.size());

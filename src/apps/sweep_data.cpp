@@ -30,10 +30,10 @@ void SweepDataSets::make(const std::string& system_name) {
     }
   } else if (file) {
     d.system = compile_system(file->text, file->entry);
-    d.data = make_ph_system_data(*d.system, spec_.data, max_train);
+    d.data = make_ph_system_data(*d.system, spec_.data, max_train, stop_);
   } else {
     d.system = builtin_system(spec_.physics.at(parse_system(system_name)), spec_.data);
-    d.data = make_ph_system_data(*d.system, spec_.data, max_train);
+    d.data = make_ph_system_data(*d.system, spec_.data, max_train, stop_);
   }
   data_.emplace(system_name, std::move(d));
 }

@@ -26,8 +26,11 @@ class SweepDataSets {
 
   /// Makes the data set of `system_name` (RunConfig::system_name()) with
   /// as many training pairs as its largest n_train, unless made already.
-  /// Throws what data generation throws (a system file's Newton failure).
+  /// Throws what data generation throws (a system file's Newton failure;
+  /// GenerationStopped when the stop set below says stop).
   void make(const std::string& system_name);
+  /// Asked between generated trajectories (a stop signal).
+  void set_stop(GenerationStop stop) { stop_ = std::move(stop); }
   /// Collective: stores the data set under /data/<system_name> (make first).
   void store(const std::string& system_name, ResultsFile* results) const;
   /// "" when the data set of `system_name` (make first) has the bits of the
@@ -49,6 +52,7 @@ class SweepDataSets {
     std::unique_ptr<PhSystem> system;
   };
   const DataSet& at(const std::string& system_name) const;
+  GenerationStop stop_;
 
   const SweepSpec& spec_;
   const Grid& grid_;

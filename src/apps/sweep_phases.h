@@ -10,6 +10,7 @@
 #include <boost/mpi/communicator.hpp>
 
 #include "apps/cli.h"
+#include "phnn/data/ph_dataset.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"  // Shard
@@ -22,6 +23,9 @@ namespace apps {
 
 /// Exit status of a sweep that failed at run time (usage errors: 2).
 constexpr int kExitFailed = 1;
+/// Exit status of a sweep stopped by a signal: EX_TEMPFAIL, "try again" —
+/// the Slurm job script requeues on it.
+constexpr int kExitStopped = 75;
 
 // Every rank passes its own (code, message); returns the largest code on
 // every rank, and rank 0 prints each distinct non-empty message once. A
@@ -42,6 +46,10 @@ int agreed(const boost::mpi::communicator& world, bool here, Body&& body) {
     } catch (const cli::UsageError& e) {
       code = cli::kUsageError;
       message = e.message;
+    } catch (const GenerationStopped&) {  // a signal during a long data generation
+      code = kExitStopped;
+      message = "phnn sweep: stopped on a signal while generating the data; run the same command "
+                "again to resume (no run had started)";
     } catch (const std::invalid_argument& e) {
       code = cli::kUsageError;
       message = cli::with_prefix("phnn sweep: ", e.what());

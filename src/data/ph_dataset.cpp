@@ -243,14 +243,27 @@ PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions
   return traj;
 }
 
+namespace {
+
+// Every 64 trajectories, the caller's stop: a long generation ends at a
+// signal within ~a trajectory's time x 64 (GenerationStopped).
+void check_stop(const GenerationStop& stop, std::int64_t index) {
+  if (stop && index % 64 == 0 && stop()) {
+    throw GenerationStopped("stopped while generating trajectory " + std::to_string(index));
+  }
+}
+
+}  // namespace
+
 PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options, std::int64_t first,
-                        int count) {
+                        int count, const GenerationStop& stop) {
   options.validate();
   const int stride = options.stride();
   const int positions = options.num_pair_positions();
   PhPairSet pairs;
   pairs.step = stride * options.generation_step;
   for (std::int64_t i = first; i < first + count; ++i) {
+    check_stop(stop, i);
     CounterRng pick = CounterRng::for_trajectory(options.data_seed, system.rng_id(), i,
                                                  CounterRng::kTrainingPair);
     const int n = static_cast<int>(pick.below(static_cast<std::uint64_t>(positions)));
@@ -264,7 +277,8 @@ PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options, s
   return pairs;
 }
 
-PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& options) {
+PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& options,
+                                const GenerationStop& stop) {
   options.validate();
   const int stride = options.stride();
   const int steps = options.num_inference_steps();
@@ -272,6 +286,7 @@ PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& op
   set.step = stride * options.generation_step;
   for (int j = 0; j < options.num_inference; ++j) {
     const std::int64_t i = options.inference_begin() + j;
+    check_stop(stop, i);
     const PhTrajectory traj = ph_generate_trajectory(system, options, i, steps * stride);
     set.trajectory.push_back(i);
     set.u.push_back(traj.u);
@@ -320,15 +335,16 @@ PhSystemData labelled_ph_system_data(const PhSystem& system) {
 }
 
 PhSystemData make_ph_system_data(const PhSystem& system, const DatasetOptions& options,
-                                 int num_train) {
+                                 int num_train, const GenerationStop& stop) {
   options.validate();
   PHNN_REQUIRE(num_train >= 1 && num_train <= options.num_train_max,
                "n_train = " << num_train << " outside [1, " << options.num_train_max << "]");
   PhSystemData data = labelled_ph_system_data(system);
   data.options = options;
-  data.train = ph_make_pairs(system, options, 0, num_train);
-  data.validation = ph_make_pairs(system, options, options.validation_begin(), options.num_validation);
-  data.inference = ph_inference_set(system, options);
+  data.train = ph_make_pairs(system, options, 0, num_train, stop);
+  data.validation =
+      ph_make_pairs(system, options, options.validation_begin(), options.num_validation, stop);
+  data.inference = ph_inference_set(system, options, stop);
   return data;
 }
 

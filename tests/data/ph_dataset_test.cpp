@@ -218,5 +218,22 @@ TEST(PhDatasetTest, DamagedFilesAreRefusedBeforeAnythingIsIndexed) {
   std::remove(path.c_str());
 }
 
+// A stop asked between trajectories ends the generation (every 64th
+// trajectory asks): the sweep's graceful stop during a long data set. Without
+// a stop, or one that says no, the same data as ever.
+TEST(PhDatasetTest, AStopEndsALongGenerationBetweenTrajectories) {
+  const auto system = load_system_file(shipped("duffing"));
+  DatasetOptions o;
+  int asked = 0;
+  const GenerationStop stop_at_third = [&asked] { return ++asked == 3; };
+  EXPECT_THROW(make_ph_system_data(*system, o, 25, stop_at_third), GenerationStopped);
+  EXPECT_EQ(asked, 3);
+  const GenerationStop never = [] { return false; };
+  const PhSystemData a = make_ph_system_data(*system, o, 25, never);
+  const PhSystemData b = make_ph_system_data(*system, o, 25);
+  EXPECT_EQ(a.validation.x, b.validation.x);
+  EXPECT_EQ(a.inference.states, b.inference.states);
+}
+
 }  // namespace
 }  // namespace phnn

@@ -7,6 +7,9 @@
 #   early:    SIGTERM to every rank while it is still starting (LibTorch's
 #             loader and initializers, before MPI is up): a clean stop, not
 #             death by signal.
+#   data:     SIGTERM to every rank while rank 0 generates a large data set
+#             (after the writer lock: the graceful phase): exit 75 within
+#             3 s, not at the end of the generation, and no run started.
 set -u
 case_name=$1 phnn=$2
 shift 2
@@ -28,6 +31,23 @@ sizes = ["small"]
 n_train = [25]
 seeds = "0-3"
 TOML
+if [[ $case_name == data ]]; then  # one cell, 2 seeds; ~10-20 s of data generation
+  cat > "$dir/stop.toml" <<'TOML'
+name = "stop"
+[data]
+num_trajectories = 400000
+num_validation = 300000
+[training]
+steps = 100
+eval_every = 50
+[grid]
+systems = ["duffing"]
+models = ["phnn-jr-rk2"]
+sizes = ["small"]
+n_train = [25]
+seeds = "0-1"
+TOML
+fi
 sweep() {
   timeout -k 5 300 "${mpiexec[@]}" "$phnn" sweep "$dir/stop.toml" --out "$dir/r.h5" \
     --max-group-size 2 > "$dir/log" 2>&1
@@ -67,9 +87,32 @@ case $case_name in
     # the launcher's mask through the loader): otherwise this tested nothing.
     (( early_ones > 0 )) || fail "both signals came after the handlers were installed"
     [[ ! -s $dir/log ]] || fail "the ranks had printed before the signal (MPI was up): too late to test" ;;
+  data)
+    for _ in $(seq 1 400); do pids=($(rank_pids)); [[ ${#pids[@]} -eq 2 ]] && break; sleep 0.01; done
+    for p in "${pids[@]}"; do
+      for _ in $(seq 1 2000); do
+        caught=$(awk '/^SigCgt/ {print $2}' "/proc/$p/status" 2>/dev/null || echo 0)
+        (( 0x$caught & 0x4000 )) && break; sleep 0.01
+      done
+    done
+    sleep 1.5  # MPI up, the lock taken: rank 0 is generating
+    [[ ! -s $dir/log ]] || fail "the sweep had printed before the signal: the generation was over"
+    signalled=$(date +%s%N)
+    kill -TERM "${pids[@]}" ;;
   *) fail "unknown case" ;;
 esac
 wait "$job"; status=$?
+if [[ $case_name == data ]]; then
+  took=$(( ($(date +%s%N) - signalled) / 1000000 ))
+  [[ $status -eq 75 ]] || fail "the sweep exited $status, expected 75"
+  (( took <= 3000 )) || fail "the stop took $took ms: the generation did not see the signal"
+  grep -q "stopped on a signal while generating the data" "$dir/log" || fail "no stop message"
+  ! grep -q "item [0-9]*/" "$dir/log" || fail "a run started after the signal"
+  sweep || fail "the resumed sweep failed"
+  grep -q "2 done, 0 diverged, 0 failed, 0 pending of 2" "$dir/log" || fail "the resume did not finish"
+  echo "PASSED (data): exit 75 $took ms after the signal, resume finished every run"
+  exit 0
+fi
 [[ $status -eq 75 ]] || fail "the sweep exited $status, expected 75 (stopped, requeue)"
 grep -q "stopped on a signal; run the same command again" "$dir/log" || fail "no resume hint"
 started=$(grep -c "item [0-9]*/8:" "$dir/log")

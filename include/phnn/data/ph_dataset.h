@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -48,6 +50,13 @@ struct PhTrajectory {
 PhTrajectory ph_generate_trajectory(const PhSystem& system, const DatasetOptions& options,
                                     std::int64_t index, int num_steps);
 
+/// Asked between trajectories of a long generation (every 64th): true ends
+/// it with GenerationStopped (a stop signal during a sweep's set-up).
+using GenerationStop = std::function<bool()>;
+struct GenerationStopped : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 /// Pairs (x_n, u, x_{n+1}) at sr_train, one per trajectory (PairSet's rules).
 struct PhPairSet {
   std::vector<VecX> x, x_next, u;
@@ -57,7 +66,7 @@ struct PhPairSet {
   std::size_t size() const { return x.size(); }
 };
 PhPairSet ph_make_pairs(const PhSystem& system, const DatasetOptions& options,
-                        std::int64_t first, int count);
+                        std::int64_t first, int count, const GenerationStop& stop = {});
 
 struct PhInferenceSet {
   std::vector<std::int64_t> trajectory;
@@ -73,7 +82,8 @@ struct PhInferenceSet {
   double step = 0.01;
   std::size_t size() const { return u.size(); }
 };
-PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& options);
+PhInferenceSet ph_inference_set(const PhSystem& system, const DatasetOptions& options,
+                                const GenerationStop& stop = {});
 
 /// The figure trajectories of a system with figure energies
 /// (PhSystem::figure_energies; the paper's Figures 4-6): x0 = s e_1 with
@@ -105,6 +115,6 @@ PhSystemData labelled_ph_system_data(const PhSystem& system);
 
 /// Generates the splits; `num_train` <= options.num_train_max training pairs.
 PhSystemData make_ph_system_data(const PhSystem& system, const DatasetOptions& options,
-                                 int num_train);
+                                 int num_train, const GenerationStop& stop = {});
 
 }  // namespace phnn
