@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every dependency of phnn-sweep from Debian packages. Idempotent:
 # packages already present are skipped by apt. Needs root (or sudo).
+#   scripts/setup.sh           everything: phnn, its tests, benchmarks, analysis
+#   scripts/setup.sh --demo    what `phnn` and the demo need (no GoogleTest, no PyTorch)
 set -euo pipefail
 
 PACKAGES=(
@@ -10,7 +12,6 @@ PACKAGES=(
   libopenmpi-dev openmpi-bin         # Open MPI
   libhdf5-openmpi-dev hdf5-tools     # parallel HDF5 + h5dump
   libboost-mpi-dev                   # Boost.MPI (environment, communicator)
-  libgtest-dev libgmock-dev googletest
   libopenblas0-pthread               # fast BLAS behind libblas.so.3 (LibTorch uses it)
   libblas-dev                        # libblas.so to link dgemm_ (src/models/stacked_matmul.cpp)
   libjemalloc-dev                    # allocator: glibc malloc costs ~16 % of a step
@@ -20,8 +21,13 @@ PACKAGES=(
   libmuparser-dev                    # muParser: evaluates them fast (bytecode)
   libmpfr-dev                        # GNU MPFR: correctly rounded sin, cos, exp, ... (same bits on every CPU)
   python3-h5py python3-numpy python3-matplotlib python3-pandas  # analysis/ only
-  python3-torch                      # bench/pytorch_step.py only
 )
+if [[ ${1:-} != --demo ]]; then
+  PACKAGES+=(
+    libgtest-dev libgmock-dev googletest   # the tests
+    python3-torch                          # bench/pytorch_step.py only
+  )
+fi
 
 SUDO=""
 if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
