@@ -68,7 +68,11 @@ if [ $# -ge 2 ]; then
     # The comparisons of the shipped adaptive sweeps are what paper_claims.py writes for their
     # grids (a sweep stopped at once: every run pending, every cell listed).
     for f in paper-adaptive paper-adaptive-both paper-adaptive-study1 paper-adaptive-study1-lean; do
-        timeout -s TERM 2 "$2" sweep "$root/sweeps/$f.toml" --out "$out/$f.h5" > /dev/null 2>&1 || true
+        # Stopped once the file exists (a stop while it generates the data writes none).
+        "$2" sweep "$root/sweeps/$f.toml" --out "$out/$f.h5" > /dev/null 2>&1 & pid=$!
+        for _ in $(seq 1 1200); do [ -f "$out/$f.h5" ] && break; sleep 0.1; done
+        kill -TERM "$pid" 2>/dev/null || true
+        wait "$pid" || true
         PHNN="$2" "$py" "$root/analysis/paper_claims.py" "$out/$f.h5" --write-comparisons > "$out/$f.cmp"
         grep -q '^  \["' "$out/$f.cmp" || { echo "$f: no comparison written" >&2; exit 1; }
         sed -n '/^comparisons = \[/,/^\]/p' "$root/sweeps/$f.toml" | diff - "$out/$f.cmp" > /dev/null \
