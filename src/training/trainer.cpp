@@ -200,6 +200,9 @@ torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torc
     if (cell_.integrator == IntegratorKind::kDg) {
       loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
     }
+    if (cell_.integrator == IntegratorKind::kDg4) {
+      loss = model_->dg4_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
+    }
     if (loss.defined()) return loss;
   }
   // A regularizer needs df/dx at the batch; the same evaluation's f is an
