@@ -1,7 +1,9 @@
 // src/training/rollout.cpp
 #include "training/rollout.h"
 
+#include <algorithm>
 #include <limits>
+#include <vector>
 
 #include "models/ordered_sum.h"
 #include "phnn/common/check.h"
@@ -33,7 +35,41 @@ torch::Tensor step_inputs(const CellData& data, int64_t B_inf, int64_t F, int st
   }
   return out;
 }
+
+// Rows per chunk of a DG4 Newton step. Its residual and Jacobians are the
+// op-by-op order-2 jets of the model (port_hamiltonian.cpp): on all 102 rows
+// at once they set the 4.4 GB peak of an n_x = 8 large cell of 10 members
+// (docs/BENCHMARKS.md "Memory").
+// Every row's iterates depend on that row alone (per-row GEMM chains and
+// jets, per-row Newton decisions; a chunk that stops early holds converged
+// rows only, which keep their solution in a longer loop too), so chunking
+// changes the memory, not the bits.
+int64_t dg4_rollout_chunk = 16;
+
+// dg4_inference_step on the rows [s, s + chunk) in turn.
+DgInferenceStep dg4_step_in_chunks(const DynamicsModel& model, const torch::Tensor& x,
+                                   const torch::Tensor& u, double h,
+                                   const DgInferenceOptions& options) {
+  const int64_t B = x.size(1);
+  if (B <= dg4_rollout_chunk) return dg4_inference_step(model, x, u, h, options);
+  std::vector<torch::Tensor> next, converged;
+  DgInferenceStep out;
+  for (int64_t s = 0; s < B; s += dg4_rollout_chunk) {
+    const int64_t len = std::min(dg4_rollout_chunk, B - s);
+    const DgInferenceStep part =
+        dg4_inference_step(model, x.narrow(1, s, len), u.narrow(1, s, len), h, options);
+    next.push_back(part.x_next);
+    converged.push_back(part.converged);
+    out.iterations = std::max(out.iterations, part.iterations);
+    out.jacobian_evaluations += part.jacobian_evaluations;
+  }
+  out.x_next = torch::cat(next, /*dim=*/1);
+  out.converged = torch::cat(converged, /*dim=*/1);
+  return out;
+}
 }  // namespace
+
+void set_dg4_rollout_chunk(int64_t rows) { dg4_rollout_chunk = rows; }
 
 Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const CellData& data) {
   PHNN_CHECK(model_ref.options().dtype == torch::kFloat64,
@@ -85,7 +121,7 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
     torch::Tensor next;
     if (use_dg) {
       const auto s = cell.integrator == IntegratorKind::kDg4
-                         ? dg4_inference_step(*model, x, u, h_inf, dg_options)
+                         ? dg4_step_in_chunks(*model, x, u, h_inf, dg_options)
                          : dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
       next = s.x_next;
       newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);

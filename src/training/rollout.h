@@ -36,6 +36,10 @@ struct Rollouts {
 };
 Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const CellData& data);
 
+// Rows per chunk of a DG4 rollout step (default 16; rollout.cpp): the bits
+// do not depend on it (tests/training/trainer_test.cpp sets others).
+void set_dg4_rollout_chunk(int64_t rows);
+
 // Eq. 31 per member from the rollouts: the mean over the inference
 // trajectories of their mean squared error, +inf if any diverged.
 std::vector<double> member_mse(const Rollouts& rollouts);
