@@ -10,8 +10,9 @@
 // product of L_H (manual_step.h's TapedGradient) where autograd's graph
 // carries L_H's forward jet, and with a penalty the field jet at x runs
 // through general_jet_heads.h (the curvature of H and the field jet heads)
-// (tests/models/general_manual_step_test.cpp, manual_step_test.cpp). The
-// composition (RK2, RK4, DG, the loss) is models/manual_step.h's. Touches
+// (tests/models/general_manual_step_test.cpp, manual_step_test.cpp,
+// dg4_manual_step_test.cpp). The composition (RK2, RK4, DG, DG4, the loss)
+// is models/manual_step.h's. Touches
 // only the models' gradient sinks.
 //
 // Backward of one PH field evaluation f(y) = F(gradH(y), y), as autograd

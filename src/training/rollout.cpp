@@ -36,26 +36,26 @@ torch::Tensor step_inputs(const CellData& data, int64_t B_inf, int64_t F, int st
   return out;
 }
 
-// Rows per chunk of a DG4 Newton step. Its residual and Jacobians are the
-// op-by-op order-2 jets of the model (port_hamiltonian.cpp): on all 102 rows
-// at once they set the 4.4 GB peak of an n_x = 8 large cell of 10 members
-// (docs/BENCHMARKS.md "Memory").
-// Every row's iterates depend on that row alone (per-row GEMM chains and
-// jets, per-row Newton decisions; a chunk that stops early holds converged
-// rows only, which keep their solution in a longer loop too), so chunking
-// changes the memory, not the bits.
-int64_t dg4_rollout_chunk = 16;
+// Rows per chunk of a DG4 Newton step: 0 = dg4_chunk_rows (rollout.h), else
+// this many (tests). Every row's iterates depend on that row alone (per-row
+// GEMM chains and jets, per-row Newton decisions; a chunk that stops early
+// holds converged rows only, which keep their solution in a longer loop
+// too), so chunking changes the memory, not the bits.
+int64_t dg4_rollout_chunk = 0;
 
 // dg4_inference_step on the rows [s, s + chunk) in turn.
 DgInferenceStep dg4_step_in_chunks(const DynamicsModel& model, const torch::Tensor& x,
                                    const torch::Tensor& u, double h,
                                    const DgInferenceOptions& options) {
   const int64_t B = x.size(1);
-  if (B <= dg4_rollout_chunk) return dg4_inference_step(model, x, u, h, options);
+  const int64_t chunk = dg4_rollout_chunk > 0
+                            ? dg4_rollout_chunk
+                            : dg4_chunk_rows(x.size(0), x.size(2), u.size(2));
+  if (B <= chunk) return dg4_inference_step(model, x, u, h, options);
   std::vector<torch::Tensor> next, converged;
   DgInferenceStep out;
-  for (int64_t s = 0; s < B; s += dg4_rollout_chunk) {
-    const int64_t len = std::min(dg4_rollout_chunk, B - s);
+  for (int64_t s = 0; s < B; s += chunk) {
+    const int64_t len = std::min(chunk, B - s);
     const DgInferenceStep part =
         dg4_inference_step(model, x.narrow(1, s, len), u.narrow(1, s, len), h, options);
     next.push_back(part.x_next);
@@ -70,6 +70,16 @@ DgInferenceStep dg4_step_in_chunks(const DynamicsModel& model, const torch::Tens
 }  // namespace
 
 void set_dg4_rollout_chunk(int64_t rows) { dg4_rollout_chunk = rows; }
+
+// The op-by-op order-2 jets of DG4 (port_hamiltonian.cpp) hold products of
+// [E, rows, n_x, n_x, m, m] doubles (m = n_x + n_u). Measured on an n_x = 8
+// large cell of 10 members: ~8 MB RSS per validation pair and ~25 MB per
+// Newton row, 4.3 GB for 500 pairs. 2^21 doubles per chunk of such a
+// product: 40 rows there; n_x <= 6 with 10 members is not chunked (>= 118).
+int64_t dg4_chunk_rows(int64_t members, int64_t n_x, int64_t n_u) {
+  const int64_t m = n_x + n_u, per_row = members * n_x * n_x * m * m;
+  return std::max<int64_t>(16, (int64_t{1} << 21) / std::max<int64_t>(per_row, 1));
+}
 
 Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const CellData& data) {
   PHNN_CHECK(model_ref.options().dtype == torch::kFloat64,

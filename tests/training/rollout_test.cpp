@@ -1,6 +1,6 @@
 // tests/training/rollout_test.cpp — the inference rollouts of a cell
 // (training/rollout.cpp): DG4's Newton steps taken in chunks of rows give
-// the bits of one step over all rows.
+// the bits of one step over all rows; the chunk rule.
 #include "training/rollout.h"
 
 #include <cmath>
@@ -35,7 +35,7 @@ TEST(RolloutTest, ChunkedDg4RolloutsAreOneRolloutToTheBit) {
       set_dg4_rollout_chunk(chunk);
       runs.push_back(train_cell(cell, small_data(SystemKind::kDuffing)));
     }
-    set_dg4_rollout_chunk(16);
+    set_dg4_rollout_chunk(0);
     for (std::size_t k = 1; k < runs.size(); ++k) {
       for (std::size_t e = 0; e < runs[0].size(); ++e) {
         const RunResult &a = runs[0][e], &b = runs[k][e];
@@ -47,6 +47,16 @@ TEST(RolloutTest, ChunkedDg4RolloutsAreOneRolloutToTheBit) {
       }
     }
   }
+}
+
+// Only large jets are chunked: n_x = 8 with 10 members in chunks of 40
+// rows, the paper's 2-state cells and n_x <= 6 with 10 members not (their
+// 102 rollout rows in one chunk), never fewer than 16 rows.
+TEST(RolloutTest, Dg4ChunksOnlyLargeJets) {
+  EXPECT_EQ(dg4_chunk_rows(10, 8, 1), 40);
+  EXPECT_GT(dg4_chunk_rows(10, 2, 1), 500);
+  EXPECT_GE(dg4_chunk_rows(10, 6, 1), 102);
+  EXPECT_EQ(dg4_chunk_rows(100, 10, 3), 16);
 }
 
 }  // namespace
