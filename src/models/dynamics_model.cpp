@@ -45,6 +45,12 @@ torch::Tensor DynamicsModel::dg_mean_l1_step(const torch::Tensor&, const torch::
   return {};
 }
 
+torch::Tensor DynamicsModel::dg4_mean_l1_step(const torch::Tensor&, const torch::Tensor&,
+                                              const torch::Tensor&, double, double,
+                                              const JacobianPenalty&) const {
+  return {};
+}
+
 torch::Tensor DynamicsModel::hamiltonian(const torch::Tensor&) const {
   PHNN_REQUIRE(false, "hamiltonian: " << to_string(options_.kind) << " has no Hamiltonian");
   return {};

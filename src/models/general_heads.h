@@ -4,8 +4,9 @@
 // by row (a row = one member and one batch element, so a member's bits never
 // depend on its stackmates). Order 0 and 1 in the state (training, RK and DG
 // fields); the jets of order 2 (regularizers, DG4, Newton Jacobians) stay on
-// the op-by-op path of general_ph.cpp, which is also the reference the tests
-// compare these heads with. Each head's arithmetic is a pair of plain
+// the op-by-op path of general_ph.cpp (the hand-written training steps have
+// their own: general_jet_heads.h, dg4_jet_heads.h), which is also the
+// reference the tests compare these heads with. Each head's arithmetic is a pair of plain
 // functions (forward, backward) that its autograd node calls and that the
 // hand-written steps (general_manual_step.cpp) call without a node, so both
 // paths compute the same bits. Private to src/models.

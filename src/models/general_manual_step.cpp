@@ -1,6 +1,7 @@
 // src/models/general_manual_step.cpp — hand-written training steps of the
 // n-dimensional NODE, PHNN-S and PHNN-JR (include/phnn/models/general_ph.h)
-// on fused float64 networks: RK2 for the three, DG for the PH models, with
+// on fused float64 networks: RK2 and RK4 for the three, DG and DG4 for the
+// PH models (DG4's order-2 field jets: dg4_jet_heads.h), with
 // the mean-L1 loss, with or without a Jacobian penalty. Forward, loss and
 // backward run without an autograd graph through the n-state heads' taped
 // forms (general_heads.h) in the order autograd takes the model's graph:
@@ -9,8 +10,9 @@
 // product of L_H (manual_step.h's TapedGradient) where autograd's graph
 // carries L_H's forward jet, and with a penalty the field jet at x runs
 // through general_jet_heads.h (the curvature of H and the field jet heads)
-// (tests/models/general_manual_step_test.cpp, manual_step_test.cpp). The
-// composition (RK2, RK4, DG, the loss) is models/manual_step.h's. Touches
+// (tests/models/general_manual_step_test.cpp, manual_step_test.cpp,
+// dg4_manual_step_test.cpp). The composition (RK2, RK4, DG, DG4, the loss)
+// is models/manual_step.h's. Touches
 // only the models' gradient sinks.
 //
 // Backward of one PH field evaluation f(y) = F(gradH(y), y), as autograd
@@ -25,6 +27,7 @@
 #include <array>
 #include <memory>
 
+#include "models/dg4_jet_heads.h"
 #include "models/fused_heads_common.h"
 #include "models/general_heads.h"
 #include "models/general_jet_heads.h"
@@ -158,6 +161,63 @@ JacobianFieldRecorder s_jacobian_field(const StackedMlp& l_h, const StackedMlp* 
   };
 }
 
+// DG4: PHNN-JR's order-2 field jet phi(s) = F(y + s, e + Q s): L_R's
+// order-2 jet of [y, u] in the n_x state directions, the JR jet head.
+// Backward: the head, L_R.
+EffortJet2Recorder jr_field_jet2(const StackedMlp& l_r, const Tensor& u,
+                                 const std::vector<double>& J) {
+  return [&l_r, u, &J](const Tensor& e, const Tensor& q, const Tensor& y) {
+    auto net_r = std::make_shared<TapedNet>(TapedNet{l_r, nullptr});
+    const auto o = net_r->forward(cat_rows(y, u), static_cast<int>(y.size(-1)), 2);
+    const auto jet = internal::jr_field_jet2_forward(e, q, o.v, o.g, o.h, u, J);
+    TapedFieldJet2 t{jet.f, jet.g, jet.h, {}};
+    t.backward = [=, &J](const Tensor& f_bar, const Tensor& g_bar, const Tensor& h_bar) {
+      const auto adj =
+          internal::jr_field_jet2_backward(e, q, o.v, o.g, o.h, u, J, {f_bar, g_bar, h_bar});
+      net_r->backward({adj.o, adj.o_g, adj.o_h}, false);
+      return std::make_pair(adj.e, adj.e_g);
+    };
+    return t;
+  };
+}
+
+// DG4: PHNN-S's order-2 field jet: the ports' jet (w = M [e; u], w_a = M_x
+// Q_a, w_ab = 0), L_z's order-2 jet from it, the S jet head. Backward: the
+// head, L_z (-> w~, w_g~), the port map. No ports: F = [S_xx S_xu] [e; u]
+// as a port map of n_x rows, phi'' = 0.
+EffortJet2Recorder s_field_jet2(const StackedMlp* l_z, const Tensor& u,
+                                const std::vector<double>& s_w_rows,
+                                const std::vector<double>& s_x_rows, const std::vector<double>& S,
+                                int n_w) {
+  return [l_z, u, &s_w_rows, &s_x_rows, &S, n_w](const Tensor& e, const Tensor& q, const Tensor&) {
+    const int n_x = static_cast<int>(e.size(-1)), n_u = static_cast<int>(u.size(-1));
+    if (n_w == 0) {
+      const auto f = internal::general_port_jet(e, q, u, s_x_rows, n_x);
+      TapedFieldJet2 t{f.w, f.w_g, torch::zeros({e.size(0), e.size(1), n_x, n_x, n_x}, e.options()),
+                       {}};
+      t.backward = [=, &s_x_rows](const Tensor& f_bar, const Tensor& g_bar, const Tensor&) {
+        const auto adj = internal::general_port_jet_backward(f_bar, g_bar, s_x_rows, n_x, n_u);
+        return std::make_pair(adj.e, adj.e_g);
+      };
+      return t;
+    }
+    const auto w = internal::general_port_jet(e, q, u, s_w_rows, n_w);
+    auto net_z = std::make_shared<TapedNet>(TapedNet{*l_z, nullptr});
+    const auto o = net_z->forward_jet(w.w, w.w_g, 2);
+    const auto jet = internal::s_field_jet2_forward(e, q, u, o.v, o.g, o.h, w, S, n_w);
+    TapedFieldJet2 t{jet.f, jet.g, jet.h, {}};
+    t.backward = [=, &s_w_rows, &S](const Tensor& f_bar, const Tensor& g_bar, const Tensor& h_bar) {
+      const auto adj = internal::s_field_jet2_backward(o.v, o.g, o.h, w, S, n_x, n_w, n_u,
+                                                       {f_bar, g_bar, h_bar});
+      const auto [w_bar, w_g_bar] = net_z->backward_jet({adj.o, adj.o_g, adj.o_h});
+      const auto port =
+          internal::general_port_jet_backward(adj.w + w_bar, adj.w_g + w_g_bar, s_w_rows, n_x, n_u);
+      return std::make_pair(adj.e + port.e, adj.e_g + port.e_g);
+    };
+    return t;
+  };
+}
+
 // PHNN-S's two recorders: the field from an effort (no ports: the linear
 // map) and the field's jet at x.
 struct SRecorders {
@@ -218,6 +278,30 @@ Tensor PhnnS::dg_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tenso
                                    s_x_rows_, structure());
   return ph_dg_mean_l1(l_h(), x, x_next, h, min_dx_norm, false, r.field, r.jacobian,
                        penalty);
+}
+
+Tensor PhnnJr::dg4_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
+                                double h, double min_dx_norm,
+                                const JacobianPenalty& penalty) const {
+  if (!has_manual_step(nets_, options().dtype)) return {};
+  torch::NoGradGuard no_grad;
+  const Tensor u = rows_like(u_in, x);
+  return ph_dg4_mean_l1(l_h(), x, x_next, h, min_dx_norm,
+                        jr_field_jet2(*nets_[1], u, structure().J),
+                        jr_jacobian_field(l_h(), *nets_[1], u, structure().J), penalty);
+}
+
+Tensor PhnnS::dg4_mean_l1_step(const Tensor& x, const Tensor& x_next, const Tensor& u_in,
+                               double h, double min_dx_norm,
+                               const JacobianPenalty& penalty) const {
+  if (!has_manual_step(nets_, options().dtype)) return {};
+  torch::NoGradGuard no_grad;
+  const Tensor u = rows_like(u_in, x);
+  const StackedMlp* l_z = nets_.size() > 1 ? nets_[1].get() : nullptr;
+  const ModelStructure& s = structure();
+  return ph_dg4_mean_l1(l_h(), x, x_next, h, min_dx_norm,
+                        s_field_jet2(l_z, u, s_w_rows_, s_x_rows_, s.S, s.n_w),
+                        s_recorders(l_h(), l_z, u, s_w_rows_, s_x_rows_, s).jacobian, penalty);
 }
 
 // NODE: f = MLP([y, u]) (manual_step.h).

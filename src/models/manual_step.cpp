@@ -24,6 +24,8 @@
 // dg from H at the ends x, x + dx (one order-0 L_H call on both) and gradH(m)
 // (gonzalez_forward); backward F~ -> dg~ -> gradH(m)'s networks first,
 // then the ends' (the same order autograd takes); no input adjoints.
+// DG4 (ph_dg4_mean_l1): the same around the AVF effort, the Hessian at m
+// and the field's order-2 jet (dg4_jet_heads.h).
 // With a Jacobian regularizer: L += P(df/dx at x), P and its adjoint from
 // the trainer (JacobianPenalty); stage 1 of RK2 is then the model's order-1
 // jet of the field at x, whose backward takes f~ and dfdx~ at once; in DG
@@ -32,6 +34,7 @@
 
 #include <cmath>
 
+#include "models/dg4_jet_heads.h"
 #include "models/general_heads.h"
 #include "models/general_jet_heads.h"
 #include "phnn/common/check.h"
@@ -136,9 +139,9 @@ Tensor TapedGradient::backward(const Tensor& grad_bar, bool input, const Tensor&
   return (c.defined() ? c + adj.x : adj.x) + a;
 }
 
-FusedMlpJet TapedNet::forward_jet(const Tensor& v, const Tensor& g) {
+FusedMlpJet TapedNet::forward_jet(const Tensor& v, const Tensor& g, int order) {
   const int directions = static_cast<int>(g.size(-2));
-  return fused_mlp_taped(net.weights(), net.biases(), v, {directions, 1}, &tape, g);
+  return fused_mlp_taped(net.weights(), net.biases(), v, {directions, order}, &tape, g);
 }
 
 std::pair<Tensor, Tensor> TapedNet::backward_jet(const std::vector<Tensor>& grads) const {
@@ -157,6 +160,25 @@ void TapedCurvature::backward(const Tensor& grad_bar, const Tensor& hessian_bar)
 }
 
 namespace {
+
+// H at a step's ends x and x + dx from one order-0 L_H call, kept for the
+// backward from (H0~, H1~).
+struct TapedEnds {
+  TapedNet net;
+  HamiltonianTape head;
+  Tensor h0, h1;
+  TapedEnds(const StackedMlp& l_h, const Tensor& x, const Tensor& dx) : net{l_h, nullptr} {
+    const int64_t B = x.size(1);
+    const Tensor ends = torch::cat({x, add_scaled(x, 1.0, dx)}, /*dim=*/1);
+    const Tensor h = general_hamiltonian_forward(net.forward(ends, 0, 0).v, Tensor(), ends, &head).h;
+    h0 = h.narrow(1, 0, B), h1 = h.narrow(1, B, B);
+  }
+  void backward(const Tensor& h0_bar, const Tensor& h1_bar) const {
+    // Two narrow adjoints summed over zeros (-0 becomes +0), as autograd's.
+    const Tensor h_bar = torch::cat({h0_bar, h1_bar}, /*dim=*/1) + 0.0;
+    net.backward({general_hamiltonian_backward(head, h_bar, Tensor()).o}, false);
+  }
+};
 
 // The RK2 step, its loss (+ the penalty of df/dx at x) and backward (file comment).
 Tensor rk2_mean_l1(const Tensor& x, const Tensor& x_next, double h, const FieldRecorder& field,
@@ -235,26 +257,60 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x_in,
                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty) {
   const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
   const TapedField at_x = penalty ? jacobian_field(x) : TapedField{};
-  const int64_t B = x.size(1);
   const Tensor dx = x_next - x, m = add_scaled(x, 0.5, dx);
-  const Tensor ends = torch::cat({x, add_scaled(x, 1.0, dx)}, /*dim=*/1);
-  TapedNet ends_net{l_h, nullptr};
-  HamiltonianTape ends_head;
-  const Tensor h_ends = general_hamiltonian_forward(ends_net.forward(ends, 0, 0).v, Tensor(), ends, &ends_head).h;
+  const TapedEnds ends(l_h, x, dx);
   const TapedGradient mid(l_h, m);
-  const Tensor h0 = h_ends.narrow(1, 0, B), h1 = h_ends.narrow(1, B, B);
-  const Tensor effort = gonzalez_forward(h0, h1, mid.grad, dx, min_dx_norm);
+  const Tensor effort = gonzalez_forward(ends.h0, ends.h1, mid.grad, dx, min_dx_norm);
   const TapedEffortField field = effort_field(effort, dissipation_at_start ? x : m);
   Tensor f_bar, dfdx_bar;
   const Tensor loss = add_penalty(mean_l1_loss(x_next, add_scaled(x, h, field.f), h, h, &f_bar),
                                   penalty, at_x.dfdx, &dfdx_bar);
-  const auto g =
-      gonzalez_backward(h0, h1, mid.grad, dx, min_dx_norm, field.backward(f_bar, false).first);
+  const auto g = gonzalez_backward(ends.h0, ends.h1, mid.grad, dx, min_dx_norm,
+                                   field.backward(f_bar, false).first);
   mid.backward(g.grad, false);
-  // The ends' adjoint is two narrow adjoints summed over zeros (-0 becomes +0).
-  const Tensor h_ends_bar = torch::cat({g.h0, g.h1}, /*dim=*/1) + 0.0;
-  const auto ends_adj = general_hamiltonian_backward(ends_head, h_ends_bar, Tensor());
-  ends_net.backward({ends_adj.o}, false);
+  ends.backward(g.h0, g.h1);
+  if (penalty) at_x.backward(Tensor(), dfdx_bar, false);
+  return loss;
+}
+
+// The DG4 step, port_hamiltonian.cpp's discrete_gradient4_field without a
+// graph (docs/METHOD.md "DG4: a fourth-order discrete gradient"):
+//   g = (5/18) gradH(x + c1 dx) + (8/18) gradH(m) + (5/18) gradH(x + c3 dx),
+//       c1,3 = 1/2 -+ sqrt(15)/10 (3-point Gauss-Legendre on [0, 1]),
+//   e = g + (H(x + dx) - H(x) - g.dx) / |dx|^2 dx  (= g below min_dx_norm),
+//   Q = the Hessian of H at m,  phi(s) = F(m + s, e + Q s) to order 2,
+//   f4 = v + h^2 (phi''[v, v] / 24 - A A v / 12),  x^ = x + h f4.
+// Backward: the correction (-> phi~), phi (-> e~, Q~), the curvature from
+// Q~, the projection (-> g~, H0~, H1~), the Gauss points from the weighted
+// g~, the ends; the field at x (penalty), created first, last.
+Tensor ph_dg4_mean_l1(const StackedMlp& l_h, const Tensor& x_in, const Tensor& x_next_in, double h,
+                      double min_dx_norm, const EffortJet2Recorder& field_jet,
+                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty) {
+  const Tensor x = x_in.contiguous(), x_next = x_next_in.contiguous();
+  const TapedField at_x = penalty ? jacobian_field(x) : TapedField{};
+  const int64_t B = x.size(1);
+  const double c = std::sqrt(15.0) / 10.0, w_end = 5.0 / 18.0, w_mid = 8.0 / 18.0;
+  const Tensor dx = x_next - x, m = add_scaled(x, 0.5, dx);
+  const TapedEnds ends(l_h, x, dx);
+  const TapedGradient gauss(
+      l_h, torch::cat({add_scaled(x, 0.5 - c, dx), m, add_scaled(x, 0.5 + c, dx)}, /*dim=*/1));
+  const Tensor g = (gauss.grad.narrow(1, 0, B) * w_end + gauss.grad.narrow(1, B, B) * w_mid) +
+                   gauss.grad.narrow(1, 2 * B, B) * w_end;
+  const Tensor effort = gonzalez_forward(ends.h0, ends.h1, g, dx, min_dx_norm);
+  const TapedCurvature curvature(l_h, m);
+  const TapedFieldJet2 phi = field_jet(effort, curvature.effort.hessian, m);
+  const FieldJet2 jet{phi.f, phi.g, phi.h};
+  Tensor f_bar, dfdx_bar;
+  const Tensor x_hat = add_scaled(x, h, dg4_correction_forward(jet, h));
+  const Tensor loss =
+      add_penalty(mean_l1_loss(x_next, x_hat, h, h, &f_bar), penalty, at_x.dfdx, &dfdx_bar);
+  const FieldJet2 jet_bar = dg4_correction_backward(jet, h, f_bar);
+  const auto [e_bar, q_bar] = phi.backward(jet_bar.f, jet_bar.g, jet_bar.h);
+  curvature.backward(Tensor(), q_bar);
+  const auto adj = gonzalez_backward(ends.h0, ends.h1, g, dx, min_dx_norm, e_bar);
+  gauss.backward(torch::cat({adj.grad * w_end, adj.grad * w_mid, adj.grad * w_end}, /*dim=*/1),
+                 false);
+  ends.backward(adj.h0, adj.h1);
   if (penalty) at_x.backward(Tensor(), dfdx_bar, false);
   return loss;
 }

@@ -1,14 +1,14 @@
 // src/models/manual_step.h — the parts of the hand-written training steps
 // that do not depend on a model's structure or size: taped networks, the
-// mean-L1 loss and its adjoint, the RK2 and DG steps of a field recorder,
-// and the PH models' steps around the Hamiltonian head of general_heads.h
-// (gradH in reverse mode). Private to src/models (general_manual_step.cpp
+// mean-L1 loss and its adjoint, the RK2 and RK4 steps of a field recorder,
+// and the PH models' steps (RK, DG, DG4) around the Hamiltonian head of
+// general_heads.h (gradH in reverse mode). Private to src/models (general_manual_step.cpp
 // composes them per model). Every function computes the operations of the
 // autograd path in its order, so NODE's loss and gradients are bitwise those
 // of loss.sum().backward(), and the PH models' equal them to round-off (their
 // gradH is a vector-Jacobian product of L_H where autograd's graph has
 // L_H's forward-mode jet; tests/models/manual_step_test.cpp,
-// general_manual_step_test.cpp).
+// general_manual_step_test.cpp, dg4_manual_step_test.cpp).
 #pragma once
 
 #include <torch/torch.h>
@@ -48,6 +48,18 @@ struct TapedEffortField {
 };
 using EffortFieldRecorder = std::function<TapedEffortField(const Tensor& effort, const Tensor& y)>;
 
+/// DG4: a PH model's order-2 field jet phi(s) = F(y + s, e + Q s) in the
+/// n_x state directions s (dg4_jet_heads.h: f, g [E, B, d, n], h [E, B, d,
+/// d, n]), and the backward (f~, g~, h~) -> (e~, Q~); no input adjoint of y.
+struct TapedFieldJet2 {
+  Tensor f, g, h;
+  std::function<std::pair<Tensor, Tensor>(const Tensor& f_bar, const Tensor& g_bar,
+                                          const Tensor& h_bar)>
+      backward;
+};
+using EffortJet2Recorder =
+    std::function<TapedFieldJet2(const Tensor& effort, const Tensor& q, const Tensor& y)>;
+
 /// A PH model's field with df/dx at a data point (no input adjoint), for a
 /// Jacobian penalty; empty where the model has none hand-written.
 using JacobianFieldRecorder = std::function<TapedField(const Tensor& x)>;
@@ -74,8 +86,9 @@ struct TapedNet {
   Tensor vjp(const Tensor& c);
   Tensor vjp_backward(const Tensor& s_bar) const;
   Tensor backward_after_vjp(const Tensor& v_bar, bool input) const;
-  /// With an order-1 input jet (v, g [E, B, d, n]); backward -> (v~, g~).
-  FusedMlpJet forward_jet(const Tensor& v, const Tensor& g);
+  /// With an order-1 input jet (v, g [E, B, d, n]) to order 1 or 2 (the
+  /// input's second derivative 0); backward -> (v~, g~).
+  FusedMlpJet forward_jet(const Tensor& v, const Tensor& g, int order = 1);
   std::pair<Tensor, Tensor> backward_jet(const std::vector<Tensor>& grads) const;
 };
 
@@ -122,6 +135,15 @@ Tensor ph_dg_mean_l1(const StackedMlp& l_h, const Tensor& x,
                      const Tensor& x_next, double h, double min_dx_norm, bool dissipation_at_start,
                      const EffortFieldRecorder& effort_field,
                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty);
+
+/// The DG4 step of a PH model (docs/METHOD.md "DG4: a fourth-order
+/// discrete gradient"): the AVF effort e (H at the ends, gradH at the three
+/// Gauss points), Q = the Hessian at m = x + dx/2, phi's order-2 jet from
+/// `field_jet`, f4 = v + h^2 (phi''[v, v] / 24 - A A v / 12); its loss
+/// (+ the penalty of df/dx at x) and backward.
+Tensor ph_dg4_mean_l1(const StackedMlp& l_h, const Tensor& x, const Tensor& x_next, double h,
+                      double min_dx_norm, const EffortJet2Recorder& field_jet,
+                      const JacobianFieldRecorder& jacobian_field, const JacobianPenalty& penalty);
 
 /// NODE's explicit step: f = MLP([y, u]) (with its order-1 jet in the n_x state
 /// directions when `penalty` asks for df/dx); y~ = the first n_x columns of

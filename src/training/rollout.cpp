@@ -1,7 +1,9 @@
 // src/training/rollout.cpp
 #include "training/rollout.h"
 
+#include <algorithm>
 #include <limits>
+#include <vector>
 
 #include "models/ordered_sum.h"
 #include "phnn/common/check.h"
@@ -33,7 +35,51 @@ torch::Tensor step_inputs(const CellData& data, int64_t B_inf, int64_t F, int st
   }
   return out;
 }
+
+// Rows per chunk of a DG4 Newton step: 0 = dg4_chunk_rows (rollout.h), else
+// this many (tests). Every row's iterates depend on that row alone (per-row
+// GEMM chains and jets, per-row Newton decisions; a chunk that stops early
+// holds converged rows only, which keep their solution in a longer loop
+// too), so chunking changes the memory, not the bits.
+int64_t dg4_rollout_chunk = 0;
+
+// dg4_inference_step on the rows [s, s + chunk) in turn.
+DgInferenceStep dg4_step_in_chunks(const DynamicsModel& model, const torch::Tensor& x,
+                                   const torch::Tensor& u, double h,
+                                   const DgInferenceOptions& options) {
+  const int64_t B = x.size(1);
+  const int64_t chunk = dg4_rollout_chunk > 0
+                            ? dg4_rollout_chunk
+                            : dg4_chunk_rows(x.size(0), x.size(2), u.size(2));
+  if (B <= chunk) return dg4_inference_step(model, x, u, h, options);
+  std::vector<torch::Tensor> next, converged;
+  DgInferenceStep out;
+  for (int64_t s = 0; s < B; s += chunk) {
+    const int64_t len = std::min(chunk, B - s);
+    const DgInferenceStep part =
+        dg4_inference_step(model, x.narrow(1, s, len), u.narrow(1, s, len), h, options);
+    next.push_back(part.x_next);
+    converged.push_back(part.converged);
+    out.iterations = std::max(out.iterations, part.iterations);
+    out.jacobian_evaluations += part.jacobian_evaluations;
+  }
+  out.x_next = torch::cat(next, /*dim=*/1);
+  out.converged = torch::cat(converged, /*dim=*/1);
+  return out;
+}
 }  // namespace
+
+void set_dg4_rollout_chunk(int64_t rows) { dg4_rollout_chunk = rows; }
+
+// The op-by-op order-2 jets of DG4 (port_hamiltonian.cpp) hold products of
+// [E, rows, n_x, n_x, m, m] doubles (m = n_x + n_u). Measured on an n_x = 8
+// large cell of 10 members: ~8 MB RSS per validation pair and ~25 MB per
+// Newton row, 4.3 GB for 500 pairs. 2^21 doubles per chunk of such a
+// product: 40 rows there; n_x <= 6 with 10 members is not chunked (>= 118).
+int64_t dg4_chunk_rows(int64_t members, int64_t n_x, int64_t n_u) {
+  const int64_t m = n_x + n_u, per_row = members * n_x * n_x * m * m;
+  return std::max<int64_t>(16, (int64_t{1} << 21) / std::max<int64_t>(per_row, 1));
+}
 
 Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const CellData& data) {
   PHNN_CHECK(model_ref.options().dtype == torch::kFloat64,
@@ -85,7 +131,7 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
     torch::Tensor next;
     if (use_dg) {
       const auto s = cell.integrator == IntegratorKind::kDg4
-                         ? dg4_inference_step(*model, x, u, h_inf, dg_options)
+                         ? dg4_step_in_chunks(*model, x, u, h_inf, dg_options)
                          : dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
       next = s.x_next;
       newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);

@@ -36,6 +36,14 @@ struct Rollouts {
 };
 Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const CellData& data);
 
+// Rows per chunk of a DG4 rollout step, or 0 (the default): dg4_chunk_rows.
+// The bits do not depend on it (tests/training/rollout_test.cpp sets others).
+void set_dg4_rollout_chunk(int64_t rows);
+
+// Rows per chunk of DG4's op-by-op jets for `members` members, n_x states
+// and n_u inputs (rollout.cpp): >= 16, 40 for n_x = 8 with 10 members.
+int64_t dg4_chunk_rows(int64_t members, int64_t n_x, int64_t n_u);
+
 // Eq. 31 per member from the rollouts: the mean over the inference
 // trajectories of their mean squared error, +inf if any diverged.
 std::vector<double> member_mse(const Rollouts& rollouts);

@@ -24,6 +24,7 @@
 #include "phnn/training/flat_adam.h"
 #include "phnn/training/regularizers.h"
 #include "training/cell_trainer.h"
+#include "training/rollout.h"
 
 namespace phnn {
 
@@ -131,15 +132,23 @@ static int64_t step_chunk = 500;
 
 void set_step_chunk(int64_t rows) { step_chunk = rows; }
 
+// DG4's pass holds the op-by-op order-2 jets of its chunk: up to 4.3 GB
+// RSS for 500 pairs of an n_x = 8 large cell of 10 members. It takes at
+// most twice a DG4 rollout chunk (rollout.h's dg4_chunk_rows: 80 pairs
+// there; the 2-state cells keep 500).
 torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor& xn,
                                      const torch::Tensor& u, const torch::Tensor& f_at_x) const {
   const int64_t B = x.size(1);
-  if (f_at_x.defined() || torch::GradMode::is_enabled() || B <= step_chunk) {
+  const int64_t chunk =
+      cell_.integrator == IntegratorKind::kDg4
+          ? std::min(step_chunk, 2 * dg4_chunk_rows(x.size(0), x.size(2), u.size(2)))
+          : step_chunk;
+  if (f_at_x.defined() || torch::GradMode::is_enabled() || B <= chunk) {
     return discrete_loss(xn, discrete_step(x, xn, u, f_at_x), h_, opt_.loss_norm);
   }
   std::vector<torch::Tensor> parts;
-  for (int64_t s = 0; s < B; s += step_chunk) {
-    const int64_t len = std::min(step_chunk, B - s);
+  for (int64_t s = 0; s < B; s += chunk) {
+    const int64_t len = std::min(chunk, B - s);
     const torch::Tensor us = u.size(1) == B ? u.narrow(1, s, len) : u;
     parts.push_back(discrete_step(x.narrow(1, s, len), xn.narrow(1, s, len), us, {}));
   }
@@ -199,6 +208,9 @@ torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torc
     }
     if (cell_.integrator == IntegratorKind::kDg) {
       loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
+    }
+    if (cell_.integrator == IntegratorKind::kDg4) {
+      loss = model_->dg4_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
     }
     if (loss.defined()) return loss;
   }

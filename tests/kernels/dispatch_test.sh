@@ -2,10 +2,12 @@
 # tests/kernels/dispatch_test.sh PHNN PYTHON — the same bits under every CPU
 # dispatch setting this machine can run (docs/METHOD.md "Deterministic
 # kernels"): one small Duffing cell (seeds 0-1, 200 Adam steps) of every model
-# x integrator and of each regularizer, three float32 cells (LibTorch's float
-# kernels replaced by pinned ones), and six cells of the 4-state coupled
-# Duffing system file (DG: the LU Newton; DG4: ordered products; CN and SR:
-# the op-by-op jets' ordered broadcast sums, Eigen's spectra), trained
+# x integrator and of each regularizer (and DG4 with CN: its hand-written
+# step's order-2 jet heads with the penalty's field jet), three float32 cells
+# (LibTorch's float kernels replaced by pinned ones), and six cells of the
+# 4-state coupled Duffing system file (DG: the LU Newton; DG4: the
+# hand-written step's order-2 jet heads, ordered products at inference; CN
+# and SR: the op-by-op jets' ordered broadcast sums, Eigen's spectra), trained
 # under OPENBLAS_CORETYPE
 # (default / Haswell), ATEN_CPU_CAPABILITY (default / avx2 / avx512) and
 # PHNN_KERNEL_ISA (avx512 / avx2 / baseline); the per-run MSEs, validation
@@ -21,7 +23,7 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 
 CELLS="node-rk2 node-rk4 phnn-s-rk2 phnn-s-dg phnn-s-rk4 phnn-s-dg4 phnn-jr-rk2 phnn-jr-dg
-       phnn-jr-rk4 phnn-jr-dg4 phnn-jr-rk2:cn phnn-s-dg:sn phnn-s-rk2:sr
+       phnn-jr-rk4 phnn-jr-dg4 phnn-jr-rk2:cn phnn-s-dg:sn phnn-s-rk2:sr phnn-jr-dg4:cn
        phnn-s-dg::coupled phnn-jr-dg4::coupled node-rk4::coupled
        phnn-s-rk2:cn:coupled phnn-jr-rk2:sr:coupled phnn-s-dg4::coupled
        phnn-jr-rk2:cn::float32 phnn-s-dg:sr::float32 node-rk4:::float32"

@@ -1,7 +1,7 @@
 // tests/models/manual_step_reference.h — what the hand-written training steps
-// are compared with (manual_step_test.cpp, general_manual_step_test.cpp): the
-// trainer's loss taken by autograd, a bitwise comparison of tensors, and the
-// comparison rule of a step with autograd.
+// are compared with (manual_step_test.cpp, general_manual_step_test.cpp,
+// dg4_manual_step_test.cpp): the trainer's loss taken by autograd, a bitwise
+// comparison of tensors, and the comparison rule of a step with autograd.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -24,7 +24,7 @@ inline bool same_bits(const torch::Tensor& a, const torch::Tensor& b) {
 }
 
 /// The trainer's loss without a hand-written step (CellTrainer::loss_and_gradients):
-/// the DG or explicit step's mean-L1 loss, + the penalty of df/dx at x (the
+/// the DG, DG4 or explicit step's mean-L1 loss, + the penalty of df/dx at x (the
 /// explicit step's first stage reused) when `regularizer` is set.
 inline torch::Tensor autograd_loss_of(const DynamicsModel& model, IntegratorKind integrator,
                                       Regularizer regularizer, const torch::Tensor& x,
@@ -35,6 +35,8 @@ inline torch::Tensor autograd_loss_of(const DynamicsModel& model, IntegratorKind
   const FieldEval at_x = regularized ? model.field(x, u, true) : FieldEval{};
   const auto x_hat = integrator == IntegratorKind::kDg
                          ? dg_training_step(model, x, x_next, u, h, min_dx_norm)
+                     : integrator == IntegratorKind::kDg4
+                         ? dg4_training_step(model, x, x_next, u, h, min_dx_norm)
                          : explicit_step(model, integrator, x, u, h, at_x.f);
   const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
   if (!regularized) return loss;

@@ -45,6 +45,9 @@ class PhnnS : public PortHamiltonianModel {
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                 const torch::Tensor& u, double h, double min_dx_norm,
                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor dg4_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                 const torch::Tensor& u, double h, double min_dx_norm,
+                                 const JacobianPenalty& penalty) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
@@ -72,6 +75,9 @@ class PhnnJr : public PortHamiltonianModel {
   torch::Tensor dg_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                 const torch::Tensor& u, double h, double min_dx_norm,
                                 const JacobianPenalty& penalty) const override;
+  torch::Tensor dg4_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
+                                 const torch::Tensor& u, double h, double min_dx_norm,
+                                 const JacobianPenalty& penalty) const override;
 
  protected:
   Jet field_from_effort(const Jet& effort, const torch::Tensor& x_dissipation,
