@@ -35,6 +35,17 @@ def field(x, u):
     return np.stack([qdot, -M * G * L * np.sin(q) - C * qdot - u], axis=1)
 
 
+def rk4_sample(x, u, h, substeps):
+    """x [K, 2] after `substeps` classical RK4 steps of h under u [K] (one sample)."""
+    for _ in range(substeps):
+        k1 = field(x, u)
+        k2 = field(x + 0.5 * h * k1, u)
+        k3 = field(x + 0.5 * h * k2, u)
+        k4 = field(x + h * k3, u)
+        x = x + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
+
+
 def rk4(x0, u, duration, rate, substeps):
     """States at `rate` Hz over `duration` s, integrated with `substeps` RK4
     steps per sample; x0 [K, 2], u [K]."""
@@ -44,12 +55,7 @@ def rk4(x0, u, duration, rate, substeps):
     x = x0.copy()
     out[0] = x
     for n in range(1, samples):
-        for _ in range(substeps):
-            k1 = field(x, u)
-            k2 = field(x + 0.5 * h * k1, u)
-            k3 = field(x + 0.5 * h * k2, u)
-            k4 = field(x + h * k3, u)
-            x = x + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        x = rk4_sample(x, u, h, substeps)
         out[n] = x
     return out  # [samples, K, 2]
 
@@ -71,13 +77,7 @@ def rk4_held(x0, u, rate, substeps):
     x = np.asarray(x0, dtype=float)[None, :]
     out[0] = x[0]
     for n in range(1, len(u)):
-        un = np.array([u[n - 1]])
-        for _ in range(substeps):
-            k1 = field(x, un)
-            k2 = field(x + 0.5 * h * k1, un)
-            k3 = field(x + 0.5 * h * k2, un)
-            k4 = field(x + h * k3, un)
-            x = x + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        x = rk4_sample(x, np.array([u[n - 1]]), h, substeps)
         out[n] = x[0]
     return out
 

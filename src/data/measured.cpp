@@ -119,6 +119,14 @@ void sort_by_id(std::vector<MeasuredTrajectory>* all) {
   }
 }
 
+void record_timing(DatasetOptions* o, std::uint64_t data_seed, double h, std::size_t samples) {
+  o->data_seed = data_seed;
+  o->sample_rate = 1.0 / h;
+  o->generation_step = h;
+  o->period = 1.0;
+  o->beta = h * static_cast<double>(samples - 1);
+}
+
 }  // namespace internal
 
 namespace {
@@ -304,11 +312,7 @@ PhSystemData split_by_trajectories(const PhSystem& system,
   // What the options record: the rate, the split sizes, the window and the
   // inference duration; no generation.
   DatasetOptions& o = data.options;
-  o.data_seed = options.data_seed;
-  o.sample_rate = 1.0 / h;
-  o.generation_step = h;
-  o.period = 1.0;
-  o.beta = h * static_cast<double>(samples - 1);
+  internal::record_timing(&o, options.data_seed, h, samples);
   double longest = 0.0;
   for (std::size_t i = 0; i < infer_begin; ++i) {
     longest = std::max(longest, trajectories[i].t.back() - trajectories[i].t.front());

@@ -24,6 +24,10 @@ double common_step(const std::vector<MeasuredTrajectory>& all, const ImportOptio
                    std::string* summary);
 /// Sorted by id; a repeated id is refused.
 void sort_by_id(std::vector<MeasuredTrajectory>* all);
+/// What a recorded data set's options say of its timing: the data seed,
+/// the rate 1 / h, nothing generated (generation step h, period 1), and
+/// inference trajectories of `samples` samples (beta = h (samples - 1)).
+void record_timing(DatasetOptions* o, std::uint64_t data_seed, double h, std::size_t samples);
 
 }  // namespace internal
 }  // namespace phnn

@@ -167,11 +167,7 @@ PhSystemData split_in_blocks(const PhSystem& system, std::vector<MeasuredTraject
   add_windows(recs, starts, w, &data.inference);
 
   DatasetOptions& d = data.options;
-  d.data_seed = o.data_seed;
-  d.sample_rate = 1.0 / h;
-  d.generation_step = h;
-  d.period = 1.0;
-  d.beta = h * static_cast<double>(w - 1);
+  internal::record_timing(&d, o.data_seed, h, w);
   d.alpha = 0.0;
   for (const Blocks& b : blocks) d.alpha = std::max(d.alpha, h * static_cast<double>(b.b1 - 1));
   d.num_trajectories = static_cast<int>(recs.size());
