@@ -6,6 +6,8 @@ port's plans against `phnn sweep --dry-run --items`.
 
     PHNN=build/phnn /usr/bin/python3 tests/analysis/test_rounds_replay.py
 """
+import contextlib
+import io
 import os
 import random
 import re
@@ -188,6 +190,15 @@ class WithBinary(unittest.TestCase):
         self.assertAlmostEqual(r["work"], measured, delta=1e-9 * measured)
         self.assertEqual(r["items"], [len(c) for c in cells])
         self.assertAlmostEqual(r["efficiency"], 1.0)
+        # The script's table: one row per rank count; 1 rank is busy all the time.
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            self.assertEqual(rr.main([results, sweep, "1,64"]), 0)
+        text = out.getvalue()
+        self.assertRegex(text, rf"\| 1 \| {len(rounds)} \| {sum(r['items'])} \| [^|]+ \| [^|]+ \| "
+                               r"100\.0 % \| [^|]+ \| 100\.0 % \|")
+        self.assertRegex(text, r"\| 64 \| .* %")
+        self.assertIn("items per round on 1 rank: " + ", ".join(str(len(c)) for c in cells), text)
 
 
 if __name__ == "__main__":
