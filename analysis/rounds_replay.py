@@ -1,0 +1,184 @@
+#!/usr/bin/env python3
+"""analysis/rounds_replay.py — a finished adaptive sweep's rounds replayed on R ranks with the
+measured costs, a barrier after each round as `phnn sweep` has, and without.
+
+    /usr/bin/python3 analysis/rounds_replay.py results/paper-adaptive.h5 \\
+        sweeps/paper-adaptive.toml 2,16,128,1024
+
+`phnn sweep --dry-run` simulates an adaptive sweep's round 0 and its worst case only. This script
+rebuilds the rounds the file's sweep ran and replays them:
+
+- A run's round: the first K for which `phnn reduce RESULTS --per-run --round K` lists it (the
+  runs rounds 0..K asked for), K = 0, 1, ... until a round adds none. Round 0 is every cell's first
+  seeds; round k the cells named after round k-1 with their added seeds.
+- Items: per rank count and round, analysis/work_plan.py's port of plan_work() on the round's
+  cells, as `phnn sweep` plans after every round (the same items as the binary's, tested against
+  `--dry-run --items`): whole cells or contiguous member groups, largest first.
+- Costs: the trainer stores in each run wall_time_s = the stack's wall time / its members, so the
+  runs of an item sum to the item's wall time. The stacks the sweep trained are its runs with equal
+  (cell, started_utc, finished_utc) (`/runs/*_utc` of the file, read with h5py; without them one
+  stack per cell and round). Per cell and round, scale = (measured seconds) / (cost model of the
+  stacks trained), fixed_s + members x member_s each (`phnn sweep SWEEP --dry-run --cell-costs`);
+  a replayed item of k runs costs scale x (fixed_s + k x member_s). Where the replay forms the
+  items the sweep trained, the item costs are the measured wall times exactly; elsewhere the cell's
+  fixed and per-member parts are assumed to scale alike. Runs without a wall time (failed before
+  training) cost nothing.
+- Schedule: every item in plan order to the rank free first (schedule_replay.py's
+  list_schedule_makespan); with barriers each round starts when the last rank finished the round
+  before; without, each rank goes on with the next round's items at once (not possible in a real
+  sweep, whose rule reads the round's results: the bound if no rank idled between rounds).
+
+Per rank count: rounds, items, core-hours (the sum of the item costs), makespan and efficiency =
+core-hours / (ranks x makespan) with barriers and without, and the items per round. The output
+depends on the file alone (deterministic). The phnn binary: $PHNN, else build/phnn. On the paper
+grid's adaptive file (2 230 runs, 12 rounds, 345 MB) it takes ~9 min of one core, nearly all in the
+`phnn reduce --round K` calls (each replays the rounds up to K).
+"""
+import argparse
+import math
+import sys
+from collections import Counter
+
+from phnn_tool import run_csv
+from schedule_replay import list_schedule_makespan
+from work_plan import PlanCell, plan_work
+
+
+def runs_by_round(results):
+    """[[per-run row of each run round k added]] for k = 0, 1, ... (last: the sweep's last)."""
+    rounds, seen = [], set()
+    while True:
+        rows = run_csv("reduce", results, "--per-run", "--round", str(len(rounds)))
+        added = [r for r in rows if r["run_id"] not in seen]
+        if not added:
+            return rounds
+        pending = [r["run_id"] for r in added if r["status"] == "pending"]
+        if pending:
+            raise ValueError(f"{results}: round {len(rounds)} has {len(pending)} pending runs "
+                             f"(e.g. {pending[0]}): replay a finished sweep")
+        seen.update(r["run_id"] for r in added)
+        rounds.append(added)
+
+
+def item_times(results):
+    """{run_id: (started_utc, finished_utc)} of the file's runs that have them; {} without h5py."""
+    try:
+        import h5py
+    except ImportError:
+        return {}
+    with h5py.File(results, "r") as f:
+        runs = f["runs"]
+        if "started_utc" not in runs:
+            return {}
+        ids, started, finished = (runs[k][()] for k in ("id", "started_utc", "finished_utc"))
+    return {i.decode(): (s.decode(), e.decode()) for i, s, e in zip(ids, started, finished)
+            if s and e}
+
+
+def round_cells(rounds, cost_rows, times):
+    """Per round {cell: (runs, scale)}: the runs it trained of the cell, and measured seconds /
+    the cost model's seconds of the stacks they were trained in."""
+    cell_of = {i: int(c["cell"]) for c in cost_rows for i in c["run_ids"].split()}
+    model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
+    out = []
+    for rows in rounds:
+        runs, seconds, stacks = Counter(), Counter(), Counter()
+        for r in rows:
+            if r["run_id"] not in cell_of:
+                raise ValueError(f"run {r['run_id']} is not in the sweep file's grid: give the "
+                                 "sweep file of the results file")
+            cell = cell_of[r["run_id"]]
+            runs[cell] += 1
+            wall = float(r["wall_time_s"]) if r["wall_time_s"] else math.nan
+            seconds[cell] += wall if math.isfinite(wall) else 0.0
+            stacks[(cell, times.get(r["run_id"], ""))] += 1
+        modelled = Counter()
+        for (cell, _), members in stacks.items():
+            modelled[cell] += model[cell][0] + members * model[cell][1]
+        out.append({c: (runs[c], seconds[c] / modelled[c]) for c in sorted(runs)})
+    return out
+
+
+def round_item_costs(cells_of_rounds, cost_rows, ranks, split=True):
+    """Per round, the measured cost of each item of `ranks`' plan, in plan order."""
+    model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
+    out = []
+    for cells in cells_of_rounds:
+        plan = plan_work([PlanCell(c, *model[c], n) for c, (n, _) in cells.items()], ranks, split)
+        out.append([cells[c][1] * (model[c][0] + k * model[c][1]) for c, k in plan])
+    return out
+
+
+def barrier_makespan(rounds, ranks):
+    """Each round on its own (every rank free at its start), one after the other."""
+    return sum(list_schedule_makespan(costs, ranks) for costs in rounds)
+
+
+def free_makespan(rounds, ranks):
+    """The rounds' items as one list: no rank waits for the others between rounds."""
+    return list_schedule_makespan([c for costs in rounds for c in costs], ranks)
+
+
+def replay(rounds, ranks):
+    """{ranks, items, work, barrier, free, efficiency, free_efficiency} of per-round item costs."""
+    work = sum(sum(costs) for costs in rounds)
+    barrier, free = barrier_makespan(rounds, ranks), free_makespan(rounds, ranks)
+    return {"ranks": ranks, "items": [len(costs) for costs in rounds], "work": work,
+            "barrier": barrier, "free": free,
+            "efficiency": work / (ranks * barrier) if barrier > 0 else 1.0,
+            "free_efficiency": work / (ranks * free) if free > 0 else 1.0}
+
+
+def duration(seconds):
+    """As `phnn sweep --dry-run` prints it (work_plan.cpp's format_duration)."""
+    if seconds < 10:
+        return f"{seconds:.1f} s"
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.1f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
+
+
+def table(rows):
+    lines = ["| ranks | rounds | items | core-hours | makespan with barriers | efficiency | "
+             "makespan without barriers | efficiency |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['ranks']} | {len(r['items'])} | {sum(r['items'])} | "
+                     f"{r['work'] / 3600:.3g} | {duration(r['barrier'])} | "
+                     f"{100 * r['efficiency']:.1f} % | {duration(r['free'])} | "
+                     f"{100 * r['free_efficiency']:.1f} % |")
+    lines.append("")
+    for r in rows:
+        lines.append(f"items per round on {r['ranks']} rank{'' if r['ranks'] == 1 else 's'}: "
+                     + ", ".join(str(n) for n in r["items"]))
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0].split(" — ")[1])
+    parser.add_argument("results", help="results file of a finished adaptive sweep")
+    parser.add_argument("sweep", help="its sweep file (cells and the cost model's seconds)")
+    parser.add_argument("ranks", help="rank counts, e.g. 2,16,128,1024")
+    parser.add_argument("--split", choices=("auto", "off"), default="auto",
+                        help="as phnn sweep's --split: off = one item per cell and round")
+    args = parser.parse_args(argv)
+    cost_rows = run_csv("sweep", args.sweep, "--dry-run", "--cell-costs")
+    try:
+        rounds = runs_by_round(args.results)
+        cells = round_cells(rounds, cost_rows, item_times(args.results))
+    except ValueError as e:
+        print(f"rounds_replay.py: {e}", file=sys.stderr)
+        return 1
+    measured = sum(float(r["wall_time_s"]) for rows in rounds for r in rows
+                   if r["wall_time_s"] and math.isfinite(float(r["wall_time_s"])))
+    print(f"{args.results}: {len(rounds)} rounds, {sum(len(r) for r in rounds)} runs "
+          f"({measured / 3600:.2f} core-hours measured); runs per round: "
+          + ", ".join(str(len(r)) for r in rounds) + "; cells per round: "
+          + ", ".join(str(len(c)) for c in cells))
+    rows = [replay(round_item_costs(cells, cost_rows, int(n), args.split == "auto"), int(n))
+            for n in args.ranks.split(",")]
+    print(table(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
