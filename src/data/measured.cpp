@@ -119,6 +119,36 @@ void sort_by_id(std::vector<MeasuredTrajectory>* all) {
   }
 }
 
+void add_pair(const MeasuredTrajectory& m, std::size_t n, PhPairSet* pairs) {
+  pairs->x.push_back(m.state(n));
+  pairs->x_next.push_back(m.state(n + 1));
+  pairs->u.push_back(m.input(n));
+  pairs->trajectory.push_back(m.id);
+  pairs->position.push_back(static_cast<int>(n));
+}
+
+void add_windows(const std::vector<MeasuredTrajectory>& all,
+                 const std::vector<std::pair<std::size_t, std::size_t>>& windows, std::size_t w,
+                 bool positions, PhInferenceSet* inference) {
+  bool varying = false;
+  for (const auto& [i, start] : windows) {
+    for (std::size_t k = start + 1; k < start + w && !varying; ++k) varying = !all[i].same_input(k, start);
+  }
+  for (const auto& [i, start] : windows) {
+    const MeasuredTrajectory& m = all[i];
+    inference->trajectory.push_back(m.id);
+    if (positions) inference->position.push_back(static_cast<std::int64_t>(start));
+    inference->u.push_back(m.input(start));
+    std::vector<VecX> states, inputs;
+    for (std::size_t k = start; k < start + w; ++k) {
+      states.push_back(m.state(k));
+      if (varying) inputs.push_back(m.input(k));
+    }
+    inference->states.push_back(std::move(states));
+    if (varying) inference->inputs.push_back(std::move(inputs));
+  }
+}
+
 void record_timing(DatasetOptions* o, std::uint64_t data_seed, double h, std::size_t samples) {
   o->data_seed = data_seed;
   o->sample_rate = 1.0 / h;
@@ -152,12 +182,8 @@ void draw_pair(const PhSystem& system, const MeasuredTrajectory& m, const Import
   }
   CounterRng pick = CounterRng::for_trajectory(o.data_seed, system.rng_id(), m.id,
                                                CounterRng::kTrainingPair);
-  const auto n = static_cast<std::size_t>(pick.below(static_cast<std::uint64_t>(positions)));
-  pairs->x.push_back(m.state(n));
-  pairs->x_next.push_back(m.state(n + 1));
-  pairs->u.push_back(m.input(n));
-  pairs->trajectory.push_back(m.id);
-  pairs->position.push_back(static_cast<int>(n));
+  internal::add_pair(m, static_cast<std::size_t>(pick.below(static_cast<std::uint64_t>(positions))),
+                     pairs);
 }
 
 // Sorted by id; unique ids; shuffled by split_seed (Fisher-Yates on one
@@ -207,10 +233,10 @@ VecX MeasuredTrajectory::input(std::size_t k) const {
   return Eigen::Map<const VecX>(u.data() + k * static_cast<std::size_t>(n_u), n_u);
 }
 
-bool MeasuredTrajectory::same_input(std::size_t k) const {
+bool MeasuredTrajectory::same_input(std::size_t k, std::size_t ref) const {
   const auto w = static_cast<std::size_t>(n_u);
   return std::equal(u.begin() + static_cast<long>(k * w), u.begin() + static_cast<long>((k + 1) * w),
-                    u.begin());
+                    u.begin() + static_cast<long>(ref * w));
 }
 
 void MeasuredTrajectory::shrink() {
@@ -249,35 +275,18 @@ void ImportOptions::validate() const {
 namespace {
 
 // Trajectories [first, end) of `all` as inference trajectories, cut to the
-// shortest; inputs that change within one are replayed sample by sample
-// (zero-order hold), constant ones stay one per trajectory. Frees them;
-// returns the samples kept.
+// shortest (internal::add_windows: from sample 0). Frees them; returns the
+// samples kept.
 std::size_t add_inference_trajectories(std::vector<MeasuredTrajectory>* all,
-                                       std::size_t infer_begin, PhInferenceSet* out_set) {
-  std::vector<MeasuredTrajectory>& trajectories = *all;
-  PhInferenceSet& out = *out_set;
-  std::size_t samples = trajectories[infer_begin].size();
-  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    samples = std::min(samples, trajectories[i].size());
+                                       std::size_t infer_begin, PhInferenceSet* out) {
+  std::size_t samples = (*all)[infer_begin].size();
+  std::vector<std::pair<std::size_t, std::size_t>> windows;
+  for (std::size_t i = infer_begin; i < all->size(); ++i) {
+    samples = std::min(samples, (*all)[i].size());
+    windows.emplace_back(i, 0);
   }
-  bool varying = false;
-  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    const MeasuredTrajectory& m = trajectories[i];
-    for (std::size_t k = 1; k < samples && !varying; ++k) varying = !m.same_input(k);
-  }
-  for (std::size_t i = infer_begin; i < trajectories.size(); ++i) {
-    MeasuredTrajectory& m = trajectories[i];
-    out.trajectory.push_back(m.id);
-    out.u.push_back(m.input(0));
-    std::vector<VecX> states, inputs;
-    for (std::size_t k = 0; k < samples; ++k) states.push_back(m.state(k));
-    out.states.push_back(std::move(states));
-    if (varying) {
-      for (std::size_t k = 0; k < samples; ++k) inputs.push_back(m.input(k));
-      out.inputs.push_back(std::move(inputs));
-    }
-    m = MeasuredTrajectory();  // its numbers are in `out` now
-  }
+  internal::add_windows(*all, windows, samples, /*positions=*/false, out);
+  for (std::size_t i = infer_begin; i < all->size(); ++i) (*all)[i] = MeasuredTrajectory();
   return samples;
 }
 

@@ -48,14 +48,6 @@ Blocks cut(const MeasuredTrajectory& m, const ImportOptions& o) {
 // A pair (recording index, sample n): (x_n, u_n, x_n+1) of that recording.
 using PairRef = std::pair<std::size_t, std::size_t>;
 
-void add_pair(const MeasuredTrajectory& m, std::size_t n, PhPairSet* p) {
-  p->x.push_back(m.state(n));
-  p->x_next.push_back(m.state(n + 1));
-  p->u.push_back(m.input(n));
-  p->trajectory.push_back(m.id);
-  p->position.push_back(static_cast<int>(n));
-}
-
 // Every pair with both samples in [begin, end) of each recording, in time order.
 std::vector<PairRef> block_pairs(const std::vector<Blocks>& blocks, bool training) {
   std::vector<PairRef> refs;
@@ -87,36 +79,6 @@ std::vector<PairRef> window_starts(const std::vector<Blocks>& blocks, std::size_
       if (start + w <= blocks[r].n) out.emplace_back(r, start), any = true;
     }
     if (!any || out.size() >= cap) return out;
-  }
-}
-
-// The windows' samples (and, when u changes inside any window, its inputs
-// per sample: zero-order hold, replayed at inference).
-void add_windows(const std::vector<MeasuredTrajectory>& recs, const std::vector<PairRef>& starts,
-                 std::size_t w, PhInferenceSet* inference) {
-  const auto same_input = [](const MeasuredTrajectory& m, std::size_t a, std::size_t b) {
-    for (int j = 0; j < m.n_u; ++j) {
-      const auto nu = static_cast<std::size_t>(m.n_u), col = static_cast<std::size_t>(j);
-      if (m.u[a * nu + col] != m.u[b * nu + col]) return false;
-    }
-    return true;
-  };
-  bool varying = false;
-  for (const auto& [r, start] : starts) {
-    for (std::size_t k = start + 1; k < start + w && !varying; ++k) varying = !same_input(recs[r], k, start);
-  }
-  for (const auto& [r, start] : starts) {
-    const MeasuredTrajectory& m = recs[r];
-    inference->trajectory.push_back(m.id);
-    inference->position.push_back(static_cast<std::int64_t>(start));
-    inference->u.push_back(m.input(start));
-    std::vector<VecX> states, inputs;
-    for (std::size_t k = start; k < start + w; ++k) {
-      states.push_back(m.state(k));
-      if (varying) inputs.push_back(m.input(k));
-    }
-    inference->states.push_back(std::move(states));
-    if (varying) inference->inputs.push_back(std::move(inputs));
   }
 }
 
@@ -160,11 +122,11 @@ PhSystemData split_in_blocks(const PhSystem& system, std::vector<MeasuredTraject
                    CounterRng::for_trajectory(o.data_seed, system.rng_id(), 0, CounterRng::kBlockValidation));
     std::sort(validation.begin(), validation.end());
   }
-  for (const auto& [r, n] : train) add_pair(recs[r], n, &data.train);
-  for (const auto& [r, n] : validation) add_pair(recs[r], n, &data.validation);
+  for (const auto& [r, n] : train) internal::add_pair(recs[r], n, &data.train);
+  for (const auto& [r, n] : validation) internal::add_pair(recs[r], n, &data.validation);
   const std::size_t w = window_samples(blocks, o, h);
   const std::vector<PairRef> starts = window_starts(blocks, w, static_cast<std::size_t>(o.num_inference));
-  add_windows(recs, starts, w, &data.inference);
+  internal::add_windows(recs, starts, w, /*positions=*/true, &data.inference);
 
   DatasetOptions& d = data.options;
   internal::record_timing(&d, o.data_seed, h, w);

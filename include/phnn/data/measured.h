@@ -46,8 +46,8 @@ struct MeasuredTrajectory {
   void add(double time, const double* state, const double* input);
   VecX state(std::size_t k) const;
   VecX input(std::size_t k) const;
-  /// u_k == u_0, value by value.
-  bool same_input(std::size_t k) const;
+  /// u_k == u_ref, value by value.
+  bool same_input(std::size_t k, std::size_t ref = 0) const;
   /// Frees the room the arrays grew beyond their samples (call once read).
   void shrink();
 
