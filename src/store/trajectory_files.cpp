@@ -62,16 +62,12 @@ std::vector<int> header_roles(const std::vector<std::string>& header, const Traj
   std::vector<int> roles;
   std::set<std::string> seen;
   for (const std::string& name : header) {
-    if (std::find(c.ignore.begin(), c.ignore.end(), name) != c.ignore.end() &&
-        std::find(expected.begin(), expected.end(), name) == expected.end()) {
-      if (!seen.insert(name).second) fail(at + ": column \"" + name + "\" appears twice" + fix);
-      roles.push_back(-3);
-      continue;
-    }
     const auto it = std::find(expected.begin(), expected.end(), name);
-    if (it == expected.end()) fail(at + ": unknown column \"" + name + "\"" + fix);
+    const bool skipped = it == expected.end() &&
+                         std::find(c.ignore.begin(), c.ignore.end(), name) != c.ignore.end();
+    if (it == expected.end() && !skipped) fail(at + ": unknown column \"" + name + "\"" + fix);
     if (!seen.insert(name).second) fail(at + ": column \"" + name + "\" appears twice" + fix);
-    roles.push_back(static_cast<int>(it - expected.begin()) - 2);
+    roles.push_back(skipped ? -3 : static_cast<int>(it - expected.begin()) - 2);
   }
   for (const std::string& name : expected) {
     if (!seen.count(name)) {

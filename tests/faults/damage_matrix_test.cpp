@@ -59,7 +59,7 @@ struct Case {
   std::uint64_t at = 0;
   unsigned char mask = 0;
   std::vector<std::string> named;
-  std::string bytes;
+  std::string bytes = {};
 };
 
 int run(const std::string& command, const std::string& log) {

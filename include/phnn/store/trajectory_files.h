@@ -17,7 +17,8 @@ struct TrajectoryColumns {
   /// `states`: the recorded columns that make the states (a system's states,
   /// or MeasurementMap::recorded()); `ignore`: columns a file may hold that
   /// are skipped.
-  std::vector<std::string> states, inputs, ignore;
+  std::vector<std::string> states, inputs;
+  std::vector<std::string> ignore = {};
 };
 
 /// CSV, one row per sample: a header naming the columns `trajectory`, `t`,
