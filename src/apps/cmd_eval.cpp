@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -18,8 +19,6 @@
 #include "phnn/store/output_path.h"
 #include "phnn/store/results_file.h"
 #include "phnn/store/scratch_file.h"
-#include "phnn/sweep/grid.h"
-#include "phnn/sweep/sweep_file.h"
 #include "phnn/systems/system_file.h"
 #include "phnn/training/evaluate.h"
 
@@ -61,11 +60,8 @@ int find_row(const ResultsFile& results, const std::vector<std::string>& ids,
 
 // The run's configuration, rebuilt from the sweep text stored in the file.
 RunConfig stored_config(const ResultsFile& results, const std::string& id) {
-  const SweepSpec spec = parse_sweep_text(results.sweep_text(), results.path() + " (sweep_text)",
-                                          results.stored_system_files());
-  for (const RunConfig& run : expand_grid(spec).runs) {
-    if (run.id() == id) return run;
-  }
+  const std::map<std::string, RunConfig> runs = stored_run_configs(results);
+  if (const auto it = runs.find(id); it != runs.end()) return it->second;
   throw std::runtime_error(results.path() + ": run " + id +
                            " is not in the sweep text stored in the file; it was written by "
                            "another program version (" + results.program_version() + ")");

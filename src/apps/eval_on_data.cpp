@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <stdexcept>
 
 #include "apps/cli.h"
@@ -21,10 +22,8 @@
 
 namespace phnn {
 namespace apps {
-namespace {
 
-// The file's runs by id, from its stored sweep text (parsed once).
-std::map<std::string, RunConfig> stored_configs(const ResultsFile& results) {
+std::map<std::string, RunConfig> stored_run_configs(const ResultsFile& results) {
   const SweepSpec spec = parse_sweep_text(results.sweep_text(), results.path() + " (sweep_text)",
                                           results.stored_system_files());
   std::map<std::string, RunConfig> out;
@@ -32,7 +31,9 @@ std::map<std::string, RunConfig> stored_configs(const ResultsFile& results) {
   return out;
 }
 
-// "" when the data set has the system's states, ports and inputs (names in
+namespace {
+
+// "" when the data set has the system's states and inputs (names in
 // order); else why not.
 std::string mismatch(const PhSystemData& stored, const PhSystemData& data) {
   if (stored.state_names == data.state_names && stored.input_names == data.input_names) return "";
@@ -46,10 +47,19 @@ std::string mismatch(const PhSystemData& stored, const PhSystemData& data) {
          join(stored.input_names);
 }
 
+// What the CSV needs of one evaluated run.
 struct Evaluated {
   std::string id;
   RunConfig run;
-  Evaluation e;
+  double mse;
+  std::vector<double> trajectory_errors;
+};
+
+// A system of the results file: its stored data set (names, text) and the
+// system compiled from it once, for all its runs.
+struct StoredSystem {
+  PhSystemData data;
+  std::unique_ptr<PhSystem> system;
 };
 
 void write_errors_csv(const std::string& path, const std::vector<Evaluated>& all,
@@ -59,15 +69,14 @@ void write_errors_csv(const std::string& path, const std::vector<Evaluated>& all
   out << "run_id,system,model,integrator,size,n_train,regularizer,seed,trajectory,position,error,mse\n";
   char buf[40];
   for (const Evaluated& v : all) {
-    const RunResult& r = v.e.result;
-    for (std::size_t k = 0; k < r.trajectory_errors.size(); ++k) {
-      std::snprintf(buf, sizeof buf, "%.17g", r.trajectory_errors[k]);
+    for (std::size_t k = 0; k < v.trajectory_errors.size(); ++k) {
+      std::snprintf(buf, sizeof buf, "%.17g", v.trajectory_errors[k]);
       out << v.id << "," << v.run.system_name() << "," << to_string(v.run.model) << ","
           << to_string(v.run.integrator) << "," << to_string(v.run.size) << "," << v.run.n_train
           << "," << to_string(v.run.regularizer) << "," << v.run.seed << ","
           << data.inference.trajectory[k] << ","
           << (data.inference.position.empty() ? 0 : data.inference.position[k]) << "," << buf;
-      std::snprintf(buf, sizeof buf, "%.17g", r.mse);
+      std::snprintf(buf, sizeof buf, "%.17g", v.mse);
       out << "," << buf << "\n";
     }
   }
@@ -86,7 +95,7 @@ CellSpec cell_on(const RunConfig& run, const PhSystemData& data) {
 
 int eval_on_data(const ResultsFile& results, const EvalOnDataOptions& o) {
   const PhSystemData data = read_ph_dataset_file(o.data_path);
-  const std::map<std::string, RunConfig> configs = stored_configs(results);
+  const std::map<std::string, RunConfig> configs = stored_run_configs(results);
   const std::vector<std::string> ids = results.read_run_ids();
   std::vector<int> rows = o.rows;
   if (rows.empty()) {
@@ -95,7 +104,7 @@ int eval_on_data(const ResultsFile& results, const EvalOnDataOptions& o) {
       if (statuses[i] == RunStatus::kDone || statuses[i] == RunStatus::kDiverged) rows.push_back(static_cast<int>(i));
     }
   }
-  std::map<std::string, PhSystemData> systems;
+  std::map<std::string, StoredSystem> systems;
   std::vector<Evaluated> all;
   std::string skipped;
   for (int row : rows) {
@@ -103,9 +112,12 @@ int eval_on_data(const ResultsFile& results, const EvalOnDataOptions& o) {
     const auto found = configs.find(id);
     if (found == configs.end()) continue;
     const RunConfig& run = found->second;
-    if (!systems.count(run.system_name())) systems[run.system_name()] = results.read_system_data(run.system_name());
-    const PhSystemData& stored = systems[run.system_name()];
-    const std::string why = mismatch(stored, data);
+    StoredSystem& stored = systems[run.system_name()];
+    if (!stored.system) {
+      stored.data = results.read_system_data(run.system_name());
+      stored.system = compile_system(stored.data.system_text, results.path() + "@/data/" + run.system_name());
+    }
+    const std::string why = mismatch(stored.data, data);
     if (!why.empty()) {
       if (!o.rows.empty()) throw cli::UsageError{"phnn eval: --data " + o.data_path + " has " + why};
       skipped = why;
@@ -113,11 +125,12 @@ int eval_on_data(const ResultsFile& results, const EvalOnDataOptions& o) {
     }
     const RunResult result = results.read_run(row);
     if (result.weights.empty()) continue;
-    const auto system = compile_system(stored.system_text, results.path() + "@/data/" + run.system_name());
-    all.push_back({id, run, evaluate_stored_run(cell_on(run, data), data, *system, result.weights)});
+    const RunResult r =
+        evaluate_stored_run(cell_on(run, data), data, *stored.system, result.weights).result;
+    all.push_back({id, run, r.mse, r.trajectory_errors});
     std::printf("phnn eval: run %s (%s %s seed %d): mse %.6e on %s (%s; %.6e on its own data)\n",
                 id.c_str(), run.system_name().c_str(), model_label(run.model, run.integrator).c_str(),
-                run.seed, all.back().e.result.mse, o.data_path.c_str(),
+                run.seed, r.mse, o.data_path.c_str(),
                 counted(static_cast<long long>(data.inference.size()), "trajectory", "trajectories").c_str(), result.mse);
   }
   if (all.empty()) {

@@ -5,13 +5,19 @@
 // files, writes only --errors.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
+#include "phnn/config/run_config.h"
 #include "phnn/store/results_file.h"
 
 namespace phnn {
 namespace apps {
+
+/// The file's runs by id, rebuilt from the sweep text stored in it (parsed
+/// and expanded once).
+std::map<std::string, RunConfig> stored_run_configs(const ResultsFile& results);
 
 struct EvalOnDataOptions {
   std::string data_path;  // a data-set file (`phnn data`, `phnn import`)
