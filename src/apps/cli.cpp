@@ -126,10 +126,9 @@ bool Parser::has(const std::string& name) const { return app_->count("--" + name
 
 double Parser::get_double(const std::string& name) const {
   const std::string text = get(name);
-  char* end = nullptr;
+  double v = 0;
   errno = 0;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || errno != 0 || !std::isfinite(v)) {
+  if (!read_number(text, &v) || errno != 0) {
     throw usage("--" + name + " = \"" + text + "\" is not a finite number");
   }
   return v;
@@ -160,6 +159,23 @@ double Parser::get_double_in(const std::string& name, double lo, double hi) cons
     throw usage("--" + name + " = " + get(name) + " is outside " + range.str());
   }
   return v;
+}
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = text.find(',', start);
+    out.push_back(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
+bool read_number(const std::string& text, double* value) {
+  char* end = nullptr;
+  *value = std::strtod(text.c_str(), &end);
+  return !text.empty() && *end == '\0' && std::isfinite(*value);
 }
 
 std::vector<std::int64_t> parse_int_list(const std::string& option, const std::string& text) {

@@ -91,6 +91,12 @@ constexpr std::size_t kMaxListLength = 100000;
 /// Largest value parse_int_list accepts (values become int seeds and ranks).
 constexpr long long kMaxListValue = 2147483647;
 
+/// The comma-separated items of `text`, empty ones kept ("a,,b" -> a, "", b).
+std::vector<std::string> split_commas(const std::string& text);
+
+/// All of `text` as a finite double (strtod; sets errno as strtod does).
+bool read_number(const std::string& text, double* value);
+
 /// Parses "0-9", "0,3,5" or "0-2,7" into a list of non-negative integers;
 /// throws UsageError for more than kMaxListLength values (before expanding).
 std::vector<std::int64_t> parse_int_list(const std::string& option, const std::string& text);

@@ -3,8 +3,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <cmath>
-#include <cstdlib>
 #include <iostream>
 
 #include "apps/cli.h"
@@ -28,20 +26,14 @@ NoiseOptions noise_options(const cli::Parser& parser, int n_x) {
   o.relative = !parser.flag_set("noise-absolute");
   if (!parser.has("noise")) return o;
   const std::string text = parser.get("noise");
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v) || v < 0) {
+  for (const std::string& item : cli::split_commas(text)) {
+    double v = 0;
+    if (!cli::read_number(item, &v) || v < 0) {
       throw cli::UsageError{"phnn data: --noise " + text + ": \"" + item + "\" is not a number "
                             ">= 0; write one level for all states (0.01) or one per state "
                             "(0.01,0.02)"};
     }
     o.levels.push_back(v);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
   }
   if (o.levels.size() == 1) o.levels.assign(static_cast<std::size_t>(n_x), o.levels[0]);
   if (static_cast<int>(o.levels.size()) != n_x) {

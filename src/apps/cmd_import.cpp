@@ -1,7 +1,6 @@
 // src/apps/cmd_import.cpp — `phnn import`: recorded trajectories (CSV or
 // HDF5) into a data-set file, split as docs/METHOD.md "Measured data" says.
 #include <chrono>
-#include <cstdlib>
 #include <iostream>
 
 #include "apps/cli.h"
@@ -32,29 +31,11 @@ std::vector<MeasuredTrajectory> read_inputs(const std::vector<std::string>& file
   return all;
 }
 
-// "a,b" -> {"a", "b"} (empty items dropped).
-std::vector<std::string> split_names(const std::string& text) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = text.find(',', start);
-    std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (!item.empty()) out.push_back(std::move(item));
-    if (comma == std::string::npos) return out;
-    start = comma + 1;
-  }
-}
-
 // --blocks "0.6,0.2": the training and validation shares of each recording.
 void parse_blocks(const std::string& text, ImportOptions* o) {
-  const std::size_t comma = text.find(',');
-  char* end_a = nullptr;
-  char* end_b = nullptr;
-  const std::string a = text.substr(0, comma);
-  const std::string b = comma == std::string::npos ? "" : text.substr(comma + 1);
-  o->train_fraction = std::strtod(a.c_str(), &end_a);
-  o->validation_fraction = std::strtod(b.c_str(), &end_b);
-  const bool numbers = !a.empty() && !b.empty() && *end_a == '\0' && *end_b == '\0';
+  const std::vector<std::string> shares = cli::split_commas(text);
+  const bool numbers = shares.size() == 2 && cli::read_number(shares[0], &o->train_fraction) &&
+                       cli::read_number(shares[1], &o->validation_fraction);
   if (!numbers || !(o->train_fraction > 0) || !(o->validation_fraction > 0) ||
       !(o->train_fraction + o->validation_fraction < 1)) {
     throw cli::UsageError{"phnn import: --blocks " + text + ": give the training and validation "
@@ -146,7 +127,9 @@ int run_import(int argc, char** argv, int first) {
       MeasurementMap::of_system_text(system->source_text(), parser.get("system"));
   TrajectoryColumns columns{measurement.recorded(), system->input_names(), measurement.ignored()};
   if (parser.has("ignore-columns")) {
-    for (const std::string& name : split_names(parser.get("ignore-columns"))) columns.ignore.push_back(name);
+    for (const std::string& name : cli::split_commas(parser.get("ignore-columns"))) {
+      if (!name.empty()) columns.ignore.push_back(name);
+    }
   }
   std::string summary;
   if (!measurement.identity()) summary += "states from [measurement]: " + measurement.describe() + "\n";
