@@ -232,19 +232,16 @@ TrainData read_train_data(const cli::Parser& parser, std::string* arg) {
   TrainData d;
   d.data = read_ph_dataset_file(path);
   if (!given) *arg = stored_system_entry(d.data, path);
-  if (!is_system_file_argument(*arg)) {
-    if (parser.has("damping")) {
-      throw cli::UsageError{"phnn train: --damping with --data: the data set " + path +
-                            " fixes the physics; drop --damping"};
-    }
-    if (d.data.system_name != *arg) {
-      throw cli::UsageError{"phnn train: --data " + path + " holds system " + d.data.system_name +
-                            ", not " + *arg + "; drop --system (the data set names its system)"};
-    }
-    d.system = compile_system(d.data.system_text, path + "@system_file");
-    return d;
+  const bool builtin = !is_system_file_argument(*arg);
+  if (builtin && parser.has("damping")) {
+    throw cli::UsageError{"phnn train: --damping with --data: the data set " + path +
+                          " fixes the physics; drop --damping"};
   }
-  if (!given) {
+  if (builtin && d.data.system_name != *arg) {
+    throw cli::UsageError{"phnn train: --data " + path + " holds system " + d.data.system_name +
+                          ", not " + *arg + "; drop --system (the data set names its system)"};
+  }
+  if (builtin || !given) {  // the data set's own text is the system
     d.system = compile_system(d.data.system_text, path + "@system_file");
     return d;
   }
