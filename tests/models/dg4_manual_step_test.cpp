@@ -97,11 +97,7 @@ TEST_P(Dg4ManualStepTest, LossAndGradientsAreAutograds) {
   const int n_x = options.general->n_x, n_u = options.general->n_u;
   auto model = DynamicsModel::create(options, {3, 4, 5});
   auto flat = model->flatten_parameters();
-  {  // weights away from their initialization, so no term is special
-    torch::NoGradGuard no_grad;
-    torch::manual_seed(11);
-    flat.values.add_(0.3 * torch::randn_like(flat.values));
-  }
+  testing_util::move_off_initialization(flat.values);
   torch::manual_seed(12);
   const int64_t rows = c.expanded ? 1 : E;
   auto x = torch::randn({rows, B, n_x}, torch::kFloat64);

@@ -93,11 +93,7 @@ TEST_P(GeneralManualStepTest, LossAndGradientsAreAutograds) {
   if (c.at_start) options.dg_structure_point = DgStructurePoint::kStart;
   auto model = DynamicsModel::create(options, seeds);
   auto flat = model->flatten_parameters();
-  {  // weights away from their initialization, so no term is special
-    torch::NoGradGuard no_grad;
-    torch::manual_seed(11);
-    flat.values.add_(0.3 * torch::randn_like(flat.values));
-  }
+  testing_util::move_off_initialization(flat.values);
   torch::manual_seed(12);
   const int64_t rows = c.expanded ? 1 : E;
   auto x = torch::randn({rows, B, c.n_x}, torch::kFloat64);
