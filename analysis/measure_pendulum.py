@@ -4,7 +4,7 @@ discrete gradient made: classical RK4 at a step 100 times finer than the data's,
 sub-sampled to 100 Hz, with Gaussian noise on the states, written as the CSV that
 `phnn import` reads (docs/DATASET_FORMAT.md, "Trajectory files").
 
-    /usr/bin/python3 analysis/measure_pendulum.py --long 2 --rms 0.3 --out results/pendulum-measured.csv
+    /usr/bin/python3 analysis/measure_pendulum.py --long 2 --rms 0.2 --out results/pendulum-measured.csv
     build/phnn import results/pendulum-measured.csv --system sweeps/systems/pendulum.toml \\
         --window 10 --out results/pendulum-measured.h5
     mpirun -np 2 build/phnn sweep sweeps/examples/pendulum-measured.toml

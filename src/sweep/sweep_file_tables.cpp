@@ -245,13 +245,19 @@ class TableWalker {
     return study;
   }
 
-  // n_train <= num_train_max: reported at the value's line (`lines` is empty
-  // for the default).
+  // n_train <= num_train_max for generated data, <= the file's training pairs
+  // for a data-set file: reported at the value's line (`lines` is empty for
+  // the default).
   void check_n_train(const StudySpec& study, const std::vector<int>& lines) const {
     const int max = spec_.data.num_train_max;
+    bool generated = false;
+    for (const std::string& system : study.systems) {
+      const SweepSystemFile* f = systems_.file(system);
+      generated = generated || !f || !f->is_data();
+    }
     for (std::size_t i = 0; i < study.n_train.size(); ++i) {
       const int n = study.n_train[i];
-      if (n >= 1 && n <= max) continue;
+      if (n >= 1 && (n <= max || !generated)) continue;
       const auto max_line = data_lines_.find("num_train_max");
       const int line = i < lines.size()                ? lines[i]
                        : max_line != data_lines_.end() ? max_line->second

@@ -35,16 +35,16 @@ std::string temp_dir(const std::string& name) {
   return dir;
 }
 
-// A small pendulum data set (8 training pairs) with this data seed.
-void write_data(const std::string& path, std::uint64_t seed) {
+// A small pendulum data set (8 training pairs unless told) with this data seed.
+void write_data(const std::string& path, std::uint64_t seed, int train_pairs = 8) {
   const auto system = load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum.toml");
   DatasetOptions o;
   o.data_seed = seed;
-  o.num_train_max = 8;
+  o.num_train_max = train_pairs;
   o.num_validation = 10;
   o.num_inference = 2;
   o.beta = 0.5;
-  write_ph_dataset_file(path, make_ph_system_data(*system, o, 8));
+  write_ph_dataset_file(path, make_ph_system_data(*system, o, train_pairs));
 }
 
 std::string sweep(const std::string& data_line, const std::string& n_train = "[4]") {
@@ -101,6 +101,18 @@ TEST(SweepDataFilesTest, ADataFileIsASystemNamedByItsStemWhoseContentsAreItsIden
   // With `systems`, both.
   const SweepSpec both = parse_in(dir, sweep("systems = [\"harmonic\"]\ndata = [\"d/meas.h5\"]", "[4]"));
   EXPECT_EQ(both.studies[0].systems, (std::vector<std::string>{"harmonic", "meas"}));
+  std::system(("rm -rf " + dir).c_str());
+}
+
+// n_train of a data-set file is bounded by its training pairs, not by [data]
+// num_train_max (400 by default), which bounds the generated systems only.
+TEST(SweepDataFilesTest, NTrainOfADataFileIsBoundedByItsPairsNotByNumTrainMax) {
+  const std::string dir = temp_dir("ntrain");
+  write_data(dir + "/d/long.h5", 0, 450);
+  const SweepSpec spec = parse_in(dir, sweep("data = \"d/long.h5\"", "[450]"));
+  EXPECT_EQ(spec.studies[0].n_train, std::vector<int>{450});
+  EXPECT_THAT(error_in(dir, sweep("systems = [\"harmonic\"]\ndata = [\"d/long.h5\"]", "[450]")),
+              AllOf(HasSubstr("s.toml:9:"), HasSubstr("num_train_max = 400")));
   std::system(("rm -rf " + dir).c_str());
 }
 
