@@ -144,6 +144,16 @@ DatasetOptions read_dataset_timing(const h5::File& file, const std::string& g) {
 
 }  // namespace internal
 
+void describe_data_file(const PhSystemData& data, SystemFileText* text) {
+  text->data_checksum = data_set_checksum(data);
+  text->data_train_pairs = static_cast<int>(data.train.size());
+  text->data_inference = static_cast<int>(data.inference.size());
+  text->data_inference_points = 0;
+  for (const auto& states : data.inference.states) {
+    text->data_inference_points = std::max(text->data_inference_points, static_cast<int>(states.size()));
+  }
+}
+
 std::string data_set_checksum(const PhSystemData& data) {
   // The bytes hashed, field by field: sizes as uint64, doubles as stored.
   std::string bytes;

@@ -148,13 +148,14 @@ ResultsLayout ResultsLayout::for_runs(const std::vector<RunConfig>& runs) {
   if (runs.empty()) return layout;
   layout.num_inference = layout.trace_points = layout.figure_points = 1;
   for (const RunConfig& run : runs) {
-    layout.num_inference = std::max(layout.num_inference, run.data.num_inference);
+    layout.num_inference =
+        std::max({layout.num_inference, run.data.num_inference, run.data_inference});
     if (run.training.eval_every > 0) {
       layout.trace_points =
           std::max(layout.trace_points, run.training.steps / run.training.eval_every + 2);
     }
-    layout.figure_points =
-        std::max(layout.figure_points, run.data.num_inference_steps() + 1);
+    layout.figure_points = std::max(
+        {layout.figure_points, run.data.num_inference_steps() + 1, run.data_inference_points});
     layout.figure_states = std::max(layout.figure_states, run.n_x);
     layout.checkpoints =
         std::max(layout.checkpoints, static_cast<int>(run.training.checkpoints.size()));
@@ -297,8 +298,7 @@ SystemFileReader ResultsFile::stored_system_files() const {
       texts.back().data_supplied = true;  // the data set is stored beside it
       if (is_data_file_entry(entries.back())) {  // a `data` file: its stored copy
         const PhSystemData data = internal::read_ph_system_data(impl_->file, group);
-        texts.back().data_checksum = data_set_checksum(data);
-        texts.back().data_train_pairs = static_cast<int>(data.train.size());
+        describe_data_file(data, &texts.back());
       }
     }
     return 0;

@@ -162,6 +162,8 @@ void set_system(const SweepSpec& spec, const std::string& name, RunConfig* run) 
     run->n_x = file->n_x;
     run->n_w = file->n_w;
     run->n_u = file->n_u;
+    run->data_inference = file->data_inference;
+    run->data_inference_points = file->data_inference_points;
     run->system = SystemKind::kHarmonic;  // unused
     run->physics = OscillatorOptions();   // unused
     return;
@@ -171,6 +173,7 @@ void set_system(const SweepSpec& spec, const std::string& name, RunConfig* run) 
   run->n_x = 2;
   run->n_w = 1;
   run->n_u = 1;
+  run->data_inference = run->data_inference_points = 0;
   run->system = parse_system(name);
   run->physics = spec.physics.at(run->system);
 }

@@ -89,8 +89,7 @@ namespace {
 SystemFileText read_data_file_entry(const std::string& file) {
   const PhSystemData data = read_ph_dataset_file(file);
   SystemFileText t{file, data.system_text};
-  t.data_checksum = data_set_checksum(data);
-  t.data_train_pairs = static_cast<int>(data.train.size());
+  describe_data_file(data, &t);
   return t;
 }
 

@@ -82,6 +82,8 @@ std::string SweepSystems::load(const std::string& entry, int line) {
     file.name.resize(file.name.size() - 3);
     file.data_checksum = source.data_checksum;
     file.data_train_pairs = source.data_train_pairs;
+    file.data_inference = source.data_inference;
+    file.data_inference_points = source.data_inference_points;
     file.path = source.shown_as;
     file.text_hash = hex64(fnv1a64(file.text + "\n# data " + file.data_checksum));
     if (file.name.empty() || find_system(file.name)) {

@@ -35,15 +35,17 @@ std::string temp_dir(const std::string& name) {
   return dir;
 }
 
-// A small pendulum data set (8 training pairs unless told) with this data seed.
-void write_data(const std::string& path, std::uint64_t seed, int train_pairs = 8) {
+// A small pendulum data set (8 training pairs and inference of 0.5 s unless
+// told) with this data seed.
+void write_data(const std::string& path, std::uint64_t seed, int train_pairs = 8,
+                double beta = 0.5) {
   const auto system = load_system_file(std::string(PHNN_SOURCE_DIR) + "/sweeps/systems/pendulum.toml");
   DatasetOptions o;
   o.data_seed = seed;
   o.num_train_max = train_pairs;
   o.num_validation = 10;
   o.num_inference = 2;
-  o.beta = 0.5;
+  o.beta = beta;
   write_ph_dataset_file(path, make_ph_system_data(*system, o, train_pairs));
 }
 
@@ -147,7 +149,9 @@ int phnn(const std::string& args, std::string* output) {
 
 TEST(SweepDataFilesTest, ASweepOfADataFileTrainsReducesAloneAndRefusesChangedData) {
   const std::string dir = temp_dir("e2e");
-  write_data(dir + "/d/meas.h5", 0);
+  // Inference trajectories of 6 s, longer than the sweep's own [data] (5 s):
+  // the results file's figure and trace columns take the data file's length.
+  write_data(dir + "/d/meas.h5", 0, 8, 6.0);
   std::ofstream(dir + "/s.toml") << sweep("data = \"d/meas.h5\"");
   std::string log;
   ASSERT_EQ(phnn("sweep " + dir + "/s.toml --out " + dir + "/r.h5", &log), 0) << log;

@@ -25,6 +25,10 @@ struct RunConfig {
   /// and the results layout's; not part of the identity, which the file's
   /// hash fixes).
   int n_x = 2, n_w = 1, n_u = 1;
+  /// A data-set file's inference trajectories and the samples of the
+  /// longest (the results layout's; 0 when the data are generated, whose
+  /// sizes `data` gives; not part of the identity either).
+  int data_inference = 0, data_inference_points = 0;
   ModelKind model = ModelKind::kNode;
   IntegratorKind integrator = IntegratorKind::kRk2;
   ModelSize size = ModelSize::kSmall;

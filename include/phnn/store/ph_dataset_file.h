@@ -7,6 +7,7 @@
 
 #include <string>
 
+#include "phnn/config/system_file_text.h"
 #include "phnn/data/ph_dataset.h"
 
 namespace phnn {
@@ -20,6 +21,11 @@ void write_ph_dataset_file(const std::string& path, const PhSystemData& data);
 /// and the steps. Two files with the same contents have the same checksum,
 /// whatever their other attributes: a data-set file's identity in sweeps.
 std::string data_set_checksum(const PhSystemData& data);
+
+/// What a sweep needs of a data-set file named in `data`: its checksum, its
+/// training pairs, its inference trajectories and the samples of the
+/// longest (the results layout's), set in `text`.
+void describe_data_file(const PhSystemData& data, SystemFileText* text);
 
 /// Reads a data-set file of either version (a built-in system's version-1
 /// file comes back with state names q, p and input u). Throws

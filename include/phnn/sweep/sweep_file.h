@@ -85,6 +85,8 @@ struct SweepSystemFile {
   /// was read (relative entries resolved against the sweep file).
   std::string data_checksum, path;
   int data_train_pairs = 0;
+  /// Its inference trajectories and the samples of the longest.
+  int data_inference = 0, data_inference_points = 0;
   bool is_data() const { return !data_checksum.empty(); }
 };
 
