@@ -98,6 +98,38 @@ struct ColumnAxes {
   }
 };
 
+// The [training] options and step budgets of a study's runs: [search]'s
+// variants and rungs, else [training] and its steps. suffix() is the part
+// of a column label they add: "learning_rate=0.001/steps=5000" ("" without
+// [search]; the variant only when there are several).
+struct Budgets {
+  std::vector<TrainerOptions> variants;
+  std::vector<std::string> labels;
+  std::vector<int> steps;
+  bool search = false;
+
+  explicit Budgets(const SweepSpec& spec) : search(spec.search.enabled) {
+    variants = search ? spec.search.variants : std::vector<TrainerOptions>{spec.training};
+    labels = search ? spec.search.variant_labels : std::vector<std::string>{""};
+    steps = search ? spec.search.rungs : std::vector<int>{spec.training.steps};
+  }
+  std::string suffix(std::size_t variant, int budget) const {
+    if (!search) return "";
+    const std::string v = variants.size() > 1 ? labels[variant] + "/" : "";
+    return v + "steps=" + std::to_string(budget);
+  }
+  std::string axis_name() const {
+    if (!search) return "";
+    return variants.size() > 1 ? "settings/steps" : "steps";
+  }
+};
+
+// "MSE" + "steps=5000" -> "steps=5000"; "small" + "" -> "small".
+std::string join_label(const std::string& base, const std::string& suffix) {
+  if (suffix.empty()) return base;
+  return base == "MSE" ? suffix : base + "/" + suffix;
+}
+
 // The weights a run with `reg` is made with: the study's lambdas for a
 // regularized run when it has any, else the [training] weight (one run).
 std::vector<double> weights_of(const StudySpec& study, Regularizer reg,
@@ -111,23 +143,31 @@ std::vector<double> weights_of(const StudySpec& study, Regularizer reg,
 namespace {
 
 // A study's table without its runs: rows (models), columns (the varied axis).
-StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes,
-                       const TrainerOptions& training) {
+StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes, const Budgets& budgets) {
   StudyTable table;
   table.name = study.name;
   table.title = study.title;
   table.systems = study.systems;
   table.varied_axis = axes.name();
+  if (!budgets.axis_name().empty()) {
+    table.varied_axis += (table.varied_axis.empty() ? "" : "/") + budgets.axis_name();
+  }
   for (const auto& [model, integrator] : study.models) {
     table.rows.push_back(model_label(model, integrator));
   }
   for (ModelSize size : study.sizes) {
     for (int n : study.n_train) {
       for (Regularizer reg : study.regularizers) {
-        for (double weight : weights_of(study, reg, training)) {
-          const std::string label = axes.label(size, n, reg, weight);
-          if (std::find(table.columns.begin(), table.columns.end(), label) == table.columns.end()) {
-            table.columns.push_back(label);
+        for (std::size_t v = 0; v < budgets.variants.size(); ++v) {
+          for (double weight : weights_of(study, reg, budgets.variants[v])) {
+            for (int steps : budgets.steps) {
+              const std::string label =
+                  join_label(axes.label(size, n, reg, weight), budgets.suffix(v, steps));
+              if (std::find(table.columns.begin(), table.columns.end(), label) ==
+                  table.columns.end()) {
+                table.columns.push_back(label);
+              }
+            }
           }
         }
       }
@@ -179,7 +219,8 @@ void set_system(const SweepSpec& spec, const std::string& name, RunConfig* run) 
 }
 
 // Every run of `study`, nested system, model, size, n_train, regularizer,
-// lambda (regularized runs only), seed (seed fastest).
+// [search] variant, lambda (regularized runs only), [search] rung, seed
+// (seed fastest).
 void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
                   std::map<std::string, int>* index_of) {
   ColumnAxes axes;
@@ -187,7 +228,8 @@ void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
   axes.n_train = study.n_train.size() > 1;
   axes.regularizer = study.regularizers.size() > 1;
   axes.lambda = study.lambdas.size() > 1;
-  StudyTable table = table_frame(study, axes, spec.training);
+  const Budgets budgets(spec);
+  StudyTable table = table_frame(study, axes, budgets);
   RunConfig run;
   run.data = spec.data;
   run.training = spec.training;
@@ -202,12 +244,19 @@ void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
           run.n_train = n;
           for (Regularizer reg : study.regularizers) {
             run.regularizer = reg;
-            for (double weight : weights_of(study, reg, spec.training)) {
-              run.training = spec.training;
-              run.training.set_weight(reg, weight);
-              for (int seed : study.seeds) {
-                run.seed = seed;
-                add_run(run, axes.label(size, n, reg, weight), grid, &table, index_of);
+            for (std::size_t v = 0; v < budgets.variants.size(); ++v) {
+              for (double weight : weights_of(study, reg, budgets.variants[v])) {
+                for (int steps : budgets.steps) {
+                  run.training = budgets.variants[v];
+                  run.training.set_weight(reg, weight);
+                  run.training.steps = steps;
+                  const std::string label =
+                      join_label(axes.label(size, n, reg, weight), budgets.suffix(v, steps));
+                  for (int seed : study.seeds) {
+                    run.seed = seed;
+                    add_run(run, label, grid, &table, index_of);
+                  }
+                }
               }
             }
           }

@@ -13,6 +13,7 @@
 
 #include "phnn/sweep/output_check.h"
 #include "sweep/sweep_file_adaptive.h"
+#include "sweep/sweep_file_search.h"
 #include "sweep/sweep_file_systems.h"
 #include "sweep/sweep_file_values.h"
 
@@ -43,7 +44,7 @@ using KeyLines = std::map<std::string, int>;
 
 const char kTableList[] =
     "[data], [training], [grid], [physics.harmonic], [physics.duffing], "
-    "[physics.self-sustained], [study.NAME], [adaptive]";
+    "[physics.self-sustained], [study.NAME], [adaptive], [search]";
 
 class TableWalker {
  public:
@@ -65,6 +66,7 @@ class TableWalker {
     check_lambdas();
     check_knobs_change_runs();
     if (spec_.adaptive.enabled) apply_adaptive(&spec_, adaptive_header_, values_);
+    if (search_table_) read_search();
     return spec_;
   }
 
@@ -96,17 +98,34 @@ class TableWalker {
     } else if (e.key == "adaptive") {
       adaptive_header_ = e.line;
       spec_.adaptive = read_adaptive_table(e, values_);
+    } else if (e.key == "search") {
+      search_header_ = e.line;
+      search_table_ = &values_.table(e, "[search]");
     } else if (e.value->is_table() || e.value->is_array_of_tables()) {
       fail(e.line,
            "unknown table [" + e.key + "]" +
                did_you_mean(e.key, {"data", "training", "grid", "physics.harmonic",
                                     "physics.duffing", "physics.self-sustained", "study.NAME",
-                                    "adaptive"}) +
+                                    "adaptive", "search"}) +
                "; expected one of: " + kTableList);
     } else {
       fail(e.line, "unknown key " + quoted(e.key) + " in the top level (before any [table])" +
                        did_you_mean(e.key, {"name", "output"}) + "; expected one of: name, output");
     }
+  }
+
+  // [search], once [training] and the studies are final.
+  void read_search() {
+    const TrainingKeySetter set = [this](TrainerOptions& t, const Entry& e) {
+      for (auto& [key, handler] : training_handlers(t)) {
+        if (key == e.key) {
+          handler(e);
+          return true;
+        }
+      }
+      return false;
+    };
+    apply_search(&spec_, *search_table_, search_header_, training_lines_, values_, set);
   }
 
   void physics_tables(const toml::table& physics) {
@@ -461,7 +480,8 @@ class TableWalker {
   KeyLines data_lines_, training_lines_;
   std::map<SystemKind, KeyLines> physics_lines_;
   std::map<SystemKind, int> physics_header_;
-  int data_header_ = 1, training_header_ = 1, adaptive_header_ = 1;
+  int data_header_ = 1, training_header_ = 1, adaptive_header_ = 1, search_header_ = 1;
+  const toml::table* search_table_ = nullptr;
   bool has_name_ = false, has_output_ = false;
 };
 

@@ -2,6 +2,7 @@
 // (CellCheckpointing in phnn/training/trainer.h): everything the remaining
 // steps read, so a restored trainer ends bitwise as an uninterrupted one.
 // Touches no file (the caller stores the bytes).
+#include <algorithm>
 #include <stdexcept>
 
 #include "training/cell_trainer.h"
@@ -27,21 +28,31 @@ void put_identity(StateWriter* out, const CellSpec& cell, const torch::Tensor& f
   out->put<std::int32_t>(static_cast<std::int32_t>(flat.scalar_type()));
 }
 
-void check_identity(StateReader* in, const CellSpec& cell, const torch::Tensor& flat) {
+// A state of this cell, or of the same cell at a smaller step budget that
+// is a validation step here (continuing it equals training straight
+// through: the budget enters nothing before the last step but its
+// validation, which this cell makes too). Returns the state's budget.
+int check_identity(StateReader* in, const CellSpec& cell, const torch::Tensor& flat) {
   StateWriter expected;
   put_identity(&expected, cell, flat);
   StateReader mine(expected.bytes());
-  const bool same = in->get_string() == mine.get_string() &&
+  const bool head = in->get_string() == mine.get_string() &&
                     in->get<std::int32_t>() == mine.get<std::int32_t>() &&
-                    in->get_vector<int>() == mine.get_vector<int>() &&
-                    in->get<std::int32_t>() == mine.get<std::int32_t>() &&
-                    in->get<std::int32_t>() == mine.get<std::int32_t>() &&
+                    in->get_vector<int>() == mine.get_vector<int>();
+  const std::int32_t budget = in->get<std::int32_t>();
+  mine.get<std::int32_t>();
+  const TrainerOptions& t = cell.training;
+  const bool budget_fits =
+      budget == t.steps ||
+      (budget < t.steps && budget % t.eval_every == 0 && t.checkpoints.empty());
+  const bool same = head && budget_fits && in->get<std::int32_t>() == mine.get<std::int32_t>() &&
                     in->get<std::int64_t>() == mine.get<std::int64_t>() &&
                     in->get<std::int32_t>() == mine.get<std::int32_t>();
   if (!same) {
     throw std::invalid_argument(
         "training state belongs to another cell (seeds, steps, N_train or model differ)");
   }
+  return budget;
 }
 
 void put_trace(StateWriter* out, const std::vector<TracePoint>& trace) {
@@ -100,7 +111,7 @@ std::string CellTrainer::save_state(int step) const {
 
 void CellTrainer::restore_state(const std::string& state) {
   StateReader in(state);
-  check_identity(&in, cell_, flat_.values);
+  const int budget = check_identity(&in, cell_, flat_.values);
   first_step_ = in.get<std::int32_t>() + 1;
   next_checkpoint_ = in.get<std::uint64_t>();
   elapsed_before_ = in.get<double>();
@@ -130,6 +141,11 @@ void CellTrainer::restore_state(const std::string& state) {
     r.checkpoint_train_seconds = in.get_vector<double>();
   }
   if (!in.at_end()) throw std::invalid_argument("training state: bytes left over");
+  // A smaller budget's final state whose members all diverged: training
+  // straight through stopped there too.
+  if (budget < opt_.steps && std::none_of(alive_.begin(), alive_.end(), [](bool a) { return a; })) {
+    first_step_ = opt_.steps + 1;
+  }
   start_ = Clock::now();
   last_save_ = elapsed();
 }

@@ -158,7 +158,9 @@ torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor
 // Steps first_step_..steps (1.. unless a saved state was restored).
 void CellTrainer::train() {
   if (first_step_ == 1) validate(0);
+  int last = first_step_ - 1;
   for (int s = first_step_; s <= opt_.steps; ++s) {
+    last = s;
     step(s, *sampler_);
     if (s % opt_.eval_every == 0 || s == opt_.steps) validate(s);
     if (next_checkpoint_ < opt_.checkpoints.size() && s == opt_.checkpoints[next_checkpoint_]) {
@@ -168,6 +170,7 @@ void CellTrainer::train() {
     if (std::none_of(alive_.begin(), alive_.end(), [](bool a) { return a; })) break;
     save_if_due(s);
   }
+  if (checkpointing_ && checkpointing_->save_final) checkpointing_->save_final(save_state(last), last);
 }
 
 // One Adam step on a minibatch (every pair when N <= batch: no gather).

@@ -2,7 +2,9 @@
 // cell (CellCheckpointing): a cell stopped and resumed, once or twice, ends
 // bitwise as the uninterrupted cell (weights, MSE, trace, budget
 // checkpoints, frozen members), on built-in and file-defined systems, in
-// float64 and float32; a state that does not fit the cell is refused.
+// float64 and float32; a rung's final state ([search]) goes on to a larger
+// step budget bitwise as training straight through; a state that does not
+// fit the cell is refused.
 #include <functional>
 #include <string>
 #include <vector>
@@ -165,6 +167,105 @@ TEST(CellCheckpointTest, TimedSavesChangeNothing) {
   CellCheckpointing resume;
   resume.resume_from = states[10];
   expect_same_results(train_cell(cell, duffing(), {}, nullptr, &resume), plain);
+}
+
+// Trains `cell` at each budget of `budgets` in turn, each going on from the
+// final state of the one before (save_final), as [search] rungs do.
+std::vector<RunResult> through_rungs(CellSpec cell, const std::vector<int>& budgets,
+                                     const std::function<std::vector<RunResult>(
+                                         const CellSpec&, const CellCheckpointing*)>& train) {
+  std::string state;
+  std::vector<RunResult> results;
+  for (int budget : budgets) {
+    cell.training.steps = budget;
+    CellCheckpointing c;
+    c.resume_from = state;
+    c.save = [](const std::string&, int) {};
+    c.save_final = [&](const std::string& s, int) { state = s; };
+    results = train(cell, &c);
+  }
+  return results;
+}
+
+// [search] rungs: PHNN-JR-DG + CN with batches (N_train 100 > 64), NODE-RK2,
+// and float32 PHNN-S whose members diverge (frozen, or all of them dead
+// before the rung ends) go on from 20 to 40 to 60 steps bitwise as 60
+// steps straight through.
+TEST(CellCheckpointTest, ARungsFinalStateGoesOnBitwiseToALargerBudget) {
+  CellSpec jr;
+  jr.model = ModelKind::kPhnnJr;
+  jr.integrator = IntegratorKind::kDg;
+  jr.n_train = 100;
+  jr.regularizer = Regularizer::kCn;
+  jr.training.eval_every = 10;
+  jr.seeds = {3, 8};
+  CellSpec node = jr;
+  node.model = ModelKind::kNode;
+  node.integrator = IntegratorKind::kRk2;
+  node.regularizer = Regularizer::kNone;
+  CellSpec diverging;
+  diverging.model = ModelKind::kPhnnS;
+  diverging.training.precision = Precision::kFloat32;
+  diverging.training.eval_every = 10;
+  diverging.training.learning_rate = 1e3;
+  diverging.seeds = {0, 1, 2};
+  CellSpec all_dead = diverging;
+  all_dead.seeds = {0, 1};
+  for (const CellSpec* cell : {&jr, &node, &diverging, &all_dead}) {
+    const auto& data = cell == &jr || cell == &node ? duffing() : harmonic();
+    const auto train = [&](const CellSpec& c, const CellCheckpointing* k) {
+      return train_cell(c, data, {}, nullptr, k);
+    };
+    CellSpec straight = *cell;
+    straight.training.steps = 60;
+    const auto plain = train(straight, nullptr);
+    if (cell == &diverging || cell == &all_dead) {  // the members the comment says diverge do
+      for (std::size_t e = 0; e < 2; ++e) {
+        EXPECT_THAT(plain[e].message, HasSubstr("training loss non-finite")) << e;
+        EXPECT_LT(plain[e].trace.back().step, 20) << e;
+      }
+    }
+    expect_same_results(through_rungs(*cell, {20, 40, 60}, train), plain);
+  }
+}
+
+// A rung's state goes on only to a larger budget that is a validation step
+// of the cell, without budget checkpoints.
+TEST(CellCheckpointTest, ARungsStateFitsOnlyALargerValidationStep) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnS;
+  cell.training.steps = 20;
+  cell.training.eval_every = 10;
+  cell.seeds = {0, 1};
+  std::string state;
+  CellCheckpointing c;
+  c.save = [](const std::string&, int) {};
+  c.save_final = [&](const std::string& s, int) { state = s; };
+  train_cell(cell, harmonic(), {}, nullptr, &c);
+  ASSERT_FALSE(state.empty());
+  auto outcome = [&](CellSpec other) {
+    CellCheckpointing r;
+    r.resume_from = state;
+    try {
+      train_cell(other, harmonic(), {}, nullptr, &r);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  CellSpec larger = cell;
+  larger.training.steps = 30;
+  EXPECT_EQ(outcome(larger), "accepted");
+  CellSpec smaller = cell;
+  smaller.training.steps = 10;
+  EXPECT_THAT(outcome(smaller), HasSubstr("another cell"));
+  CellSpec off_step = cell;  // 20 is no validation step at eval_every 15
+  off_step.training.steps = 45;
+  off_step.training.eval_every = 15;
+  EXPECT_THAT(outcome(off_step), HasSubstr("another cell"));
+  CellSpec with_checkpoints = larger;
+  with_checkpoints.training.checkpoints = {30};
+  EXPECT_THAT(outcome(with_checkpoints), HasSubstr("another cell"));
 }
 
 // A state of other seeds, other steps or cut short is refused before training.

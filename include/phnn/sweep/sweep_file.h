@@ -166,6 +166,29 @@ struct AdaptiveSpec {
   std::vector<int> initial_seeds;
 };
 
+/// [search]: successive halving over settings (sweeps/FORMAT.md, docs/METHOD.md
+/// "Search"). A configuration is a cell without its step budget: a model,
+/// size, N_train, regularizer, weight and one `variants` entry. Every
+/// configuration trains its seeds to rungs[0] steps; of each study's
+/// configurations on a system, the best ceil(n / eta) by the median over
+/// seeds of the best validation loss go on to the next rung, from their
+/// saved training state, and so on to the last rung.
+struct SearchSpec {
+  bool enabled = false;
+  /// Step budgets, strictly increasing, each a multiple of eval_every (so
+  /// training on from a rung equals training straight through).
+  std::vector<int> rungs;
+  int eta = 3;
+  /// The search axes: [training] keys given a list of values in [search],
+  /// in file order (e.g. "learning_rate").
+  std::vector<std::string> axes;
+  /// [training] with one value of every axis set, for every combination
+  /// (the first axis slowest); one entry (the [training] table) without axes.
+  std::vector<TrainerOptions> variants;
+  /// "learning_rate=0.001/batch_size=32" per variant ("" without axes).
+  std::vector<std::string> variant_labels;
+};
+
 /// A parsed and validated sweep file: docs/METHOD.md defaults overridden by the file.
 ///
 ///   const SweepSpec spec = parse_sweep_file("sweeps/paper.toml");
@@ -197,6 +220,8 @@ struct SweepSpec {
   std::vector<SweepSystemFile> system_files;
   /// [adaptive]; enabled = false without it.
   AdaptiveSpec adaptive;
+  /// [search]; enabled = false without it.
+  SearchSpec search;
 
   /// The system file named `name`, or nullptr for a built-in system.
   const SweepSystemFile* system_file(const std::string& name) const;

@@ -74,14 +74,20 @@ struct CellCheckpointing {
   /// stopped.
   double interval_s = 0.0;
   /// A state `save` received earlier for this same cell (spec, seeds and
-  /// data); empty: start at step 0. One that does not fit the cell throws
-  /// std::invalid_argument before any training.
+  /// data), or `save_final` received for it at a smaller step budget that is
+  /// a validation step of this one (a [search] rung: training goes on to
+  /// the larger budget, bitwise as training straight through); empty: start
+  /// at step 0. One that does not fit the cell throws std::invalid_argument
+  /// before any training.
   std::string resume_from;
   /// Receives each state and the step it ends; required.
   std::function<void(const std::string& state, int step)> save;
   /// Polled after every step (keep it cheap); true: save the state and
   /// throw CellInterrupted.
   std::function<bool()> stop_requested;
+  /// When set, receives the state after the last step (before inference):
+  /// what a cell of the same runs at a larger step budget goes on from.
+  std::function<void(const std::string& state, int step)> save_final;
 };
 
 /// Thrown by train_cell when CellCheckpointing::stop_requested said stop,

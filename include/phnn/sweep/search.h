@@ -1,0 +1,66 @@
+// include/phnn/sweep/search.h — successive halving over settings ([search]
+// in a sweep file, docs/METHOD.md "Search"): which runs the rungs have asked
+// for, decided from finished results alone. Pure functions over a Grid and
+// its runs' statuses and best validation losses; no HDF5, no MPI: the sweep
+// and the reducer call them on what the results file holds.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "phnn/config/run_result.h"
+#include "phnn/sweep/adaptive.h"
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/sweep_file.h"
+
+namespace phnn {
+
+/// One configuration at one rung of one group (a study's configurations on
+/// one system): its cell, the median over its finished seeds of the
+/// criterion (best validation loss; a diverged seed +inf, a failed one left
+/// out; +inf when none is left) and of the inference MSE, and whether it
+/// went on to the next rung.
+struct SearchEntry {
+  int cell = -1;
+  std::string label;  // the cell's table row and column: "PHNN-S-DG small/learning_rate=0.001"
+  double criterion = 0.0, mse = 0.0;
+  bool kept = false;
+};
+
+/// A group's rungs as far as they were decided: rungs[r] lists the
+/// configurations that trained to spec.search.rungs[r], best criterion first.
+struct SearchGroup {
+  std::string study, system;
+  std::vector<std::vector<SearchEntry>> rungs;
+};
+
+struct SearchReplay {
+  /// As for adaptive sweeps: active runs, the round (rung) in progress or
+  /// the last, complete, and per finished rung the configurations kept.
+  AdaptiveState state;
+  std::vector<SearchGroup> groups;
+};
+
+/// Replays the rungs on the results so far (status[i], criterion[i] =
+/// best validation loss and mse[i] of grid.runs[i]): rung 0 asks for every
+/// configuration's runs at rungs[0] steps; when every run asked for has
+/// finished, each group keeps its best ceil(n / eta) configurations (ties
+/// by grid order) and asks for their runs at the next rung; stops at the
+/// first rung with a pending run, after the last rung, or after rung
+/// `last_round` (>= 0). The same whichever ranks trained which runs, and
+/// after any kill. Throws std::invalid_argument unless spec.search.enabled
+/// and the sizes match.
+SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
+                           const std::vector<RunStatus>& status,
+                           const std::vector<double>& criterion, const std::vector<double>& mse,
+                           int last_round = -1);
+
+/// The key of the configuration of `run`: its cell key at step budget 0.
+std::string configuration_key(const RunConfig& run);
+
+/// The Markdown report of a replay: per group and rung, each configuration's
+/// criterion and MSE medians and whether it went on; the winner (the best
+/// criterion at the last rung).
+std::string search_report(const SweepSpec& spec, const SearchReplay& replay);
+
+}  // namespace phnn

@@ -1,0 +1,221 @@
+// src/sweep/search.cpp — successive halving ([search]): the rungs replayed
+// from finished results (each group keeps its best ceil(n / eta)
+// configurations by the median best validation loss over seeds), and their
+// Markdown report. Reads the grid; writes nothing.
+#include "phnn/sweep/search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+
+namespace phnn {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A configuration of a group: its cell at each rung (-1: none).
+struct Configuration {
+  std::string label;
+  std::vector<int> cells;
+};
+
+struct Group {
+  std::string study, system;
+  std::vector<Configuration> configurations;
+};
+
+// "small/learning_rate=0.001/steps=5000" -> "small/learning_rate=0.001";
+// "steps=5000" -> "".
+std::string without_budget(const std::string& column) {
+  const std::size_t at = column.rfind("steps=");
+  if (at == std::string::npos) return column;
+  return at == 0 ? "" : column.substr(0, at - 1);
+}
+
+// The groups of the grid: per study and system, its configurations in grid
+// order, each with its cell per rung.
+std::vector<Group> groups_of(const SweepSpec& spec, const Grid& grid) {
+  std::vector<int> cell_of(grid.runs.size(), -1);
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    for (int r : grid.cells[c].runs) cell_of[static_cast<std::size_t>(r)] = static_cast<int>(c);
+  }
+  const std::vector<int>& rungs = spec.search.rungs;
+  std::vector<Group> groups;
+  for (const StudyTable& study : grid.studies) {
+    for (const std::string& system : study.systems) {
+      Group g{study.name, system, {}};
+      std::map<std::string, std::size_t> index;  // configuration key -> position
+      for (std::size_t i = 0; i < study.runs.size(); ++i) {
+        const RunConfig& run = grid.runs[static_cast<std::size_t>(study.runs[i])];
+        if (run.system_name() != system) continue;
+        const auto rung = std::find(rungs.begin(), rungs.end(), run.training.steps) - rungs.begin();
+        if (rung == static_cast<long>(rungs.size())) {
+          throw std::invalid_argument("replay_search: a run of " + std::to_string(run.training.steps) +
+                                      " steps is at no rung");
+        }
+        const auto [it, added] = index.emplace(configuration_key(run), g.configurations.size());
+        if (added) {
+          const std::string column = without_budget(study.run_columns[i]);
+          g.configurations.push_back(
+              {model_label(run.model, run.integrator) + (column.empty() ? "" : " " + column),
+               std::vector<int>(rungs.size(), -1)});
+        }
+        g.configurations[it->second].cells[static_cast<std::size_t>(rung)] =
+            cell_of[static_cast<std::size_t>(study.runs[i])];
+      }
+      groups.push_back(std::move(g));
+    }
+  }
+  return groups;
+}
+
+// Median with infinities: the middle value, or the mean of the two middle
+// ones (+inf if either is); +inf for no values.
+double median_of(std::vector<double> v) {
+  if (v.empty()) return kInf;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  if (n % 2 == 1) return v[n / 2];
+  const double a = v[n / 2 - 1], b = v[n / 2];
+  return std::isinf(a) || std::isinf(b) ? std::max(a, b) : 0.5 * (a + b);
+}
+
+// The entry of `cell` from its finished runs: criterion and MSE medians,
+// a diverged run +inf in both, a failed one left out.
+SearchEntry entry_of(const Grid& grid, int cell, const std::string& label,
+                     const std::vector<RunStatus>& status, const std::vector<double>& criterion,
+                     const std::vector<double>& mse) {
+  std::vector<double> c, m;
+  for (int r : grid.cells[static_cast<std::size_t>(cell)].runs) {
+    const auto i = static_cast<std::size_t>(r);
+    if (status[i] == RunStatus::kDone) {
+      c.push_back(std::isnan(criterion[i]) ? kInf : criterion[i]);
+      m.push_back(mse[i]);
+    } else if (status[i] == RunStatus::kDiverged) {
+      c.push_back(kInf);
+      m.push_back(kInf);
+    }
+  }
+  return SearchEntry{cell, label, median_of(c), median_of(m), false};
+}
+
+}  // namespace
+
+std::string configuration_key(const RunConfig& run) {
+  RunConfig c = run;
+  c.training.steps = 0;
+  return c.cell_key();
+}
+
+SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
+                           const std::vector<RunStatus>& status,
+                           const std::vector<double>& criterion, const std::vector<double>& mse,
+                           int last_round) {
+  if (!spec.search.enabled || status.size() != grid.runs.size() ||
+      criterion.size() != grid.runs.size() || mse.size() != grid.runs.size()) {
+    throw std::invalid_argument("replay_search: needs [search] and one status, criterion and MSE per run");
+  }
+  const std::vector<Group> groups = groups_of(spec, grid);
+  const std::size_t R = spec.search.rungs.size();
+  SearchReplay out;
+  AdaptiveState& state = out.state;
+  state.active.assign(grid.runs.size(), 0);
+  // alive[g][k]: configuration k of group g trains at the current rung.
+  std::vector<std::vector<char>> alive;
+  for (const Group& g : groups) {
+    alive.emplace_back(g.configurations.size(), 1);
+    out.groups.push_back({g.study, g.system, {}});
+  }
+  for (std::size_t r = 0; r < R; ++r) {
+    state.round = static_cast<int>(r);
+    state.pending = state.failed = 0;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      for (std::size_t k = 0; k < alive[g].size(); ++k) {
+        const int cell = groups[g].configurations[k].cells[r];
+        if (!alive[g][k] || cell < 0) continue;
+        for (int run : grid.cells[static_cast<std::size_t>(cell)].runs) {
+          state.active[static_cast<std::size_t>(run)] = 1;
+        }
+      }
+    }
+    for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+      if (!state.active[i] || grid.runs[i].training.steps != spec.search.rungs[r]) continue;
+      state.pending += status[i] == RunStatus::kPending ? 1 : 0;
+      state.failed += status[i] == RunStatus::kFailed ? 1 : 0;
+    }
+    if (state.pending > 0) return out;
+    const bool last = r + 1 == R || static_cast<int>(r) == last_round;
+    int kept_total = 0;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      std::vector<SearchEntry> entries;
+      std::vector<std::size_t> which;
+      for (std::size_t k = 0; k < alive[g].size(); ++k) {
+        const Configuration& conf = groups[g].configurations[k];
+        if (!alive[g][k] || conf.cells[r] < 0) continue;
+        entries.push_back(entry_of(grid, conf.cells[r], conf.label, status, criterion, mse));
+        which.push_back(k);
+      }
+      std::vector<std::size_t> order(entries.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return entries[a].criterion < entries[b].criterion;
+      });
+      const std::size_t keep = (entries.size() + static_cast<std::size_t>(spec.search.eta) - 1) /
+                               static_cast<std::size_t>(spec.search.eta);
+      std::vector<SearchEntry> sorted;
+      std::vector<char> next(alive[g].size(), 0);
+      for (std::size_t i = 0; i < order.size(); ++i) {
+        SearchEntry e = entries[order[i]];
+        e.kept = !last && i < keep;
+        if (e.kept) next[which[order[i]]] = 1;
+        kept_total += e.kept ? 1 : 0;
+        sorted.push_back(e);
+      }
+      out.groups[g].rungs.push_back(std::move(sorted));
+      alive[g] = std::move(next);
+    }
+    if (last) {
+      state.complete = r + 1 == R;
+      return out;
+    }
+    state.cells_grown.push_back(kept_total);
+  }
+  return out;
+}
+
+std::string search_report(const SweepSpec& spec, const SearchReplay& replay) {
+  std::ostringstream out;
+  const auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3e", v);
+    return std::isinf(v) ? std::string("inf") : std::string(text);
+  };
+  for (const SearchGroup& g : replay.groups) {
+    out << "### Search " << g.study << " — " << g.system << "\n\n";
+    for (std::size_t r = 0; r < g.rungs.size(); ++r) {
+      const bool last = r + 1 == spec.search.rungs.size();
+      out << "Rung " << r << " (" << spec.search.rungs[r] << " steps): " << g.rungs[r].size()
+          << " configuration" << (g.rungs[r].size() == 1 ? "" : "s")
+          << (last ? "" : ", the best 1/" + std::to_string(spec.search.eta) + " go on") << "\n\n"
+          << "| configuration | best validation loss | MSE | |\n|---|---|---|---|\n";
+      for (const SearchEntry& e : g.rungs[r]) {
+        out << "| " << e.label << " | " << number(e.criterion) << " | " << number(e.mse) << " | "
+            << (e.kept ? "on" : "") << " |\n";
+      }
+      out << "\n";
+    }
+    if (replay.state.complete && !g.rungs.empty() && !g.rungs.back().empty()) {
+      const SearchEntry& best = g.rungs.back().front();
+      out << "Best: **" << best.label << "** (best validation loss " << number(best.criterion)
+          << ", inference MSE " << number(best.mse) << ", medians over seeds)\n\n";
+    }
+  }
+  return out.str();
+}
+
+}  // namespace phnn
