@@ -20,6 +20,7 @@
 #include "phnn/report/tables.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/adaptive.h"
+#include "phnn/sweep/search.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
 
@@ -205,6 +206,7 @@ std::optional<AdaptiveState> adaptive_rounds(const SweepSpec& spec, const Grid& 
                                              const std::vector<RunStatus>& statuses,
                                              const std::vector<double>& mse,
                                              const cli::Parser& parser, const std::string& path) {
+  if (spec.search.enabled) return std::nullopt;  // search_rungs
   if (!spec.adaptive.enabled) {
     if (parser.has("round")) {
       throw cli::UsageError{"phnn reduce: --round: " + path + " is not an adaptive sweep (its "
@@ -256,6 +258,7 @@ struct Inputs {
   std::vector<int> damaged;
   std::vector<RunStatus> statuses;
   std::vector<double> mse;
+  std::vector<double> best_validation;  // [search]'s criterion
 };
 
 Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
@@ -265,6 +268,7 @@ Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
   auto statuses = file.read_statuses();
   for (int row : in.damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
   auto mse = file.read_double_column("mse");
+  auto best_validation = file.read_double_column("best_validation_loss");
   SweepSpec own;
   try {
     own = parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
@@ -280,12 +284,24 @@ Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
     for (std::size_t i = 0; i < statuses.size(); ++i) in.view.row[i] = static_cast<int>(i);
     in.statuses = std::move(statuses);
     in.mse = std::move(mse);
+    in.best_validation = std::move(best_validation);
     return in;
   }
   in.view = rule_view(file, parser.get("rule"));
   in.statuses = through_view(in.view, statuses, RunStatus::kPending);
   in.mse = through_view(in.view, mse, std::numeric_limits<double>::quiet_NaN());
+  in.best_validation =
+      through_view(in.view, best_validation, std::numeric_limits<double>::quiet_NaN());
   return in;
+}
+
+// A [search] sweep's rungs as far as decided (up to --round K); nothing
+// for other sweeps.
+std::optional<SearchReplay> search_rungs(const SweepSpec& spec, const Grid& grid,
+                                         const Inputs& in, const cli::Parser& parser) {
+  if (!spec.search.enabled) return std::nullopt;
+  const int last = parser.has("round") ? parser.get_int_in("round", 0, 1 << 20) : -1;
+  return replay_search(spec, grid, in.statuses, in.best_validation, in.mse, last);
 }
 
 // --rule: a replay that stops at a round the file cannot finish says so.
@@ -448,8 +464,10 @@ int run_reduce(int argc, char** argv, int first) {
   const SweepSpec& spec = in.view.spec;
   const Grid& grid = in.view.grid;
   const std::vector<RunStatus>& statuses = in.statuses;
+  const std::optional<SearchReplay> search = search_rungs(spec, grid, in, parser);
   const std::optional<AdaptiveState> adaptive =
-      adaptive_rounds(spec, grid, statuses, in.mse, parser, path);
+      search ? std::optional<AdaptiveState>(search->state)
+             : adaptive_rounds(spec, grid, statuses, in.mse, parser, path);
   if (adaptive) warn_unfinished_replay(in, *adaptive, parser, path);
   if (per_run) {
     std::vector<RunRecord> records = view_records(file, in);
@@ -488,6 +506,11 @@ int run_reduce(int argc, char** argv, int first) {
       if (!adaptive || adaptive->active[i]) covered.push_back(statuses[i]);
     }
     print_markdown_preamble(file, spec, covered, seeds_summary, view.statistic);
+    if (search) {  // the rungs, not a table of every configuration x rung
+      std::cout << search_report(spec, *search)
+                << "(every cell of every rung: phnn reduce --format csv or --per-run)\n";
+      return 0;
+    }
     if (adaptive) {
       print_adaptive_preamble(spec, *adaptive, parser.has("rule") ? parser.get("rule") : "");
     }

@@ -39,7 +39,9 @@
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "phnn/store/scratch_file.h"
+#include "apps/sweep_search.h"
 #include "phnn/sweep/adaptive.h"
+#include "phnn/sweep/search.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"
 #include "phnn/sweep/output_check.h"
@@ -173,6 +175,8 @@ class SweepRun {
           std::cout << plan_items_csv(grid_, plan_work(grid_, ranks_.front(), split_));
         } else if (spec_.adaptive.enabled) {
           std::cout << adaptive_dry_run();
+        } else if (spec_.search.enabled) {
+          std::cout << search_dry_run(spec_, grid_, ranks_, split_);
         } else {
           std::cout << dry_run_summary(grid_, ranks_, split_);
         }
@@ -192,7 +196,7 @@ class SweepRun {
     }
     mpi::broadcast(world_, status_codes, 0);
     mpi::broadcast(world_, session_, 0);
-    if (spec_.adaptive.enabled) {
+    if (in_rounds()) {
       if (int status = replay_rounds(&status_codes)) return status;
     }
     if (int status = open_results()) return status;
@@ -208,7 +212,8 @@ class SweepRun {
     parser_.get_int_in("threads", 1, 4096);
     // 0: save a cell's training state only when stopped by a signal.
     checkpoint_every_ = parser_.get_double_in("checkpoint-every", 0, 1e9);
-    state_key_ = spec_.text_hash + " " + git_commit() + " threads=" + parser_.get("threads");
+    build_key_ = git_commit() + " threads=" + parser_.get("threads");
+    state_key_ = spec_.text_hash + " " + build_key_;
     if (parser_.flag_set("cell-costs") && !parser_.flag_set("dry-run")) {
       throw cli::UsageError{"phnn sweep: --cell-costs prints the cost model's estimates and trains "
                             "nothing: add --dry-run"};
@@ -219,6 +224,11 @@ class SweepRun {
                             "nothing: use it with --dry-run, without --cell-costs"};
     }
     split_ = split_options(parser_);
+    // [search]: a rung's item goes on from the state of the same seeds at
+    // the rung before, so cells stay whole unless --split asks otherwise.
+    if (spec_.search.enabled && !parser_.has("split") && !parser_.has("max-group-size")) {
+      split_.mode = SplitOptions::Mode::kOff;
+    }
     if (parser_.has("shard")) {
       try {
         shard_ = Shard::parse(parser_.get("shard"));
@@ -226,10 +236,10 @@ class SweepRun {
         throw cli::UsageError{cli::with_prefix("phnn sweep: ", e.what())};
       }
     }
-    if (spec_.adaptive.enabled && shard_.count > 1) {
-      throw cli::UsageError{"phnn sweep: --shard: an adaptive sweep ([adaptive]) decides each "
-                            "round from every cell's results, which one shard does not hold; "
-                            "run it as one job (its ranks share the cells)"};
+    if (in_rounds() && shard_.count > 1) {
+      throw cli::UsageError{"phnn sweep: --shard: an adaptive or search sweep ([adaptive], "
+                            "[search]) decides each round from every cell's results, which one "
+                            "shard does not hold; run it as one job (its ranks share the cells)"};
     }
     ranks_ = dry_run_ranks(parser_, size_);
     if (parser_.flag_set("items") && ranks_.size() != 1) {
@@ -339,6 +349,8 @@ class SweepRun {
     });
   }
   int replay_rounds(std::vector<int>* status_codes);
+  // Trained in rounds decided on the results: [adaptive] or [search].
+  bool in_rounds() const { return spec_.adaptive.enabled || spec_.search.enabled; }
   std::string adaptive_dry_run() const;
   std::string adaptive_line() const;
   // Seconds since this sweep started.
@@ -365,6 +377,9 @@ class SweepRun {
   // the build (a changed trainer would mix two builds in one cell) and the
   // intra-op thread count.
   std::string state_key_;
+  // The build and thread count alone: what a [search] rung state must match
+  // besides its runs' configurations and seeds (apps/sweep_search.h).
+  std::string build_key_;
   std::string out_;
   WriterLock lock_;  // rank 0 only; released after the file is closed
   std::optional<ResultsFile> results_;
@@ -513,7 +528,7 @@ SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
                               shard_, &p.runs_done_before);
   planned_once_ = true;
   for (const auto& runs : pending) p.runs_to_do += static_cast<int>(runs.size());
-  if (spec_.adaptive.enabled) {  // the seeds no round asked for read as finished
+  if (in_rounds()) {  // the runs no round asked for read as finished
     p.runs_done_before -= static_cast<int>(grid_.runs.size()) - adaptive_.active_runs();
   }
   std::vector<std::vector<int>> resumed;
@@ -576,6 +591,7 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
     const CellSpec cell = cell_spec_for(head, seeds);
     ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, state_key_),
                                 checkpoint_every_, &g_stop_signal, prefix_);
+    link_rung_states(spec_, grid_, item.runs, out_, build_key_, &checkpoints);
     if (!quiet) announce_item(prefix_, i + 1, work.size(), head, cell, checkpoints.resume_step());
     const auto cell_start = Clock::now();
     const std::string started = utc_now();
@@ -623,7 +639,7 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
     my_runs += round.my_runs;
     const bool io_failed =
         mpi::all_reduce(world_, round.io_error.empty() ? 0 : 1, mpi::maximum<int>()) != 0;
-    if (!spec_.adaptive.enabled || round.stopped || io_failed) break;
+    if (!in_rounds() || round.stopped || io_failed) break;
     std::string close_error;
     try {
       results_->close();
@@ -658,7 +674,12 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
   if (int status = agreed(world_, root_, [&] {
         const ResultsFile file = ResultsFile::open_read_only(out_);
         const std::vector<RunStatus> statuses = file.read_statuses();
-        adaptive_ = replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
+        adaptive_ = spec_.search.enabled
+                        ? replay_search(spec_, grid_, statuses,
+                                        file.read_double_column("best_validation_loss"),
+                                        file.read_double_column("mse"))
+                              .state
+                        : replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
         for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
       })) {
     return status;
@@ -682,7 +703,9 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
                  "rounds were decided without them; --retry-failed retries them and the rounds "
                  "after are decided again" << std::endl;
   }
-  if (root_ && !adaptive_.complete) {
+  if (root_ && spec_.search.enabled && !adaptive_.complete) {
+    std::cout << search_round_line(spec_, adaptive_) << std::endl;
+  } else if (root_ && !adaptive_.complete) {
     std::cout << "phnn sweep: adaptive round " << round << ": " << adaptive_.active_runs()
               << " runs asked for of at most " << grid_.runs.size() << " ("
               << (round == 0 ? std::string("every cell's first ") +
@@ -709,6 +732,7 @@ std::string SweepRun::adaptive_dry_run() const {
 }
 
 std::string SweepRun::adaptive_line() const {
+  if (spec_.search.enabled) return search_complete_line(spec_, grid_, adaptive_);
   if (!spec_.adaptive.enabled || !adaptive_.complete) return "";
   const int asked = adaptive_.active_runs();
   const int left = static_cast<int>(grid_.runs.size()) - asked;

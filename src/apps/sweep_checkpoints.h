@@ -34,6 +34,13 @@ class ItemCheckpoints {
     resume_step_ = 0;
   }
   const std::string& path() const { return path_; }
+  /// [search]: without a state of its own, the item goes on from the state
+  /// at `path` if it is there under `key` (a smaller rung's final state).
+  void go_on_from(const std::string& path, const std::string& key);
+  /// [search]: the state after the last step goes to `path` under `key`,
+  /// for the next rung (a state that cannot be written is reported once:
+  /// the next rung then trains from the start).
+  void keep_final(const std::string& path, const std::string& key);
   /// The last step saved (0: none).
   int saved_step() const { return saved_step_; }
   void remove() const;

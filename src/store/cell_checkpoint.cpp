@@ -93,6 +93,10 @@ std::string cell_checkpoint_path(const std::string& results_path, const std::str
   return journal_directory(results_path) + "/cell-" + hex64(fnv1a64(key)) + ".state";
 }
 
+std::string rung_state_path(const std::string& results_path, const std::string& key) {
+  return journal_directory(results_path) + "/rung-" + hex64(fnv1a64(key)) + ".state";
+}
+
 void write_cell_checkpoint(const std::string& path, const CellCheckpoint& checkpoint) {
   const std::string dir = parent_directory(path);
   if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) {

@@ -188,6 +188,31 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
   return out;
 }
 
+SearchCost estimate_search_cost(const SweepSpec& spec, const Grid& grid) {
+  const std::vector<int>& rungs = spec.search.rungs;
+  SearchCost cost;
+  cost.configurations.assign(rungs.size(), 0);
+  for (const Group& g : groups_of(spec, grid)) {
+    std::size_t n = g.configurations.size();
+    for (std::size_t r = 0; r < rungs.size(); ++r) {
+      double sum = 0.0;
+      int cells = 0;
+      for (const Configuration& c : g.configurations) {
+        if (c.cells[r] < 0) continue;
+        sum += grid.cells[static_cast<std::size_t>(c.cells[r])].estimated_cost_s;
+        ++cells;
+      }
+      const double mean = cells > 0 ? sum / cells : 0.0;
+      const double share = r == 0 ? 1.0 : 1.0 - static_cast<double>(rungs[r - 1]) / rungs[r];
+      cost.configurations[r] += static_cast<int>(n);
+      cost.halving_s += static_cast<double>(n) * mean * share;
+      if (r + 1 == rungs.size()) cost.full_s += sum;
+      n = (n + static_cast<std::size_t>(spec.search.eta) - 1) / static_cast<std::size_t>(spec.search.eta);
+    }
+  }
+  return cost;
+}
+
 std::string search_report(const SweepSpec& spec, const SearchReplay& replay) {
   std::ostringstream out;
   const auto number = [](double v) {

@@ -70,14 +70,10 @@ Axis read_axis(const Entry& e, const TrainerOptions& base, const ValueReader& va
   return axis;
 }
 
-// rungs = [5000, 15000, 50000]: at least two, strictly increasing, each a
-// multiple of eval_every.
+// rungs = [5000, 15000, 50000]: strictly increasing, each a multiple of
+// eval_every.
 std::vector<int> read_rungs(const Entry& e, int eval_every, const ValueReader& values) {
   const std::vector<int> rungs = values.int_axis(e, 1, nullptr);
-  if (rungs.size() < 2) {
-    values.fail(e.line, "rungs lists " + std::to_string(rungs.size()) + " budget; successive "
-                        "halving needs at least two, e.g. rungs = [5000, 15000, 50000]");
-  }
   for (std::size_t i = 0; i < rungs.size(); ++i) {
     if (i > 0 && rungs[i] <= rungs[i - 1]) {
       values.fail(e.line, "rungs must increase: " + std::to_string(rungs[i]) + " follows " +
@@ -131,7 +127,7 @@ SearchSpec read_search_table(const toml::table& table, int line, const TrainerOp
       s.rungs = read_rungs(e, base.eval_every, values);
       rungs_line = e.line;
     } else if (e.key == "eta") {
-      s.eta = static_cast<int>(values.integer(e, *e.value, 2, 1000, "an integer in [2, 1000]"));
+      s.eta = static_cast<int>(values.integer(e, *e.value, 1, 1000, "an integer in [1, 1000]"));
     } else if (e.key == "criterion") {
       values.choice_index(e, {"validation"});
     } else {

@@ -23,6 +23,12 @@ struct CellCheckpoint {
 /// journal_directory(results_path) + "/cell-" + hex64(fnv1a64(key)) + ".state".
 std::string cell_checkpoint_path(const std::string& results_path, const std::string& key);
 
+/// Where the final training state of a [search] rung's item lives, for the
+/// next rung's item of the same runs to go on from:
+/// journal_directory(results_path) + "/rung-" + hex64(fnv1a64(key)) + ".state"
+/// (same layout; list_cell_checkpoints does not list them).
+std::string rung_state_path(const std::string& results_path, const std::string& key);
+
 /// Writes `checkpoint` to `path` through `<path>.writing`, fsync, rename and
 /// a directory fsync: the file holds the previous state or the whole new
 /// one. Creates the journal directory if needed. Throws std::runtime_error

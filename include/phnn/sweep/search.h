@@ -55,6 +55,17 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
                            const std::vector<double>& criterion, const std::vector<double>& mse,
                            int last_round = -1);
 
+/// The cost model's estimate of a search: per rung the configurations that
+/// train (summed over groups, each keeping ceil(n / eta)), the core-seconds
+/// of halving (a configuration at rung r > 0 pays only the steps from the
+/// rung before: it goes on from its state) and of every configuration
+/// trained to the last rung.
+struct SearchCost {
+  std::vector<int> configurations;
+  double halving_s = 0.0, full_s = 0.0;
+};
+SearchCost estimate_search_cost(const SweepSpec& spec, const Grid& grid);
+
 /// The key of the configuration of `run`: its cell key at step budget 0.
 std::string configuration_key(const RunConfig& run);
 

@@ -178,6 +178,8 @@ struct SearchSpec {
   /// Step budgets, strictly increasing, each a multiple of eval_every (so
   /// training on from a rung equals training straight through).
   std::vector<int> rungs;
+  /// Each rung keeps ceil(n / eta); eta = 1 keeps every configuration (the
+  /// full grid a search is checked against: the same runs).
   int eta = 3;
   /// The search axes: [training] keys given a list of values in [search],
   /// in file order (e.g. "learning_rate").
