@@ -104,6 +104,16 @@ SearchEntry entry_of(const Grid& grid, int cell, const std::string& label,
   return SearchEntry{cell, label, median_of(c), median_of(m), false};
 }
 
+// The cost-model seconds of `cell`'s steps and validations up to `steps`
+// (no inference): what going on from that rung's state saves.
+double trained_before_s(const Grid& grid, const Cell& cell, int steps) {
+  RunConfig run = grid.runs[static_cast<std::size_t>(cell.runs.front())];
+  run.training.steps = steps;
+  run.training.checkpoints.clear();
+  run.data.num_inference = 0;
+  return estimate_group_cost_s(run, static_cast<int>(cell.runs.size()));
+}
+
 }  // namespace
 
 std::string configuration_key(const RunConfig& run) {
@@ -195,17 +205,17 @@ SearchCost estimate_search_cost(const SweepSpec& spec, const Grid& grid) {
   for (const Group& g : groups_of(spec, grid)) {
     std::size_t n = g.configurations.size();
     for (std::size_t r = 0; r < rungs.size(); ++r) {
-      double sum = 0.0;
+      double sum = 0.0, going_on = 0.0;
       int cells = 0;
       for (const Configuration& c : g.configurations) {
         if (c.cells[r] < 0) continue;
-        sum += grid.cells[static_cast<std::size_t>(c.cells[r])].estimated_cost_s;
+        const Cell& cell = grid.cells[static_cast<std::size_t>(c.cells[r])];
+        sum += cell.estimated_cost_s;
+        going_on += cell.estimated_cost_s - (r == 0 ? 0.0 : trained_before_s(grid, cell, rungs[r - 1]));
         ++cells;
       }
-      const double mean = cells > 0 ? sum / cells : 0.0;
-      const double share = r == 0 ? 1.0 : 1.0 - static_cast<double>(rungs[r - 1]) / rungs[r];
       cost.configurations[r] += static_cast<int>(n);
-      cost.halving_s += static_cast<double>(n) * mean * share;
+      if (cells > 0) cost.halving_s += static_cast<double>(n) * going_on / cells;
       if (r + 1 == rungs.size()) cost.full_s += sum;
       n = (n + static_cast<std::size_t>(spec.search.eta) - 1) / static_cast<std::size_t>(spec.search.eta);
     }

@@ -65,8 +65,8 @@ class TableWalker {
     spec_.system_files = systems_.files();
     check_lambdas();
     check_knobs_change_runs();
+    if (search_table_) read_search();  // first: it refuses [adaptive] beside it
     if (spec_.adaptive.enabled) apply_adaptive(&spec_, adaptive_header_, values_);
-    if (search_table_) read_search();
     return spec_;
   }
 

@@ -57,9 +57,9 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
 
 /// The cost model's estimate of a search: per rung the configurations that
 /// train (summed over groups, each keeping ceil(n / eta)), the core-seconds
-/// of halving (a configuration at rung r > 0 pays only the steps from the
-/// rung before: it goes on from its state) and of every configuration
-/// trained to the last rung.
+/// of halving (a configuration at rung r > 0 pays its steps and validations
+/// from the rung before, going on from its state, and its own inference)
+/// and of every configuration trained to the last rung.
 struct SearchCost {
   std::vector<int> configurations;
   double halving_s = 0.0, full_s = 0.0;
