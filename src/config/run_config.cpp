@@ -117,6 +117,7 @@ std::string RunConfig::cell_key() const {
     s << ";checkpoints=";
     for (std::size_t i = 0; i < t.checkpoints.size(); ++i) s << (i ? "," : "") << t.checkpoints[i];
   }
+  if (t.skip_inference) s << ";inference=skipped";
   return s.str();
 }
 

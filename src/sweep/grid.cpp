@@ -250,6 +250,8 @@ void expand_study(const SweepSpec& spec, const StudySpec& study, Grid* grid,
                   run.training = budgets.variants[v];
                   run.training.set_weight(reg, weight);
                   run.training.steps = steps;
+                  // A rung before the last is decided on its validation loss.
+                  run.training.skip_inference = budgets.search && steps != budgets.steps.back();
                   const std::string label =
                       join_label(axes.label(size, n, reg, weight), budgets.suffix(v, steps));
                   for (int seed : study.seeds) {

@@ -95,13 +95,15 @@ SearchEntry entry_of(const Grid& grid, int cell, const std::string& label,
     const auto i = static_cast<std::size_t>(r);
     if (status[i] == RunStatus::kDone) {
       c.push_back(std::isnan(criterion[i]) ? kInf : criterion[i]);
-      m.push_back(mse[i]);
+      if (!std::isnan(mse[i])) m.push_back(mse[i]);
     } else if (status[i] == RunStatus::kDiverged) {
       c.push_back(kInf);
       m.push_back(kInf);
     }
   }
-  return SearchEntry{cell, label, median_of(c), median_of(m), false};
+  // A rung before the last has no inference (MSE NaN).
+  const double mse_median = m.empty() ? std::numeric_limits<double>::quiet_NaN() : median_of(m);
+  return SearchEntry{cell, label, median_of(c), mse_median, false};
 }
 
 // The cost-model seconds of `cell`'s steps and validations up to `steps`
@@ -119,6 +121,7 @@ double trained_before_s(const Grid& grid, const Cell& cell, int steps) {
 std::string configuration_key(const RunConfig& run) {
   RunConfig c = run;
   c.training.steps = 0;
+  c.training.skip_inference = false;
   return c.cell_key();
 }
 
@@ -228,7 +231,7 @@ std::string search_report(const SweepSpec& spec, const SearchReplay& replay) {
   const auto number = [](double v) {
     char text[32];
     std::snprintf(text, sizeof text, "%.3e", v);
-    return std::isinf(v) ? std::string("inf") : std::string(text);
+    return std::isnan(v) ? std::string("—") : std::isinf(v) ? std::string("inf") : std::string(text);
   };
   for (const SearchGroup& g : replay.groups) {
     out << "### Search " << g.study << " — " << g.system << "\n\n";

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,7 +91,10 @@ class CellTrainer {
   double train_seconds_per_run() const {
     return (elapsed() - checkpoint_overhead_s_) / static_cast<double>(E_);
   }
-  void fill_result(int64_t e, const Rollouts& rollouts, double mse, double train_s, double wall);
+  void fill_result(int64_t e, const Rollouts* rollouts, double mse, double train_s, double wall);
+  void fill_with_rollouts(int64_t e, const Rollouts& rollouts, double mse, double train_s,
+                          RunResult* r) const;
+  static constexpr double kNoMse = std::numeric_limits<double>::quiet_NaN();
 
   const CellSpec& cell_;
   const CellData& data_;

@@ -339,32 +339,29 @@ void CellTrainer::checkpoint(int step) {
 std::vector<RunResult> CellTrainer::finish() {
   torch::NoGradGuard no_grad;
   const double train_s = train_seconds_per_run();
+  if (opt_.skip_inference) {  // a [search] rung before the last: no rollouts
+    for (int64_t e = 0; e < E_; ++e) fill_result(e, nullptr, kNoMse, train_s, elapsed());
+    return std::move(results_);
+  }
   const Rollouts rollouts = roll_out_best();
   const double wall = elapsed();
   const std::vector<double> mse = member_mse(rollouts);
   for (int64_t e = 0; e < E_; ++e) {
-    fill_result(e, rollouts, mse[static_cast<std::size_t>(e)], train_s, wall);
+    fill_result(e, &rollouts, mse[static_cast<std::size_t>(e)], train_s, wall);
   }
   return std::move(results_);
 }
 
-void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts, double mse, double train_s,
+// `rollouts` null: no inference (TrainerOptions::skip_inference), MSE NaN.
+void CellTrainer::fill_result(int64_t e, const Rollouts* rollouts, double mse, double train_s,
                               double wall) {
   RunResult& r = results_[static_cast<std::size_t>(e)];
-  const int64_t B_inf = rollouts.sq_err.size(1);
   r.steps = opt_.steps;
   r.parameter_count = model_->parameter_count();
   r.best_validation_loss = best_val_[static_cast<std::size_t>(e)];
   r.wall_time_s = wall / static_cast<double>(E_);
-  fill_inference(rollouts, e, mse, &r);
-  // Budgets not reached in the loop (the last step, or every member
-  // diverged earlier): the final best weights are the best up to them.
-  while (r.checkpoint_steps.size() < opt_.checkpoints.size()) {
-    r.checkpoint_steps.push_back(opt_.checkpoints[r.checkpoint_steps.size()]);
-    r.checkpoint_mse.push_back(r.mse);
-    r.checkpoint_train_seconds.push_back(train_s);
-  }
-  fill_figures(rollouts, e, data_, &r);
+  r.mse = mse;
+  if (rollouts) fill_with_rollouts(e, *rollouts, mse, train_s, &r);
   // The weights the rollouts used (float32 training: upcast, exactly).
   for (const torch::Tensor& best : best_) {
     const torch::Tensor w = best[e].to(torch::kFloat64).contiguous();
@@ -382,13 +379,31 @@ void CellTrainer::fill_result(int64_t e, const Rollouts& rollouts, double mse, d
   }
   if (r.diverged_rollouts > 0) {
     r.status = RunStatus::kDiverged;
-    msg << r.diverged_rollouts << " of " << B_inf << " rollouts diverged (non-finite or |x| > "
-        << opt_.divergence_norm << "). ";
+    msg << r.diverged_rollouts << " of " << r.trajectory_errors.size()
+        << " rollouts diverged (non-finite or |x| > " << opt_.divergence_norm << "). ";
+  }
+  if (!rollouts) {
+    msg << "No inference: a [search] rung before the last, decided on its validation loss. ";
   }
   if (r.newton_failures > 0) {
     msg << r.newton_failures << " DG Newton steps did not converge.";
   }
   r.message = msg.str();
+}
+
+// The results a member's rollouts give: inference errors, the budget
+// checkpoints not reached in the loop, the figure trajectories.
+void CellTrainer::fill_with_rollouts(int64_t e, const Rollouts& rollouts, double mse,
+                                     double train_s, RunResult* r) const {
+  fill_inference(rollouts, e, mse, r);
+  // Budgets not reached in the loop (the last step, or every member
+  // diverged earlier): the final best weights are the best up to them.
+  while (r->checkpoint_steps.size() < opt_.checkpoints.size()) {
+    r->checkpoint_steps.push_back(opt_.checkpoints[r->checkpoint_steps.size()]);
+    r->checkpoint_mse.push_back(r->mse);
+    r->checkpoint_train_seconds.push_back(train_s);
+  }
+  fill_figures(rollouts, e, data_, r);
 }
 
 }  // namespace internal

@@ -120,14 +120,20 @@ TEST(SearchGridTest, ConfigurationsTimesRungsTimesSeedsWithIdsThatDifferByTheBud
   EXPECT_EQ(b.training.steps, 200);
   EXPECT_EQ(configuration_key(a), configuration_key(b));
   EXPECT_NE(a.id(), b.id());
-  // A run of a rung is the run of a plain sweep of that budget: the same id.
-  RunConfig plain = b;
+  // Rungs before the last skip inference; a run of the last rung is the run
+  // of a plain sweep of that budget: the same id.
+  EXPECT_TRUE(a.training.skip_inference);
+  EXPECT_TRUE(b.training.skip_inference);
+  const RunConfig& c = grid.runs[6];
+  ASSERT_EQ(c.training.steps, 400);
+  EXPECT_FALSE(c.training.skip_inference);
+  RunConfig plain = c;
   plain.training = TrainerOptions();
   plain.training.eval_every = 100;
-  plain.training.steps = 200;
+  plain.training.steps = 400;
   plain.training.learning_rate = 1e-3;
   plain.training.batch_size = 16;
-  EXPECT_EQ(plain.id(), b.id());
+  EXPECT_EQ(plain.id(), c.id());
 }
 
 constexpr double kInf = std::numeric_limits<double>::infinity();

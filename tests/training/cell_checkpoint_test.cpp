@@ -5,6 +5,7 @@
 // float64 and float32; a rung's final state ([search]) goes on to a larger
 // step budget bitwise as training straight through; a state that does not
 // fit the cell is refused.
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -226,6 +227,33 @@ TEST(CellCheckpointTest, ARungsFinalStateGoesOnBitwiseToALargerBudget) {
       }
     }
     expect_same_results(through_rungs(*cell, {20, 40, 60}, train), plain);
+  }
+}
+
+// skip_inference (a rung before the last): no rollouts, MSE NaN, and every
+// training result (weights, best step and loss, trace, status) as with them.
+TEST(CellCheckpointTest, ARungBeforeTheLastSkipsInferenceAndChangesNothingElse) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnJr;
+  cell.integrator = IntegratorKind::kDg;
+  cell.training.steps = 30;
+  cell.training.eval_every = 10;
+  cell.seeds = {0, 1};
+  const auto full = train_cell(cell, harmonic());
+  cell.training.skip_inference = true;
+  const auto skipped = train_cell(cell, harmonic());
+  ASSERT_EQ(skipped.size(), full.size());
+  for (std::size_t e = 0; e < full.size(); ++e) {
+    EXPECT_TRUE(std::isnan(skipped[e].mse));
+    EXPECT_TRUE(skipped[e].trajectory_errors.empty());
+    EXPECT_TRUE(skipped[e].figure_prediction_05.empty());
+    EXPECT_THAT(skipped[e].message, HasSubstr("No inference"));
+    EXPECT_EQ(skipped[e].status, full[e].status);
+    EXPECT_EQ(skipped[e].weights, full[e].weights);
+    EXPECT_EQ(skipped[e].best_step, full[e].best_step);
+    EXPECT_EQ(skipped[e].best_validation_loss, full[e].best_validation_loss);
+    ASSERT_EQ(skipped[e].trace.size(), full[e].trace.size());
+    EXPECT_EQ(skipped[e].trace.back().validation_loss, full[e].trace.back().validation_loss);
   }
 }
 

@@ -101,6 +101,10 @@ struct TrainerOptions {
   /// same). Strictly increasing, each <= steps and a validation step
   /// (a multiple of eval_every, or steps itself). Empty: none.
   std::vector<int> checkpoints;
+  /// No inference after training (a [search] rung before the last, which is
+  /// decided on the validation loss): the runs' MSE is NaN, with no
+  /// trajectory errors or figures. Enters the run id only when set.
+  bool skip_inference = false;
 
   /// The weight of `reg` (lambda_cn, lambda_sn or lambda_sr); 0 for kNone.
   double weight(Regularizer reg) const;

@@ -18,8 +18,9 @@ namespace phnn {
 /// One configuration at one rung of one group (a study's configurations on
 /// one system): its cell, the median over its finished seeds of the
 /// criterion (best validation loss; a diverged seed +inf, a failed one left
-/// out; +inf when none is left) and of the inference MSE, and whether it
-/// went on to the next rung.
+/// out; +inf when none is left) and of the inference MSE (NaN before the
+/// last rung, which has no inference), and whether it went on to the next
+/// rung.
 struct SearchEntry {
   int cell = -1;
   std::string label;  // the cell's table row and column: "PHNN-S-DG small/learning_rate=0.001"
@@ -66,7 +67,8 @@ struct SearchCost {
 };
 SearchCost estimate_search_cost(const SweepSpec& spec, const Grid& grid);
 
-/// The key of the configuration of `run`: its cell key at step budget 0.
+/// The key of the configuration of `run`: its cell key at step budget 0,
+/// with inference (the same at every rung).
 std::string configuration_key(const RunConfig& run);
 
 /// The Markdown report of a replay: per group and rung, each configuration's
