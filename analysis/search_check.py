@@ -21,13 +21,15 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from analysis.results import load  # noqa: E402
 
-NOT_SETTINGS = {"run_id", "studies", "seed", "steps"}
+NOT_SETTINGS = {"run_id", "studies", "seed", "steps", "inference"}
 
 
 def configuration_columns(runs):
     """The setting columns (before `status`) that vary, the model label first."""
     settings = list(runs.columns[: list(runs.columns).index("status")])
-    varying = [c for c in settings if c not in NOT_SETTINGS and runs[c].nunique(dropna=False) > 1]
+    # A column set for some models only (the DG Newton settings) varies by
+    # NaN alone: not a setting of its own.
+    varying = [c for c in settings if c not in NOT_SETTINGS and runs[c].nunique() > 1]
     return ["model_label"] + [c for c in varying if c not in ("model_label", "model", "integrator")]
 
 
@@ -46,7 +48,7 @@ def last_rung(runs, columns):
     """Per configuration at the largest budget: criterion and MSE medians, the MSE values."""
     top = runs[(runs.status.isin(["done", "diverged"])) & (runs.steps == runs.steps.max())]
     out = []
-    for key, g in top.groupby(columns, sort=False):
+    for key, g in top.groupby(columns, sort=False, dropna=False):
         crit = np.where(g.status == "diverged", np.inf, g.best_validation_loss)
         mse = np.where(g.status == "diverged", np.inf, g.mse)
         out.append((label(key, columns), float(np.median(crit)), float(np.median(mse)), mse))
@@ -55,7 +57,7 @@ def last_rung(runs, columns):
 
 def core_seconds(runs, columns):
     finished = runs[runs.status.isin(["done", "diverged", "failed"])]
-    last = finished.sort_values("steps").groupby(columns + ["seed"], sort=False).tail(1)
+    last = finished.sort_values("steps").groupby(columns + ["seed"], sort=False, dropna=False).tail(1)
     return float(last.wall_time_s.sum())
 
 

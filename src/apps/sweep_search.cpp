@@ -88,7 +88,17 @@ std::string search_dry_run(const SweepSpec& spec, const Grid& grid, const std::v
   out << " steps)\nrung 0 (every configuration at " << spec.search.rungs.front() << " steps):\n"
       << dry_run_summary(expand_grid(first), ranks, split) << "configurations per rung:";
   for (int n : cost.configurations) out << " " << n;
-  out << "\nestimated " << hours(cost.halving_s) << " core-hours with halving (each rung going on "
+  out << "\nrungs one after the other (every rank waits for a rung's last item):\n";
+  for (int ranks_n : ranks) {
+    double makespan = 0.0;
+    for (const std::vector<double>& items : cost.items_s) makespan += greedy_makespan_s(items, ranks_n);
+    char line[160];
+    std::snprintf(line, sizeof line, "  %d rank%s: makespan %.0f s, efficiency %.1f %%\n", ranks_n,
+                  ranks_n == 1 ? "" : "s", makespan,
+                  100.0 * cost.halving_s / (ranks_n * std::max(makespan, 1e-9)));
+    out << line;
+  }
+  out << "estimated " << hours(cost.halving_s) << " core-hours with halving (each rung going on "
       << "from the one before) against " << hours(cost.full_s) << " for every configuration at "
       << spec.search.rungs.back() << " steps ("
       << static_cast<int>(100.0 * cost.halving_s / std::max(cost.full_s, 1e-9) + 0.5) << " %)\n";

@@ -36,8 +36,8 @@ CostParts cost_parts(const RunConfig& run, const CostModel& c) {
   const int evaluations = 1 + t.steps / t.eval_every + (t.steps % t.eval_every != 0 ? 1 : 0);
   const double validation = evaluations * run.data.num_validation / c.reference_batch;
   // One rollout of the inference set per checkpoint before the last step,
-  // plus the final one.
-  const auto rollouts = 1 + std::count_if(t.checkpoints.begin(), t.checkpoints.end(),
+  // plus the final one (none for a [search] rung before the last).
+  const auto rollouts = t.skip_inference ? 0 : 1 + std::count_if(t.checkpoints.begin(), t.checkpoints.end(),
                                           [&](int step) { return step < t.steps; });
   const double inference = static_cast<double>(rollouts) * run.data.num_inference *
                            run.data.num_inference_steps() / c.reference_batch / c.rollout_speedup *

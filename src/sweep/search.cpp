@@ -205,6 +205,7 @@ SearchCost estimate_search_cost(const SweepSpec& spec, const Grid& grid) {
   const std::vector<int>& rungs = spec.search.rungs;
   SearchCost cost;
   cost.configurations.assign(rungs.size(), 0);
+  cost.items_s.assign(rungs.size(), {});
   for (const Group& g : groups_of(spec, grid)) {
     std::size_t n = g.configurations.size();
     for (std::size_t r = 0; r < rungs.size(); ++r) {
@@ -219,6 +220,7 @@ SearchCost estimate_search_cost(const SweepSpec& spec, const Grid& grid) {
       }
       cost.configurations[r] += static_cast<int>(n);
       if (cells > 0) cost.halving_s += static_cast<double>(n) * going_on / cells;
+      if (cells > 0) cost.items_s[r].insert(cost.items_s[r].end(), n, going_on / cells);
       if (r + 1 == rungs.size()) cost.full_s += sum;
       n = (n + static_cast<std::size_t>(spec.search.eta) - 1) / static_cast<std::size_t>(spec.search.eta);
     }

@@ -64,6 +64,10 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
 struct SearchCost {
   std::vector<int> configurations;
   double halving_s = 0.0, full_s = 0.0;
+  /// Per rung, the estimated cost of each configuration's item (a group's
+  /// mean, going on from the rung before), for schedules with a barrier
+  /// after each rung.
+  std::vector<std::vector<double>> items_s;
 };
 SearchCost estimate_search_cost(const SweepSpec& spec, const Grid& grid);
 
