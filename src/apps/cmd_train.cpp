@@ -318,7 +318,9 @@ int run_train(int argc, char** argv, int first) {
   SystemFileReader read;
   if (!builtin) {
     read = [&](const std::string&) {
-      return SystemFileText{arg, system.source_text(), "", 0, /*data_supplied=*/true};
+      SystemFileText t{arg, system.source_text()};
+      t.data_supplied = true;
+      return t;
     };
   }
   const std::string text = cell_sweep_text(cell, d.data, arg);

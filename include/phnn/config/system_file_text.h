@@ -17,13 +17,13 @@ struct SystemFileText {
   /// and 0 for a system file.
   std::string data_checksum = "";
   int data_train_pairs = 0;
-  /// Its inference trajectories and the samples of the longest (0 for a
-  /// system file).
-  int data_inference = 0, data_inference_points = 0;
   /// The data set comes with the text (a results file's /data, `phnn train
   /// --data`), so nothing is generated: a structure-only system file (no
   /// energy H) is accepted. False for files a sweep reads from disk.
   bool data_supplied = false;
+  /// A data-set file's inference trajectories and the samples of the
+  /// longest (0 for a system file).
+  int data_inference = 0, data_inference_points = 0;
 };
 
 /// True for a `data` entry of a sweep file: a path ending in ".h5".
