@@ -5,7 +5,6 @@
 
 #include "apps/cli.h"
 #include "apps/commands.h"
-#include "h5/h5file.h"
 #include "phnn/common/counted.h"
 #include "phnn/data/measured.h"
 #include "phnn/store/output_path.h"
@@ -19,17 +18,6 @@ namespace phnn {
 namespace apps {
 
 namespace {
-
-std::vector<MeasuredTrajectory> read_inputs(const std::vector<std::string>& files,
-                                            const TrajectoryColumns& columns) {
-  std::vector<MeasuredTrajectory> all;
-  for (const std::string& f : files) {
-    std::vector<MeasuredTrajectory> part =
-        h5::File::is_hdf5(f) ? read_trajectory_h5(f, columns) : read_trajectory_csv(f, columns);
-    for (auto& m : part) all.push_back(std::move(m));
-  }
-  return all;
-}
 
 // --blocks "0.6,0.2": the training and validation shares of each recording.
 void parse_blocks(const std::string& text, ImportOptions* o) {
@@ -133,23 +121,26 @@ int run_import(int argc, char** argv, int first) {
   }
   std::string summary;
   if (!measurement.identity()) summary += "states from [measurement]: " + measurement.describe() + "\n";
-  PhSystemData data;
+  // Two passes over the files (docs/METHOD.md "Measured data"): memory
+  // follows the data set written, not the recordings.
+  MeasuredDataSet set;
   try {
-    std::vector<MeasuredTrajectory> recorded = read_inputs(parser.rest(), columns);
-    apply_measurement(measurement, &recorded);
-    data = split_measured_data(*system, std::move(recorded), options, &summary);
+    set = split_measured_stream(*system, recorded_trajectories(parser.rest(), columns, measurement),
+                                options, &summary);
   } catch (const MeasuredDataError& e) {
     throw cli::UsageError{std::string("phnn import: ") + e.what()};  // bad input: exit 2
   }
-  write_atomically(out, "writing", [&](const std::string& path) { write_ph_dataset_file(path, data); });
+  write_atomically(out, "writing", [&](const std::string& path) {
+    write_ph_dataset_file(path, set.data, set.train, set.validation, set.inference);
+  });
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const bool blocks = options.split == ImportSplit::kBlocks;
   std::cout << summary << "phnn import: " << system->name() << ": "
-            << counted(static_cast<long long>(data.train.size()), "training pair") << ", "
-            << counted(static_cast<long long>(data.validation.size()), "validation pair") << ", "
-            << (blocks ? counted(static_cast<long long>(data.inference.size()), "inference window")
-                       : counted(static_cast<long long>(data.inference.size()), "inference trajectory",
+            << counted(static_cast<long long>(set.train.size()), "training pair") << ", "
+            << counted(static_cast<long long>(set.validation.size()), "validation pair") << ", "
+            << (blocks ? counted(static_cast<long long>(set.inference.size()), "inference window")
+                       : counted(static_cast<long long>(set.inference.size()), "inference trajectory",
                                  "inference trajectories"))
             << " -> " << out << " (" << seconds << " s)\n";
   return 0;

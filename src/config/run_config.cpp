@@ -8,12 +8,16 @@
 namespace phnn {
 
 std::uint64_t fnv1a64(const std::string& text) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
+  return fnv1a64_update(kFnv1a64Basis, text.data(), text.size());
+}
+
+std::uint64_t fnv1a64_update(std::uint64_t hash, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < size; ++i) {
+    hash ^= bytes[i];
+    hash *= 0x100000001b3ULL;
   }
-  return h;
+  return hash;
 }
 
 std::string hex64(std::uint64_t value) {

@@ -6,6 +6,7 @@
 
 #include "h5/h5file.h"
 #include "phnn/data/ph_dataset.h"
+#include "phnn/data/ph_rows.h"
 
 namespace phnn {
 namespace internal {
@@ -23,7 +24,15 @@ PhSystemData read_version1_data(const h5::File& file, const std::string& group);
 /// "/data/duffing"; format_version 2: state names, units, the system
 /// file's text as attributes of `group`). In a parallel file every rank
 /// calls it with the same data. read_ph_system_data reads either version.
-void write_ph_system_data(h5::File& file, const std::string& group, const PhSystemData& data);
+/// Splits given as rows (when not null) are written instead of data's own
+/// (data.train, data.validation, data.inference), with no copy.
+struct SplitRows {
+  const PhPairRows* train = nullptr;
+  const PhPairRows* validation = nullptr;
+  const PhInferenceRows* inference = nullptr;
+};
+void write_ph_system_data(h5::File& file, const std::string& group, const PhSystemData& data,
+                          const SplitRows& rows = {});
 PhSystemData read_ph_system_data(const h5::File& file, const std::string& group);
 
 }  // namespace internal

@@ -5,6 +5,7 @@
 
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "h5/h5file.h"
 #include "phnn/common/check.h"
@@ -30,12 +31,6 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
-std::vector<double> flatten(const std::vector<VecX>& rows) {
-  std::vector<double> out;
-  for (const VecX& r : rows) out.insert(out.end(), r.data(), r.data() + r.size());
-  return out;
-}
-
 // `count` rows of `width` from a dataset's values; a dataset of another size
 // (a damaged or hand-made file) is refused before anything is indexed.
 std::vector<VecX> unflatten(const std::vector<double>& flat, int width, std::size_t count,
@@ -53,16 +48,8 @@ std::vector<VecX> unflatten(const std::vector<double>& flat, int width, std::siz
   return out;
 }
 
-// [trajectory][sample] vectors as one [m, samples, width] array, and back
-// (inference states and time-varying inputs); every trajectory the same length.
-std::vector<double> flatten_trajectories(const std::vector<std::vector<VecX>>& trajectories) {
-  std::vector<double> out;
-  for (const auto& traj : trajectories) {
-    const auto flat = flatten(traj);
-    out.insert(out.end(), flat.begin(), flat.end());
-  }
-  return out;
-}
+// One [m, samples, width] array as [trajectory][sample] vectors (inference
+// states and time-varying inputs).
 std::vector<std::vector<VecX>> unflatten_trajectories(const std::vector<double>& flat, std::size_t m,
                                                       std::size_t samples, int width) {
   std::vector<std::vector<VecX>> out;
@@ -75,15 +62,34 @@ std::vector<std::vector<VecX>> unflatten_trajectories(const std::vector<double>&
   return out;
 }
 
-void write_pairs(h5::File& file, const std::string& group, const PhPairSet& p, int nx, int nu) {
+void write_pairs(h5::File& file, const std::string& group, const PhPairRows& p) {
   file.create_group(group);
   const std::uint64_t n = p.size();
-  file.write(group + "/x", {n, static_cast<std::uint64_t>(nx)}, flatten(p.x));
-  file.write(group + "/x_next", {n, static_cast<std::uint64_t>(nx)}, flatten(p.x_next));
-  if (nu > 0) file.write(group + "/u", {n, static_cast<std::uint64_t>(nu)}, flatten(p.u));
+  const auto nx = static_cast<std::uint64_t>(p.n_x), nu = static_cast<std::uint64_t>(p.n_u);
+  file.write(group + "/x", {n, nx}, p.x);
+  file.write(group + "/x_next", {n, nx}, p.x_next);
+  if (nu > 0) file.write(group + "/u", {n, nu}, p.u);
   file.write(group + "/trajectory", {n}, p.trajectory);
-  file.write(group + "/position", {n}, std::vector<std::int64_t>(p.position.begin(), p.position.end()));
+  file.write(group + "/position", {n}, p.position);
   file.set_attribute(group, "step_s", p.step);
+}
+
+// Trajectory i's samples are rows [i samples, (i+1) samples) of states
+// (and inputs, when they vary).
+void write_inference(h5::File& file, const std::string& group, const PhInferenceRows& r) {
+  file.create_group(group);
+  const std::uint64_t m = r.size(), steps = r.samples;
+  const auto nx = static_cast<std::uint64_t>(r.n_x), nu = static_cast<std::uint64_t>(r.n_u);
+  PHNN_CHECK(r.states.size() >= m * steps * nx && r.u.size() >= m * nu &&
+                 (r.inputs.empty() || r.inputs.size() >= m * steps * nu),
+             "write_inference: " << r.states.size() << " state values for " << m << " x " << steps
+                                 << " samples");
+  file.write(group + "/states", {m, steps, nx}, r.states);
+  if (nu > 0) file.write(group + "/u", {m, nu}, r.u);
+  if (!r.inputs.empty()) file.write(group + "/inputs", {m, steps, nu}, r.inputs);
+  file.write(group + "/trajectory", {m}, r.trajectory);
+  if (!r.position.empty()) file.write(group + "/position", {m}, r.position);
+  file.set_attribute(group, "step_s", r.step);
 }
 
 PhPairSet read_pairs(const h5::File& file, const std::string& group, int nx, int nu) {
@@ -155,15 +161,14 @@ void describe_data_file(const PhSystemData& data, SystemFileText* text) {
 }
 
 std::string data_set_checksum(const PhSystemData& data) {
-  // The bytes hashed, field by field: sizes as uint64, doubles as stored.
-  std::string bytes;
-  const auto raw = [&bytes](const void* p, std::size_t n) {
-    bytes.append(static_cast<const char*>(p), n);
-  };
+  // The bytes hashed, field by field: sizes as uint64, doubles as stored;
+  // hashed as they come (the hash of them joined, without joining them).
+  std::uint64_t hash = kFnv1a64Basis;
+  const auto raw = [&hash](const void* p, std::size_t n) { hash = fnv1a64_update(hash, p, n); };
   const auto text = [&](const std::string& s) {
     const std::uint64_t n = s.size();
     raw(&n, sizeof n);
-    bytes += s;
+    raw(s.data(), s.size());
   };
   const auto vec = [&](const VecX& v) {
     const std::uint64_t n = static_cast<std::uint64_t>(v.size());
@@ -191,12 +196,13 @@ std::string data_set_checksum(const PhSystemData& data) {
   for (const auto& traj : data.inference.inputs) {
     for (const VecX& u : traj) vec(u);
   }
-  return hex64(fnv1a64(bytes));
+  return hex64(hash);
 }
 
 namespace internal {
 
-void write_ph_system_data(h5::File& file, const std::string& group, const PhSystemData& data) {
+void write_ph_system_data(h5::File& file, const std::string& group, const PhSystemData& data,
+                          const SplitRows& rows) {
   const std::string g = group;
   const std::string p = group == "/" ? "" : group;  // prefix of the sub-groups
   const int nx = static_cast<int>(data.state_names.size());
@@ -216,34 +222,22 @@ void write_ph_system_data(h5::File& file, const std::string& group, const PhSyst
   if (!data.noise.empty()) file.set_attribute(g, "noise", data.noise);
   if (!data.split.empty()) file.set_attribute(g, "split", data.split);
   write_options(file, g, data.options);
-  write_pairs(file, p + "/train", data.train, nx, nu);
-  write_pairs(file, p + "/validation", data.validation, nx, nu);
-  file.create_group(p + "/inference");
-  const std::uint64_t m = data.inference.size();
-  const std::uint64_t steps = m ? data.inference.states[0].size() : 0;
-  file.write(p + "/inference/states", {m, steps, static_cast<std::uint64_t>(nx)},
-             flatten_trajectories(data.inference.states));
-  if (nu > 0) {
-    file.write(p + "/inference/u", {m, static_cast<std::uint64_t>(nu)}, flatten(data.inference.u));
-  }
-  if (!data.inference.inputs.empty()) {
-    PHNN_REQUIRE(data.inference.inputs.size() == m, "write_ph_system_data: inputs of "
-                                                        << data.inference.inputs.size() << " of " << m
-                                                        << " inference trajectories");
-    for (const auto& traj : data.inference.inputs) {
-      PHNN_REQUIRE(traj.size() == steps, "write_ph_system_data: " << traj.size()
-                                                                  << " inputs for " << steps << " samples");
+  // Splits given as PhPairSet / PhInferenceSet are written through a flat
+  // copy of one at a time; rows as they are (if / else: `cond ? *rows :
+  // copy` would copy the rows too).
+  for (const auto& [name, given, set] : {std::tuple{"/train", rows.train, &data.train},
+                                         std::tuple{"/validation", rows.validation, &data.validation}}) {
+    if (given) {
+      write_pairs(file, p + name, *given);
+    } else {
+      write_pairs(file, p + name, PhPairRows::of(*set, nx, nu));
     }
-    file.write(p + "/inference/inputs", {m, steps, static_cast<std::uint64_t>(nu)},
-               flatten_trajectories(data.inference.inputs));
   }
-  file.write(p + "/inference/trajectory", {m}, data.inference.trajectory);
-  if (!data.inference.position.empty()) {
-    PHNN_REQUIRE(data.inference.position.size() == m, "write_ph_system_data: "
-                     << data.inference.position.size() << " start samples for " << m << " windows");
-    file.write(p + "/inference/position", {m}, data.inference.position);
+  if (rows.inference) {
+    write_inference(file, p + "/inference", *rows.inference);
+  } else {
+    write_inference(file, p + "/inference", PhInferenceRows::of(data.inference, nx, nu));
   }
-  file.set_attribute(p + "/inference", "step_s", data.inference.step);
 }
 
 PhSystemData read_ph_system_data(const h5::File& file, const std::string& group) {
@@ -318,6 +312,15 @@ PhSystemData read_ph_system_data(const h5::File& file, const std::string& group)
 void write_ph_dataset_file(const std::string& path, const PhSystemData& data) {
   h5::File file = h5::File::create(path);
   internal::write_ph_system_data(file, "/", data);
+}
+
+void write_ph_dataset_file(const std::string& path, const PhSystemData& data, const PhPairRows& train,
+                           const PhPairRows& validation, const PhInferenceRows& inference) {
+  PHNN_REQUIRE(data.train.size() == 0 && data.validation.size() == 0 && data.inference.size() == 0,
+               "write_ph_dataset_file: splits both in the data set (" << data.train.size() << ", "
+               << data.validation.size() << ", " << data.inference.size() << ") and given as rows");
+  h5::File file = h5::File::create(path);
+  internal::write_ph_system_data(file, "/", data, {&train, &validation, &inference});
 }
 
 PhSystemData read_ph_dataset_file(const std::string& path) {

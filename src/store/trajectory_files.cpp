@@ -1,6 +1,7 @@
 // src/store/trajectory_files.cpp — recorded trajectories from CSV and HDF5
-// files, and the CSV writer (include/phnn/store/trajectory_files.h). Reads
-// and writes only the files it is given.
+// files, one at a time or all at once, and the CSV writer
+// (include/phnn/store/trajectory_files.h). Reads and writes only the files
+// it is given.
 #include "phnn/store/trajectory_files.h"
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string_view>
@@ -109,21 +111,44 @@ std::int64_t trajectory_id(std::string_view field, const Where& at) {
   return id;
 }
 
-}  // namespace
+// Trajectory id -> the line of its first row, for the ids of one file: ids
+// that arrive in increasing order (the usual file) in a sorted array, 16
+// bytes each, the others in a map (48 bytes each, as all were before).
+class FirstLines {
+ public:
+  // The line `id` started at: `line` when it is new (and now recorded).
+  int add(std::int64_t id, int line) {
+    if (increasing_.empty() || id > increasing_.back().first) {
+      increasing_.emplace_back(id, line);
+      return line;
+    }
+    const auto it = std::lower_bound(increasing_.begin(), increasing_.end(), std::pair{id, 0},
+                                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    if (it != increasing_.end() && it->first == id) return it->second;
+    return others_.emplace(id, line).first->second;
+  }
 
-namespace {
+ private:
+  std::vector<std::pair<std::int64_t, int>> increasing_;
+  std::map<std::int64_t, int> others_;
+};
 
 // The rows of one CSV file into trajectories, one line at a time: fields
-// are views into the line and samples go straight into the trajectory's
-// flat arrays, so a row allocates nothing (a large file costs its numbers).
+// are views into the line and samples go straight into the current
+// trajectory's flat arrays, handed to `visit` once its last row is read and
+// then cleared for the next (a file costs one trajectory, whatever its size).
 class CsvTrajectories {
  public:
-  CsvTrajectories(const std::string& path, const TrajectoryColumns& c)
-      : path_(path), columns_(c), nx_(static_cast<int>(c.states.size())),
-        nu_(static_cast<int>(c.inputs.size())), x_(c.states.size()), u_(c.inputs.size()) {}
+  // check_split: refuse a trajectory whose rows are split by another's
+  // (FirstLines: 16 bytes a trajectory).
+  CsvTrajectories(const std::string& path, const TrajectoryColumns& c, const TrajectoryVisitor& visit,
+                  bool check_split)
+      : path_(path), columns_(c), visit_(visit), check_split_(check_split),
+        nx_(static_cast<int>(c.states.size())), nu_(static_cast<int>(c.inputs.size())),
+        x_(c.states.size()), u_(c.inputs.size()), current_(nx_, nu_) {}
 
   void add_line(std::string_view text, int lineno);
-  std::vector<MeasuredTrajectory> finish();
+  void finish();
 
  private:
   void add_sample(int lineno);
@@ -131,13 +156,15 @@ class CsvTrajectories {
 
   const std::string& path_;
   const TrajectoryColumns& columns_;
+  const TrajectoryVisitor& visit_;
+  const bool check_split_;
   const int nx_, nu_;
-  std::vector<MeasuredTrajectory> out_;
-  std::map<std::int64_t, int> first_line_;  // trajectory id -> line of its first row
+  std::vector<double> x_, u_;
+  MeasuredTrajectory current_;  // no samples before the first row
+  FirstLines first_line_;
   std::vector<int> roles_;
   std::vector<std::string> names_;
   std::vector<std::string_view> fields_;
-  std::vector<double> x_, u_;
 };
 
 void CsvTrajectories::add_line(std::string_view text, int lineno) {
@@ -176,8 +203,8 @@ void CsvTrajectories::add_sample(int lineno) {
       u_[static_cast<std::size_t>(role - nx_)] = v;
     }
   }
-  if (out_.empty() || out_.back().id != id) start_trajectory(id, lineno);
-  MeasuredTrajectory& m = out_.back();
+  if (current_.size() == 0 || current_.id != id) start_trajectory(id, lineno);
+  MeasuredTrajectory& m = current_;
   if (m.size() > 0 && !(t > m.t.back())) {
     std::ostringstream msg;
     msg.precision(17);
@@ -189,41 +216,56 @@ void CsvTrajectories::add_sample(int lineno) {
   m.line.push_back(lineno);
 }
 
+// Hands the trajectory read so far to visit_ and starts trajectory `id`.
 void CsvTrajectories::start_trajectory(std::int64_t id, int lineno) {
-  const auto [it, fresh] = first_line_.emplace(id, lineno);
-  if (!fresh) {
+  const int started = check_split_ ? first_line_.add(id, lineno) : lineno;
+  if (started != lineno) {
     fail(path_ + ":" + std::to_string(lineno) + ": trajectory " + std::to_string(id) +
-         " continues here after other rows (it started at line " + std::to_string(it->second) +
+         " continues here after other rows (it started at line " + std::to_string(started) +
          "); keep each trajectory's rows together, or give this one another id");
   }
-  if (!out_.empty()) out_.back().shrink();
-  out_.emplace_back(nx_, nu_);
-  out_.back().id = id;
-  out_.back().source = path_;
+  if (current_.size() > 0) visit_(current_);
+  current_.t.clear();
+  current_.x.clear();
+  current_.u.clear();
+  current_.line.clear();
+  current_.id = id;
+  current_.source = path_;
 }
 
-std::vector<MeasuredTrajectory> CsvTrajectories::finish() {
+void CsvTrajectories::finish() {
   if (roles_.empty()) {
     fail(path_ + ": no header line (the file is empty); write the header trajectory,t," +
          list(columns_.states) + (columns_.inputs.empty() ? "" : "," + list(columns_.inputs)) +
          " and one row per sample");
   }
-  if (out_.empty()) fail(path_ + ": a header and no samples; add one row per sample");
-  out_.back().shrink();
-  return std::move(out_);
+  if (current_.size() == 0) fail(path_ + ": a header and no samples; add one row per sample");
+  visit_(current_);
+}
+
+void read_csv(const std::string& path, const TrajectoryColumns& c, const TrajectoryVisitor& visit,
+              bool check_split) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path + ": cannot open it (" + std::strerror(errno) + "); check the path");
+  CsvTrajectories reader(path, c, visit, check_split);
+  std::string line;
+  for (int lineno = 1; std::getline(in, line); ++lineno) reader.add_line(line, lineno);
+  if (in.bad()) fail(path + ": read error (" + std::strerror(errno) + ")");
+  reader.finish();
 }
 
 }  // namespace
 
+void for_each_csv_trajectory(const std::string& path, const TrajectoryColumns& c,
+                             const TrajectoryVisitor& visit) {
+  read_csv(path, c, visit, /*check_split=*/true);
+}
+
 std::vector<MeasuredTrajectory> read_trajectory_csv(const std::string& path,
                                                     const TrajectoryColumns& c) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path + ": cannot open it (" + std::strerror(errno) + "); check the path");
-  CsvTrajectories reader(path, c);
-  std::string line;
-  for (int lineno = 1; std::getline(in, line); ++lineno) reader.add_line(line, lineno);
-  if (in.bad()) fail(path + ": read error (" + std::strerror(errno) + ")");
-  return reader.finish();
+  std::vector<MeasuredTrajectory> out;
+  for_each_csv_trajectory(path, c, [&out](const MeasuredTrajectory& m) { out.push_back(m); });
+  return out;
 }
 
 bool is_phnn_trajectory_csv(const std::string& path) {
@@ -259,8 +301,8 @@ void write_trajectory_csv(const std::string& path, const TrajectoryColumns& c,
   if (!out) fail(path + ": write failed (" + std::strerror(errno) + "); check the free space");
 }
 
-std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
-                                                   const TrajectoryColumns& c) {
+void for_each_h5_trajectory(const std::string& path, const TrajectoryColumns& c,
+                            const TrajectoryVisitor& visit) {
   const std::string fix = "; see docs/DATASET_FORMAT.md, \"Trajectory files\"";
   if (!h5::File::is_hdf5(path)) fail(path + ": not an HDF5 file (missing or another format)" + fix);
   const h5::File file = h5::File::open(path, h5::Access::kReadOnly);
@@ -275,7 +317,7 @@ std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
     }
   }
   const std::size_t nx = c.states.size(), nu = c.inputs.size();
-  std::vector<MeasuredTrajectory> out;
+  bool any = false;
   for (const std::string& name : file.link_names(root)) {
     const std::string g = root + "/" + name, at = path + ":" + g;
     MeasuredTrajectory m(static_cast<int>(c.states.size()), static_cast<int>(c.inputs.size()));
@@ -303,10 +345,50 @@ std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
       }
       m.u = file.read_doubles(g + "/u");
     }
-    out.push_back(std::move(m));
+    visit(m);
+    any = true;
   }
-  if (out.empty()) fail(path + ":" + root + " holds no trajectory" + fix);
+  if (!any) fail(path + ":" + root + " holds no trajectory" + fix);
+}
+
+std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
+                                                   const TrajectoryColumns& c) {
+  std::vector<MeasuredTrajectory> out;
+  for_each_h5_trajectory(path, c, [&out](const MeasuredTrajectory& m) { out.push_back(m); });
   return out;
+}
+
+// A file read whole once is not checked again for split trajectories (a
+// check of 16 bytes a trajectory): split_measured_stream checks every later
+// pass against the first, trajectory by trajectory, so a file changed in
+// between is refused all the same.
+TrajectorySource recorded_trajectories(const std::vector<std::string>& files,
+                                       const TrajectoryColumns& columns, const MeasurementMap& map) {
+  auto read_whole = std::make_shared<std::vector<bool>>(files.size(), false);
+  return [files, columns, &map, read_whole](const TrajectoryVisitor& visit) {
+    std::string measurement_error;  // the first; thrown once every file is read
+    MeasuredTrajectory states;
+    const TrajectoryVisitor each = [&](const MeasuredTrajectory& m) {
+      if (map.identity()) return visit(m);
+      if (!measurement_error.empty()) return;
+      try {
+        apply_measurement(map, m, &states);
+      } catch (const MeasuredDataError& e) {
+        measurement_error = e.what();
+        return;
+      }
+      visit(states);
+    };
+    for (std::size_t f = 0; f < files.size(); ++f) {
+      if (h5::File::is_hdf5(files[f])) {
+        for_each_h5_trajectory(files[f], columns, each);
+      } else {
+        read_csv(files[f], columns, each, /*check_split=*/!(*read_whole)[f]);
+      }
+      (*read_whole)[f] = true;
+    }
+    if (!measurement_error.empty()) fail(measurement_error);
+  };
 }
 
 }  // namespace phnn

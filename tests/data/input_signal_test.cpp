@@ -4,6 +4,7 @@
 // exact with u held over a step, pairs carrying u_n, the data-set file
 // round trip, and the [control] table's errors.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "phnn/config/run_config.h"
 #include "phnn/data/ph_dataset.h"
 #include "phnn/integrators/ph_steps.h"
 #include "phnn/store/ph_dataset_file.h"
@@ -135,6 +137,45 @@ TEST(InputSignalTest, PairsCarryTheirSamplesInputAndFilesKeepTheSignals) {
   changed.inference.inputs[1][5](0) += 1e-3;
   EXPECT_NE(data_set_checksum(changed), data_set_checksum(data));
   std::remove(path.c_str());
+}
+
+// data_set_checksum hashes its fields as they come (no string of a whole
+// data set): the hash of the bytes joined, as it was computed before, so a
+// data-set file's identity in sweeps is unchanged. The bytes: the system
+// text and names (each with its length), then per split its step and every
+// VecX (length, values), then the per-sample inputs.
+TEST(InputSignalTest, TheChecksumIsTheHashOfEveryFieldJoined) {
+  const auto system = compile_system(coupled_with(kSines), "forced.toml");
+  const PhSystemData data = make_ph_system_data(*system, small_options(), 10);
+  ASSERT_FALSE(data.inference.inputs.empty());
+  std::string bytes;
+  const auto raw = [&](const void* p, std::size_t n) { bytes.append(static_cast<const char*>(p), n); };
+  const auto text = [&](const std::string& t) {
+    const std::uint64_t n = t.size();
+    raw(&n, sizeof n);
+    bytes += t;
+  };
+  const auto vec = [&](const VecX& v) {
+    const auto n = static_cast<std::uint64_t>(v.size());
+    raw(&n, sizeof n);
+    raw(v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
+  };
+  text(data.system_text);
+  for (const auto& n : data.state_names) text(n);
+  for (const auto& n : data.input_names) text(n);
+  for (const PhPairSet* p : {&data.train, &data.validation}) {
+    raw(&p->step, sizeof p->step);
+    for (std::size_t i = 0; i < p->size(); ++i) vec(p->x[i]), vec(p->x_next[i]), vec(p->u[i]);
+  }
+  raw(&data.inference.step, sizeof data.inference.step);
+  for (std::size_t i = 0; i < data.inference.size(); ++i) {
+    vec(data.inference.u[i]);
+    for (const VecX& x : data.inference.states[i]) vec(x);
+  }
+  for (const auto& traj : data.inference.inputs) {
+    for (const VecX& u : traj) vec(u);
+  }
+  EXPECT_EQ(data_set_checksum(data), hex64(fnv1a64(bytes)));
 }
 
 std::string control_error(const std::string& control) {

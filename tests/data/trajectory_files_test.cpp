@@ -1,6 +1,7 @@
 // tests/data/trajectory_files_test.cpp — every malformed CSV or HDF5
 // trajectory file, and every recording the split refuses, fails with its
-// place (FILE:LINE, or FILE:/trajectories/ID) and the fix.
+// place (FILE:LINE, or FILE:/trajectories/ID) and the fix; the files read
+// twice, one trajectory at a time, give the data set of reading them all.
 #include "phnn/store/trajectory_files.h"
 
 #include <cstdio>
@@ -8,12 +9,15 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <utility>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
 #include "phnn/data/measured.h"
+#include "phnn/store/ph_dataset_file.h"
+#include "phnn/systems/measurement_map.h"
 #include "phnn/systems/system_file.h"
 #include "test_util.h"
 
@@ -207,6 +211,87 @@ TEST(MeasuredDataTest, CsvTrajectoriesAreReadIntoFlatArraysOfTheirSize) {
     EXPECT_EQ(m.input(7)(0), 0.5);
   }
   std::remove(path.c_str());
+}
+
+// 40 trajectories of 12 to 23 samples at 10 Hz over two files (ids 0, 3,
+// 6, ... in the second, so the files interleave), every fourth with an
+// input that changes at every sample.
+std::pair<std::string, std::string> two_recording_files() {
+  std::string a = kHeader, b = kHeader;
+  for (int id = 0; id < 40; ++id) {
+    std::string& text = id % 3 == 0 ? b : a;
+    for (int k = 0; k < 12 + id % 12; ++k) {
+      const double q = ((id * 37 + k * 11) % 201 - 100) / 100.0, p = ((id * 13 + k * 29) % 97 - 48) / 50.0;
+      text += std::to_string(id) + "," + std::to_string(k) + "e-1," + std::to_string(q) + "," +
+              std::to_string(p) + "," + (id % 4 == 0 ? std::to_string(k) + "e-2" : "0.5") + "\n";
+    }
+  }
+  return {csv_file(a), csv_file(b)};
+}
+
+// `phnn import` reads its files twice, one trajectory at a time
+// (recorded_trajectories, split_measured_stream): the data set, its
+// options and its summary are those of reading every trajectory first, in
+// both splits, shuffled or not. The checksums are those of the data sets
+// phnn import wrote for these files and options before it streamed
+// (48ade44): the same data set, bit for bit.
+TEST(MeasuredDataTest, TwoPassesOverTheFilesGiveTheDataSetOfReadingThemAll) {
+  const auto system = pendulum();
+  const auto [a, b] = two_recording_files();
+  std::vector<MeasuredTrajectory> all = read_trajectory_csv(a, kPendulum);
+  for (auto& m : read_trajectory_csv(b, kPendulum)) all.push_back(std::move(m));
+  const MeasurementMap states = MeasurementMap::of_system_text(system->source_text(), "pendulum.toml");
+  ImportOptions by_id, shuffled, blocks, windows;
+  by_id.num_validation = shuffled.num_validation = 5;
+  by_id.num_inference = shuffled.num_inference = 4;
+  shuffled.split_seed = 3;
+  shuffled.pair_window = 0.45;
+  blocks.split = windows.split = ImportSplit::kBlocks;
+  windows.window = 0.2;
+  windows.num_validation = 30;
+  windows.data_seed = 7;
+  const std::pair<ImportOptions, std::string> cases[] = {
+      {by_id, "ad8c324ff05a773f"}, {shuffled, "ac2b43035f5b40b6"},
+      {blocks, "89e853f1155bc8a4"}, {windows, "e8fce8fe83fff1d5"}};
+  for (const auto& [o, checksum] : cases) {
+    std::string in_memory, streamed;
+    const PhSystemData want = split_measured_data(*system, all, o, &in_memory);
+    const MeasuredDataSet rows =
+        split_measured_stream(*system, recorded_trajectories({a, b}, kPendulum, states), o, &streamed);
+    const PhSystemData got = to_ph_system_data(rows);
+    EXPECT_EQ(data_set_checksum(got), data_set_checksum(want));
+    EXPECT_EQ(data_set_checksum(got), checksum) << streamed;
+    EXPECT_EQ(streamed, in_memory);
+    EXPECT_EQ(got.train.trajectory, want.train.trajectory);
+    EXPECT_EQ(got.train.position, want.train.position);
+    EXPECT_EQ(got.validation.trajectory, want.validation.trajectory);
+    EXPECT_EQ(got.validation.position, want.validation.position);
+    EXPECT_EQ(got.inference.trajectory, want.inference.trajectory);
+    EXPECT_EQ(got.inference.position, want.inference.position);
+    EXPECT_EQ(got.inference.inputs.size(), want.inference.inputs.size());
+    EXPECT_EQ(got.split, want.split);
+    EXPECT_EQ(got.options.alpha, want.options.alpha);
+    EXPECT_EQ(got.options.beta, want.options.beta);
+    EXPECT_EQ(got.options.num_train_max, want.options.num_train_max);
+    // The file written from the rows is the file of the data set.
+    const std::string path = ::testing::TempDir() + "phnn_streamed.h5";
+    write_ph_dataset_file(path, rows.data, rows.train, rows.validation, rows.inference);
+    EXPECT_EQ(data_set_checksum(read_ph_dataset_file(path)), checksum);
+    std::remove(path.c_str());
+  }
+  // A file that changes between the passes is refused, not half read.
+  int pass = 0;
+  const TrajectorySource changing = [&](const TrajectoryVisitor& visit) {
+    for (const MeasuredTrajectory& m : all) {
+      if (pass == 0 || m.id != 7) visit(m);
+    }
+    ++pass;
+  };
+  EXPECT_THAT(error_of([&] { split_measured_stream(*system, changing, by_id); }),
+              AllOf(HasSubstr("not what the first pass over the recordings read"),
+                    HasSubstr("did a file change")));
+  std::remove(a.c_str());
+  std::remove(b.c_str());
 }
 
 // HDF5 trajectory files: the documented layout reads like the CSV.

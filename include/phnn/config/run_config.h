@@ -1,6 +1,7 @@
 // include/phnn/config/run_config.h — one run of a sweep, fully resolved.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -54,6 +55,11 @@ struct RunConfig {
 
 /// 64-bit FNV-1a of a string.
 std::uint64_t fnv1a64(const std::string& text);
+/// FNV-1a 64 continued over `size` more bytes, from `hash` (kFnv1a64Basis
+/// to start): fnv1a64(a + b) == fnv1a64_update(fnv1a64(a), b.data(),
+/// b.size()), so a hash of many pieces needs no string of them all.
+constexpr std::uint64_t kFnv1a64Basis = 0xcbf29ce484222325ULL;
+std::uint64_t fnv1a64_update(std::uint64_t hash, const void* data, std::size_t size);
 /// 16 lower-case hex digits.
 std::string hex64(std::uint64_t value);
 

@@ -2,15 +2,18 @@
 // `phnn import` reads from CSV or HDF5, store/trajectory_files.h): the checks
 // of uniform sampling, the split into training / validation pairs and
 // inference trajectories (docs/METHOD.md "Measured data"), and the way back —
-// a generated data set's trajectories, for `phnn data --csv`. In memory only.
+// a generated data set's trajectories, for `phnn data --csv`. In memory only:
+// files reach it as a TrajectorySource that store/trajectory_files.h makes.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "phnn/data/ph_dataset.h"
+#include "phnn/data/ph_rows.h"
 #include "phnn/systems/measurement_map.h"
 #include "phnn/systems/ph_system.h"
 
@@ -61,6 +64,21 @@ struct MeasuredTrajectory {
 /// n_x states per sample. Throws MeasuredDataError naming the sample where
 /// a computed state is not finite.
 void apply_measurement(const MeasurementMap& map, std::vector<MeasuredTrajectory>* trajectories);
+/// The same for one trajectory: *out = `recorded` with its states computed
+/// (*out's arrays are reused, so a loop over trajectories allocates once).
+void apply_measurement(const MeasurementMap& map, const MeasuredTrajectory& recorded,
+                       MeasuredTrajectory* out);
+
+/// One pass over recorded trajectories: source(visit) calls visit(m) for
+/// each, in the same order at every call (a file's rows, a vector's
+/// elements); `m` lives until visit returns. What split_measured_stream
+/// reads twice instead of holding every trajectory. A source throws
+/// MeasuredDataError for what it cannot read.
+using TrajectoryVisitor = std::function<void(const MeasuredTrajectory&)>;
+using TrajectorySource = std::function<void(const TrajectoryVisitor&)>;
+
+/// The trajectories of `all`, in their order (`all` must outlive it).
+TrajectorySource trajectories_of(const std::vector<MeasuredTrajectory>& all);
 
 /// Bad measured data: the message names the file and line (or trajectory
 /// and sample) and the fix.
@@ -129,6 +147,34 @@ struct ImportOptions {
 PhSystemData split_measured_data(const PhSystem& system,
                                  std::vector<MeasuredTrajectory> trajectories,
                                  const ImportOptions& options, std::string* summary = nullptr);
+
+/// A data set of recorded trajectories as `phnn import` writes it: the
+/// pairs and inference trajectories as flat rows (`data` holds the rest:
+/// names, options, split; its train, validation and inference hold none).
+struct MeasuredDataSet {
+  PhSystemData data;
+  PhPairRows train, validation;
+  PhInferenceRows inference;
+};
+
+/// split_measured_data of the trajectories `source` visits, in two passes
+/// over them, never holding more than the one visited (docs/METHOD.md
+/// "Measured data", point 4): the first keeps what the split needs of each
+/// (id, sample count, step, first line) and finds every error of
+/// split_measured_data, thrown in its order; the second copies each
+/// trajectory's pairs and inference samples to their rows. Memory: the
+/// rows it returns (8 bytes a value), 28 bytes a trajectory (kTrajectories)
+/// or 72 (kBlocks), 4 bytes a training or validation pair of the blocks.
+/// The same data set, bit for bit, and the same errors as
+/// split_measured_data of all the trajectories at once; MeasuredDataError
+/// naming the trajectory when the second pass does not see what the first
+/// did (a file changed in between).
+MeasuredDataSet split_measured_stream(const PhSystem& system, const TrajectorySource& source,
+                                      const ImportOptions& options, std::string* summary = nullptr);
+
+/// `set` with its pairs as PhPairSet and its inference trajectories as
+/// PhInferenceSet (what training reads).
+PhSystemData to_ph_system_data(MeasuredDataSet set);
 
 /// kBlocks (docs/METHOD.md "Measured data"): recording r of N samples
 /// (sorted by id) is cut at b1 = round(train_fraction N) and b2 = b1 +

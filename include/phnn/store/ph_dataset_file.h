@@ -9,11 +9,17 @@
 
 #include "phnn/config/system_file_text.h"
 #include "phnn/data/ph_dataset.h"
+#include "phnn/data/ph_rows.h"
 
 namespace phnn {
 
 /// Writes `data` to a new HDF5 file (replaces `path`).
 void write_ph_dataset_file(const std::string& path, const PhSystemData& data);
+/// The same file for a data set whose splits are given as rows (`data`
+/// holds the rest and no pairs or inference trajectories): what `phnn
+/// import` writes, with no object per pair or sample and no copy.
+void write_ph_dataset_file(const std::string& path, const PhSystemData& data, const PhPairRows& train,
+                           const PhPairRows& validation, const PhInferenceRows& inference);
 
 /// hex64(fnv1a64(...)) (the run ids' hash) over what training and inference
 /// read: the system text, the state and input names, every pair's x,

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "phnn/data/measured.h"
+#include "phnn/systems/measurement_map.h"
 
 namespace phnn {
 
@@ -31,6 +32,12 @@ struct TrajectoryColumns {
 /// trajectory whose rows are split, an empty file).
 std::vector<MeasuredTrajectory> read_trajectory_csv(const std::string& path,
                                                     const TrajectoryColumns& columns);
+/// The same, one trajectory at a time: visit(m) once its last row is read
+/// (`m` is reused for the next: copy what you keep), so a file costs its
+/// longest trajectory, not its size. The trajectories before a malformed
+/// row are visited before the error is thrown.
+void for_each_csv_trajectory(const std::string& path, const TrajectoryColumns& columns,
+                             const TrajectoryVisitor& visit);
 
 /// The first line of every trajectory CSV phnn writes starts with this (the
 /// readers skip it as a comment): only such files are ever replaced.
@@ -53,5 +60,21 @@ void write_trajectory_csv(const std::string& path, const TrajectoryColumns& colu
 /// Throws MeasuredDataError naming "FILE:/trajectories/ID" and the fix.
 std::vector<MeasuredTrajectory> read_trajectory_h5(const std::string& path,
                                                    const TrajectoryColumns& columns);
+/// The same, one trajectory (group) at a time.
+void for_each_h5_trajectory(const std::string& path, const TrajectoryColumns& columns,
+                            const TrajectoryVisitor& visit);
+
+/// What `phnn import` splits: the trajectories of `files` (each HDF5 or
+/// CSV by its content) one at a time, file after file, with the states
+/// [measurement] computes (`map`, which must outlive the source; columns:
+/// map.recorded() as the states). A pass reads the files anew, so a source
+/// holds one trajectory, not the files. Errors as the readers' and
+/// apply_measurement's, in the order of reading every file first and then
+/// computing the states: a [measurement] error is thrown at the end of the
+/// pass. A CSV file read whole once is not checked again for trajectories
+/// whose rows are split (16 bytes a trajectory): split_measured_stream
+/// checks each later pass against the first.
+TrajectorySource recorded_trajectories(const std::vector<std::string>& files,
+                                       const TrajectoryColumns& columns, const MeasurementMap& map);
 
 }  // namespace phnn
