@@ -7,7 +7,7 @@ result.
 
     from analysis.results import load, traces
     runs = load("results/paper.h5")              # every run, pending ones included (of an
-                                                 # adaptive sweep: those its rounds asked for)
+                                                 # adaptive or search sweep: those its rounds asked for)
     done = runs[runs.status == "done"]
     done.groupby(["system", "model_label", "n_train"]).mse.median()
     t = traces("results/paper.h5")              # one row per validation point of every run

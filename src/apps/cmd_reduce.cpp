@@ -436,6 +436,20 @@ View read_view(const cli::Parser& parser) {
   return v;
 }
 
+// --per-run: a row per run (of an adaptive or search sweep: those its rounds
+// asked for, `asked`).
+void print_per_run(const ResultsFile& file, const Inputs& in, const AdaptiveState* asked) {
+  std::vector<RunRecord> records = view_records(file, in);
+  if (asked) {
+    std::vector<RunRecord> kept;
+    for (std::size_t i = 0; i < records.size(); ++i) {
+      if (asked->active[i]) kept.push_back(std::move(records[i]));
+    }
+    records = std::move(kept);
+  }
+  std::cout << render_per_run_csv(records);
+}
+
 }  // namespace
 
 int run_reduce(int argc, char** argv, int first) {
@@ -470,15 +484,7 @@ int run_reduce(int argc, char** argv, int first) {
              : adaptive_rounds(spec, grid, statuses, in.mse, parser, path);
   if (adaptive) warn_unfinished_replay(in, *adaptive, parser, path);
   if (per_run) {
-    std::vector<RunRecord> records = view_records(file, in);
-    if (adaptive) {  // only the runs the rounds asked for
-      std::vector<RunRecord> asked;
-      for (std::size_t i = 0; i < records.size(); ++i) {
-        if (adaptive->active[i]) asked.push_back(std::move(records[i]));
-      }
-      records = std::move(asked);
-    }
-    std::cout << render_per_run_csv(records);
+    print_per_run(file, in, adaptive ? &*adaptive : nullptr);
     return 0;
   }
   const auto entries =

@@ -14,15 +14,7 @@ ItemCheckpoints::ItemCheckpoints(const std::string& out, const std::string& key,
                                  double interval_s, const volatile std::sig_atomic_t* stop_signal,
                                  std::string prefix)
     : path_(cell_checkpoint_path(out, key)), key_(key), prefix_(std::move(prefix)) {
-  CellCheckpoint saved;
-  std::string problem;
-  if (read_cell_checkpoint(path_, &saved, &problem) && saved.key == key_) {
-    checkpointing_.resume_from = std::move(saved.state);
-    resume_step_ = saved.step;
-  } else if (!problem.empty()) {
-    std::fprintf(stderr, "%s%s; training the item from the start\n", prefix_.c_str(),
-                 problem.c_str());
-  }
+  adopt(path_, key_);
   checkpointing_.interval_s = interval_s;
   checkpointing_.stop_requested = [stop_signal] { return *stop_signal != 0; };
   checkpointing_.save = [this](const std::string& state, int step) {
@@ -42,7 +34,10 @@ ItemCheckpoints::ItemCheckpoints(const std::string& out, const std::string& key,
 void ItemCheckpoints::remove() const { remove_cell_checkpoint(path_); }
 
 void ItemCheckpoints::go_on_from(const std::string& path, const std::string& key) {
-  if (resume_step_ > 0) return;
+  if (resume_step_ == 0) adopt(path, key);
+}
+
+void ItemCheckpoints::adopt(const std::string& path, const std::string& key) {
   CellCheckpoint saved;
   std::string problem;
   if (read_cell_checkpoint(path, &saved, &problem) && saved.key == key) {

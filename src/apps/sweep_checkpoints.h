@@ -46,6 +46,10 @@ class ItemCheckpoints {
   void remove() const;
 
  private:
+  // Resumes from the state at `path` if it is there under `key` (a damaged
+  // one is reported on stderr and ignored).
+  void adopt(const std::string& path, const std::string& key);
+
   std::string path_, key_, prefix_;
   CellCheckpointing checkpointing_;
   int resume_step_ = 0, saved_step_ = 0;

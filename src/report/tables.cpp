@@ -34,6 +34,7 @@ std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<R
       const int r = study.runs[i];
       if (only && !(*only)[static_cast<std::size_t>(r)]) continue;
       const RunConfig& run = grid.runs[r];
+      if (run.training.skip_inference) continue;  // a [search] rung before the last: no MSE
       TableEntry e;
       e.study = study.name;
       e.system = run.system_name();

@@ -34,8 +34,10 @@ struct TableEntry {
 
 /// Entries for every run of every study of `grid`; status[i] and mse[i]
 /// belong to grid.runs[i]. With `only`, just the runs i with only[i] != 0 (an
-/// adaptive sweep's runs asked for so far, phnn/sweep/adaptive.h). Throws
-/// std::invalid_argument if the sizes differ.
+/// adaptive sweep's runs asked for so far, phnn/sweep/adaptive.h). Runs
+/// without inference (TrainerOptions::skip_inference: a [search] rung before
+/// the last) have no MSE and no entry. Throws std::invalid_argument if the
+/// sizes differ.
 std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<RunStatus>& status,
                                            const std::vector<double>& mse,
                                            const std::vector<char>* only = nullptr);
