@@ -1,0 +1,386 @@
+// src/apps/sweep_rounds.cpp — SweepRun's rounds (sweep_run.h): plan what is
+// left as work items, train them from the shared queue (each item: train,
+// journal, row), close and report; an adaptive or search sweep round after
+// round, each replayed from the finished file.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <functional>
+#include <iostream>
+#include <sstream>
+
+#include <boost/mpi/collectives.hpp>
+#include <boost/serialization/string.hpp>
+#include <boost/serialization/vector.hpp>
+
+#include "apps/sweep_checkpoints.h"
+#include "apps/sweep_report.h"
+#include "apps/sweep_run.h"
+#include "apps/sweep_search.h"
+#include "phnn/common/counted.h"
+#include "phnn/sweep/resumed_items.h"
+#include "phnn/sweep/scheduler.h"
+#include "phnn/sweep/search.h"
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+namespace apps {
+
+namespace mpi = boost::mpi;
+
+namespace {
+
+// Trains one item's cell, from its saved state if it has one. A cell that
+// throws is a result too: every run failed, with the message. A cell stopped
+// by a signal returns no results (its state is saved; *interrupted), and so
+// does one whose data set a signal stopped while it was being generated.
+std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
+                                  const std::string& system, const std::function<void()>& tick,
+                                  ItemCheckpoints* checkpoints, const std::string& prefix,
+                                  int item_number, bool* interrupted) {
+  *interrupted = false;
+  const auto progress = [&](const TrainProgress&) { tick(); };
+  try {
+    data->make(system);
+    try {
+      return data->train(cell, system, progress, &checkpoints->checkpointing());
+    } catch (const std::invalid_argument& e) {
+      // A saved state that does not fit (e.g. written by another build).
+      if (checkpoints->resume_step() == 0 ||
+          std::string(e.what()).rfind("training state", 0) != 0) {
+        throw;
+      }
+      std::fprintf(stderr, "%sitem %d: %s; training it from the start\n", prefix.c_str(),
+                   item_number, e.what());
+      checkpoints->forget_state();
+      return data->train(cell, system, progress, &checkpoints->checkpointing());
+    }
+  } catch (const CellInterrupted& e) {
+    *interrupted = true;
+    if (checkpoints->saved_step() == e.step) {
+      std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its training state is in %s\n",
+                   prefix.c_str(), item_number, e.step, cell.training.steps,
+                   checkpoints->path().c_str());
+    } else {
+      std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its state could not be saved "
+                   "(see above): it trains again from %s\n", prefix.c_str(), item_number, e.step,
+                   cell.training.steps,
+                   checkpoints->saved_step() > 0 || checkpoints->resume_step() > 0
+                       ? "its last saved state"
+                       : "the start");
+    }
+    return {};
+  } catch (const GenerationStopped&) {  // a signal while this rank made its data: nothing trained
+    *interrupted = true;
+    std::fprintf(stderr, "%sitem %d stopped while making its data set; it trains at the next run\n",
+                 prefix.c_str(), item_number);
+    return {};
+  } catch (const std::exception& e) {
+    std::vector<RunResult> failed(cell.seeds.size());
+    for (auto& r : failed) {
+      r.status = RunStatus::kFailed;
+      r.message = e.what();
+    }
+    std::fprintf(stderr, "%sitem %d failed: %s\n", prefix.c_str(), item_number, e.what());
+    return failed;
+  }
+}
+
+// "item 3/8: <cell>, 2 seeds", and where it goes on from a saved state.
+void announce_item(const std::string& prefix, int number, std::size_t items,
+                   const RunConfig& head, const CellSpec& cell, int resume_step) {
+  print_item("%sitem %d/%zu: %s\n", prefix, number, items,
+             describe(head) + ", " + std::to_string(cell.seeds.size()) + " seed" +
+                 (cell.seeds.size() > 1 ? "s" : ""));
+  if (resume_step > 0) {
+    print_item("%sitem %d/%zu: going on after step %s\n", prefix, number, items,
+               std::to_string(resume_step) + " of " + std::to_string(cell.training.steps) +
+                   " (saved training state)");
+  }
+}
+
+// Journal record first (the source of truth), then the row, each with the
+// item's run times, for each run of the item. A failed journal append (a full disk) does
+// not stop the row: its space was allocated when the file was made, so the
+// result is kept there. Returns "" or the first I/O error.
+std::string record_item(const Grid& grid, const WorkItem& item,
+                        const std::vector<RunResult>& cell_results, const std::string& started,
+                        const std::string& finished, Journal* journal, ResultsFile* results) {
+  std::string error;
+  auto attempt = [&](const auto& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      if (error.empty()) error = cli::with_prefix("phnn sweep: ", e.what());
+    }
+  };
+  for (std::size_t k = 0; k < item.runs.size(); ++k) {
+    const int row = item.runs[k];
+    RunResult result = cell_results[k];
+    result.started_utc = started;
+    result.finished_utc = finished;
+    attempt([&] { journal->append(grid.runs[static_cast<std::size_t>(row)].id(), result); });
+    attempt([&] { results->write_run(row, result); });
+  }
+  return error;
+}
+
+}  // namespace
+
+// Every rank closes the file (collective, but nothing is left to write: rows
+// are raw data in allocated space), every rank learns every error, rank 0
+// ends the session in place and prints the summary. Returns the exit status
+// of a failure (0: none).
+int SweepRun::close_and_report(std::string io_error, bool stopped, int total_runs,
+                               double seconds) {
+  try {
+    results_->close();
+  } catch (const std::exception& e) {
+    if (io_error.empty()) io_error = prefix_ + e.what();
+  }
+  int failed = agree(world_, io_error.empty() ? 0 : kExitFailed, io_error);
+  if (int status = agreed(world_, root_, [&] {
+        ResultsFile file = ResultsFile::open(out_, MPI_COMM_NULL, spec_.text_hash);
+        file.end_session(session_, utc_now());
+        file.close();
+      })) {
+    failed = std::max(failed, status);
+  }
+  if (!root_) return failed;
+  try {
+    print_summary(out_, total_runs, seconds,
+                  failed ? StopReason::kError : stopped ? StopReason::kSignal : StopReason::kNone,
+                  shard_, adaptive_line());
+  } catch (const std::exception& e) {
+    std::cerr << cli::with_prefix("phnn sweep: ", e.what()) << "\n";
+  }
+  return failed;
+}
+
+// What is left to train, as work items: the saved states' items as they
+// were (rank 0 reads the states), then the plan of the rest. The same
+// broadcast lists give the same items on every rank.
+SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
+  Planned p;
+  // --retry-failed retries in the session's first round only (an adaptive
+  // sweep plans again after each round; a run that fails again stays failed).
+  auto pending = pending_runs(grid_, status_codes, parser_.flag_set("retry-failed") && !planned_once_,
+                              shard_, &p.runs_done_before);
+  planned_once_ = true;
+  for (const auto& runs : pending) p.runs_to_do += static_cast<int>(runs.size());
+  if (in_rounds()) {  // the runs no round asked for read as finished
+    p.runs_done_before -= static_cast<int>(grid_.runs.size()) - adaptive_.active_runs();
+  }
+  std::vector<std::vector<int>> resumed;
+  if (root_) {
+    try {
+      resumed = resumed_groups(grid_, &pending, out_, state_key_);
+    } catch (const std::exception& e) {  // never leave the others waiting in the broadcast
+      std::cerr << "phnn sweep: cannot read the saved training states (" << e.what()
+                << "); their items train from the start\n";
+      resumed.clear();
+    }
+  }
+  mpi::broadcast(world_, resumed, 0);
+  mpi::broadcast(world_, pending, 0);
+  p.plan = plan_work(grid_, pending, size_, split_);
+  p.plan.items = with_resumed(grid_, resumed, p.plan.items);
+  p.resumed = resumed.size();
+  return p;
+}
+
+SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_codes) {
+  const Planned planned = plan(status_codes);
+  const std::vector<WorkItem>& work = planned.plan.items;
+  const ScheduleMode mode = parser_.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
+  WorkQueue queue(MPI_COMM_WORLD, static_cast<int>(work.size()), mode);
+  if (root_) {
+    print_plan(spec_, grid_, shard_, planned.runs_done_before, planned.runs_to_do, planned.plan,
+               size_, queue.mode(), out_);
+    if (planned.resumed > 0) {
+      std::cout << "phnn sweep: " << planned.resumed
+                << " of them go on from their saved training state\n";
+    }
+  }
+  const bool quiet = parser_.flag_set("quiet");
+  RoundOutcome outcome;
+  double last_progress = -1e9;
+  const ProgressLine progress_line(work, size_, queue.mode() == ScheduleMode::kStatic);
+  auto report_progress = [&](bool force) {
+    if (!root_ || quiet || (!force && elapsed() - last_progress < 10.0)) return;
+    last_progress = elapsed();
+    progress_line.print(queue.done(), elapsed());
+  };
+  // An I/O error on this rank: it takes no more items, nor do the others
+  // after the one in hand; then every rank learns of it (agree below) and
+  // exits 1 (outcome.io_error).
+  // A stop signal on any rank stops every rank at its next item boundary:
+  // this rank posts it at once, from the training's progress ticks too.
+  auto post_stop = [&] {
+    if (g_stop_signal != 0 && !queue.stop_requested()) queue.request_stop();
+  };
+  auto next_item = [&] {
+    post_stop();
+    return queue.next();
+  };
+  for (int i = next_item(); i >= 0; i = next_item()) {
+    const WorkItem& item = work[static_cast<std::size_t>(i)];
+    const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
+    std::vector<int> seeds;
+    for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
+    const CellSpec cell = cell_spec_for(head, seeds);
+    ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, state_key_),
+                                checkpoint_every_, &g_stop_signal, prefix_);
+    link_rung_states(spec_, grid_, item.runs, out_, build_key_, &checkpoints);
+    if (!quiet) announce_item(prefix_, i + 1, work.size(), head, cell, checkpoints.resume_step());
+    const auto cell_start = SweepClock::now();
+    const std::string started = utc_now();
+    bool interrupted = false;
+    const std::vector<RunResult> cell_results =
+        train_item(cell, &data_, head.system_name(), [&] {
+          post_stop();
+          queue.progress();  // rank 0's window answers the others mid-cell too
+          report_progress(false);
+        }, &checkpoints, prefix_, i + 1, &interrupted);
+    if (interrupted) {
+      post_stop();
+      break;
+    }
+    std::string& io_error = outcome.io_error;
+    io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
+    if (io_error.empty()) checkpoints.remove();
+    outcome.my_runs += static_cast<int>(item.runs.size());
+    if (!io_error.empty()) {
+      queue.request_stop();  // the others stop at their next item too
+      break;
+    }
+    queue.mark_done();
+    if (!quiet) {
+      print_item("%sitem %d/%zu done in %s\n", prefix_, i + 1, work.size(),
+                 format_duration(std::chrono::duration<double>(SweepClock::now() - cell_start).count()));
+    }
+    report_progress(true);
+  }
+  post_stop();
+  outcome.stopped =
+      mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>()) != 0;
+  queue.close();
+  return outcome;
+}
+
+// Trains what is left; an adaptive sweep round after round, each decided on
+// the finished file (every rank closes it, rank 0 replays the rounds, every
+// rank opens it again), until its rule names no cell that can grow.
+int SweepRun::train_and_close(std::vector<int> status_codes) {
+  int my_runs = 0;
+  RoundOutcome round;
+  for (;;) {
+    round = train_round(status_codes);
+    my_runs += round.my_runs;
+    const bool io_failed =
+        mpi::all_reduce(world_, round.io_error.empty() ? 0 : 1, mpi::maximum<int>()) != 0;
+    if (!in_rounds() || round.stopped || io_failed) break;
+    std::string close_error;
+    try {
+      results_->close();
+    } catch (const std::exception& e) {
+      close_error = prefix_ + e.what();
+    }
+    if (int status = agree(world_, close_error.empty() ? 0 : kExitFailed, close_error)) {
+      return status;
+    }
+    const int round_before = adaptive_.round;
+    const int round_runs = mpi::all_reduce(world_, round.my_runs, std::plus<int>());
+    if (int status = replay_rounds(&status_codes)) return status;
+    if (int status = open_results()) return status;
+    if (adaptive_.complete) break;
+    if (round_runs == 0 && adaptive_.round == round_before) {  // never loop without progress
+      round.io_error = prefix_ + "adaptive round " + std::to_string(round_before) +
+                       " has pending runs that this sweep did not train; stopping";
+      break;
+    }
+  }
+  const int total_runs = mpi::all_reduce(world_, my_runs, std::plus<int>());
+  const int failed = close_and_report(round.io_error, round.stopped, total_runs, elapsed());
+  if (failed) return failed;
+  return round.stopped ? kExitStopped : 0;
+}
+
+// Rank 0 replays an adaptive sweep's rounds on the file (closed on every
+// rank), every rank gets the state, and the runs no round asked for read as
+// finished in *status_codes, so no rank plans them.
+int SweepRun::replay_rounds(std::vector<int>* status_codes) {
+  std::vector<int> codes;
+  if (int status = agreed(world_, root_, [&] {
+        const ResultsFile file = ResultsFile::open_read_only(out_);
+        const std::vector<RunStatus> statuses = file.read_statuses();
+        adaptive_ = spec_.search.enabled
+                        ? replay_search(spec_, grid_, statuses,
+                                        file.read_double_column("best_validation_loss"),
+                                        file.read_double_column("mse"))
+                              .state
+                        : replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
+        for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
+      })) {
+    return status;
+  }
+  // What the other ranks use of the state (cell_seeds, pending and failed
+  // stay rank 0's).
+  mpi::broadcast(world_, codes, 0);
+  mpi::broadcast(world_, adaptive_.active, 0);
+  mpi::broadcast(world_, adaptive_.cells_grown, 0);
+  mpi::broadcast(world_, adaptive_.round, 0);
+  mpi::broadcast(world_, adaptive_.complete, 0);
+  for (std::size_t i = 0; i < codes.size(); ++i) {
+    if (!adaptive_.active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
+  }
+  *status_codes = codes;
+  const int round = adaptive_.round, failed = adaptive_.failed;
+  const std::vector<int>& cells_grown = adaptive_.cells_grown;
+  if (root_ && failed > 0) {
+    std::cout << "phnn sweep: warning: " << failed << " failed run" << (failed > 1 ? "s" : "")
+              << " asked for by the rounds so far (their messages: phnn reduce --per-run); the "
+                 "rounds were decided without them; --retry-failed retries them and the rounds "
+                 "after are decided again" << std::endl;
+  }
+  if (root_ && spec_.search.enabled && !adaptive_.complete) {
+    std::cout << search_round_line(spec_, adaptive_) << std::endl;
+  } else if (root_ && !adaptive_.complete) {
+    std::cout << "phnn sweep: adaptive round " << round << ": " << adaptive_.active_runs()
+              << " runs asked for of at most " << grid_.runs.size() << " ("
+              << (round == 0 ? std::string("every cell's first ") +
+                                   std::to_string(spec_.adaptive.initial_seeds.size()) + " seeds"
+                             : counted(cells_grown.back(), "cell") + " got " +
+                                   std::to_string(spec_.adaptive.batch) + " more seeds after round " +
+                                   std::to_string(round - 1))
+              << ", rule " << to_string(spec_.adaptive.rule) << ")" << std::endl;
+  }
+  return 0;
+}
+
+// --dry-run of an adaptive sweep: round 0's schedule and the worst case,
+// every cell at max_seeds.
+std::string SweepRun::adaptive_dry_run() const {
+  std::ostringstream out;
+  out << "adaptive sweep (rule " << to_string(spec_.adaptive.rule) << ", batch "
+      << spec_.adaptive.batch << ", max_seeds " << spec_.adaptive.max_seeds << ")\n"
+      << "round 0 (" << spec_.adaptive.initial_seeds.size() << " seeds per cell):\n"
+      << dry_run_summary(expand_grid(round_zero_spec(spec_)), ranks_, split_)
+      << "worst case (every cell at " << spec_.adaptive.max_seeds << " seeds):\n"
+      << dry_run_summary(grid_, ranks_, split_);
+  return out.str();
+}
+
+std::string SweepRun::adaptive_line() const {
+  if (spec_.search.enabled) return search_complete_line(spec_, grid_, adaptive_);
+  if (!spec_.adaptive.enabled || !adaptive_.complete) return "";
+  const int asked = adaptive_.active_runs();
+  const int left = static_cast<int>(grid_.runs.size()) - asked;
+  return "adaptive sweep complete after round " + std::to_string(adaptive_.round) + ": " +
+         std::to_string(asked) + " runs of at most " + std::to_string(grid_.runs.size()) +
+         (left > 0 ? "; the " + std::to_string(left) + " pending runs are seeds no round asked for"
+                   : " (every cell at max_seeds)");
+}
+
+}  // namespace apps
+}  // namespace phnn
