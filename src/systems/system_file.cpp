@@ -3,13 +3,14 @@
 // z'', and the Gonzalez defect in closed form when it is a polynomial);
 // muParser compiles the results to bytecode for fast evaluation. Reads the
 // system file; writes nothing.
-// Size: one class around one variable buffer that every compiled expression
-// points into: its compilation, evaluation and the checks that evaluate it.
+// The class (FileSystem) is in file_system.h; its evaluations and the
+// checks that evaluate it: system_file_eval.cpp.
 #include "phnn/systems/system_file.h"
 
 #include "phnn/systems/oscillators.h"
 #include "systems/expression_bounds.h"
 #include "systems/expression_code.h"
+#include "systems/file_system.h"
 
 #include <sys/stat.h>
 
@@ -22,6 +23,9 @@
 
 namespace phnn {
 namespace {
+
+using internal::FileSystem;
+using internal::Symbols;
 
 using internal::CompiledExpressions;
 
@@ -43,13 +47,6 @@ const Eigen::IOFormat kRow(Eigen::StreamPrecision, Eigen::DontAlignCols, ", ", "
 
 std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
 
-// Symbols of one system: states, parameters, ports, and the midpoint a and
-// increment d of the closed-form Gonzalez defect.
-struct Symbols {
-  std::vector<GiNaC::realsymbol> x, params, w, a, d;
-  std::vector<std::string> names;  // muParser variable order: x, params, w, a, d
-  GiNaC::symtab energy_table, dissipation_table;
-};
 
 Symbols make_symbols(const SystemDefinition& def) {
   Symbols s;
@@ -118,115 +115,9 @@ GiNaC::ex parse_expression(const SystemDefinition& def, const std::string& key,
   return e;
 }
 
-class FileSystem : public PhSystem {
- public:
-  explicit FileSystem(SystemDefinition def);
-  FileSystem(const FileSystem&) = delete;
-  FileSystem& operator=(const FileSystem&) = delete;
+}  // namespace
 
-  const std::string& name() const override { return def_.name; }
-  const std::vector<std::string>& state_names() const override { return def_.states; }
-  const std::vector<std::string>& state_units() const override { return def_.state_units; }
-  const std::vector<std::string>& input_names() const override { return def_.inputs; }
-  bool has_energy() const override { return def_.has_energy(); }
-  double hamiltonian(const VecX& x) const override {
-    need_energy();
-    set_states(x);
-    return *energy_->eval();
-  }
-  VecX grad_hamiltonian(const VecX& x) const override {
-    need_energy();
-    set_states(x);
-    return Eigen::Map<const VecX>(gradient_->eval(), n_x());
-  }
-  MatX hessian(const VecX& x) const override;
-  VecX dissipation(const VecX& w) const override {
-    need_energy();
-    if (n_w() == 0) return VecX(0);
-    set_ports(w);
-    return Eigen::Map<const VecX>(dissipation_->eval(), n_w());
-  }
-  MatX dissipation_jacobian(const VecX& w) const override {
-    need_energy();
-    if (n_w() == 0) return MatX(0, 0);
-    set_ports(w);
-    return Eigen::Map<const Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(
-        dissipation_jacobian_->eval(), n_w(), n_w());
-  }
-  VecX dissipation_second(const VecX& w, const VecX& s) const override;
-  const MatX& S() const override { return def_.S; }
-  const MatX& J() const override { return def_.J; }
-  VecX discrete_gradient(const VecX& x, const VecX& dx) const override;
-  MatX discrete_gradient_jacobian(const VecX& x, const VecX& dx) const override;
-  const InitialConditionDesign& initial_design() const override { return def_.initial; }
-  const ControlDesign& control_design() const override { return def_.control; }
-  int rng_id() const override { return system_rng_id(def_.name); }
-  const std::string& source_text() const override { return def_.text; }
-  std::string energy_location() const override { return location("H"); }
-  std::string initial_location() const override { return location("initial"); }
-  std::string control_location(const std::string& key = "") const override {
-    const std::string full = "control." + key;
-    return location(!key.empty() && def_.lines.count(full) ? full : "control");
-  }
-  std::array<double, 2> self_oscillation_interval() const override;
-  std::vector<std::array<int, 2>> phase_pairs() const override {
-    return def_.phase_pairs.empty() ? PhSystem::phase_pairs() : def_.phase_pairs;
-  }
-  const std::vector<double>& figure_energies() const override { return def_.figure_energies; }
-
-  /// Resolves the automatic box of initial.method = "energy" and checks H
-  /// at the box's centre, axis ends and corners (finite, >= 0).
-  void check_energy_and_box();
-  /// H finite and >= 0 at each point, else an error at the file's H.
-  void check_energy_at(const std::vector<VecX>& points) const;
-
- private:
-  // A structure-only file generates nothing: its energy and dissipation
-  // law are not defined.
-  void need_energy() const {
-    if (def_.has_energy()) return;
-    throw SystemFileError(def_.file, def_.line_of("name"),
-                          "system \"" + def_.name + "\" defines no energy H (a structure-only "
-                          "file): it can describe measured data (phnn import, then --data or "
-                          "data = [...]) but cannot generate any; add H, z, [initial] and "
-                          "[control] to generate data");
-  }
-  std::string location(const std::string& key) const {
-    return def_.file + ":" + std::to_string(def_.line_of(key));
-  }
-  void compile();
-  void compile_defect(const GiNaC::ex& H, const std::vector<GiNaC::ex>& grad,
-                      const std::vector<GiNaC::ex>& hess);
-  void compile_limit_cycle(const GiNaC::ex& z);
-  void set_states(const VecX& x) const {
-    for (int i = 0; i < n_x(); ++i) vars_[static_cast<std::size_t>(i)] = x(i);
-  }
-  void set_midpoint_and_increment(const VecX& x, const VecX& dx) const {
-    for (int i = 0; i < n_x(); ++i) {
-      vars_[static_cast<std::size_t>(i)] = x(i) + 0.5 * dx(i);
-      vars_[d_offset_ + static_cast<std::size_t>(i)] = dx(i);
-    }
-  }
-  void set_ports(const VecX& w) const {
-    for (int i = 0; i < n_w(); ++i) vars_[w_offset_ + static_cast<std::size_t>(i)] = w(i);
-  }
-  std::unique_ptr<CompiledExpressions> make(const std::vector<GiNaC::ex>& exprs,
-                                            const std::string& what) const;
-
-  SystemDefinition def_;
-  Symbols syms_;  // one set: GiNaC symbols of equal names are still distinct
-  // Each parameter's exact value (the rational its double stands for):
-  // substituted before compiling, so GiNaC folds products of parameters and
-  // numbers exactly (k3/4, 1/m) and muParser evaluates one constant each.
-  GiNaC::exmap parameter_values_;
-  std::unique_ptr<double[]> vars_;
-  std::size_t w_offset_ = 0, d_offset_ = 0;
-  std::unique_ptr<CompiledExpressions> energy_, gradient_, hessian_, dissipation_,
-      dissipation_jacobian_, dissipation_second_, gradient_and_defect_, hessian_and_defect_;
-  bool defect_is_zero_ = false;
-  bool has_limit_cycle_ = false;
-  std::array<double, 2> limit_cycle_ = {0.0, 0.0};
-};
+namespace internal {
 
 FileSystem::FileSystem(SystemDefinition def) : def_(std::move(def)) { compile(); }
 
@@ -369,148 +260,7 @@ void FileSystem::compile_limit_cycle(const GiNaC::ex& z) {
   has_limit_cycle_ = true;
 }
 
-std::array<double, 2> FileSystem::self_oscillation_interval() const {
-  if (!has_limit_cycle_) return PhSystem::self_oscillation_interval();
-  return limit_cycle_;
-}
-
-MatX FileSystem::hessian(const VecX& x) const {
-  need_energy();
-  set_states(x);
-  const double* v = hessian_->eval();
-  MatX h(n_x(), n_x());
-  for (int i = 0, k = 0; i < n_x(); ++i) {
-    for (int j = i; j < n_x(); ++j, ++k) h(i, j) = h(j, i) = v[k];
-  }
-  return h;
-}
-
-VecX FileSystem::dissipation_second(const VecX& w, const VecX& s) const {
-  need_energy();
-  const int nw = n_w();
-  VecX out = VecX::Zero(nw);
-  if (nw == 0) return out;
-  set_ports(w);
-  const double* v = dissipation_second_->eval();
-  for (int k = 0, idx = 0; k < nw; ++k) {
-    for (int l = 0; l < nw; ++l) {
-      for (int m = l; m < nw; ++m, ++idx) out(k) += (l == m ? 1.0 : 2.0) * v[idx] * s(l) * s(m);
-    }
-  }
-  return out;
-}
-
-VecX FileSystem::discrete_gradient(const VecX& x, const VecX& dx) const {
-  need_energy();
-  if (!defect_is_zero_ && !gradient_and_defect_) return PhSystem::discrete_gradient(x, dx);
-  const int n = n_x();
-  const double n2 = dx.squaredNorm();
-  if (defect_is_zero_ || n2 == 0.0) return grad_hamiltonian(x + 0.5 * dx);
-  set_midpoint_and_increment(x, dx);
-  const double* v = gradient_and_defect_->eval();
-  VecX g(n);
-  for (int i = 0; i < n; ++i) g(i) = v[i] + (v[n] / n2) * dx(i);
-  return g;
-}
-
-MatX FileSystem::discrete_gradient_jacobian(const VecX& x, const VecX& dx) const {
-  need_energy();
-  if (!defect_is_zero_ && !hessian_and_defect_) return PhSystem::discrete_gradient_jacobian(x, dx);
-  const double n2 = dx.squaredNorm();
-  if (defect_is_zero_ || n2 == 0.0) return 0.5 * hessian(x + 0.5 * dx);
-  const int n = n_x();
-  set_midpoint_and_increment(x, dx);
-  const double* v = hessian_and_defect_->eval();
-  const int m = n * (n + 1) / 2;
-  const double D = v[m];
-  MatX jac(n, n);
-  for (int i = 0, k = 0; i < n; ++i) {
-    for (int j = i; j < n; ++j, ++k) jac(i, j) = jac(j, i) = 0.5 * v[k];
-  }
-  // + (D/n2) I + dx (dD/n2 - 2 D dx / n2^2)^T
-  for (int i = 0; i < n; ++i) {
-    jac(i, i) += D / n2;
-    for (int j = 0; j < n; ++j) {
-      jac(i, j) += dx(i) * (v[m + 1 + j] / n2 - 2.0 * D * dx(j) / (n2 * n2));
-    }
-  }
-  return jac;
-}
-
-// Largest s with H(s e) <= e_max along direction e (bisection after
-// doubling); < 0 when H stays below e_max up to |s| = 1e6.
-double axis_bound(const PhSystem& sys, const VecX& e, double e_max) {
-  double hi = 1e-3;
-  while (!(sys.hamiltonian(hi * e) > e_max)) {
-    hi *= 2.0;
-    if (hi > 1e6) return -1.0;
-  }
-  double lo = 0.0;
-  for (int it = 0; it < 200 && lo < hi; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    if (mid <= lo || mid >= hi) break;
-    (sys.hamiltonian(mid * e) > e_max ? hi : lo) = mid;
-  }
-  return lo;
-}
-
-void FileSystem::check_energy_and_box() {
-  InitialConditionDesign& d = def_.initial;
-  const int nx = n_x();
-  check_energy_at({VecX::Zero(nx)});
-  if (d.method == InitialConditionDesign::Method::kEnergy && d.box.empty()) {
-    for (int i = 0; i < nx; ++i) {
-      VecX e = VecX::Zero(nx);
-      e(i) = 1.0;
-      const double b = std::max(axis_bound(*this, e, d.energy_max), axis_bound(*this, -e, d.energy_max));
-      if (!(b > 0.0)) {
-        throw SystemFileError(def_.file, def_.line_of("initial"),
-                              "cannot bound state \"" + def_.states[static_cast<std::size_t>(i)] +
-                                  "\" for initial.method = \"energy\": H along it stays below "
-                                  "energy_max = " + std::to_string(d.energy_max) +
-                                  " (or is not finite); give initial.box = [[lo, hi], ...]");
-      }
-      d.box.push_back({-b, b});
-    }
-  }
-  if (d.method == InitialConditionDesign::Method::kAlgorithm1) {
-    const MatX h0 = hessian(VecX::Zero(nx));
-    if (!(h0(0, 0) > 0.0 && h0(1, 1) > 0.0 && std::isfinite(h0(0, 0)) && std::isfinite(h0(1, 1)))) {
-      throw SystemFileError(def_.file, def_.line_of("initial"),
-                            "initial.method = \"algorithm1\" needs d2H/dq2 > 0 and d2H/dp2 > 0 at "
-                            "x = 0 (an ellipse around the origin); use \"energy\" or \"box\"");
-    }
-  }
-  // H at the box's (up to 2^10) corners.
-  std::vector<VecX> points;
-  if (!d.box.empty()) {
-    const int corners = nx <= 10 ? 1 << nx : 0;
-    for (int c = 0; c < corners; ++c) {
-      VecX p(nx);
-      for (int i = 0; i < nx; ++i) p(i) = d.box[static_cast<std::size_t>(i)][(c >> i) & 1];
-      points.push_back(p);
-    }
-  }
-  check_energy_at(points);
-}
-
-void FileSystem::check_energy_at(const std::vector<VecX>& points) const {
-  for (const VecX& p : points) {
-    const double h = hamiltonian(p);
-    if (!std::isfinite(h) || h < 0.0) {
-      std::ostringstream os;
-      os << "H = " << h << " at x = (" << p.transpose().format(kRow) << ")" << (std::isfinite(h) ? " is negative" : " is not finite");
-      if (std::isfinite(h)) {
-        os << negative_energy_advice(*this, def_.initial.box, h);
-      } else {
-        os << "; an energy must be finite wherever initial states are drawn: fix H or shrink initial.box";
-      }
-      throw SystemFileError(def_.file, def_.line_of("H"), os.str());
-    }
-  }
-}
-
-}  // namespace
+}  // namespace internal
 
 std::string read_system_file_text(const std::string& path) {
   struct stat st;
