@@ -33,12 +33,6 @@ extern "C" void install_early_handlers(int, char**, char**) {
 __attribute__((section(".preinit_array"), used)) void (*const kPreinit)(int, char**, char**) =
     install_early_handlers;
 
-}  // namespace
-
-int early_stop_signal() { return g_early_signal; }
-
-namespace {
-
 volatile std::sig_atomic_t g_in_setup = 0;
 volatile std::sig_atomic_t* g_stop_flag = nullptr;
 int g_setup_status = 0;

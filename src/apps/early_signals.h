@@ -10,9 +10,6 @@
 namespace phnn {
 namespace apps {
 
-/// The stop signal caught before a command took over (0: none).
-int early_stop_signal();
-
 /// For commands that do not stop gracefully: the default action again, and
 /// a signal caught early is raised now.
 void restore_default_stop_signals();

@@ -7,7 +7,6 @@
 #include <string>
 #include <vector>
 
-#include "phnn/config/run_result.h"
 #include "phnn/store/results_file.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"

@@ -91,17 +91,6 @@ long mlp_parameter_count(int in, const std::vector<int>& hidden, int out) {
   return count + static_cast<long>(prev) * out + out;
 }
 
-long parameter_count(ModelKind kind, ModelSize size) {
-  const NetworkWidths w = network_widths(size);
-  switch (kind) {
-    case ModelKind::kNode: return mlp_parameter_count(3, w.node, 2);
-    case ModelKind::kPhnnJr:
-      return mlp_parameter_count(2, w.l_h, 3) + mlp_parameter_count(3, w.l_r, 6);
-    case ModelKind::kPhnnS:
-      return mlp_parameter_count(2, w.l_h, 3) + mlp_parameter_count(1, w.l_z, 1);
-  }
-  return 0;
-}
 
 long parameter_count(ModelKind kind, ModelSize size, int n_x, int n_w, int n_u) {
   const NetworkWidths w = network_widths(size);

@@ -52,25 +52,10 @@ void MeasuredTrajectory::add(double time, const double* state, const double* inp
   u.insert(u.end(), input, input + n_u);
 }
 
-VecX MeasuredTrajectory::state(std::size_t k) const {
-  return Eigen::Map<const VecX>(x.data() + k * static_cast<std::size_t>(n_x), n_x);
-}
-
-VecX MeasuredTrajectory::input(std::size_t k) const {
-  return Eigen::Map<const VecX>(u.data() + k * static_cast<std::size_t>(n_u), n_u);
-}
-
 bool MeasuredTrajectory::same_input(std::size_t k, std::size_t ref) const {
   const auto w = static_cast<std::size_t>(n_u);
   return std::equal(u.begin() + static_cast<long>(k * w), u.begin() + static_cast<long>((k + 1) * w),
                     u.begin() + static_cast<long>(ref * w));
-}
-
-void MeasuredTrajectory::shrink() {
-  t.shrink_to_fit();
-  x.shrink_to_fit();
-  u.shrink_to_fit();
-  line.shrink_to_fit();
 }
 
 std::string MeasuredTrajectory::where(std::size_t k) const {

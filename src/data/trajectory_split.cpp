@@ -8,7 +8,6 @@
 #include <limits>
 
 #include "data/measured_checks.h"
-#include "phnn/common/cr_math.h"
 #include "phnn/data/counter_rng.h"
 
 namespace phnn {

@@ -3,7 +3,6 @@
 
 #include "phnn/common/check.h"
 #include "phnn/models/general_ph.h"
-#include "phnn/models/port_hamiltonian.h"
 #include "phnn/systems/builtin_systems.h"
 
 namespace phnn {

@@ -1,12 +1,11 @@
 // src/models/fused_heads_common.h — shared by the fused heads of src/models
 // only (general*_heads.cpp, general_curvature_head.cpp; manual_step.cpp for rows_like):
-// softplus/sigmoid from one exp, the structure matrices a head saves for its
-// backward, and the row and lower-triangle indexing of the n-state heads.
+// softplus/sigmoid from one exp, and the row and lower-triangle indexing of
+// the n-state heads.
 #pragma once
 
 #include <torch/torch.h>
 
-#include <array>
 #include <cmath>
 #include <vector>
 
@@ -115,23 +114,6 @@ inline double skew_entry(const double* o, int n, int r, int c) {
   if (r == c) return 0.0;
   const int base = n * (n + 1) / 2;
   return r > c ? o[base + r * (r - 1) / 2 + c] : -o[base + c * (c - 1) / 2 + r];
-}
-
-// A head's constant structure matrix (J or S), kept for its backward as one
-// list entry of the context.
-template <std::size_t R, std::size_t C>
-void save_matrix(AutogradContext* ctx, const std::array<std::array<double, C>, R>& m) {
-  std::vector<double> flat;
-  for (const auto& row : m) flat.insert(flat.end(), row.begin(), row.end());
-  ctx->saved_data["matrix"] = flat;
-}
-template <std::size_t R, std::size_t C>
-std::array<std::array<double, C>, R> load_matrix(AutogradContext* ctx) {
-  const std::vector<double> flat = ctx->saved_data["matrix"].toDoubleVector();
-  std::array<std::array<double, C>, R> m;
-  for (std::size_t i = 0; i < R; ++i)
-    for (std::size_t j = 0; j < C; ++j) m[i][j] = flat[i * C + j];
-  return m;
 }
 
 }  // namespace heads

@@ -33,7 +33,6 @@
 #include "models/jet_kernels.h"
 #include "models/member_gemm.h"
 #include "models/vector_math.h"
-#include "phnn/common/check.h"
 
 namespace phnn {
 namespace internal {

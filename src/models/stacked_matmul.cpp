@@ -2,7 +2,6 @@
 #include "models/stacked_matmul.h"
 
 #include "models/member_gemm.h"
-#include "phnn/common/check.h"
 
 namespace phnn {
 namespace internal {

@@ -37,15 +37,6 @@ Jet Jet::constant(const torch::Tensor& v, int directions, int order) {
   return j;
 }
 
-Jet Jet::component(int64_t k) const {
-  using torch::indexing::Slice;
-  Jet j;
-  j.v = v.narrow(-1, k, 1);
-  if (g.defined()) j.g = g.narrow(-1, k, 1);
-  if (h.defined()) j.h = h.narrow(-1, k, 1);
-  return j;
-}
-
 Jet Jet::cat(const std::vector<Jet>& parts) {
   std::vector<torch::Tensor> vs, gs, hs;
   for (const Jet& p : parts) {

@@ -314,10 +314,6 @@ SystemFileReader ResultsFile::stored_system_files() const {
   };
 }
 
-void ResultsFile::flush() {
-  impl_->collective([&] { impl_->file.flush(); });
-}
-
 void ResultsFile::close() {
   if (!impl_ || !impl_->open) return;
   impl_->open = false;

@@ -234,18 +234,7 @@ std::vector<std::string> ResultsFile::read_run_ids() const { return impl_->strin
 std::vector<std::string> ResultsFile::read_canonical() const {
   return impl_->strings(kCanonical);
 }
-std::vector<std::string> ResultsFile::read_systems() const { return impl_->strings(kSystem); }
-std::vector<std::string> ResultsFile::read_models() const { return impl_->strings(kModel); }
-std::vector<std::string> ResultsFile::read_integrators() const {
-  return impl_->strings(kIntegrator);
-}
-std::vector<std::string> ResultsFile::read_sizes() const { return impl_->strings(kSize); }
-std::vector<std::string> ResultsFile::read_regularizers() const {
-  return impl_->strings(kRegularizer);
-}
 std::vector<std::string> ResultsFile::read_studies() const { return impl_->strings(kStudies); }
-std::vector<std::int64_t> ResultsFile::read_n_train() const { return impl_->ints(kNTrain); }
-std::vector<std::int64_t> ResultsFile::read_n_x() const { return impl_->run_states; }
 std::vector<std::int64_t> ResultsFile::read_seeds() const { return impl_->ints(kSeed); }
 
 void ResultsFile::rewrite_configuration(const std::vector<RunConfig>& runs,

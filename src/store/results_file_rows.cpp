@@ -8,7 +8,6 @@
 #include <limits>
 
 #include "phnn/config/run_config.h"  // fnv1a64
-#include "phnn/store/journal.h"
 #include "store/results_file_internal.h"
 
 namespace phnn {

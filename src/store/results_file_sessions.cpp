@@ -1,6 +1,6 @@
-// src/store/results_file_sessions.cpp — ResultsFile: when each run was
-// trained (the readers of /runs/started_utc, finished_utc; write_run stores
-// them) and who wrote the file (/provenance/session_<k>).
+// src/store/results_file_sessions.cpp — ResultsFile: who wrote the file
+// (/provenance/session_<k>) and which sessions trained runs (by
+// /runs/finished_utc; write_run stores it, read_run reads it).
 #include "phnn/store/results_file.h"
 #include "store/results_file_internal.h"
 
@@ -40,18 +40,6 @@ std::vector<bool> sessions_with_runs(const std::vector<Provenance>& sessions,
     }
   }
   return out;
-}
-
-bool ResultsFile::has_run_times() const { return impl_->has_run_times; }
-
-std::vector<std::string> ResultsFile::read_started_utc() const {
-  if (!impl_->has_run_times) return std::vector<std::string>(static_cast<std::size_t>(num_runs()));
-  return impl_->strings(kStartedUtc);
-}
-
-std::vector<std::string> ResultsFile::read_finished_utc() const {
-  if (!impl_->has_run_times) return std::vector<std::string>(static_cast<std::size_t>(num_runs()));
-  return impl_->strings(kFinishedUtc);
 }
 
 std::vector<bool> ResultsFile::sessions_with_runs() const {

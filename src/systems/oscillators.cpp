@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "phnn/common/check.h"
-#include "phnn/common/cr_math.h"
 #include "phnn/common/closest_name.h"
 
 namespace phnn {

@@ -16,8 +16,6 @@
 #include <torch/torch.h>
 
 #include "models/ordered_sum.h"
-#include "phnn/common/check.h"
-#include "phnn/data/counter_rng.h"
 #include "phnn/integrators/step_options.h"
 #include "phnn/models/dynamics_model.h"
 #include "phnn/training/discrete_step.h"

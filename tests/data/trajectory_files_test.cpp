@@ -207,8 +207,8 @@ TEST(MeasuredDataTest, CsvTrajectoriesAreReadIntoFlatArraysOfTheirSize) {
     EXPECT_EQ(m.u.size(), m.size());
     EXPECT_EQ(m.x.capacity(), m.x.size());
     EXPECT_EQ(m.t.capacity(), m.t.size());
-    EXPECT_EQ(m.state(7)(1), 7.0);
-    EXPECT_EQ(m.input(7)(0), 0.5);
+    EXPECT_EQ(m.x[7 * 2 + 1], 7.0);  // sample 7: state 1, input 0
+    EXPECT_EQ(m.u[7], 0.5);
   }
   std::remove(path.c_str());
 }
@@ -332,8 +332,8 @@ TEST(MeasuredDataTest, Hdf5TrajectoryFilesReadAndFailWithTheirPlace) {
   for (const auto& m : read) {
     got.insert(m.id);
     EXPECT_EQ(m.x.size(), 2 * m.t.size());
-    EXPECT_EQ(m.state(1)(1), 2.0);
-    EXPECT_EQ(m.input(0)(0), 0.5);
+    EXPECT_EQ(m.x[1 * 2 + 1], 2.0);  // sample 1: state 1
+    EXPECT_EQ(m.u[0], 0.5);
   }
   EXPECT_EQ(got, (std::set<std::int64_t>{3, 12}));
   // 21. no /trajectories group

@@ -40,9 +40,9 @@ TEST(ModelParameterCountTest, MatchesSpecTable) {
     EXPECT_EQ(s->networks()[1]->parameter_count(), r.l_z);
     EXPECT_EQ(jr->parameter_count(), r.l_h + r.l_r);
     EXPECT_EQ(s->parameter_count(), r.l_h + r.l_z);
-    EXPECT_EQ(jr->parameter_count(), parameter_count(ModelKind::kPhnnJr, r.size));
-    EXPECT_EQ(s->parameter_count(), parameter_count(ModelKind::kPhnnS, r.size));
-    EXPECT_EQ(node->parameter_count(), parameter_count(ModelKind::kNode, r.size));
+    EXPECT_EQ(jr->parameter_count(), parameter_count(ModelKind::kPhnnJr, r.size, 2, 1, 1));
+    EXPECT_EQ(s->parameter_count(), parameter_count(ModelKind::kPhnnS, r.size, 2, 1, 1));
+    EXPECT_EQ(node->parameter_count(), parameter_count(ModelKind::kNode, r.size, 2, 1, 1));
   }
 }
 

@@ -141,9 +141,9 @@ TEST_F(ResultsFileTest, RoundTripsWeightsAtTheirOffsets) {
   layout.weights = true;
   const std::vector<RunConfig> runs = sample_runs(kNumRuns);
   auto weights_of = [&](int row) {
+    const RunConfig& run = runs[static_cast<std::size_t>(row)];
     std::vector<double> w(static_cast<std::size_t>(
-        parameter_count(runs[static_cast<std::size_t>(row)].model,
-                        runs[static_cast<std::size_t>(row)].size)));
+        parameter_count(run.model, run.size, run.n_x, run.n_w, run.n_u)));
     for (std::size_t i = 0; i < w.size(); ++i) w[i] = row + 1.0 / (3.0 + static_cast<double>(i));
     return w;
   };
@@ -185,12 +185,12 @@ TEST_F(ResultsFileTest, StoresConfigColumnsAndFileAttributes) {
   for (std::size_t i = 0; i < runs.size(); ++i) {
     EXPECT_EQ(ids[i], runs[i].id());
     EXPECT_EQ(canonical[i], runs[i].canonical());
-    EXPECT_EQ(file.read_systems()[i], to_string(runs[i].system));
-    EXPECT_EQ(file.read_models()[i], to_string(runs[i].model));
-    EXPECT_EQ(file.read_integrators()[i], to_string(runs[i].integrator));
-    EXPECT_EQ(file.read_sizes()[i], to_string(runs[i].size));
-    EXPECT_EQ(file.read_regularizers()[i], to_string(runs[i].regularizer));
-    EXPECT_EQ(file.read_n_train()[i], runs[i].n_train);
+    EXPECT_EQ(file.read_string_column("system")[i], to_string(runs[i].system));
+    EXPECT_EQ(file.read_string_column("model")[i], to_string(runs[i].model));
+    EXPECT_EQ(file.read_string_column("integrator")[i], to_string(runs[i].integrator));
+    EXPECT_EQ(file.read_string_column("size")[i], to_string(runs[i].size));
+    EXPECT_EQ(file.read_string_column("regularizer")[i], to_string(runs[i].regularizer));
+    EXPECT_EQ(file.read_int_column("n_train")[i], runs[i].n_train);
     EXPECT_EQ(file.read_seeds()[i], runs[i].seed);
     EXPECT_EQ(file.read_studies()[i], sample_studies(kNumRuns)[i]);
   }
@@ -448,7 +448,7 @@ TEST_F(ResultsFileTest, StoresFiguresOfAnyStateCountAndSystemFileData) {
   }
   const ResultsFile file = ResultsFile::open_read_only(path_);
   EXPECT_EQ(file.layout().figure_states, 4);
-  EXPECT_EQ(file.read_n_x(), (std::vector<std::int64_t>{2, 4}));
+  EXPECT_EQ(file.read_int_column("n_x"), (std::vector<std::int64_t>{2, 4}));
   expect_bit_equal(two, file.read_run(0));
   expect_bit_equal(four, file.read_run(1));
   const std::vector<double> column = file.read_double_column("figure/prediction_05");

@@ -152,7 +152,6 @@ TEST_F(WriteGrownResultsTest, GrownFileKeepsEveryResultBitwiseInItsNewRow) {
   EXPECT_EQ(file.sweep_hash(), grown.text_hash);
   ASSERT_EQ(file.num_runs(), 6);
   const auto status = file.read_statuses();
-  const auto started = file.read_started_utc();
   int kept = 0;
   for (int run = 0; run < 6; ++run) {
     auto it = original_.find(grid.runs[run].canonical());
@@ -162,7 +161,7 @@ TEST_F(WriteGrownResultsTest, GrownFileKeepsEveryResultBitwiseInItsNewRow) {
     }
     ++kept;
     testing_util::expect_bit_equal(it->second, file.read_run(run));
-    EXPECT_EQ(started[run][0], 's');
+    EXPECT_EQ(file.read_run(run).started_utc[0], 's');
   }
   EXPECT_EQ(kept, 3);
   const auto sessions = file.read_sessions();

@@ -194,7 +194,7 @@ TEST(SweepSystemFilesTest, SweepOfASystemFileFinishesResumesReducesAndEvaluates)
   {
     const ResultsFile a = ResultsFile::open_read_only(out), b = ResultsFile::open_read_only(one);
     ASSERT_EQ(a.read_run_ids(), b.read_run_ids());
-    EXPECT_EQ(a.read_systems(), (std::vector<std::string>{"osc", "osc", "osc", "osc", "harmonic",
+    EXPECT_EQ(a.read_string_column("system"), (std::vector<std::string>{"osc", "osc", "osc", "osc", "harmonic",
                                                           "harmonic", "harmonic", "harmonic"}));
     for (int row = 0; row < a.num_runs(); ++row) {
       const RunResult x = a.read_run(row), y = b.read_run(row);

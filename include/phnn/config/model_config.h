@@ -61,12 +61,10 @@ struct NetworkWidths {
 };
 NetworkWidths network_widths(ModelSize size);
 
-/// Number of trainable parameters of one member (docs/METHOD.md §3): NODE 746 /
-/// 4022 / 20802; PHNN-JR = L_H + L_R; PHNN-S = L_H + L_z.
-long parameter_count(ModelKind kind, ModelSize size);
-/// The same for the n-dimensional models (general_ph.h) of a system with
-/// n_x states, n_w dissipation ports and n_u inputs; equal to the above at
-/// (2, 1, 1).
+/// Number of trainable parameters of one member (docs/METHOD.md §3) of the
+/// models (general_ph.h) of a system with n_x states, n_w dissipation ports
+/// and n_u inputs: PHNN-JR = L_H + L_R; PHNN-S = L_H + L_z; at (2, 1, 1)
+/// NODE 746 / 4022 / 20802.
 long parameter_count(ModelKind kind, ModelSize size, int n_x, int n_w, int n_u);
 /// Parameters of an MLP with the given input, hidden widths and output.
 long mlp_parameter_count(int in, const std::vector<int>& hidden, int out);

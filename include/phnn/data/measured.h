@@ -26,7 +26,7 @@ namespace phnn {
 ///
 ///   MeasuredTrajectory m(/*n_x=*/2, /*n_u=*/1);
 ///   m.add(/*t=*/0.0, x0.data(), u0.data());
-///   const VecX x0_again = m.state(0);
+///   const double p0 = m.x[1];  // sample 0, state 1
 struct MeasuredTrajectory {
   MeasuredTrajectory() = default;
   MeasuredTrajectory(int states, int inputs) : n_x(states), n_u(inputs) {}
@@ -47,12 +47,8 @@ struct MeasuredTrajectory {
   std::size_t size() const { return t.size(); }
   /// Appends sample (t, x, u): n_x and n_u values.
   void add(double time, const double* state, const double* input);
-  VecX state(std::size_t k) const;
-  VecX input(std::size_t k) const;
   /// u_k == u_ref, value by value.
   bool same_input(std::size_t k, std::size_t ref = 0) const;
-  /// Frees the room the arrays grew beyond their samples (call once read).
-  void shrink();
 
   /// "a.csv:14: trajectory 7" (sample k's line) or "b.h5:/trajectories/7,
   /// sample 3".

@@ -24,8 +24,6 @@ struct Jet {
   static Jet input(const torch::Tensor& x, int directions, int order);
   /// Jet of a value that does not depend on the directions.
   static Jet constant(const torch::Tensor& v, int directions, int order);
-  /// Component slice [..., k:k+1] (n = 1 afterwards).
-  Jet component(int64_t k) const;
   /// Concatenation along the value dimension.
   static Jet cat(const std::vector<Jet>& parts);
 };

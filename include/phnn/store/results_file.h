@@ -55,7 +55,7 @@ using Provenance = std::vector<std::pair<std::string, std::string>>;
 
 /// Per session of `sessions` (ResultsFile::read_sessions): true when at
 /// least one run finished in it, i.e. one of `finished_utc`
-/// (ResultsFile::read_finished_utc, "" for runs not done) lies between the
+/// (/runs/finished_utc, "" for runs not done) lies between the
 /// session's `started` and its end (its `finished`, else the next session's
 /// `started`, else open). Sessions without `started` count as having runs,
 /// and so does every session when `finished_utc` is empty (a file that
@@ -187,15 +187,7 @@ class ResultsFile {
   /// Config columns, one entry per row.
   std::vector<std::string> read_run_ids() const;
   std::vector<std::string> read_canonical() const;
-  std::vector<std::string> read_systems() const;       // "harmonic", ...
-  std::vector<std::string> read_models() const;        // "node", "phnn-s", ...
-  std::vector<std::string> read_integrators() const;   // "rk2", "dg"
-  std::vector<std::string> read_sizes() const;         // "small", ...
-  std::vector<std::string> read_regularizers() const;  // "none", "cn", ...
-  std::vector<std::string> read_studies() const;       // "I,II"
-  std::vector<std::int64_t> read_n_train() const;
-  /// States of each run's system (/runs/n_x; 2 in files written before it).
-  std::vector<std::int64_t> read_n_x() const;
+  std::vector<std::string> read_studies() const;  // "I,II"
   std::vector<std::int64_t> read_seeds() const;
 
   /// Any column of /runs by name ("mse", "wall_time_s", "figure/length",
@@ -222,16 +214,10 @@ class ResultsFile {
   /// throws std::runtime_error naming the file when none is stored.
   SystemFileReader stored_system_files() const;
 
-  /// Whether the file has /runs/started_utc and /runs/finished_utc, where
-  /// write_run stores RunResult::started_utc and finished_utc (files
-  /// written before provenance have neither and drop the times).
-  bool has_run_times() const;
-  /// One entry per row; "" where unknown (pending, recovered from a
-  /// journal record written before 2026-11-28, or an older file).
-  std::vector<std::string> read_started_utc() const;
-  std::vector<std::string> read_finished_utc() const;
-  /// sessions_with_runs(read_sessions(), read_finished_utc()), every
-  /// session counting in a file that records no run times.
+  /// sessions_with_runs(read_sessions(), /runs/finished_utc), every session
+  /// counting in a file that records no run times (files written before
+  /// provenance have no /runs/started_utc and finished_utc: write_run drops
+  /// RunResult::started_utc and finished_utc there, read_run gives "").
   std::vector<bool> sessions_with_runs() const;
 
   /// Integrity (docs/RESULTS_FORMAT.md, "Checksums"): every row written by
@@ -322,8 +308,6 @@ class ResultsFile {
   /// Every session, in order; empty for files written before provenance.
   std::vector<Provenance> read_sessions() const;
 
-  /// Collective: flushes HDF5's buffers to the file.
-  void flush();
   /// Collective: closes the file; later calls throw. Idempotent.
   void close();
 
