@@ -121,6 +121,11 @@ void print_markdown_preamble(const ResultsFile& file, const SweepSpec& spec,
             << "expected.\n\n";
 }
 
+// --round K: the last round (rung) replayed; -1 without it: all.
+int last_round(const cli::Parser& parser) {
+  return parser.has("round") ? parser.get_int_in("round", 0, 1 << 20) : -1;
+}
+
 // An adaptive sweep's rounds (up to --round K): the runs they asked for,
 // each cell expecting its own number of seeds. Nothing for other sweeps.
 std::optional<AdaptiveState> adaptive_rounds(const SweepSpec& spec, const Grid& grid,
@@ -135,7 +140,7 @@ std::optional<AdaptiveState> adaptive_rounds(const SweepSpec& spec, const Grid& 
     }
     return std::nullopt;
   }
-  const int last = parser.has("round") ? parser.get_int_in("round", 0, 1 << 20) : -1;
+  const int last = last_round(parser);
   AdaptiveState state = replay_adaptive_rounds(spec, grid, statuses, mse, {}, last);
   if (last > state.round || (last == state.round && state.pending > 0)) {
     std::cerr << "phnn reduce: warning: --round " << last << ": " << path
@@ -179,7 +184,6 @@ struct Inputs {
   std::vector<int> damaged;
   std::vector<RunStatus> statuses;
   std::vector<double> mse;
-  std::vector<double> best_validation;  // [search]'s criterion
 };
 
 Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
@@ -189,7 +193,6 @@ Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
   auto statuses = file.read_statuses();
   for (int row : in.damaged) statuses[static_cast<std::size_t>(row)] = RunStatus::kPending;
   auto mse = file.read_double_column("mse");
-  auto best_validation = file.read_double_column("best_validation_loss");
   SweepSpec own;
   try {
     own = parse_sweep_text(file.sweep_text(), path + "@sweep_text", file.stored_system_files());
@@ -205,24 +208,24 @@ Inputs read_inputs(const ResultsFile& file, const cli::Parser& parser) {
     for (std::size_t i = 0; i < statuses.size(); ++i) in.view.row[i] = static_cast<int>(i);
     in.statuses = std::move(statuses);
     in.mse = std::move(mse);
-    in.best_validation = std::move(best_validation);
     return in;
   }
   in.view = rule_view(file, parser.get("rule"));
   in.statuses = through_view(in.view, statuses, RunStatus::kPending);
   in.mse = through_view(in.view, mse, std::numeric_limits<double>::quiet_NaN());
-  in.best_validation =
-      through_view(in.view, best_validation, std::numeric_limits<double>::quiet_NaN());
   return in;
 }
 
-// A [search] sweep's rungs as far as decided (up to --round K); nothing
-// for other sweeps.
-std::optional<SearchReplay> search_rungs(const SweepSpec& spec, const Grid& grid,
-                                         const Inputs& in, const cli::Parser& parser) {
+// A [search] sweep's rungs as far as decided (up to --round K), from its
+// best validation losses (read only then); nothing for other sweeps. A
+// --rule view is never a search (a rule has [adaptive], which excludes
+// [search]), so the rows are the file's.
+std::optional<SearchReplay> search_rungs(const ResultsFile& file, const SweepSpec& spec,
+                                         const Grid& grid, const Inputs& in,
+                                         const cli::Parser& parser) {
   if (!spec.search.enabled) return std::nullopt;
-  const int last = parser.has("round") ? parser.get_int_in("round", 0, 1 << 20) : -1;
-  return replay_search(spec, grid, in.statuses, in.best_validation, in.mse, last);
+  return replay_search(spec, grid, in.statuses, file.read_double_column("best_validation_loss"),
+                       in.mse, last_round(parser));
 }
 
 // --rule: a replay that stops at a round the file cannot finish says so.
@@ -399,7 +402,7 @@ int run_reduce(int argc, char** argv, int first) {
   const SweepSpec& spec = in.view.spec;
   const Grid& grid = in.view.grid;
   const std::vector<RunStatus>& statuses = in.statuses;
-  const std::optional<SearchReplay> search = search_rungs(spec, grid, in, parser);
+  const std::optional<SearchReplay> search = search_rungs(file, spec, grid, in, parser);
   const std::optional<AdaptiveState> adaptive =
       search ? std::optional<AdaptiveState>(search->state)
              : adaptive_rounds(spec, grid, statuses, in.mse, parser, path);

@@ -20,14 +20,6 @@
 namespace phnn {
 namespace {
 
-std::vector<int> cell_of_runs(const Grid& grid) {
-  std::vector<int> cell_of(grid.runs.size(), -1);
-  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
-    for (int r : grid.cells[c].runs) cell_of[static_cast<std::size_t>(r)] = static_cast<int>(c);
-  }
-  return cell_of;
-}
-
 std::vector<int> column_best_cells(const Grid& grid, const std::vector<char>& active,
                                    const std::vector<RunStatus>& status,
                                    const std::vector<double>& mse,

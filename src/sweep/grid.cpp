@@ -306,6 +306,14 @@ Grid expand_grid(const SweepSpec& spec, const CostModel& cost_model) {
   return grid;
 }
 
+std::vector<int> cell_of_runs(const Grid& grid) {
+  std::vector<int> cell_of(grid.runs.size(), -1);
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    for (int r : grid.cells[c].runs) cell_of[static_cast<std::size_t>(r)] = static_cast<int>(c);
+  }
+  return cell_of;
+}
+
 double greedy_makespan_s(std::vector<double> item_costs_s, int ranks) {
   if (ranks < 1) {
     throw std::invalid_argument("greedy_makespan_s: ranks = " + std::to_string(ranks) +

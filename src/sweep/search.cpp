@@ -4,6 +4,8 @@
 // Markdown report. Reads the grid; writes nothing.
 #include "phnn/sweep/search.h"
 
+#include "phnn/report/statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -40,10 +42,7 @@ std::string without_budget(const std::string& column) {
 // The groups of the grid: per study and system, its configurations in grid
 // order, each with its cell per rung.
 std::vector<Group> groups_of(const SweepSpec& spec, const Grid& grid) {
-  std::vector<int> cell_of(grid.runs.size(), -1);
-  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
-    for (int r : grid.cells[c].runs) cell_of[static_cast<std::size_t>(r)] = static_cast<int>(c);
-  }
+  const std::vector<int> cell_of = cell_of_runs(grid);
   const std::vector<int>& rungs = spec.search.rungs;
   std::vector<Group> groups;
   for (const StudyTable& study : grid.studies) {
@@ -74,16 +73,8 @@ std::vector<Group> groups_of(const SweepSpec& spec, const Grid& grid) {
   return groups;
 }
 
-// Median with infinities: the middle value, or the mean of the two middle
-// ones (+inf if either is); +inf for no values.
-double median_of(std::vector<double> v) {
-  if (v.empty()) return kInf;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  if (n % 2 == 1) return v[n / 2];
-  const double a = v[n / 2 - 1], b = v[n / 2];
-  return std::isinf(a) || std::isinf(b) ? std::max(a, b) : 0.5 * (a + b);
-}
+// The median (quantile_linear, exact with +inf), +inf for no values.
+double median_of(const std::vector<double>& v) { return v.empty() ? kInf : quantile_linear(v, 0.5); }
 
 // The entry of `cell` from its finished runs: criterion and MSE medians,
 // a diverged run +inf in both, a failed one left out.

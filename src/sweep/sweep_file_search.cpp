@@ -43,12 +43,15 @@ Axis read_axis(const Entry& e, const TrainerOptions& base, const ValueReader& va
                             "rungs = [...]");
   }
   TrainerOptions probe = base;
-  const toml::array* items = e.value->as_array();
-  if (!items) {
-    if (!set(probe, e)) {
+  const auto set_known = [&](const Entry& one) {
+    if (!set(probe, one)) {
       values.fail(e.line, "unknown key " + quoted(e.key) + " in [search]; expected rungs, eta, "
                           "criterion, or a [training] key with a list of values to search");
     }
+  };
+  const toml::array* items = e.value->as_array();
+  if (!items) {
+    set_known(e);
     values.fail(e.line, "search axis " + e.key + " expects a list of values, e.g. " + e.key +
                             " = [..., ...], got " + values.describe(*e.value));
   }
@@ -56,10 +59,7 @@ Axis read_axis(const Entry& e, const TrainerOptions& base, const ValueReader& va
   Axis axis{e.key, {}, {}};
   for (const toml::node& v : *items) {
     const Entry one{e.key, line_of(v) > 0 ? line_of(v) : e.line, &v};
-    if (!set(probe, one)) {
-      values.fail(e.line, "unknown key " + quoted(e.key) + " in [search]; expected rungs, eta, "
-                          "criterion, or a [training] key with a list of values to search");
-    }
+    set_known(one);
     const std::string text = value_text(one, v, values);
     if (std::find(axis.texts.begin(), axis.texts.end(), text) != axis.texts.end()) {
       values.fail(one.line, "search axis " + e.key + " lists " + text + " twice; list each value once");

@@ -196,6 +196,9 @@ struct Grid {
 /// the same spec gives the same runs, ids and cell order.
 Grid expand_grid(const SweepSpec& spec, const CostModel& cost_model = CostModel());
 
+/// Per run of grid.runs, the index of its cell in grid.cells.
+std::vector<int> cell_of_runs(const Grid& grid);
+
 /// Makespan of items with the given costs on `ranks` ranks when each item
 /// goes, largest first, to the rank that becomes free first (LPT list
 /// scheduling, what the dynamic WorkQueue does) [s]. Throws
