@@ -142,7 +142,8 @@ std::vector<double> weights_of(const StudySpec& study, Regularizer reg,
 
 namespace {
 
-// A study's table without its runs: rows (models), columns (the varied axis).
+// A study's table without its runs: rows (models); its columns (the varied
+// axis) come with the runs (add_run), in the order the first model meets them.
 StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes, const Budgets& budgets) {
   StudyTable table;
   table.name = study.name;
@@ -154,24 +155,6 @@ StudyTable table_frame(const StudySpec& study, const ColumnAxes& axes, const Bud
   }
   for (const auto& [model, integrator] : study.models) {
     table.rows.push_back(model_label(model, integrator));
-  }
-  for (ModelSize size : study.sizes) {
-    for (int n : study.n_train) {
-      for (Regularizer reg : study.regularizers) {
-        for (std::size_t v = 0; v < budgets.variants.size(); ++v) {
-          for (double weight : weights_of(study, reg, budgets.variants[v])) {
-            for (int steps : budgets.steps) {
-              const std::string label =
-                  join_label(axes.label(size, n, reg, weight), budgets.suffix(v, steps));
-              if (std::find(table.columns.begin(), table.columns.end(), label) ==
-                  table.columns.end()) {
-                table.columns.push_back(label);
-              }
-            }
-          }
-        }
-      }
-    }
   }
   return table;
 }
@@ -191,6 +174,9 @@ void add_run(const RunConfig& run, const std::string& column, Grid* grid, StudyT
   }
   table->runs.push_back(it->second);
   table->run_columns.push_back(column);
+  if (std::find(table->columns.begin(), table->columns.end(), column) == table->columns.end()) {
+    table->columns.push_back(column);
+  }
 }
 
 // The system of `run`: a system file of the spec, or a built-in system and

@@ -2,7 +2,6 @@
 // (CellCheckpointing in phnn/training/trainer.h): everything the remaining
 // steps read, so a restored trainer ends bitwise as an uninterrupted one.
 // Touches no file (the caller stores the bytes).
-#include <algorithm>
 #include <stdexcept>
 
 #include "training/cell_trainer.h"
@@ -31,8 +30,8 @@ void put_identity(StateWriter* out, const CellSpec& cell, const torch::Tensor& f
 // A state of this cell, or of the same cell at a smaller step budget that
 // is a validation step here (continuing it equals training straight
 // through: the budget enters nothing before the last step but its
-// validation, which this cell makes too). Returns the state's budget.
-int check_identity(StateReader* in, const CellSpec& cell, const torch::Tensor& flat) {
+// validation, which this cell makes too).
+void check_identity(StateReader* in, const CellSpec& cell, const torch::Tensor& flat) {
   StateWriter expected;
   put_identity(&expected, cell, flat);
   StateReader mine(expected.bytes());
@@ -52,7 +51,6 @@ int check_identity(StateReader* in, const CellSpec& cell, const torch::Tensor& f
     throw std::invalid_argument(
         "training state belongs to another cell (seeds, steps, N_train or model differ)");
   }
-  return budget;
 }
 
 void put_trace(StateWriter* out, const std::vector<TracePoint>& trace) {
@@ -111,7 +109,7 @@ std::string CellTrainer::save_state(int step) const {
 
 void CellTrainer::restore_state(const std::string& state) {
   StateReader in(state);
-  const int budget = check_identity(&in, cell_, flat_.values);
+  check_identity(&in, cell_, flat_.values);
   first_step_ = in.get<std::int32_t>() + 1;
   next_checkpoint_ = in.get<std::uint64_t>();
   elapsed_before_ = in.get<double>();
@@ -141,11 +139,6 @@ void CellTrainer::restore_state(const std::string& state) {
     r.checkpoint_train_seconds = in.get_vector<double>();
   }
   if (!in.at_end()) throw std::invalid_argument("training state: bytes left over");
-  // A smaller budget's final state whose members all diverged: training
-  // straight through stopped there too.
-  if (budget < opt_.steps && std::none_of(alive_.begin(), alive_.end(), [](bool a) { return a; })) {
-    first_step_ = opt_.steps + 1;
-  }
   start_ = Clock::now();
   last_save_ = elapsed();
 }

@@ -154,10 +154,17 @@ torch::Tensor CellTrainer::data_loss(const torch::Tensor& x, const torch::Tensor
 }
 
 // Steps first_step_..steps (1.. unless a saved state was restored).
+// Steps until the budget, or until no member is alive. A state restored
+// with every member dead (a smaller [search] rung's final one) trains no
+// further, as training straight through stopped there.
 void CellTrainer::train() {
+  const auto any_alive = [this] {
+    return std::any_of(alive_.begin(), alive_.end(), [](bool a) { return a; });
+  };
   if (first_step_ == 1) validate(0);
   int last = first_step_ - 1;
-  for (int s = first_step_; s <= opt_.steps; ++s) {
+  const int first = any_alive() ? first_step_ : opt_.steps + 1;
+  for (int s = first; s <= opt_.steps; ++s) {
     last = s;
     step(s, *sampler_);
     if (s % opt_.eval_every == 0 || s == opt_.steps) validate(s);
@@ -165,7 +172,7 @@ void CellTrainer::train() {
       if (s < opt_.steps) checkpoint(s);  // the last step's is the final inference
       ++next_checkpoint_;
     }
-    if (std::none_of(alive_.begin(), alive_.end(), [](bool a) { return a; })) break;
+    if (!any_alive()) break;
     save_if_due(s);
   }
   if (checkpointing_ && checkpointing_->save_final) checkpointing_->save_final(save_state(last), last);
