@@ -11,12 +11,11 @@ namespace phnn {
 namespace apps {
 
 ItemCheckpoints::ItemCheckpoints(const std::string& out, const std::string& key,
-                                 double interval_s, const volatile std::sig_atomic_t* stop_signal,
-                                 std::string prefix)
+                                 double interval_s, std::function<bool()> stop, std::string prefix)
     : path_(cell_checkpoint_path(out, key)), key_(key), prefix_(std::move(prefix)) {
   adopt(path_, key_);
   checkpointing_.interval_s = interval_s;
-  checkpointing_.stop_requested = [stop_signal] { return *stop_signal != 0; };
+  checkpointing_.stop_requested = std::move(stop);
   checkpointing_.save = [this](const std::string& state, int step) {
     try {
       write_cell_checkpoint(path_, CellCheckpoint{key_, state, step});

@@ -5,7 +5,7 @@
 // (docs/DECISIONS.md, "Preemptible cells").
 #pragma once
 
-#include <csignal>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -15,14 +15,15 @@ namespace phnn {
 namespace apps {
 
 /// One item's checkpointing: reads the saved state if there is one
-/// (resume_step() > 0), saves every `interval_s` and on `stop_signal`,
+/// (resume_step() > 0), saves every `interval_s` and when `stop` says so
+/// (asked at every step: a signal, or the end of the round it trains ahead of),
 /// and remove() deletes the state once the item's results are journaled.
 /// A state that cannot be written is reported once on stderr and training
 /// goes on (it is only lost work, never a lost result).
 class ItemCheckpoints {
  public:
   ItemCheckpoints(const std::string& out, const std::string& key, double interval_s,
-                  const volatile std::sig_atomic_t* stop_signal, std::string prefix);
+                  std::function<bool()> stop, std::string prefix);
   ItemCheckpoints(const ItemCheckpoints&) = delete;  // `save` refers to this object
   ItemCheckpoints& operator=(const ItemCheckpoints&) = delete;
   const CellCheckpointing& checkpointing() const { return checkpointing_; }

@@ -68,14 +68,9 @@ void print_plan(const SweepSpec& spec, const Grid& grid, const Shard& shard,
             << to_string(mode) << " scheduling) -> " << out << std::endl;
 }
 
-void print_item(const char* format, const std::string& prefix, int item_number,
-                std::size_t items, const std::string& what) {
-  std::vector<char> line(512 + prefix.size() + what.size());
-  std::snprintf(line.data(), line.size(), format, prefix.c_str(), item_number, items, what.c_str());
-  std::string text = line.data();
-  if (!text.empty() && text.back() == '\n') text.pop_back();
+void print_item(const std::string& prefix, const std::string& text) {
   // Each rank's line with its time: logs of long sweeps read as a timeline.
-  std::printf("%s  (%s)\n", text.c_str(), utc_now().c_str());
+  std::printf("%s%s  (%s)\n", prefix.c_str(), text.c_str(), utc_now().c_str());
   std::fflush(stdout);
 }
 

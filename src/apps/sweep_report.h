@@ -44,9 +44,8 @@ void print_plan(const SweepSpec& spec, const Grid& grid, const Shard& shard,
                 int runs_done_before, int runs_to_do, const WorkPlan& plan, int size,
                 ScheduleMode mode, const std::string& out);
 
-/// One per-item line, e.g. format "%sitem %d/%zu: %s\n" (prefix, item, items, what).
-void print_item(const char* format, const std::string& prefix, int item_number,
-                std::size_t items, const std::string& what);
+/// One per-item line, prefix + text, with the time: e.g. "item 3/8: <cell>, 2 seeds".
+void print_item(const std::string& prefix, const std::string& text);
 
 /// Why a sweep ended before its queue was empty.
 enum class StopReason { kNone, kSignal, kError };

@@ -37,7 +37,7 @@ namespace {
 std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
                                   const std::string& system, const std::function<void()>& tick,
                                   ItemCheckpoints* checkpoints, const std::string& prefix,
-                                  int item_number, bool* interrupted) {
+                                  const std::string& label, bool* interrupted) {
   *interrupted = false;
   const auto progress = [&](const TrainProgress&) { tick(); };
   try {
@@ -50,20 +50,20 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
           std::string(e.what()).rfind("training state", 0) != 0) {
         throw;
       }
-      std::fprintf(stderr, "%sitem %d: %s; training it from the start\n", prefix.c_str(),
-                   item_number, e.what());
+      std::fprintf(stderr, "%s%s: %s; training it from the start\n", prefix.c_str(),
+                   label.c_str(), e.what());
       checkpoints->forget_state();
       return data->train(cell, system, progress, &checkpoints->checkpointing());
     }
   } catch (const CellInterrupted& e) {
     *interrupted = true;
     if (checkpoints->saved_step() == e.step) {
-      std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its training state is in %s\n",
-                   prefix.c_str(), item_number, e.step, cell.training.steps,
+      std::fprintf(stderr, "%s%s stopped after step %d of %d; its training state is in %s\n",
+                   prefix.c_str(), label.c_str(), e.step, cell.training.steps,
                    checkpoints->path().c_str());
     } else {
-      std::fprintf(stderr, "%sitem %d stopped after step %d of %d; its state could not be saved "
-                   "(see above): it trains again from %s\n", prefix.c_str(), item_number, e.step,
+      std::fprintf(stderr, "%s%s stopped after step %d of %d; its state could not be saved "
+                   "(see above): it trains again from %s\n", prefix.c_str(), label.c_str(), e.step,
                    cell.training.steps,
                    checkpoints->saved_step() > 0 || checkpoints->resume_step() > 0
                        ? "its last saved state"
@@ -72,8 +72,8 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
     return {};
   } catch (const GenerationStopped&) {  // a signal while this rank made its data: nothing trained
     *interrupted = true;
-    std::fprintf(stderr, "%sitem %d stopped while making its data set; it trains at the next run\n",
-                 prefix.c_str(), item_number);
+    std::fprintf(stderr, "%s%s stopped while making its data set; it trains at the next run\n",
+                 prefix.c_str(), label.c_str());
     return {};
   } catch (const std::exception& e) {
     std::vector<RunResult> failed(cell.seeds.size());
@@ -81,22 +81,25 @@ std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
       r.status = RunStatus::kFailed;
       r.message = e.what();
     }
-    std::fprintf(stderr, "%sitem %d failed: %s\n", prefix.c_str(), item_number, e.what());
+    std::fprintf(stderr, "%s%s failed: %s\n", prefix.c_str(), label.c_str(), e.what());
     return failed;
   }
 }
 
 // "item 3/8: <cell>, 2 seeds", and where it goes on from a saved state.
-void announce_item(const std::string& prefix, int number, std::size_t items,
-                   const RunConfig& head, const CellSpec& cell, int resume_step) {
-  print_item("%sitem %d/%zu: %s\n", prefix, number, items,
-             describe(head) + ", " + std::to_string(cell.seeds.size()) + " seed" +
-                 (cell.seeds.size() > 1 ? "s" : ""));
+void announce_item(const std::string& prefix, const std::string& label, const RunConfig& head,
+                   const CellSpec& cell, int resume_step) {
+  print_item(prefix, label + ": " + describe(head) + ", " + std::to_string(cell.seeds.size()) +
+                         " seed" + (cell.seeds.size() > 1 ? "s" : ""));
   if (resume_step > 0) {
-    print_item("%sitem %d/%zu: going on after step %s\n", prefix, number, items,
-               std::to_string(resume_step) + " of " + std::to_string(cell.training.steps) +
-                   " (saved training state)");
+    print_item(prefix, label + ": going on after step " + std::to_string(resume_step) + " of " +
+                           std::to_string(cell.training.steps) + " (saved training state)");
   }
+}
+
+// "item 3/8", "ahead 2/5" (trained ahead of the round's end).
+std::string item_label(const char* kind, int index, std::size_t items) {
+  return std::string(kind) + " " + std::to_string(index + 1) + "/" + std::to_string(items);
 }
 
 // Journal record first (the source of truth), then the row, each with the
@@ -189,11 +192,51 @@ SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
   return p;
 }
 
+// Trains and records one item (the queue's or one ahead of the round).
+// `stop` is asked at every step; `tick` at every validation.
+SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const std::string& label,
+                                          std::function<bool()> stop,
+                                          const std::function<void()>& tick) {
+  const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
+  std::vector<int> seeds;
+  for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
+  const CellSpec cell = cell_spec_for(head, seeds);
+  ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, state_key_), checkpoint_every_,
+                              std::move(stop), prefix_);
+  link_rung_states(spec_, grid_, item.runs, out_, build_key_, &checkpoints);
+  const bool quiet = parser_.flag_set("quiet");
+  if (!quiet) announce_item(prefix_, label, head, cell, checkpoints.resume_step());
+  const auto cell_start = SweepClock::now();
+  const std::string started = utc_now();
+  ItemOutcome outcome;
+  const std::vector<RunResult> cell_results = train_item(
+      cell, &data_, head.system_name(), tick, &checkpoints, prefix_, label, &outcome.stopped);
+  if (outcome.stopped) return outcome;
+  outcome.io_error =
+      record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
+  if (outcome.io_error.empty()) checkpoints.remove();
+  outcome.runs = static_cast<int>(item.runs.size());
+  if (!quiet && outcome.io_error.empty()) {
+    print_item(prefix_, label + " done in " + format_duration(std::chrono::duration<double>(
+                                                  SweepClock::now() - cell_start).count()));
+  }
+  return outcome;
+}
+
 SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_codes) {
   const Planned planned = plan(status_codes);
   const std::vector<WorkItem>& work = planned.plan.items;
   const ScheduleMode mode = parser_.flag_set("static") ? ScheduleMode::kStatic : ScheduleMode::kDynamic;
   WorkQueue queue(MPI_COMM_WORLD, static_cast<int>(work.size()), mode);
+  // Items to train ahead while the round drains, their queue made now (a
+  // collective call); they need the shared count of finished items, which
+  // static mode lacks.
+  const std::vector<WorkItem> ahead =
+      queue.mode() == ScheduleMode::kDynamic ? ahead_items() : std::vector<WorkItem>();
+  std::optional<WorkQueue> ahead_queue;
+  if (!ahead.empty()) {
+    ahead_queue.emplace(MPI_COMM_WORLD, static_cast<int>(ahead.size()), ScheduleMode::kDynamic);
+  }
   if (root_) {
     print_plan(spec_, grid_, shard_, planned.runs_done_before, planned.runs_to_do, planned.plan,
                size_, queue.mode(), out_);
@@ -202,70 +245,89 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
                 << " of them go on from their saved training state\n";
     }
   }
-  const bool quiet = parser_.flag_set("quiet");
   RoundOutcome outcome;
   double last_progress = -1e9;
   const ProgressLine progress_line(work, size_, queue.mode() == ScheduleMode::kStatic);
-  auto report_progress = [&](bool force) {
-    if (!root_ || quiet || (!force && elapsed() - last_progress < 10.0)) return;
-    last_progress = elapsed();
-    progress_line.print(queue.done(), elapsed());
-  };
+  // A stop signal on any rank stops every rank at its next item boundary:
+  // this rank posts it at once, from the training's progress ticks too.
   // An I/O error on this rank: it takes no more items, nor do the others
   // after the one in hand; then every rank learns of it (agree below) and
   // exits 1 (outcome.io_error).
-  // A stop signal on any rank stops every rank at its next item boundary:
-  // this rank posts it at once, from the training's progress ticks too.
   auto post_stop = [&] {
     if (g_stop_signal != 0 && !queue.stop_requested()) queue.request_stop();
   };
-  auto next_item = [&] {
-    post_stop();
-    return queue.next();
+  auto report_progress = [&](bool force) {
+    if (!root_ || parser_.flag_set("quiet") || (!force && elapsed() - last_progress < 10.0)) return;
+    last_progress = elapsed();
+    progress_line.print(queue.done(), elapsed());
   };
-  for (int i = next_item(); i >= 0; i = next_item()) {
-    const WorkItem& item = work[static_cast<std::size_t>(i)];
-    const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
-    std::vector<int> seeds;
-    for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
-    const CellSpec cell = cell_spec_for(head, seeds);
-    ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, state_key_),
-                                checkpoint_every_, &g_stop_signal, prefix_);
-    link_rung_states(spec_, grid_, item.runs, out_, build_key_, &checkpoints);
-    if (!quiet) announce_item(prefix_, i + 1, work.size(), head, cell, checkpoints.resume_step());
-    const auto cell_start = SweepClock::now();
-    const std::string started = utc_now();
-    bool interrupted = false;
-    const std::vector<RunResult> cell_results =
-        train_item(cell, &data_, head.system_name(), [&] {
-          post_stop();
-          queue.progress();  // rank 0's window answers the others mid-cell too
-          report_progress(false);
-        }, &checkpoints, prefix_, i + 1, &interrupted);
-    if (interrupted) {
-      post_stop();
-      break;
-    }
-    std::string& io_error = outcome.io_error;
-    io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
-    if (io_error.empty()) checkpoints.remove();
-    outcome.my_runs += static_cast<int>(item.runs.size());
-    if (!io_error.empty()) {
-      queue.request_stop();  // the others stop at their next item too
-      break;
-    }
+  const auto tick = [&] {
+    post_stop();
+    queue.progress();  // rank 0's window answers the others mid-cell too
+    report_progress(false);
+  };
+  const auto signalled = [] { return g_stop_signal != 0; };
+  bool ended = false;  // stopped by a signal or an I/O error
+  for (post_stop(); !ended; post_stop()) {
+    const int i = queue.next();
+    if (i < 0) break;
+    const ItemOutcome done = train_one(work[static_cast<std::size_t>(i)],
+                                       item_label("item", i, work.size()), signalled, tick);
+    outcome.my_runs += done.runs;
+    outcome.io_error = done.io_error;
+    ended = done.stopped || !done.io_error.empty();
+    if (!done.io_error.empty()) queue.request_stop();  // the others stop at their next item too
+    if (ended) break;
     queue.mark_done();
-    if (!quiet) {
-      print_item("%sitem %d/%zu done in %s\n", prefix_, i + 1, work.size(),
-                 format_duration(std::chrono::duration<double>(SweepClock::now() - cell_start).count()));
-    }
     report_progress(true);
+  }
+  if (ahead_queue) {
+    if (!ended) train_ahead(ahead, &queue, static_cast<int>(work.size()), &*ahead_queue, tick, &outcome);
+    ahead_queue->close();
   }
   post_stop();
   outcome.stopped =
       mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>()) != 0;
   queue.close();
   return outcome;
+}
+
+// The runs to train ahead (runs_to_speculate, on every rank) as items of
+// this rank count's plan, largest first; none with --no-speculation.
+std::vector<WorkItem> SweepRun::ahead_items() const {
+  if (ahead_.empty() || parser_.flag_set("no-speculation")) return {};
+  return plan_work(grid_, ahead_, size_, split_).items;
+}
+
+// While the round's last items train elsewhere, this rank trains `ahead`
+// items from their queue; each stops (its state saved, for the round that
+// asks for it) once every one of the round's `asked` items has finished,
+// or on a stop. Their results are recorded like any other.
+void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue, int asked,
+                           WorkQueue* ahead_queue, const std::function<void()>& tick,
+                           RoundOutcome* outcome) {
+  bool round_over = false;
+  SweepClock::time_point last_poll{};
+  const auto stop = [&] {  // asked at every step: the shared count read at most 10 times a second
+    if (g_stop_signal != 0 || round_over) return true;
+    if (SweepClock::now() - last_poll < std::chrono::milliseconds(100)) return false;
+    last_poll = SweepClock::now();
+    queue->progress();
+    round_over = queue->done() >= asked || queue->stop_requested();
+    return round_over;
+  };
+  while (!stop()) {
+    const int i = ahead_queue->next();
+    if (i < 0) return;
+    const ItemOutcome done =
+        train_one(ahead[static_cast<std::size_t>(i)], item_label("ahead", i, ahead.size()), stop, tick);
+    outcome->ahead_runs += done.runs;
+    if (!done.io_error.empty()) {
+      outcome->io_error = done.io_error;
+      queue->request_stop();
+    }
+    if (done.stopped || !done.io_error.empty()) return;
+  }
 }
 
 // Trains what is left; an adaptive sweep round after round, each decided on
@@ -276,7 +338,7 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
   RoundOutcome round;
   for (;;) {
     round = train_round(status_codes);
-    my_runs += round.my_runs;
+    my_runs += round.my_runs + round.ahead_runs;
     const bool io_failed =
         mpi::all_reduce(world_, round.io_error.empty() ? 0 : 1, mpi::maximum<int>()) != 0;
     if (!in_rounds() || round.stopped || io_failed) break;
@@ -321,6 +383,9 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
                               .state
                         : replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
         for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
+        ahead_ = spec_.adaptive.enabled && !spec_.search.enabled
+                     ? runs_to_speculate(spec_, grid_, adaptive_, statuses)
+                     : std::vector<std::vector<int>>();
       })) {
     return status;
   }
@@ -331,6 +396,8 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
   mpi::broadcast(world_, adaptive_.cells_grown, 0);
   mpi::broadcast(world_, adaptive_.round, 0);
   mpi::broadcast(world_, adaptive_.complete, 0);
+  mpi::broadcast(world_, adaptive_.trained_ahead, 0);
+  mpi::broadcast(world_, ahead_, 0);
   for (std::size_t i = 0; i < codes.size(); ++i) {
     if (!adaptive_.active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
   }
@@ -376,10 +443,15 @@ std::string SweepRun::adaptive_line() const {
   if (!spec_.adaptive.enabled || !adaptive_.complete) return "";
   const int asked = adaptive_.active_runs();
   const int left = static_cast<int>(grid_.runs.size()) - asked;
+  const int ahead = adaptive_.trained_ahead;
   return "adaptive sweep complete after round " + std::to_string(adaptive_.round) + ": " +
          std::to_string(asked) + " runs of at most " + std::to_string(grid_.runs.size()) +
-         (left > 0 ? "; the " + std::to_string(left) + " pending runs are seeds no round asked for"
-                   : " (every cell at max_seeds)");
+         (left == 0 ? std::string(" (every cell at max_seeds)")
+                    : "; the other " + std::to_string(left) + " are seeds no round asked for" +
+                          (ahead > 0 ? " (" + std::to_string(ahead) +
+                                           " of them trained ahead while a round drained, left "
+                                           "out of every table)"
+                                     : ""));
 }
 
 }  // namespace apps

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "phnn/sweep/adaptive.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"
+#include "phnn/sweep/scheduler.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/sweep/work_plan.h"
 #include "phnn/sweep/writer_lock.h"
@@ -59,11 +61,23 @@ class SweepRun {
   };
   Planned plan(const std::vector<int>& status_codes);
   struct RoundOutcome {
-    int my_runs = 0;
+    int my_runs = 0;     // runs of the round's items trained here
+    int ahead_runs = 0;  // runs trained here ahead of the round's end
     std::string io_error;
     bool stopped = false;  // a stop signal on any rank
   };
   RoundOutcome train_round(const std::vector<int>& status_codes);
+  struct ItemOutcome {
+    int runs = 0;          // recorded
+    bool stopped = false;  // stopped before its end, its state saved
+    std::string io_error;
+  };
+  ItemOutcome train_one(const WorkItem& item, const std::string& label,
+                        std::function<bool()> stop, const std::function<void()>& tick);
+  std::vector<WorkItem> ahead_items() const;
+  void train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue, int asked,
+                   WorkQueue* ahead_queue, const std::function<void()>& tick,
+                   RoundOutcome* outcome);
   int train_and_close(std::vector<int> status_codes);
   int open_results() {
     return agreed(world_, true, [&] {
@@ -110,6 +124,9 @@ class SweepRun {
   SweepDataSets data_{spec_, grid_};
   // An adaptive sweep's rounds so far (replay_rounds); unused otherwise.
   AdaptiveState adaptive_;
+  // The runs idle ranks train ahead of the round in progress, per cell
+  // (runs_to_speculate; the same on every rank).
+  std::vector<std::vector<int>> ahead_;
   bool planned_once_ = false;
   SweepClock::time_point start_ = SweepClock::now();
 };

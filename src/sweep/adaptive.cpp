@@ -236,6 +236,20 @@ void mark_active(const Grid& grid, AdaptiveState* state) {
   }
 }
 
+// Counts the runs asked for that are pending or failed, and the finished
+// runs not asked for.
+void count_runs(const std::vector<RunStatus>& status, AdaptiveState* state) {
+  state->pending = state->failed = state->trained_ahead = 0;
+  for (std::size_t i = 0; i < status.size(); ++i) {
+    if (!state->active[i]) {
+      state->trained_ahead += status[i] == RunStatus::kPending ? 0 : 1;
+      continue;
+    }
+    state->pending += status[i] == RunStatus::kPending ? 1 : 0;
+    state->failed += status[i] == RunStatus::kFailed ? 1 : 0;
+  }
+}
+
 }  // namespace
 
 int AdaptiveState::active_runs() const {
@@ -279,12 +293,7 @@ AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
   state.cell_seeds.assign(grid.cells.size(), static_cast<int>(a.initial_seeds.size()));
   for (;;) {
     mark_active(grid, &state);
-    state.pending = state.failed = 0;
-    for (std::size_t i = 0; i < status.size(); ++i) {
-      if (!state.active[i]) continue;
-      state.pending += status[i] == RunStatus::kPending ? 1 : 0;
-      state.failed += status[i] == RunStatus::kFailed ? 1 : 0;
-    }
+    count_runs(status, &state);
     if (state.pending > 0) return state;  // round in progress
     std::vector<int> grow;
     for (int c : adaptive_rule_cells(spec, grid, state.active, status, mse, bootstrap)) {
@@ -302,6 +311,29 @@ AdaptiveState replay_adaptive_rounds(const SweepSpec& spec, const Grid& grid,
     state.cells_grown.push_back(static_cast<int>(grow.size()));
     ++state.round;
   }
+}
+
+std::vector<std::vector<int>> runs_to_speculate(const SweepSpec& spec, const Grid& grid,
+                                                const AdaptiveState& state,
+                                                const std::vector<RunStatus>& status) {
+  std::vector<std::vector<int>> ahead(grid.cells.size());
+  if (!spec.adaptive.enabled || state.complete) return {};
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    const auto& runs = grid.cells[c].runs;
+    const auto asked = std::min<std::size_t>(runs.size(), static_cast<std::size_t>(state.cell_seeds[c]));
+    const bool growing = std::any_of(runs.begin(), runs.begin() + static_cast<long>(asked), [&](int r) {
+      return status[static_cast<std::size_t>(r)] == RunStatus::kPending;
+    });
+    if (!growing) continue;
+    const std::size_t next = std::min<std::size_t>(
+        {runs.size(), asked + static_cast<std::size_t>(spec.adaptive.batch),
+         static_cast<std::size_t>(spec.adaptive.max_seeds)});
+    for (std::size_t k = asked; k < next; ++k) {
+      if (status[static_cast<std::size_t>(runs[k])] == RunStatus::kPending) ahead[c].push_back(runs[k]);
+    }
+  }
+  const bool none = std::all_of(ahead.begin(), ahead.end(), [](const auto& r) { return r.empty(); });
+  return none ? std::vector<std::vector<int>>() : ahead;
 }
 
 SweepSpec round_zero_spec(const SweepSpec& spec) {

@@ -33,6 +33,10 @@ struct AdaptiveState {
   /// failed run counts as finished and its MSE is left out of the decisions,
   /// as out of the tables).
   int pending = 0, failed = 0;
+  /// Finished runs no round asked for: trained ahead by idle ranks
+  /// (runs_to_speculate) and not asked for since. Left out of every
+  /// decision and table.
+  int trained_ahead = 0;
 
   /// Runs asked for.
   int active_runs() const;
@@ -75,6 +79,18 @@ std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
                                      const std::vector<RunStatus>& status,
                                      const std::vector<double>& mse,
                                      const BootstrapOptions& bootstrap = {});
+
+/// What idle ranks train ahead while a round drains (docs/METHOD.md,
+/// "Speculation"): the runs the next round asks for if it names again every
+/// cell the round in progress grows (a cell with a pending run asked for) —
+/// per such cell below max_seeds, its next `batch` seeds (fewer at the cap)
+/// that are still pending: element c lists cell c's (ascending; empty for
+/// most), the form plan_work() takes. Empty (no elements) when none is left
+/// or `state` is complete. A run's result depends only on its configuration and seed, so
+/// training a run early changes neither what the rule asks for nor a number.
+std::vector<std::vector<int>> runs_to_speculate(const SweepSpec& spec, const Grid& grid,
+                                                const AdaptiveState& state,
+                                                const std::vector<RunStatus>& status);
 
 /// The sweep of round 0 alone: `spec` without [adaptive], every study's
 /// seeds its initial ones (for --dry-run's round-0 cost).
