@@ -1,0 +1,190 @@
+// src/apps/sweep_items.cpp — SweepRun's work items (sweep_run.h): one
+// item trained (from its saved state if it has one), journaled and written
+// as rows; and the items idle ranks train ahead of a round's end.
+#include <chrono>
+#include <cstdio>
+#include <functional>
+
+#include "apps/sweep_checkpoints.h"
+#include "apps/sweep_report.h"
+#include "apps/sweep_run.h"
+#include "apps/sweep_search.h"
+#include "phnn/sweep/resumed_items.h"
+#include "phnn/training/trainer.h"
+
+namespace phnn {
+namespace apps {
+
+namespace {
+
+// Trains one item's cell, from its saved state if it has one. A cell that
+// throws is a result too: every run failed, with the message. A cell stopped
+// by a signal returns no results (its state is saved; *interrupted), and so
+// does one whose data set a signal stopped while it was being generated.
+std::vector<RunResult> train_item(const CellSpec& cell, SweepDataSets* data,
+                                  const std::string& system, const std::function<void()>& tick,
+                                  ItemCheckpoints* checkpoints, const std::string& prefix,
+                                  const std::string& label, bool* interrupted) {
+  *interrupted = false;
+  const auto progress = [&](const TrainProgress&) { tick(); };
+  try {
+    data->make(system);
+    try {
+      return data->train(cell, system, progress, &checkpoints->checkpointing());
+    } catch (const std::invalid_argument& e) {
+      // A saved state that does not fit (e.g. written by another build).
+      if (checkpoints->resume_step() == 0 ||
+          std::string(e.what()).rfind("training state", 0) != 0) {
+        throw;
+      }
+      std::fprintf(stderr, "%s%s: %s; training it from the start\n", prefix.c_str(),
+                   label.c_str(), e.what());
+      checkpoints->forget_state();
+      return data->train(cell, system, progress, &checkpoints->checkpointing());
+    }
+  } catch (const CellInterrupted& e) {
+    *interrupted = true;
+    if (checkpoints->saved_step() == e.step) {
+      std::fprintf(stderr, "%s%s stopped after step %d of %d; its training state is in %s\n",
+                   prefix.c_str(), label.c_str(), e.step, cell.training.steps,
+                   checkpoints->path().c_str());
+    } else {
+      std::fprintf(stderr, "%s%s stopped after step %d of %d; its state could not be saved "
+                   "(see above): it trains again from %s\n", prefix.c_str(), label.c_str(), e.step,
+                   cell.training.steps,
+                   checkpoints->saved_step() > 0 || checkpoints->resume_step() > 0
+                       ? "its last saved state"
+                       : "the start");
+    }
+    return {};
+  } catch (const GenerationStopped&) {  // a signal while this rank made its data: nothing trained
+    *interrupted = true;
+    std::fprintf(stderr, "%s%s stopped while making its data set; it trains at the next run\n",
+                 prefix.c_str(), label.c_str());
+    return {};
+  } catch (const std::exception& e) {
+    std::vector<RunResult> failed(cell.seeds.size());
+    for (auto& r : failed) {
+      r.status = RunStatus::kFailed;
+      r.message = e.what();
+    }
+    std::fprintf(stderr, "%s%s failed: %s\n", prefix.c_str(), label.c_str(), e.what());
+    return failed;
+  }
+}
+
+// "item 3/8: <cell>, 2 seeds", and where it goes on from a saved state.
+void announce_item(const std::string& prefix, const std::string& label, const RunConfig& head,
+                   const CellSpec& cell, int resume_step) {
+  print_item(prefix, label + ": " + describe(head) + ", " + std::to_string(cell.seeds.size()) +
+                         " seed" + (cell.seeds.size() > 1 ? "s" : ""));
+  if (resume_step > 0) {
+    print_item(prefix, label + ": going on after step " + std::to_string(resume_step) + " of " +
+                           std::to_string(cell.training.steps) + " (saved training state)");
+  }
+}
+
+// "item 3/8", "ahead 2/5" (trained ahead of the round's end).
+std::string item_label(const char* kind, int index, std::size_t items) {
+  return std::string(kind) + " " + std::to_string(index + 1) + "/" + std::to_string(items);
+}
+
+// Journal record first (the source of truth), then the row, each with the
+// item's run times, for each run of the item. A failed journal append (a full disk) does
+// not stop the row: its space was allocated when the file was made, so the
+// result is kept there. Returns "" or the first I/O error.
+std::string record_item(const Grid& grid, const WorkItem& item,
+                        const std::vector<RunResult>& cell_results, const std::string& started,
+                        const std::string& finished, Journal* journal, ResultsFile* results) {
+  std::string error;
+  auto attempt = [&](const auto& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      if (error.empty()) error = cli::with_prefix("phnn sweep: ", e.what());
+    }
+  };
+  for (std::size_t k = 0; k < item.runs.size(); ++k) {
+    const int row = item.runs[k];
+    RunResult result = cell_results[k];
+    result.started_utc = started;
+    result.finished_utc = finished;
+    attempt([&] { journal->append(grid.runs[static_cast<std::size_t>(row)].id(), result); });
+    attempt([&] { results->write_run(row, result); });
+  }
+  return error;
+}
+
+}  // namespace
+
+// Trains and records one item (the queue's or one ahead of the round).
+// `stop` is asked at every step; `tick` at every validation.
+SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const std::string& label,
+                                          std::function<bool()> stop,
+                                          const std::function<void()>& tick) {
+  const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
+  std::vector<int> seeds;
+  for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
+  const CellSpec cell = cell_spec_for(head, seeds);
+  ItemCheckpoints checkpoints(out_, item_key(grid_, item.runs, state_key_), checkpoint_every_,
+                              std::move(stop), prefix_);
+  link_rung_states(spec_, grid_, item.runs, out_, build_key_, &checkpoints);
+  const bool quiet = parser_.flag_set("quiet");
+  if (!quiet) announce_item(prefix_, label, head, cell, checkpoints.resume_step());
+  const auto cell_start = SweepClock::now();
+  const std::string started = utc_now();
+  ItemOutcome outcome;
+  const std::vector<RunResult> cell_results = train_item(
+      cell, &data_, head.system_name(), tick, &checkpoints, prefix_, label, &outcome.stopped);
+  if (outcome.stopped) return outcome;
+  outcome.io_error =
+      record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
+  if (outcome.io_error.empty()) checkpoints.remove();
+  outcome.runs = static_cast<int>(item.runs.size());
+  if (!quiet && outcome.io_error.empty()) {
+    print_item(prefix_, label + " done in " + format_duration(std::chrono::duration<double>(
+                                                  SweepClock::now() - cell_start).count()));
+  }
+  return outcome;
+}
+
+// The runs to train ahead (runs_to_speculate, on every rank) as items of
+// this rank count's plan, largest first; none with --no-speculation.
+std::vector<WorkItem> SweepRun::ahead_items() const {
+  if (ahead_.empty() || parser_.flag_set("no-speculation")) return {};
+  return plan_work(grid_, ahead_, size_, split_).items;
+}
+
+// While the round's last items train elsewhere, this rank trains `ahead`
+// items from their queue; each stops (its state saved, for the round that
+// asks for it) once every one of the round's `asked` items has finished,
+// or on a stop. Their results are recorded like any other.
+void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue, int asked,
+                           WorkQueue* ahead_queue, const std::function<void()>& tick,
+                           RoundOutcome* outcome) {
+  bool round_over = false;
+  SweepClock::time_point last_poll{};
+  const auto stop = [&] {  // asked at every step: the shared count read at most 10 times a second
+    if (g_stop_signal != 0 || round_over) return true;
+    if (SweepClock::now() - last_poll < std::chrono::milliseconds(100)) return false;
+    last_poll = SweepClock::now();
+    queue->progress();
+    round_over = queue->done() >= asked || queue->stop_requested();
+    return round_over;
+  };
+  while (!stop()) {
+    const int i = ahead_queue->next();
+    if (i < 0) return;
+    const ItemOutcome done =
+        train_one(ahead[static_cast<std::size_t>(i)], item_label("ahead", i, ahead.size()), stop, tick);
+    outcome->ahead_runs += done.runs;
+    if (!done.io_error.empty()) {
+      outcome->io_error = done.io_error;
+      queue->request_stop();
+    }
+    if (done.stopped || !done.io_error.empty()) return;
+  }
+}
+
+}  // namespace apps
+}  // namespace phnn
