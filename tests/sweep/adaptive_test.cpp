@@ -182,6 +182,59 @@ TEST(AdaptiveRoundsTest, ARoundWithAPendingRunIsInProgress) {
   EXPECT_EQ(replay_adaptive_rounds(spec, grid, r.status, r.mse, {}, 3).round, 1);
 }
 
+// What idle ranks train ahead: the next batch of the cells the round in
+// progress grows, still pending ones only; nothing once the sweep is done.
+TEST(AdaptiveRoundsTest, SpeculationTakesTheNextBatchOfTheCellsTheRoundGrows) {
+  const SweepSpec spec = parse_sweep_text(sweep_text(kTwoModels, kColumnBest), "x.toml");
+  const Grid grid = expand_grid(spec);
+  // RK4's seed 2 failed, so round 0 leaves it without an interval and round
+  // 1 grows it alone (5 -> 8 seeds), its seed 6 still pending; no run beyond
+  // those asked for is finished. Ahead: RK4's seeds 8-10.
+  Results r = results_of(grid, [](const RunConfig& run) {
+    return run.integrator == IntegratorKind::kRk2 ? 1e-3 * (1.0 + run.seed) : 1.0 + run.seed;
+  });
+  int rk4_cell = -1;
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+    const bool rk4 = grid.runs[i].integrator == IntegratorKind::kRk4;
+    if (rk4 && grid.runs[i].seed == 2) r.status[i] = RunStatus::kFailed;  // RK4 grows in round 1
+    if (grid.runs[i].seed >= 5 && !(rk4 && grid.runs[i].seed < 8)) r.status[i] = RunStatus::kPending;
+    if (rk4 && grid.runs[i].seed == 6) r.status[i] = RunStatus::kPending;
+  }
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    if (grid.runs[static_cast<std::size_t>(grid.cells[c].runs[0])].integrator == IntegratorKind::kRk4) {
+      rk4_cell = static_cast<int>(c);
+    }
+  }
+  AdaptiveState s = replay_adaptive_rounds(spec, grid, r.status, r.mse);
+  ASSERT_EQ(s.round, 1);
+  ASSERT_EQ(seeds_of(s, grid, IntegratorKind::kRk4), 8);
+  std::vector<std::vector<int>> ahead = runs_to_speculate(spec, grid, s, r.status);
+  ASSERT_EQ(ahead.size(), grid.cells.size());
+  std::vector<int> seeds;
+  for (std::size_t c = 0; c < ahead.size(); ++c) {
+    if (static_cast<int>(c) != rk4_cell) EXPECT_TRUE(ahead[c].empty()) << "cell " << c;
+  }
+  for (int row : ahead[static_cast<std::size_t>(rk4_cell)]) {
+    seeds.push_back(grid.runs[static_cast<std::size_t>(row)].seed);
+  }
+  EXPECT_THAT(seeds, ElementsAre(8, 9, 10));
+  // Seed 9 already trained ahead: not again; it is counted as trained ahead.
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+    if (grid.runs[i].integrator == IntegratorKind::kRk4 && grid.runs[i].seed == 9) {
+      r.status[i] = RunStatus::kDone;
+    }
+  }
+  s = replay_adaptive_rounds(spec, grid, r.status, r.mse);
+  EXPECT_EQ(s.trained_ahead, 1);
+  ahead = runs_to_speculate(spec, grid, s, r.status);
+  EXPECT_EQ(ahead[static_cast<std::size_t>(rk4_cell)].size(), 2u);
+  // Finished: nothing ahead.
+  const Results all = results_of(grid, [](const RunConfig& run) { return 1e-3 * (1.0 + run.seed); });
+  const AdaptiveState done = replay_adaptive_rounds(spec, grid, all.status, all.mse);
+  ASSERT_TRUE(done.complete);
+  EXPECT_TRUE(runs_to_speculate(spec, grid, done, all.status).empty());
+}
+
 TEST(AdaptiveRoundsTest, ComparisonsGrowOnlyTheCellsOfUnresolvedComparisons) {
   const std::string comparisons =
       "max_seeds = 8\nbatch = 3\nrule = \"comparisons\"\n"
