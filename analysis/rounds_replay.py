@@ -27,16 +27,23 @@ rebuilds the rounds the file's sweep ran and replays them:
   list_schedule_makespan); with barriers each round starts when the last rank finished the round
   before; without, each rank goes on with the next round's items at once (not possible in a real
   sweep, whose rule reads the round's results: the bound if no rank idled between rounds).
+- With speculation (speculative_replay, as `phnn sweep` without --no-speculation): barriers,
+  and while a round drains the idle ranks train the next seeds of the cells the round grows; what
+  the next round asks for of that goes on from where it stopped, the rest is lost work.
 
 Per rank count: rounds, items, core-hours (the sum of the item costs), makespan and efficiency =
-core-hours / (ranks x makespan) with barriers and without, and the items per round. The output
+core-hours / (ranks x makespan) with barriers, with speculation (the same core-hours: the work
+asked for; the work spent ahead and the part of it no round asked for beside it) and without
+barriers, and the items per round. The output
 depends on the file alone (deterministic). The phnn binary: $PHNN, else build/phnn. On the paper
 grid's adaptive file (2 230 runs, 12 rounds, 345 MB) it takes ~9 min of one core, nearly all in the
 `phnn reduce --round K` calls (each replays the rounds up to K).
 """
 import argparse
+import heapq
 import math
 import sys
+import tomllib
 from collections import Counter
 
 from phnn_tool import run_csv
@@ -119,6 +126,69 @@ def free_makespan(rounds, ranks):
     return list_schedule_makespan([c for costs in rounds for c in costs], ranks)
 
 
+def ahead_schedule(costs, ahead, ranks):
+    """One round with ranks left idle training ahead: `costs` (the round's items, plan order) each
+    to the rank free first; the round ends when its last item does (T). Then, in order, each
+    ahead item ({"left": cost left, ...}) to the rank free first while that is before T: it
+    finishes (left 0) or stops at T with its progress kept. Returns (T, work spent ahead)."""
+    loads = [0.0] * ranks
+    for cost in costs:
+        heapq.heappush(loads, heapq.heappop(loads) + cost)
+    end, spent = max(loads), 0.0
+    for item in ahead:
+        free = heapq.heappop(loads)
+        if free >= end:
+            break
+        done = min(item["left"], end - free)
+        item["left"] -= done
+        spent += done
+        heapq.heappush(loads, free + done)
+    return end, spent
+
+
+def speculative_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, split=True):
+    """The rounds with speculation as `phnn sweep` does it (docs/METHOD.md "Speculation"): while
+    round k drains, idle ranks train the next `batch` seeds (fewer at max_seeds) of each cell
+    round k grows, largest items first; an ahead item stops at the round's end and goes on, as
+    a resumed item first in the plan, if round k+1 asks for its cell; otherwise its work is lost.
+    An ahead item costs what it costs in the round that asks for it (that round's scale), else in
+    this one. Returns (makespan, work spent ahead, of it never asked for)."""
+    model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
+    seeds, carried = {}, {}  # cell -> seeds asked so far; cell -> started ahead items it asks for
+    makespan = spent = lost = 0.0
+    for k, cells in enumerate(cells_of_rounds):
+        resumed, to_plan = [], []
+        for c, (n, _) in cells.items():
+            for item in carried.get(c, []):
+                n -= item["runs"]
+                if item["left"] > 0:
+                    resumed.append(item["left"])
+            if n > 0:
+                to_plan.append(PlanCell(c, *model[c], n))
+            seeds[c] = seeds.get(c, 0) + cells[c][0]
+        costs = resumed + [cells[c][1] * (model[c][0] + m * model[c][1])
+                           for c, m in plan_work(to_plan, ranks, split)]
+        following = cells_of_rounds[k + 1] if k + 1 < len(cells_of_rounds) else {}
+        candidates = [PlanCell(c, *model[c], min(batch, max_seeds - seeds[c]))
+                      for c in cells if seeds[c] < max_seeds]
+        ahead = []
+        for c, m in plan_work(candidates, ranks, split):
+            scale = following[c][1] if c in following else cells[c][1]
+            cost = scale * (model[c][0] + m * model[c][1])
+            ahead.append({"cell": c, "runs": m, "cost": cost, "left": cost})
+        end, _ = ahead_schedule(costs, ahead, ranks)
+        makespan += end
+        carried = {}
+        for item in ahead:
+            work = item["cost"] - item["left"]
+            spent += work
+            if item["cell"] not in following:
+                lost += work
+            elif work > 0:
+                carried.setdefault(item["cell"], []).append(item)
+    return makespan, spent, lost
+
+
 def replay(rounds, ranks):
     """{ranks, items, work, barrier, free, efficiency, free_efficiency} of per-round item costs."""
     work = sum(sum(costs) for costs in rounds)
@@ -140,11 +210,15 @@ def duration(seconds):
 
 def table(rows):
     lines = ["| ranks | rounds | items | core-hours | makespan with barriers | efficiency | "
-             "makespan without barriers | efficiency |", "|---|---|---|---|---|---|---|---|"]
+             "with speculation | efficiency | core-hours ahead (never asked for) | "
+             "without barriers | efficiency |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
+        spec, ahead, lost = r["speculative"]
         lines.append(f"| {r['ranks']} | {len(r['items'])} | {sum(r['items'])} | "
                      f"{r['work'] / 3600:.3g} | {duration(r['barrier'])} | "
-                     f"{100 * r['efficiency']:.1f} % | {duration(r['free'])} | "
+                     f"{100 * r['efficiency']:.1f} % | {duration(spec)} | "
+                     f"{100 * r['work'] / (r['ranks'] * spec):.1f} % | "
+                     f"{ahead / 3600:.2f} ({lost / 3600:.2f}) | {duration(r['free'])} | "
                      f"{100 * r['free_efficiency']:.1f} % |")
     lines.append("")
     for r in rows:
@@ -174,8 +248,14 @@ def main(argv=None):
           f"({measured / 3600:.2f} core-hours measured); runs per round: "
           + ", ".join(str(len(r)) for r in rounds) + "; cells per round: "
           + ", ".join(str(len(c)) for c in cells))
-    rows = [replay(round_item_costs(cells, cost_rows, int(n), args.split == "auto"), int(n))
-            for n in args.ranks.split(",")]
+    with open(args.sweep, "rb") as f:
+        adaptive = tomllib.load(f)["adaptive"]
+    rows = []
+    for n in (int(r) for r in args.ranks.split(",")):
+        row = replay(round_item_costs(cells, cost_rows, n, args.split == "auto"), n)
+        row["speculative"] = speculative_replay(cells, cost_rows, n, adaptive["batch"],
+                                                adaptive["max_seeds"], args.split == "auto")
+        rows.append(row)
     print(table(rows))
     return 0
 

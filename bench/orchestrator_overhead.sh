@@ -7,7 +7,8 @@
 # cell). The marginal cost per item is
 #   (2 x d(wall) - d(sum of run times)) / d(N),
 # core time outside the runs' own work: the shared counter, journal append
-# with fsync, the HDF5 row, checksums, logging.
+# with fsync, the HDF5 row, checksums, logging; each sweep's --timings line
+# (stderr) says where an item's time goes.
 #   bash bench/orchestrator_overhead.sh        (REPEATS=3, ~30 s)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,7 +42,8 @@ PY
   for ((r = 0; r < REPEATS; r++)); do
     rm -rf "$work/o$n.h5"*
     start=$(date +%s.%N)
-    OMP_NUM_THREADS=1 "${MPIRUN[@]}" "$PHNN" sweep "$work/s$n.toml" --out "$work/o$n.h5" >/dev/null
+    OMP_NUM_THREADS=1 "${MPIRUN[@]}" "$PHNN" sweep "$work/s$n.toml" --out "$work/o$n.h5" --timings \
+      > "$work/log"
     end=$(date +%s.%N)
     "$PHNN" reduce "$work/o$n.h5" --per-run > "$work/runs.csv"
     python3 - "$n" "$start" "$end" "$work/runs.csv" <<'PY'
@@ -50,6 +52,7 @@ n, start, end, path = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), 
 runs = sum(float(row["wall_time_s"]) for row in csv.DictReader(open(path)))
 print(f"{n} {end - start:.3f} {runs:.3f}")
 PY
+    grep "time per item" "$work/log" | sed 's/^phnn sweep: /  /' >&2
   done
 done | python3 -c '
 import statistics, sys

@@ -132,6 +132,8 @@ void declare_options(cli::Parser* parser) {
                  "300");
   parser->option("threads", "LibTorch intra-op threads per rank", "1");
   parser->flag("quiet", "no per-item log lines");
+  parser->flag("timings", "at the end, where the time per work item went (training, its setup, "
+               "journal, results row, shared queue), mean over every rank's items");
 }
 
 }  // namespace

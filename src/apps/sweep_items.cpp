@@ -93,24 +93,29 @@ std::string item_label(const char* kind, int index, std::size_t items) {
 // item's run times, for each run of the item. A failed journal append (a full disk) does
 // not stop the row: its space was allocated when the file was made, so the
 // result is kept there. Returns "" or the first I/O error.
+// The seconds of each go to times[kJournal] and times[kRow].
 std::string record_item(const Grid& grid, const WorkItem& item,
                         const std::vector<RunResult>& cell_results, const std::string& started,
-                        const std::string& finished, Journal* journal, ResultsFile* results) {
+                        const std::string& finished, Journal* journal, ResultsFile* results,
+                        ItemTimes* times) {
   std::string error;
-  auto attempt = [&](const auto& write) {
+  auto attempt = [&](ItemTimes::Part part, const auto& write) {
+    const auto begin = SweepClock::now();
     try {
       write();
     } catch (const std::exception& e) {
       if (error.empty()) error = cli::with_prefix("phnn sweep: ", e.what());
     }
+    times->add(part, begin);
   };
   for (std::size_t k = 0; k < item.runs.size(); ++k) {
     const int row = item.runs[k];
     RunResult result = cell_results[k];
     result.started_utc = started;
     result.finished_utc = finished;
-    attempt([&] { journal->append(grid.runs[static_cast<std::size_t>(row)].id(), result); });
-    attempt([&] { results->write_run(row, result); });
+    attempt(ItemTimes::kJournal,
+            [&] { journal->append(grid.runs[static_cast<std::size_t>(row)].id(), result); });
+    attempt(ItemTimes::kRow, [&] { results->write_run(row, result); });
   }
   return error;
 }
@@ -122,6 +127,7 @@ std::string record_item(const Grid& grid, const WorkItem& item,
 SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const std::string& label,
                                           std::function<bool()> stop,
                                           const std::function<void()>& tick) {
+  const auto item_start = SweepClock::now();
   const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
   std::vector<int> seeds;
   for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
@@ -137,14 +143,18 @@ SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const std::strin
   const std::vector<RunResult> cell_results = train_item(
       cell, &data_, head.system_name(), tick, &checkpoints, prefix_, label, &outcome.stopped);
   if (outcome.stopped) return outcome;
-  outcome.io_error =
-      record_item(grid_, item, cell_results, started, utc_now(), &*journal_, &*results_);
+  times_.add(ItemTimes::kTrain, cell_start);
+  for (const RunResult& r : cell_results) times_.s[ItemTimes::kRuns] += r.wall_time_s;
+  outcome.io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_,
+                                 &*results_, &times_);
   if (outcome.io_error.empty()) checkpoints.remove();
   outcome.runs = static_cast<int>(item.runs.size());
   if (!quiet && outcome.io_error.empty()) {
     print_item(prefix_, label + " done in " + format_duration(std::chrono::duration<double>(
                                                   SweepClock::now() - cell_start).count()));
   }
+  times_.add(ItemTimes::kItem, item_start);
+  ++times_.items;
   return outcome;
 }
 

@@ -134,17 +134,23 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
   };
   const auto signalled = [] { return g_stop_signal != 0; };
   bool ended = false;  // stopped by a signal or an I/O error
-  for (post_stop(); !ended; post_stop()) {
+  for (;;) {
+    const auto asking = SweepClock::now();
+    post_stop();
     const int i = queue.next();
+    times_.add(ItemTimes::kQueue, asking);
     if (i < 0) break;
     const ItemOutcome done = train_one(work[static_cast<std::size_t>(i)],
-                                       "item " + std::to_string(i + 1) + "/" + std::to_string(work.size()), signalled, tick);
+                                       "item " + std::to_string(i + 1) + "/" +
+                                           std::to_string(work.size()), signalled, tick);
     outcome.my_runs += done.runs;
     outcome.io_error = done.io_error;
     ended = done.stopped || !done.io_error.empty();
     if (!done.io_error.empty()) queue.request_stop();  // the others stop at their next item too
     if (ended) break;
+    const auto marking = SweepClock::now();
     queue.mark_done();
+    times_.add(ItemTimes::kQueue, marking);
     report_progress(true);
   }
   if (ahead_queue) {
@@ -192,8 +198,34 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
   }
   const int total_runs = mpi::all_reduce(world_, my_runs, std::plus<int>());
   const int failed = close_and_report(round.io_error, round.stopped, total_runs, elapsed());
+  if (parser_.flag_set("timings")) report_times();
   if (failed) return failed;
   return round.stopped ? kExitStopped : 0;
+}
+
+// --timings: "per item (N items, R ranks, mean): ..." on rank 0.
+void SweepRun::report_times() {
+  std::vector<double> sums(times_.s.begin(), times_.s.end());
+  sums.push_back(times_.items);
+  std::vector<double> all(sums.size());
+  mpi::reduce(world_, sums.data(), static_cast<int>(sums.size()), all.data(), std::plus<double>(), 0);
+  if (!root_ || all.back() == 0) return;
+  const double n = all.back();
+  const auto ms = [&](double s) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f ms", 1e3 * s / n);
+    return std::string(text);
+  };
+  const double recorded = all[ItemTimes::kJournal] + all[ItemTimes::kRow];
+  std::cout << "phnn sweep: time per item (" << static_cast<long>(n) << " items on " << size_
+            << " rank" << (size_ > 1 ? "s" : "") << ", mean): " << ms(all[ItemTimes::kItem])
+            << " in all: the runs' training " << ms(all[ItemTimes::kRuns]) << ", its setup "
+            << ms(all[ItemTimes::kTrain] - all[ItemTimes::kRuns]) << " (data set, models, "
+            << "tensors), journal " << ms(all[ItemTimes::kJournal]) << ", results row "
+            << ms(all[ItemTimes::kRow]) << ", the rest "
+            << ms(all[ItemTimes::kItem] - all[ItemTimes::kTrain] - recorded)
+            << " (checkpoint file, log lines); shared queue " << ms(all[ItemTimes::kQueue])
+            << " between items\n";
 }
 
 // Rank 0 replays an adaptive sweep's rounds on the file (closed on every

@@ -3,6 +3,7 @@
 // cmd_sweep.cpp, its rounds of work items in sweep_rounds.cpp.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <functional>
@@ -36,6 +37,19 @@ namespace apps {
 extern volatile std::sig_atomic_t g_stop_signal;
 
 using SweepClock = std::chrono::steady_clock;
+
+/// Where this rank's time per item goes (`phnn sweep --timings`) [s]:
+/// kItem an item from its start to its last line, of which kTrain trains its
+/// cell (kRuns of that: the runs' own wall_time_s, the trainer's clock),
+/// kJournal and kRow record it; kQueue the shared counter between items.
+struct ItemTimes {
+  enum Part { kItem, kTrain, kRuns, kJournal, kRow, kQueue, kParts };
+  std::array<double, kParts> s{};
+  int items = 0;  // recorded (stopped ones are not counted)
+  void add(Part part, SweepClock::time_point since) {
+    s[part] += std::chrono::duration<double>(SweepClock::now() - since).count();
+  }
+};
 
 // One `phnn sweep` on this rank: each phase that can fail on some ranks ends
 // in agree(), so every rank fails together and none waits forever.
@@ -124,6 +138,9 @@ class SweepRun {
   SweepDataSets data_{spec_, grid_};
   // An adaptive sweep's rounds so far (replay_rounds); unused otherwise.
   AdaptiveState adaptive_;
+  ItemTimes times_;
+  // Rank 0 prints every rank's ItemTimes, summed (collective).
+  void report_times();
   // The runs idle ranks train ahead of the round in progress, per cell
   // (runs_to_speculate; the same on every rank).
   std::vector<std::vector<int>> ahead_;

@@ -53,6 +53,37 @@ class Barriers(unittest.TestCase):
             self.assertGreaterEqual(r["free"], r["work"] / ranks * (1 - 1e-12))
 
 
+class Speculation(unittest.TestCase):
+    COSTS = [{"cell": "0", "fixed_s": "0", "member_s": "1"},
+             {"cell": "1", "fixed_s": "0", "member_s": "1"}]
+
+    def test_ahead_items_fill_the_drain_and_stop_at_its_end(self):
+        # 3 | 1 on 2 ranks: the round ends at 3; rank 1 trains a 2 s ahead item from 1 to 3
+        # (finished), then nothing: the next one would start at the end.
+        ahead = [{"left": 2.0}, {"left": 5.0}]
+        self.assertEqual(rr.ahead_schedule([3.0, 1.0], ahead, 2), (3.0, 2.0))
+        self.assertEqual([a["left"] for a in ahead], [0.0, 5.0])
+
+    def test_hand_computed_rounds(self):
+        # Round 0: cell 0 (2 runs, 2 s) | cell 1 (1 run, 1 s): ends at 2. Rank 1 then trains
+        # cell 0's next 2 seeds (2 s, asked for by round 1) from 1 to 2: 1 s done, 1 s left.
+        # Round 1 asks for them: the resumed item's 1 s on rank 0 -> ends at 1; meanwhile rank 1
+        # trains cell 0's next seeds, which no round asks for: 1 s lost. Makespan 2 + 1 = 3
+        # against 2 + 2 with barriers alone.
+        rounds = [{0: (2, 1.0), 1: (1, 1.0)}, {0: (2, 1.0)}]
+        self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 2, 2, 10, split=False),
+                         (3.0, 2.0, 1.0))
+        self.assertEqual(rr.barrier_makespan(rr.round_item_costs(rounds, self.COSTS, 2, False), 2),
+                         4.0)
+        # One rank never idles: the makespan is the work, nothing is trained ahead.
+        self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 1, 2, 10, split=False),
+                         (5.0, 0.0, 0.0))
+        # max_seeds 2: cell 0 is at the cap after round 0, so only cell 1's second seed (1 s,
+        # never asked for) is trained ahead.
+        self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 2, 2, 2, split=False)[1:],
+                         (1.0, 1.0))
+
+
 class WorkPlanPort(unittest.TestCase):
     def test_split_by_hand(self):
         # 4 runs, fixed 1 s, member 1 s, 4 ranks: whole 5 s; 2 groups of 2: 3 s each (6 s of
