@@ -116,6 +116,15 @@ def round_item_costs(cells_of_rounds, cost_rows, ranks, split=True):
     return out
 
 
+def critical_path(cells_of_rounds, cost_rows):
+    """Sum over rounds of the round's costliest single run (fixed + one member, at its measured
+    scale) [s]: no schedule that waits for each round's decision is shorter, at any rank count
+    and however finely cells are split."""
+    model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
+    return sum(max(scale * (model[c][0] + model[c][1]) for c, (_, scale) in cells.items())
+               for cells in cells_of_rounds if cells)
+
+
 def barrier_makespan(rounds, ranks):
     """Each round on its own (every rank free at its start), one after the other."""
     return sum(list_schedule_makespan(costs, ranks) for costs in rounds)
@@ -146,46 +155,65 @@ def ahead_schedule(costs, ahead, ranks):
     return end, spent
 
 
-def speculative_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, split=True):
+def speculative_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, split=True,
+                       depth=1, window=1):
     """The rounds with speculation as `phnn sweep` does it (docs/METHOD.md "Speculation"): while
-    round k drains, idle ranks train the next `batch` seeds (fewer at max_seeds) of each cell
-    round k grows, largest items first; an ahead item stops at the round's end and goes on, as
-    a resumed item first in the plan, if round k+1 asks for its cell; otherwise its work is lost.
-    An ahead item costs what it costs in the round that asks for it (that round's scale), else in
-    this one. Returns (makespan, work spent ahead, of it never asked for)."""
+    round k drains, idle ranks train the next `depth` batches of `batch` seeds (fewer at
+    max_seeds) of each cell round k grows, nearer batches first, largest items first within
+    one; an ahead item stops at the round's end. A round that asks for an ahead item's runs
+    takes them as they are (finished, or a resumed item first in the plan, what is left of its
+    cost); a cell that stops growing loses the work ahead of it. An ahead item costs what it
+    costs in the round that asks for it (that round's scale), else in this one. window > 1: the
+    cells grown in any of the last `window` rounds (`phnn sweep`: 1).
+    Returns (makespan, work spent ahead, of it never asked for)."""
     model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
-    seeds, carried = {}, {}  # cell -> seeds asked so far; cell -> started ahead items it asks for
+    seeds = {}    # cell -> seeds asked so far
+    grown = {}    # cell -> the last round that gave it seeds
+    started = {}  # cell -> {first seed: ahead item} trained ahead, not yet asked for
     makespan = spent = lost = 0.0
+
+    def scale_of(c, k):  # of the first later round that asks for cell c, else its last round's
+        for later in cells_of_rounds[k + 1:]:
+            if c in later:
+                return later[c][1]
+        return cells_of_rounds[grown[c]][c][1]
+
     for k, cells in enumerate(cells_of_rounds):
         resumed, to_plan = [], []
         for c, (n, _) in cells.items():
-            for item in carried.get(c, []):
+            first = seeds.get(c, 0)
+            for start in [s0 for s0 in started.get(c, {}) if s0 < first + n]:
+                item = started[c].pop(start)
                 n -= item["runs"]
                 if item["left"] > 0:
                     resumed.append(item["left"])
             if n > 0:
                 to_plan.append(PlanCell(c, *model[c], n))
-            seeds[c] = seeds.get(c, 0) + cells[c][0]
+            seeds[c] = first + cells[c][0]
+            grown[c] = k
+        growing = [c for c in sorted(grown) if k - grown[c] < window]
+        for c in [c for c in started if c not in growing]:  # stopped growing
+            lost += sum(i["cost"] - i["left"] for i in started.pop(c).values())
         costs = resumed + [cells[c][1] * (model[c][0] + m * model[c][1])
                            for c, m in plan_work(to_plan, ranks, split)]
-        following = cells_of_rounds[k + 1] if k + 1 < len(cells_of_rounds) else {}
-        candidates = [PlanCell(c, *model[c], min(batch, max_seeds - seeds[c]))
-                      for c in cells if seeds[c] < max_seeds]
         ahead = []
-        for c, m in plan_work(candidates, ranks, split):
-            scale = following[c][1] if c in following else cells[c][1]
-            cost = scale * (model[c][0] + m * model[c][1])
-            ahead.append({"cell": c, "runs": m, "cost": cost, "left": cost})
-        end, _ = ahead_schedule(costs, ahead, ranks)
-        makespan += end
-        carried = {}
+        for j in range(depth):
+            candidates, firsts = [], {}
+            for c in growing:
+                first = seeds[c] + j * batch
+                if first < max_seeds and first not in started.get(c, {}):
+                    candidates.append(PlanCell(c, *model[c], min(batch, max_seeds - first)))
+                    firsts[c] = first
+            for c, m in plan_work(candidates, ranks, split):
+                cost = scale_of(c, k) * (model[c][0] + m * model[c][1])
+                ahead.append({"cell": c, "first": firsts[c], "runs": m, "cost": cost, "left": cost})
+                firsts[c] += m
+        makespan += ahead_schedule(costs, ahead, ranks)[0]
         for item in ahead:
-            work = item["cost"] - item["left"]
-            spent += work
-            if item["cell"] not in following:
-                lost += work
-            elif work > 0:
-                carried.setdefault(item["cell"], []).append(item)
+            spent += item["cost"] - item["left"]
+            if item["left"] < item["cost"]:
+                started.setdefault(item["cell"], {})[item["first"]] = item
+    lost += sum(i["cost"] - i["left"] for items in started.values() for i in items.values())
     return makespan, spent, lost
 
 
@@ -257,6 +285,8 @@ def main(argv=None):
                                                 adaptive["max_seeds"], args.split == "auto")
         rows.append(row)
     print(table(rows))
+    print(f"critical path of the rounds (each round's costliest single run, summed): "
+          f"{duration(critical_path(cells, cost_rows))}")
     return 0
 
 

@@ -294,7 +294,9 @@ std::string SweepRun::adaptive_dry_run() const {
       << "round 0 (" << spec_.adaptive.initial_seeds.size() << " seeds per cell):\n"
       << dry_run_summary(expand_grid(round_zero_spec(spec_)), ranks_, split_)
       << "worst case (every cell at " << spec_.adaptive.max_seeds << " seeds):\n"
-      << dry_run_summary(grid_, ranks_, split_);
+      << dry_run_summary(grid_, ranks_, split_)
+      << "the rounds after round 0 depend on its results: replay a finished file's rounds per "
+         "rank count, with barriers and speculation, with analysis/rounds_replay.py\n";
   return out.str();
 }
 

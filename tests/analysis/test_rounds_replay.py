@@ -78,6 +78,8 @@ class Speculation(unittest.TestCase):
         # One rank never idles: the makespan is the work, nothing is trained ahead.
         self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 1, 2, 10, split=False),
                          (5.0, 0.0, 0.0))
+        # Critical path: round 0's costliest run 1 s, round 1's 1 s.
+        self.assertEqual(rr.critical_path(rounds, self.COSTS), 2.0)
         # max_seeds 2: cell 0 is at the cap after round 0, so only cell 1's second seed (1 s,
         # never asked for) is trained ahead.
         self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 2, 2, 2, split=False)[1:],
