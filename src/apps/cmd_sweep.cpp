@@ -36,7 +36,6 @@
 #include "apps/sweep_phases.h"
 #include "apps/sweep_report.h"
 #include "apps/sweep_run.h"
-#include "h5/h5file.h"
 #include "phnn/common/counted.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"

@@ -13,8 +13,8 @@
 #include <torch/torch.h>
 #include <torch/version.h>
 
-#include "h5/h5file.h"
 #include "models/kernel_isa.h"
+#include "phnn/store/file_probe.h"
 #include "phnn/sweep/version.h"
 #include "phnn/sweep/writer_lock.h"
 
@@ -120,7 +120,7 @@ Provenance build_provenance() {
           {"libtorch", std::string("LibTorch ") + TORCH_VERSION},
           {"blas", blas_version()},
           {"kernels", internal::kernel_description()},
-          {"hdf5", h5::library_version()},
+          {"hdf5", hdf5_library_version()},
           {"mpi", mpi_version()}};
 }
 

@@ -1,4 +1,5 @@
-// src/models/dynamics_model.cpp
+// src/models/dynamics_model.cpp — the learned vector field f_theta of a stack
+// of E models (phnn/models/dynamics_model.h).
 #include "phnn/models/dynamics_model.h"
 
 #include "phnn/common/check.h"

@@ -1,4 +1,5 @@
-// src/models/stacked_matmul.cpp
+// src/models/stacked_matmul.cpp — per-member matrix products of a model stack
+// (models/stacked_matmul.h).
 #include "models/stacked_matmul.h"
 
 #include "models/member_gemm.h"

@@ -1,4 +1,5 @@
-// src/models/stacked_mlp.cpp
+// src/models/stacked_mlp.cpp — E tanh MLPs as one stack, with their jets
+// (phnn/models/stacked_mlp.h).
 #include "phnn/models/stacked_mlp.h"
 
 #include <cmath>

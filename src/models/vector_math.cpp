@@ -1,4 +1,5 @@
-// src/models/vector_math.cpp
+// src/models/vector_math.cpp — tanh over arrays in one fixed operation order,
+// compiled once per instruction set (models/vector_math.h).
 #include "models/vector_math.h"
 
 #include <cmath>

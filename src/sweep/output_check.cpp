@@ -14,7 +14,7 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "h5/h5file.h"
+#include "phnn/store/file_probe.h"
 #include "phnn/store/journal.h"
 #include "phnn/store/results_file.h"
 #include "phnn/store/scratch_file.h"
@@ -36,9 +36,7 @@ OutputCheck refused(const std::string& message) { return {OutputState::kRefused,
 OutputCheck inspect_hdf5(const std::string& out, const std::string& sweep_hash) {
   std::string format;
   try {
-    const h5::File file = h5::File::open(out, h5::Access::kReadOnly);
-    format = file.has_attribute("/", "format") ? file.string_attribute("/", "format")
-                                               : std::string("(missing)");
+    format = hdf5_format_attribute(out);
   } catch (const std::exception& e) {
     return {OutputState::kDamaged, std::string("cannot be opened as HDF5 (") + e.what() + ")"};
   }
@@ -55,9 +53,8 @@ OutputCheck inspect_hdf5(const std::string& out, const std::string& sweep_hash) 
     // repeated id): moved aside and rebuilt from the journals.
     const std::vector<std::string> problems = file.structure_problems();
     if (!problems.empty()) return {OutputState::kDamaged, problems.front()};
-  } catch (const h5::Error& e) {
-    return {OutputState::kDamaged, e.what()};
   } catch (const std::exception& e) {
+    if (is_hdf5_error(e)) return {OutputState::kDamaged, e.what()};
     return refused(e.what());  // another format version, ...
   }
   if (!same_text) return {OutputState::kOtherText, "written by another sweep text"};

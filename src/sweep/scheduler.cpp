@@ -1,4 +1,5 @@
-// src/sweep/scheduler.cpp
+// src/sweep/scheduler.cpp — WorkQueue (phnn/sweep/scheduler.h): the MPI-3
+// shared counter that hands out work items, with the stop flag.
 #include "phnn/sweep/scheduler.h"
 
 namespace phnn {

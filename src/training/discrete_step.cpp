@@ -1,4 +1,5 @@
-// src/training/discrete_step.cpp
+// src/training/discrete_step.cpp — the discrete models g_theta (Eqs. 28-30)
+// declared in phnn/training/discrete_step.h.
 #include "phnn/training/discrete_step.h"
 
 #include <cmath>

@@ -1,4 +1,5 @@
-// src/training/flat_adam.cpp
+// src/training/flat_adam.cpp — Adam on one contiguous parameter tensor
+// (phnn/training/flat_adam.h), one fixed operation order.
 #include "phnn/training/flat_adam.h"
 
 #include <cmath>

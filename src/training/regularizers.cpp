@@ -1,4 +1,5 @@
-// src/training/regularizers.cpp
+// src/training/regularizers.cpp — the Jacobian regularizers CN, SN, SR
+// (phnn/training/regularizers.h, docs/METHOD.md §4).
 #include "phnn/training/regularizers.h"
 
 #include <cmath>

@@ -1,4 +1,5 @@
-// src/training/rollout.cpp
+// src/training/rollout.cpp — the inference phase of a cell (training/rollout.h):
+// rollouts of every member, Eq. 31, figure trajectories. Touches no file.
 #include "training/rollout.h"
 
 #include <algorithm>

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
 
 namespace phnn {

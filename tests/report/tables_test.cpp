@@ -12,6 +12,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "phnn/sweep/grid.h"
+#include "phnn/sweep/sweep_file.h"
+
 namespace phnn {
 namespace {
 

@@ -1,4 +1,5 @@
-// include/phnn/common/check.h
+// include/phnn/common/check.h — invariant and option checks (PHNN_REQUIRE,
+// PHNN_CHECK, PHNN_OPTION_*): the exceptions a bug and bad input throw.
 #pragma once
 
 #include <sstream>

@@ -1,4 +1,5 @@
-// include/phnn/data/counter_rng.h
+// include/phnn/data/counter_rng.h — counter-based random numbers: a value is a
+// function of its keys (seed, system, trajectory, purpose), never of call order.
 #pragma once
 
 #include <cstdint>

@@ -10,7 +10,7 @@
 
 #include "phnn/report/comparison.h"
 #include "phnn/report/tables.h"
-#include "phnn/sweep/grid.h"
+#include "phnn/config/run_grid.h"
 
 namespace phnn {
 

@@ -10,7 +10,7 @@
 
 #include "phnn/config/run_result.h"
 #include "phnn/report/statistics.h"
-#include "phnn/sweep/grid.h"
+#include "phnn/config/run_grid.h"
 #include "phnn/systems/oscillators.h"
 
 namespace phnn {
