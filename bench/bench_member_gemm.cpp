@@ -1,5 +1,5 @@
 // bench/bench_member_gemm.cpp — µs per call and multiply-add rate of our
-// member GEMM (src/models/member_gemm.h) on the shapes of one small
+// member GEMM (src/kernels/member_gemm.h) on the shapes of one small
 // PHNN-JR-RK2 training step (E = 10, batch 64, hidden 16: L_H's jet rows
 // 192 = 64 x 3 channels, L_R's 64), on every instruction set this CPU has.
 // Not a test; numbers in docs/BENCHMARKS.md ("Our own kernels").
@@ -11,8 +11,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "models/kernel_isa.h"
-#include "models/member_gemm.h"
+#include "kernels/kernel_isa.h"
+#include "kernels/member_gemm.h"
 
 namespace {
 

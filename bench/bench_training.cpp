@@ -41,7 +41,7 @@
 
 #include <torch/torch.h>
 
-#include "models/member_gemm.h"
+#include "kernels/member_gemm.h"
 #include "phnn/data/ph_dataset.h"
 #include "phnn/systems/system_file.h"
 #include "phnn/training/trainer.h"

@@ -13,7 +13,7 @@ PACKAGES=(
   libhdf5-openmpi-dev hdf5-tools     # parallel HDF5 + h5dump
   libboost-mpi-dev                   # Boost.MPI (environment, communicator)
   libopenblas0-pthread               # fast BLAS behind libblas.so.3 (LibTorch uses it)
-  libblas-dev                        # libblas.so to link dgemm_ (src/models/stacked_matmul.cpp)
+  libblas-dev                        # libblas.so to link dgemm_ (src/kernels/stacked_matmul.cpp)
   libjemalloc-dev                    # allocator: glibc malloc costs ~16 % of a step
   libtomlplusplus-dev                # toml++: the TOML parser of sweep files
   libcli11-dev                       # CLI11: the command-line parser of `phnn`

@@ -13,7 +13,7 @@
 #include <torch/torch.h>
 #include <torch/version.h>
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 #include "phnn/store/file_probe.h"
 #include "phnn/sweep/version.h"
 #include "phnn/sweep/writer_lock.h"

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "models/head_sizes.h"
-#include "models/vector_math.h"
+#include "kernels/vector_math.h"
 
 namespace phnn {
 namespace internal {

@@ -30,9 +30,9 @@
 
 #include <torch/csrc/autograd/functions/utils.h>
 
-#include "models/jet_kernels.h"
-#include "models/member_gemm.h"
-#include "models/vector_math.h"
+#include "kernels/jet_kernels.h"
+#include "kernels/member_gemm.h"
+#include "kernels/vector_math.h"
 
 namespace phnn {
 namespace internal {

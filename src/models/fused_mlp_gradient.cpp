@@ -19,7 +19,7 @@
 #include <algorithm>
 
 #include "models/fused_mlp_plan.h"
-#include "models/jet_kernels.h"
+#include "kernels/jet_kernels.h"
 
 namespace phnn {
 namespace internal {

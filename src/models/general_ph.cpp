@@ -7,7 +7,7 @@
 
 #include "models/general_heads.h"
 #include "models/manual_step.h"
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 #include "phnn/common/check.h"
 
 namespace phnn {

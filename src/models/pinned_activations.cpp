@@ -4,7 +4,7 @@
 #include "models/pinned_activations.h"
 
 #include "models/fused_heads_common.h"
-#include "models/vector_math.h"
+#include "kernels/vector_math.h"
 
 namespace phnn {
 namespace internal {

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <utility>
 
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 #include "phnn/common/check.h"
 
 namespace phnn {

@@ -5,9 +5,9 @@
 #include <cmath>
 
 #include "models/fused_mlp.h"
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 #include "models/pinned_activations.h"
-#include "models/stacked_matmul.h"
+#include "kernels/stacked_matmul.h"
 #include "phnn/common/check.h"
 #include "phnn/data/counter_rng.h"
 

@@ -13,7 +13,7 @@
 #include <torch/torch.h>
 
 #include "phnn/models/dynamics_model.h"
-#include "phnn/training/flat_adam.h"
+#include "phnn/kernels/flat_adam.h"
 #include "phnn/training/trainer.h"
 #include "training/batch_sampler.h"
 #include "training/cell_data.h"

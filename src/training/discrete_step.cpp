@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 #include "phnn/common/check.h"
 #include "phnn/common/small_lu.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 #include "training/jacobian_spectrum.h"
 
 namespace phnn {

@@ -6,7 +6,7 @@
 #include <limits>
 #include <vector>
 
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 #include "phnn/common/check.h"
 
 #include "phnn/training/discrete_step.h"

@@ -15,11 +15,11 @@
 
 #include <torch/torch.h>
 
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 #include "phnn/integrators/step_options.h"
 #include "phnn/models/dynamics_model.h"
 #include "phnn/training/discrete_step.h"
-#include "phnn/training/flat_adam.h"
+#include "phnn/kernels/flat_adam.h"
 #include "phnn/training/regularizers.h"
 #include "training/cell_trainer.h"
 #include "training/rollout.h"

@@ -13,8 +13,8 @@
 #include <torch/torch.h>
 
 #include "models/fused_heads_common.h"
-#include "models/kernel_isa.h"
-#include "models/vector_math.h"
+#include "kernels/kernel_isa.h"
+#include "kernels/vector_math.h"
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/discrete_step.h"
 #include "phnn/training/regularizers.h"

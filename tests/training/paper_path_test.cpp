@@ -16,7 +16,7 @@
 
 #include <gtest/gtest.h>
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 #include "phnn/training/trainer.h"
 #include "training/small_data.h"
 

@@ -1,5 +1,5 @@
-// src/models/ordered_sum.cpp — see ordered_sum.h.
-#include "models/ordered_sum.h"
+// src/kernels/ordered_sum.cpp — see ordered_sum.h.
+#include "kernels/ordered_sum.h"
 
 #include "phnn/common/check.h"
 

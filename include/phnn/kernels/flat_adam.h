@@ -1,4 +1,4 @@
-// include/phnn/training/flat_adam.h — Adam on one contiguous parameter tensor.
+// include/phnn/kernels/flat_adam.h — Adam on one contiguous parameter tensor.
 #pragma once
 
 #include <torch/torch.h>

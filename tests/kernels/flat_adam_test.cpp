@@ -1,5 +1,5 @@
-// tests/training/flat_adam_test.cpp
-#include "phnn/training/flat_adam.h"
+// tests/kernels/flat_adam_test.cpp
+#include "phnn/kernels/flat_adam.h"
 
 #include <cmath>
 #include <vector>
@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 #include "phnn/models/dynamics_model.h"
 
 namespace phnn {

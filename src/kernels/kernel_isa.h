@@ -1,4 +1,4 @@
-// src/models/kernel_isa.h — which instruction set our own kernels run on
+// src/kernels/kernel_isa.h — which instruction set our own kernels run on
 // (the member GEMM, tanh, the jet maps, Adam): chosen once per process from
 // the CPU, or pinned with PHNN_KERNEL_ISA. Every choice gives the same bits
 // (docs/METHOD.md "Deterministic kernels"); the variable exists so a test can

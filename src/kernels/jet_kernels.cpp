@@ -1,10 +1,10 @@
-// src/models/jet_kernels.cpp — see jet_kernels.h. Each loop lives in its own
+// src/kernels/jet_kernels.cpp — see jet_kernels.h. Each loop lives in its own
 // inline function with restrict-qualified channel pointers (the channels of
 // one buffer never overlap), so the compiler vectorizes it; compiled without
 // FMA contraction so every clone gives the same bits.
-#include "models/jet_kernels.h"
+#include "kernels/jet_kernels.h"
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 
 namespace phnn {
 namespace internal {

@@ -1,11 +1,11 @@
-// src/models/vector_math.cpp — tanh over arrays in one fixed operation order,
-// compiled once per instruction set (models/vector_math.h).
-#include "models/vector_math.h"
+// src/kernels/vector_math.cpp — tanh over arrays in one fixed operation order,
+// compiled once per instruction set (kernels/vector_math.h).
+#include "kernels/vector_math.h"
 
 #include <cmath>
 #include <cstring>
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 #include "phnn/common/cr_math.h"
 
 namespace phnn {

@@ -1,4 +1,4 @@
-// src/models/member_gemm.h — the matrix products of the stacked networks
+// src/kernels/member_gemm.h — the matrix products of the stacked networks
 // (one small GEMM per ensemble member), computed by our own kernel so the
 // bits do not depend on which BLAS kernels the CPU gets (docs/METHOD.md
 // "Deterministic kernels"). Replaces the dgemm_/sgemm_ calls of fused_mlp.cpp

@@ -1,4 +1,4 @@
-// src/models/jet_kernels.h — the elementwise part of a tanh layer's jet and
+// src/kernels/jet_kernels.h — the elementwise part of a tanh layer's jet and
 // its adjoint (formulas (F) and (B) in fused_mlp.cpp), and the bias of a
 // linear layer and its adjoint, compiled for AVX-512, AVX2 and baseline
 // x86-64 and chosen by kernel_isa.h.

@@ -1,8 +1,8 @@
-// src/models/stacked_matmul.cpp — per-member matrix products of a model stack
-// (models/stacked_matmul.h).
-#include "models/stacked_matmul.h"
+// src/kernels/stacked_matmul.cpp — per-member matrix products of a model stack
+// (kernels/stacked_matmul.h).
+#include "kernels/stacked_matmul.h"
 
-#include "models/member_gemm.h"
+#include "kernels/member_gemm.h"
 
 namespace phnn {
 namespace internal {

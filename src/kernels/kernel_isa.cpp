@@ -1,5 +1,5 @@
-// src/models/kernel_isa.cpp — see kernel_isa.h.
-#include "models/kernel_isa.h"
+// src/kernels/kernel_isa.cpp — see kernel_isa.h.
+#include "kernels/kernel_isa.h"
 
 #include <atomic>
 #include <cstdlib>

@@ -1,9 +1,9 @@
-// tests/models/ordered_sum_test.cpp — the fixed-order sums: values equal the
+// tests/kernels/ordered_sum_test.cpp — the fixed-order sums: values equal the
 // left-to-right loop bit for bit, gradients are the broadcast of the
 // adjoint (first and second order), float32 too; the broadcast product's
 // backward sums its broadcast dimensions in row-major order, and so does an
 // ordered expand's.
-#include "models/ordered_sum.h"
+#include "kernels/ordered_sum.h"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>

@@ -1,7 +1,7 @@
-// tests/models/stacked_matmul_test.cpp — the per-member dgemm product against
+// tests/kernels/stacked_matmul_test.cpp — the per-member dgemm product against
 // torch::bmm, values and gradients, for plain, transposed and broadcast operands;
 // the sgemm product of float32 training.
-#include "models/stacked_matmul.h"
+#include "kernels/stacked_matmul.h"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>

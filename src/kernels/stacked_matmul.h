@@ -1,4 +1,4 @@
-// src/models/stacked_matmul.h — per-member matrix products of a model stack.
+// src/kernels/stacked_matmul.h — per-member matrix products of a model stack.
 #pragma once
 
 #include <torch/torch.h>

@@ -1,4 +1,4 @@
-// src/models/ordered_sum.h — sums over trailing dimensions in one fixed
+// src/kernels/ordered_sum.h — sums over trailing dimensions in one fixed
 // order, differentiable: the reductions of the loss, the regularizers and
 // the rollout errors. LibTorch's sum and mean add in an order set by the
 // vector width of the kernel it dispatches to (ATEN_CPU_CAPABILITY: 4

@@ -1,4 +1,4 @@
-// src/models/vector_math.h — tanh over arrays, written so the compiler
+// src/kernels/vector_math.h — tanh over arrays, written so the compiler
 // vectorizes it (AVX-512 / AVX2 / baseline copies, kernel_isa.h), for the fused
 // networks. LibTorch's tanh on this build goes through Sleef's 1-ulp AVX2
 // kernel at ~5 ns per element, 20 % of a small training step (perf).

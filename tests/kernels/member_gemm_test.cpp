@@ -1,9 +1,9 @@
-// tests/models/member_gemm_test.cpp — the member GEMM against its documented
+// tests/kernels/member_gemm_test.cpp — the member GEMM against its documented
 // element formula (one std::fma chain over the inner index, in order), bit
 // for bit, on every instruction set this CPU has, for tile-edge shapes and
 // strided, transposed, broadcast and accumulating operands; and against a
 // long-double product within the forward error bound.
-#include "models/member_gemm.h"
+#include "kernels/member_gemm.h"
 
 #include <cmath>
 #include <cstring>
@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 
 namespace phnn {
 namespace internal {

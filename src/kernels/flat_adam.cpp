@@ -1,11 +1,11 @@
-// src/training/flat_adam.cpp — Adam on one contiguous parameter tensor
-// (phnn/training/flat_adam.h), one fixed operation order.
-#include "phnn/training/flat_adam.h"
+// src/kernels/flat_adam.cpp — Adam on one contiguous parameter tensor
+// (phnn/kernels/flat_adam.h), one fixed operation order.
+#include "phnn/kernels/flat_adam.h"
 
 #include <cmath>
 #include <type_traits>
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 #include "phnn/common/check.h"
 
 namespace phnn {

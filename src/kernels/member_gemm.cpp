@@ -1,4 +1,4 @@
-// src/models/member_gemm.cpp — see member_gemm.h. Three kernels chosen by
+// src/kernels/member_gemm.cpp — see member_gemm.h. Three kernels chosen by
 // kernel_isa(): AVX-512 and AVX2 + FMA with intrinsics, and the portable
 // tiles below for baseline x86-64 (and for float). All name their fused
 // multiply-adds (an FMA instruction or std::fma: one rounding, by IEEE 754,
@@ -11,14 +11,14 @@
 // and nothing else, so the tile shape (16, 8, 4, 1 columns; 8, 4, 3, 2 or 1
 // rows), or AVX-512's lanes running over rows instead of columns, changes
 // the speed, never the value.
-#include "models/member_gemm.h"
+#include "kernels/member_gemm.h"
 
 #include <immintrin.h>
 
 #include <cmath>
 #include <vector>
 
-#include "models/kernel_isa.h"
+#include "kernels/kernel_isa.h"
 
 namespace phnn {
 namespace internal {
