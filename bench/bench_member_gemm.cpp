@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
   for (const auto isa : {KernelIsa::kAvx512, KernelIsa::kAvx2, KernelIsa::kBaseline}) {
     const phnn::internal::ScopedKernelIsa scope(isa);
     if (phnn::internal::kernel_isa() != isa) continue;  // this CPU lacks it
-    std::printf("\n%s, E = 10, best of %d x 300 calls\n\n", phnn::internal::kernel_isa_name(isa),
+    std::printf("\n%s, E = 10, best of %d x 300 calls\n\n", phnn::internal::kernel_isa_name(isa).c_str(),
                 repeats);
     std::printf("| product | rows x K x cols | µs per call | G multiply-adds/s |\n");
     std::printf("|---|---|---|---|\n");

@@ -35,11 +35,10 @@ void parse_blocks(const std::string& text, ImportOptions* o) {
 ImportOptions import_options(const cli::Parser& parser) {
   ImportOptions o;
   const std::string split = parser.get("split");
-  if (split != "blocks" && split != "trajectories") {
+  if (!kImportSplitNames.find(split, &o.split)) {
     throw cli::UsageError{"phnn import: --split " + split + ": give blocks (a few long recordings, "
                           "cut in time) or trajectories (one pair per trajectory)"};
   }
-  o.split = split == "blocks" ? ImportSplit::kBlocks : ImportSplit::kTrajectories;
   const bool blocks = o.split == ImportSplit::kBlocks;
   for (const char* name : {"pair-window", "split-seed"}) {
     if (blocks && parser.has(name)) {

@@ -20,6 +20,7 @@
 #include "phnn/common/counted.h"
 #include "phnn/common/closest_name.h"
 #include "phnn/common/utc_time.h"
+#include "phnn/config/training_settings.h"
 #include "phnn/report/tables.h"
 #include "phnn/store/ph_dataset_file.h"
 #include "phnn/store/output_path.h"
@@ -65,12 +66,18 @@ void declare_train_options(cli::Parser* parser) {
   parser->option("n-train", "training pairs (1..400)", "25");
   parser->option("reg", "none | cn | sn | sr", "none");
   parser->option("seeds", "model seeds, e.g. 0-9 or 0,3,5", "0-9");
-  parser->option("steps", "Adam steps", "50000");
-  parser->option("lr", "learning rate", "1e-3");
-  parser->option("batch", "minibatch size", "64");
-  parser->option("eval-every", "validation cadence in steps", "500");
-  parser->option("precision", "float64 | float32 (float32 trains only; inference stays float64)",
-                 "float64");
+  // The training settings with a flag (phnn/config/training_settings.h).
+  const TrainerOptions defaults;
+  for (const TrainingSetting& s : training_settings()) {
+    if (*s.flag == '\0') continue;
+    std::string help = s.doc;
+    if (s.kind == TrainingSetting::Kind::kChoice) {
+      std::string names;
+      for (const std::string& n : s.choices()) names += (names.empty() ? "" : " | ") + n;
+      help = names + ": " + help;
+    }
+    parser->option(s.flag, help, s.text(defaults));
+  }
   parser->option("data", "read the data set from this file (`phnn data`) instead of generating it");
   parser->option("data-seed", "data-set seed when generating", "0");
   parser->option("damping", "c of z(w) = c w [N s/m] when generating", "0.14737");
@@ -125,12 +132,22 @@ CellSpec cell_from_options(const cli::Parser& parser) {
   cell.n_train = parser.get_int_in("n-train", 1, kMax);
   cell.seeds.clear();
   for (auto s : cli::parse_int_list("seeds", parser.get("seeds"))) cell.seeds.push_back(static_cast<int>(s));
-  // In the range of the trainer's int counters: no silent wrap-around.
-  cell.training.steps = parser.get_int_in("steps", 1, kMax);
-  cell.training.learning_rate = parser.get_double("lr");
-  cell.training.batch_size = parser.get_int_in("batch", 1, kMax);
-  cell.training.eval_every = parser.get_int_in("eval-every", 1, kMax);
-  cell.training.precision = parse_precision(parser.get("precision"));
+  // The training settings with a flag; integers in the range of the
+  // trainer's int counters: no silent wrap-around.
+  for (const TrainingSetting& s : training_settings()) {
+    if (*s.flag == '\0') continue;
+    switch (s.kind) {
+      case TrainingSetting::Kind::kReal:
+        cell.training.*s.real = parser.get_double(s.flag);
+        break;
+      case TrainingSetting::Kind::kInteger:
+        cell.training.*s.integer = parser.get_int_in(s.flag, s.min_integer, kMax);
+        break;
+      case TrainingSetting::Kind::kChoice:
+        s.parse_choice(&cell.training, parser.get(s.flag));
+        break;
+    }
+  }
   return cell;
 }
 

@@ -7,6 +7,7 @@
 
 #include "phnn/common/check.h"
 #include "phnn/common/utc_time.h"
+#include "phnn/config/training_settings.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/version.h"
 #include "phnn/systems/builtin_systems.h"
@@ -33,14 +34,18 @@ std::string grid_text(const CellSpec& cell, const std::string& system) {
   return s.str();
 }
 
-// The cell's [training] table (precision only when not the default).
+// The cell's [training] table: the settings `phnn train` has flags for
+// (phnn/config/training_settings.h), a choice only away from its default.
 std::string training_text(const CellSpec& cell) {
   std::ostringstream s;
-  s << "\n\n[training]\nsteps = " << cell.training.steps
-    << "\nlearning_rate = " << g17(cell.training.learning_rate)
-    << "\nbatch_size = " << cell.training.batch_size << "\neval_every = " << cell.training.eval_every;
-  if (cell.training.precision != Precision::kFloat64) {
-    s << "\nprecision = \"" << to_string(cell.training.precision) << "\"";
+  s << "\n\n[training]";
+  for (const TrainingSetting& setting : training_settings()) {
+    if (*setting.flag == '\0') continue;
+    if (setting.kind != TrainingSetting::Kind::kChoice) {
+      s << "\n" << setting.key << " = " << setting.text(cell.training);
+    } else if (!setting.is_default(cell.training)) {
+      s << "\n" << setting.key << " = \"" << setting.text(cell.training) << "\"";
+    }
   }
   return s.str();
 }

@@ -1,76 +1,11 @@
-// src/config/model_config.cpp — model kinds, sizes and widths: names, parsers,
-// parameter counts (LibTorch-free).
+// src/config/model_config.cpp — network widths and parameter counts of each
+// model and size (LibTorch-free; the names are in the header).
 #include "phnn/config/model_config.h"
 
 #include <cctype>
 #include <stdexcept>
 
 namespace phnn {
-
-std::string to_string(ModelKind kind) {
-  switch (kind) {
-    case ModelKind::kNode: return "node";
-    case ModelKind::kPhnnS: return "phnn-s";
-    case ModelKind::kPhnnJr: return "phnn-jr";
-  }
-  return "unknown";
-}
-
-std::string to_string(IntegratorKind kind) {
-  switch (kind) {
-    case IntegratorKind::kRk2: return "rk2";
-    case IntegratorKind::kDg: return "dg";
-    case IntegratorKind::kRk4: return "rk4";
-    case IntegratorKind::kDg4: return "dg4";
-  }
-  return "unknown";
-}
-
-std::string to_string(ModelSize size) {
-  switch (size) {
-    case ModelSize::kSmall: return "small";
-    case ModelSize::kMedium: return "medium";
-    case ModelSize::kLarge: return "large";
-  }
-  return "unknown";
-}
-
-std::string to_string(DgStructurePoint point) {
-  switch (point) {
-    case DgStructurePoint::kMidpoint: return "midpoint";
-    case DgStructurePoint::kStart: return "start";
-  }
-  return "unknown";
-}
-
-std::vector<DgStructurePoint> all_dg_structure_points() {
-  return {DgStructurePoint::kMidpoint, DgStructurePoint::kStart};
-}
-
-ModelKind parse_model(const std::string& name) {
-  for (ModelKind k : {ModelKind::kNode, ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
-    if (name == to_string(k)) return k;
-  }
-  throw std::invalid_argument("unknown model \"" + name +
-                              "\"; expected one of: node, phnn-s, phnn-jr");
-}
-
-IntegratorKind parse_integrator(const std::string& name) {
-  if (name == "rk2") return IntegratorKind::kRk2;
-  if (name == "dg") return IntegratorKind::kDg;
-  if (name == "rk4") return IntegratorKind::kRk4;
-  if (name == "dg4") return IntegratorKind::kDg4;
-  throw std::invalid_argument("unknown integrator \"" + name +
-                              "\"; expected one of: rk2, dg, rk4, dg4");
-}
-
-ModelSize parse_size(const std::string& name) {
-  for (ModelSize s : {ModelSize::kSmall, ModelSize::kMedium, ModelSize::kLarge}) {
-    if (name == to_string(s)) return s;
-  }
-  throw std::invalid_argument("unknown size \"" + name +
-                              "\"; expected one of: small, medium, large");
-}
 
 NetworkWidths network_widths(ModelSize size) {
   switch (size) {

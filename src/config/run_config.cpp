@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "phnn/config/training_settings.h"
+
 namespace phnn {
 
 std::uint64_t fnv1a64(const std::string& text) {
@@ -92,29 +94,11 @@ std::string RunConfig::cell_key() const {
   } else {
     builtin_system_key(*this, s);
   }
-  const TrainerOptions& t = training;
-  s << ";steps=" << t.steps << ";lr=" << num(t.learning_rate) << ";adam=" << num(t.adam_beta1)
-    << "," << num(t.adam_beta2) << "," << num(t.adam_eps) << ";batch=" << t.batch_size
-    << ";eval_every=" << t.eval_every;
-  if (regularizer != Regularizer::kNone) s << ";lambda=" << num(t.weight(regularizer));
-  // Knobs below are printed only away from their defaults, so the identity
+  // The training settings' parts (phnn/config/training_settings.h); settings
+  // added later are printed only away from their defaults, so the identity
   // of every run made before they existed is unchanged.
-  if (t.loss_norm != LossNorm::kMeanL1) s << ";loss_norm=" << to_string(t.loss_norm);
-  if (t.precision != Precision::kFloat64) s << ";precision=" << to_string(t.precision);
-  if (t.inference_weights != InferenceWeights::kBestValidation) {
-    s << ";inference_weights=" << to_string(t.inference_weights);
-  }
-  s << ";jac_eps=" << num(t.jacobian_eps);
-  if (is_discrete_gradient(integrator)) {
-    s << ";newton=" << num(t.newton_tolerance) << "," << t.newton_max_iterations
-      << ";tau=" << num(t.dg_min_dx_norm);
-  }
-  // Only PHNN-JR's DG step has a state-dependent structure (R_theta).
-  if (model == ModelKind::kPhnnJr && integrator == IntegratorKind::kDg &&
-      t.dg_structure_point != DgStructurePoint::kMidpoint) {
-    s << ";dg_structure_point=" << to_string(t.dg_structure_point);
-  }
-  s << ";divergence=" << num(t.divergence_norm);
+  const TrainerOptions& t = training;
+  s << training_key(t, model, integrator, regularizer);
   // Only when set, so the identity of every run without checkpoints is
   // unchanged from before they existed.
   if (!t.checkpoints.empty()) {

@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "phnn/config/training_settings.h"
+
 namespace phnn {
 
 std::vector<std::pair<std::string, std::string>> parse_canonical(const std::string& canonical) {
@@ -34,24 +36,25 @@ namespace {
 // Canonical keys (RunConfig::canonical(), short) -> sweep-file names
 // (sweeps/FORMAT.md); a value of several comma-separated numbers gets one
 // name per part. Keys not listed, or with another number of parts, keep their
-// canonical name and value.
+// canonical name and value. The training settings' come from their table
+// (phnn/config/training_settings.h; "lambda" stands for one of three and
+// keeps its name); the data and physics ones are these.
 const std::map<std::string, std::vector<std::string>>& column_names() {
-  static const std::map<std::string, std::vector<std::string>> names = {
-      {"h_gen", {"generation_step"}},
-      {"e0", {"energy_min", "energy_max"}},
-      {"eeq", {"equilibrium_energy_min", "equilibrium_energy_max"}},
-      {"n_traj", {"num_trajectories"}},
-      {"splits", {"num_train_max", "num_validation", "num_inference"}},
-      {"gen_tol", {"generation_newton_tolerance"}},
-      {"lr", {"learning_rate"}},
-      {"adam", {"adam_beta1", "adam_beta2", "adam_eps"}},
-      {"batch", {"batch_size"}},
-      {"jac_eps", {"jacobian_eps"}},
-      {"newton", {"newton_tolerance", "newton_max_iterations"}},
-      {"tau", {"dg_min_dx_norm"}},
-      {"divergence", {"divergence_norm"}},
-      {"z", {"z1", "z2", "z3"}},
-  };
+  static const std::map<std::string, std::vector<std::string>> names = [] {
+    std::map<std::string, std::vector<std::string>> m = {
+        {"h_gen", {"generation_step"}},
+        {"e0", {"energy_min", "energy_max"}},
+        {"eeq", {"equilibrium_energy_min", "equilibrium_energy_max"}},
+        {"n_traj", {"num_trajectories"}},
+        {"splits", {"num_train_max", "num_validation", "num_inference"}},
+        {"gen_tol", {"generation_newton_tolerance"}},
+        {"z", {"z1", "z2", "z3"}},
+    };
+    for (const TrainingSetting& s : training_settings()) {
+      if (s.in_key != TrainingSetting::InKey::kRegularizer) m[s.canonical].push_back(s.key);
+    }
+    return m;
+  }();
   return names;
 }
 

@@ -1,5 +1,5 @@
-// src/config/trainer_options.cpp — training settings and run statuses: names,
-// parsers, validation (LibTorch-free).
+// src/config/trainer_options.cpp — training settings: regularizer weights and
+// validation (LibTorch-free; the names are in the header).
 #include "phnn/config/trainer_options.h"
 
 #include <cmath>
@@ -9,84 +9,6 @@
 #include "phnn/config/run_result.h"
 
 namespace phnn {
-
-std::string to_string(Regularizer reg) {
-  switch (reg) {
-    case Regularizer::kNone: return "none";
-    case Regularizer::kCn: return "cn";
-    case Regularizer::kSn: return "sn";
-    case Regularizer::kSr: return "sr";
-  }
-  return "unknown";
-}
-
-Regularizer parse_regularizer(const std::string& name) {
-  for (Regularizer r : {Regularizer::kNone, Regularizer::kCn, Regularizer::kSn, Regularizer::kSr}) {
-    if (name == to_string(r)) return r;
-  }
-  throw std::invalid_argument("unknown regularizer \"" + name +
-                              "\"; expected one of: none, cn, sn, sr");
-}
-
-std::string to_string(LossNorm norm) {
-  switch (norm) {
-    case LossNorm::kMeanL1: return "mean-l1";
-    case LossNorm::kSumL1: return "sum-l1";
-    case LossNorm::kMse: return "mse";
-  }
-  return "unknown";
-}
-
-std::vector<LossNorm> all_loss_norms() {
-  return {LossNorm::kMeanL1, LossNorm::kSumL1, LossNorm::kMse};
-}
-
-std::string to_string(Precision precision) {
-  switch (precision) {
-    case Precision::kFloat64: return "float64";
-    case Precision::kFloat32: return "float32";
-  }
-  return "unknown";
-}
-
-std::vector<Precision> all_precisions() { return {Precision::kFloat64, Precision::kFloat32}; }
-
-Precision parse_precision(const std::string& name) {
-  for (Precision p : all_precisions()) {
-    if (name == to_string(p)) return p;
-  }
-  throw std::invalid_argument("unknown precision \"" + name + "\"; expected one of: float64, float32");
-}
-
-std::string to_string(InferenceWeights weights) {
-  switch (weights) {
-    case InferenceWeights::kBestValidation: return "best-validation";
-    case InferenceWeights::kFinal: return "final";
-  }
-  return "unknown";
-}
-
-std::vector<InferenceWeights> all_inference_weights() {
-  return {InferenceWeights::kBestValidation, InferenceWeights::kFinal};
-}
-
-std::string to_string(RunStatus status) {
-  switch (status) {
-    case RunStatus::kPending: return "pending";
-    case RunStatus::kDone: return "done";
-    case RunStatus::kDiverged: return "diverged";
-    case RunStatus::kFailed: return "failed";
-  }
-  return "unknown";
-}
-
-RunStatus parse_run_status(const std::string& name) {
-  for (RunStatus s : {RunStatus::kPending, RunStatus::kDone, RunStatus::kDiverged, RunStatus::kFailed}) {
-    if (name == to_string(s)) return s;
-  }
-  throw std::invalid_argument("unknown run status \"" + name +
-                              "\"; expected one of: pending, done, diverged, failed");
-}
 
 double TrainerOptions::weight(Regularizer reg) const {
   switch (reg) {

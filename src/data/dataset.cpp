@@ -21,18 +21,6 @@ long integer_ratio(double a, double b) {
 
 }  // namespace
 
-std::string to_string(EnergySampling sampling) {
-  switch (sampling) {
-    case EnergySampling::kAlgorithm1: return "algorithm1";
-    case EnergySampling::kDirect: return "direct";
-  }
-  return "unknown";
-}
-
-std::vector<EnergySampling> all_energy_samplings() {
-  return {EnergySampling::kAlgorithm1, EnergySampling::kDirect};
-}
-
 int DatasetOptions::stride() const {
   const long s = integer_ratio(1.0 / generation_step, sample_rate);
   PHNN_REQUIRE(s >= 1, "Invalid DatasetOptions: sr_gen / sample_rate = "

@@ -22,13 +22,4 @@ void DiscreteGradientOptions::validate() const {
                    << "; violated constraint: min_dx_norm >= 0.");
 }
 
-std::string to_string(StepStatus status) {
-  switch (status) {
-    case StepStatus::kConverged: return "converged";
-    case StepStatus::kMaxIterations: return "max-iterations";
-    case StepStatus::kNonFinite: return "non-finite";
-  }
-  return "unknown";
-}
-
 }  // namespace phnn

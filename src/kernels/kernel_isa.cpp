@@ -25,16 +25,10 @@ KernelIsa decide() {
   const char* env = std::getenv("PHNN_KERNEL_ISA");
   if (env == nullptr || *env == '\0') return best;
   const std::string v(env);
-  KernelIsa asked;
-  if (v == "baseline") {
-    asked = KernelIsa::kBaseline;
-  } else if (v == "avx2") {
-    asked = KernelIsa::kAvx2;
-  } else if (v == "avx512") {
-    asked = KernelIsa::kAvx512;
-  } else {
-    throw std::runtime_error("PHNN_KERNEL_ISA=" + v +
-                             ": expected baseline, avx2 or avx512 (or unset: the CPU's best)");
+  KernelIsa asked{};
+  if (!kKernelIsaNames.find(v, &asked)) {
+    throw std::runtime_error("PHNN_KERNEL_ISA=" + v + ": expected " + kKernelIsaNames.list() +
+                             " (or unset: the CPU's best)");
   }
   return lower(asked, best);
 }
@@ -67,15 +61,6 @@ std::string kernel_description() {
   cpu = cpu.empty() ? "baseline" : cpu.substr(1);
   return "phnn kernels " + std::to_string(kKernelSet) + "; " + kernel_isa_name(kernel_isa()) +
          " of " + kernel_isa_name(cpu_isa()) + " (CPU: " + cpu + ")";
-}
-
-const char* kernel_isa_name(KernelIsa isa) {
-  switch (isa) {
-    case KernelIsa::kAvx512: return "avx512";
-    case KernelIsa::kAvx2: return "avx2";
-    case KernelIsa::kBaseline: break;
-  }
-  return "baseline";
 }
 
 }  // namespace internal

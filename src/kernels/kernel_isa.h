@@ -7,6 +7,8 @@
 
 #include <string>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 namespace internal {
 
@@ -19,8 +21,11 @@ enum class KernelIsa { kBaseline = 0, kAvx2 = 1, kAvx512 = 2 };
 /// std::runtime_error naming it. Decided at the first call, then fixed.
 KernelIsa kernel_isa();
 
+inline constexpr EnumNames<KernelIsa, 3> kKernelIsaNames{
+    "PHNN_KERNEL_ISA",
+    {{{KernelIsa::kBaseline, "baseline"}, {KernelIsa::kAvx2, "avx2"}, {KernelIsa::kAvx512, "avx512"}}}};
 /// "baseline", "avx2" or "avx512".
-const char* kernel_isa_name(KernelIsa isa);
+inline std::string kernel_isa_name(KernelIsa isa) { return kKernelIsaNames.name(isa); }
 
 /// The version of our kernels' arithmetic: results are bitwise equal across
 /// CPUs within one kernel set; it changes when a kernel's operation order

@@ -128,20 +128,6 @@ std::string render_comparisons_csv(const std::vector<NamedComparison>& compariso
   return out;
 }
 
-std::string to_string(ComparisonReading reading) {
-  switch (reading) {
-    case ComparisonReading::kABetter:
-      return "A better";
-    case ComparisonReading::kBBetter:
-      return "B better";
-    case ComparisonReading::kEquivalent:
-      return "equivalent";
-    case ComparisonReading::kUndecided:
-      break;
-  }
-  return "undecided";
-}
-
 void ComparisonOptions::validate() const {
   const auto fail = [](const std::string& what) {
     throw std::invalid_argument("Invalid ComparisonOptions: " + what);

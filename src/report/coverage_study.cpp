@@ -88,52 +88,8 @@ Interval interval_of(CoverageMethod method, const Sample& s, const BootstrapOpti
 
 }  // namespace
 
-std::string to_string(CoverageScenario scenario) {
-  switch (scenario) {
-    case CoverageScenario::kCellLogNormal:
-      return "cell, log-normal";
-    case CoverageScenario::kCellBimodal:
-      return "cell, bimodal 0.7/0.3";
-    case CoverageScenario::kPairsLogNormal:
-      return "pairs, log-normal";
-    case CoverageScenario::kPairsLogNormalShared:
-      return "pairs, log-normal, shared seed effect";
-    case CoverageScenario::kPairsBimodal:
-      return "pairs, bimodal";
-    case CoverageScenario::kPairsBimodalShared:
-      return "pairs, bimodal, shared mode";
-  }
-  return "?";
-}
-
-std::vector<CoverageScenario> all_coverage_scenarios() {
-  return {CoverageScenario::kCellLogNormal,  CoverageScenario::kCellBimodal,
-          CoverageScenario::kPairsLogNormal, CoverageScenario::kPairsLogNormalShared,
-          CoverageScenario::kPairsBimodal,   CoverageScenario::kPairsBimodalShared};
-}
-
 bool is_pairs(CoverageScenario scenario) {
   return scenario != CoverageScenario::kCellLogNormal && scenario != CoverageScenario::kCellBimodal;
-}
-
-std::string to_string(CoverageMethod method) {
-  switch (method) {
-    case CoverageMethod::kPercentileBootstrap:
-      return "percentile bootstrap";
-    case CoverageMethod::kBca:
-      return "BCa";
-    case CoverageMethod::kOrderStatistic:
-      return "order statistic (binomial)";
-    case CoverageMethod::kPairedBootstrap:
-      return "paired bootstrap of the log ratio";
-    case CoverageMethod::kPairedBca:
-      return "paired BCa of the log ratio";
-    case CoverageMethod::kPairedOrderStatistic:
-      return "paired order statistic (sign test)";
-    case CoverageMethod::kUnpairedMoses:
-      return "unpaired Hodges-Lehmann (Moses)";
-  }
-  return "?";
 }
 
 std::vector<CoverageMethod> coverage_methods(CoverageScenario scenario) {

@@ -50,36 +50,6 @@ std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<R
   return entries;
 }
 
-TableFormat parse_table_format(const std::string& name) {
-  if (name == "markdown") return TableFormat::kMarkdown;
-  if (name == "latex") return TableFormat::kLatex;
-  if (name == "csv") return TableFormat::kCsv;
-  throw std::invalid_argument("unknown table format \"" + name +
-                              "\"; expected one of: markdown, latex, csv");
-}
-
-std::string to_string(TableFormat format) {
-  switch (format) {
-    case TableFormat::kMarkdown:
-      return "markdown";
-    case TableFormat::kLatex:
-      return "latex";
-    case TableFormat::kCsv:
-      return "csv";
-  }
-  return "unknown";
-}
-
-CellStatistic parse_cell_statistic(const std::string& name) {
-  if (name == "median") return CellStatistic::kMedian;
-  if (name == "iqm") return CellStatistic::kIqm;
-  throw std::invalid_argument("unknown statistic \"" + name + "\"; expected one of: median, iqm");
-}
-
-std::string to_string(CellStatistic statistic) {
-  return statistic == CellStatistic::kIqm ? "iqm" : "median";
-}
-
 double CellSummary::iqr() const {
   if (std::isinf(q75) && q75 > 0) return q75;
   return q75 - q25;

@@ -4,10 +4,6 @@
 
 namespace phnn {
 
-std::string to_string(ScheduleMode mode) {
-  return mode == ScheduleMode::kDynamic ? "dynamic" : "static";
-}
-
 WorkQueue::WorkQueue(MPI_Comm comm, int num_items, ScheduleMode mode)
     : comm_(comm), num_items_(num_items), mode_(mode) {
   MPI_Comm_rank(comm_, &rank_);

@@ -10,14 +10,6 @@
 
 namespace phnn {
 
-std::string to_string(AdaptiveRule rule) {
-  return rule == AdaptiveRule::kColumnBest ? "column-best" : "comparisons";
-}
-
-std::vector<AdaptiveRule> all_adaptive_rules() {
-  return {AdaptiveRule::kColumnBest, AdaptiveRule::kComparisons};
-}
-
 namespace {
 
 // Largest max_seeds: seeds of one cell are one stack of networks.

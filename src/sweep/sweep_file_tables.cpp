@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 
+#include "phnn/config/training_settings.h"
 #include "phnn/sweep/output_check.h"
 #include "sweep/sweep_file_adaptive.h"
 #include "sweep/sweep_file_search.h"
@@ -430,30 +431,30 @@ class TableWalker {
             {"newton_tolerance", number(d.newton.newton_tolerance)}};
   }
 
+  // Every setting of the table (phnn/config/training_settings.h), then
+  // checkpoints (a list).
   Handlers training_handlers(TrainerOptions& t) const {
-    return {{"steps", integer(t.steps, 1)},
-            {"learning_rate", number(t.learning_rate)},
-            {"adam_beta1", number(t.adam_beta1)},
-            {"adam_beta2", number(t.adam_beta2)},
-            {"adam_eps", number(t.adam_eps)},
-            {"batch_size", integer(t.batch_size, 1)},
-            {"eval_every", integer(t.eval_every, 1)},
-            {"lambda_cn", number(t.lambda_cn)},
-            {"lambda_sn", number(t.lambda_sn)},
-            {"lambda_sr", number(t.lambda_sr)},
-            {"loss_norm", choice(t.loss_norm, &all_loss_norms)},
-            {"precision", choice(t.precision, &all_precisions)},
-            {"inference_weights", choice(t.inference_weights, &all_inference_weights)},
-            {"jacobian_eps", number(t.jacobian_eps)},
-            {"newton_tolerance", number(t.newton_tolerance)},
-            {"newton_max_iterations", integer(t.newton_max_iterations, 1)},
-            {"dg_structure_point", choice(t.dg_structure_point, &all_dg_structure_points)},
-            {"dg_min_dx_norm", number(t.dg_min_dx_norm)},
-            {"divergence_norm", number(t.divergence_norm)},
-            {"checkpoints", [this, &t](const Entry& e) {
-               t.checkpoints = values_.int_axis(e, 1, nullptr);
-               std::sort(t.checkpoints.begin(), t.checkpoints.end());
-             }}};
+    Handlers h;
+    for (const TrainingSetting& s : training_settings()) {
+      switch (s.kind) {
+        case TrainingSetting::Kind::kReal:
+          h.emplace_back(s.key, number(t.*s.real));
+          break;
+        case TrainingSetting::Kind::kInteger:
+          h.emplace_back(s.key, integer(t.*s.integer, s.min_integer));
+          break;
+        case TrainingSetting::Kind::kChoice:
+          h.emplace_back(s.key, [this, &t, &s](const Entry& e) {
+            s.set_choice(&t, static_cast<int>(values_.choice_index(e, s.choices())));
+          });
+          break;
+      }
+    }
+    h.emplace_back("checkpoints", [this, &t](const Entry& e) {
+      t.checkpoints = values_.int_axis(e, 1, nullptr);
+      std::sort(t.checkpoints.begin(), t.checkpoints.end());
+    });
+    return h;
   }
 
   // Only the parameters the system uses (RunConfig::cell_key() hashes exactly

@@ -33,16 +33,6 @@ void SplitOptions::validate() const {
   }
 }
 
-std::string to_string(SplitOptions::Mode mode) {
-  return mode == SplitOptions::Mode::kAuto ? "auto" : "off";
-}
-
-SplitOptions::Mode parse_split_mode(const std::string& text) {
-  if (text == "auto") return SplitOptions::Mode::kAuto;
-  if (text == "off") return SplitOptions::Mode::kOff;
-  throw std::invalid_argument("unknown split mode \"" + text + "\"; expected one of: auto, off");
-}
-
 double WorkPlan::efficiency() const {
   return makespan_s > 0.0 ? unsplit_cost_s / (ranks * makespan_s) : 1.0;
 }

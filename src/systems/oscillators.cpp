@@ -6,34 +6,15 @@
 #include <stdexcept>
 
 #include "phnn/common/check.h"
-#include "phnn/common/closest_name.h"
 
 namespace phnn {
 
-std::string to_string(SystemKind kind) {
-  switch (kind) {
-    case SystemKind::kHarmonic: return "harmonic";
-    case SystemKind::kDuffing: return "duffing";
-    case SystemKind::kSelfSustained: return "self-sustained";
-  }
-  return "unknown";
-}
-
 SystemKind parse_system(const std::string& name) {
-  for (SystemKind kind : all_systems()) {
-    if (name == to_string(kind)) return kind;
-  }
-  const std::string near = closest_name(name, {"harmonic", "duffing", "self-sustained"});
-  throw std::invalid_argument("unknown system \"" + name + "\"" +
-                              (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
-                              "; expected one of: harmonic, duffing, self-sustained, the name "
-                              "of a shipped system file (sweeps/systems/NAME.toml), or a system "
-                              "file (a path ending in .toml)");
-}
-
-std::vector<SystemKind> all_systems() {
-  return {SystemKind::kHarmonic, SystemKind::kDuffing,
-          SystemKind::kSelfSustained};
+  SystemKind kind{};
+  if (kSystemNames.find(name, &kind)) return kind;
+  throw std::invalid_argument(kSystemNames.unknown(
+      name, ", the name of a shipped system file (sweeps/systems/NAME.toml), or a system file "
+            "(a path ending in .toml)"));
 }
 
 OscillatorOptions OscillatorOptions::defaults(SystemKind kind) {

@@ -32,15 +32,8 @@ void read_initial(const Reader& r, const toml::table& t, SystemDefinition* def) 
   InitialConditionDesign& d = def->initial;
   const toml::node* method_node = r.get(*it, "method", true, " in [initial]", line);
   const std::string method = r.string(*method_node, "initial.method");
-  const std::vector<std::string> methods = {"energy", "box", "algorithm1"};
-  if (method == "energy") d.method = InitialConditionDesign::Method::kEnergy;
-  else if (method == "box") d.method = InitialConditionDesign::Method::kBox;
-  else if (method == "algorithm1") d.method = InitialConditionDesign::Method::kAlgorithm1;
-  else {
-    const std::string near = closest_name(method, methods);
-    r.fail(Reader::line(*method_node), "unknown initial.method \"" + method + "\"" +
-                     (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
-                     "; expected one of: energy, box, algorithm1");
+  if (!InitialConditionDesign::kMethodNames.find(method, &d.method)) {
+    r.fail(Reader::line(*method_node), InitialConditionDesign::kMethodNames.unknown(method));
   }
   const bool needs_energy = d.method != InitialConditionDesign::Method::kBox;
   if (const toml::node* e = r.get(*it, "energy", needs_energy, " in [initial] (the interval "
@@ -144,12 +137,13 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
   def->lines["control"] = line;
   const toml::node* design_node = r.get(*ct, "design", true, " in [control]", line);
   const std::string design = r.string(*design_node, "control.design");
+  if (!ControlDesign::kDesignNames.find(design, &c.design)) {
+    r.fail(Reader::line(*design_node), ControlDesign::kDesignNames.unknown(design));
+  }
   if (design == "constant") {
-    c.design = ControlDesign::Design::kConstant;
     const toml::node* range = r.get(*ct, "range", nu > 0, " in [control] (one [lo, hi] per input)", line);
     if (range != nullptr) c.range = r.intervals(*range, "control.range", nu, "input");
   } else if (design == "energy-shaping") {
-    c.design = ControlDesign::Design::kEnergyShaping;
     if (def->states.size() != 2 || nu != 1) {
       r.fail(line, "control.design = \"energy-shaping\" is the paper's Algorithm 3 for 2 states "
                    "and 1 input; use \"constant\"");
@@ -161,19 +155,12 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
       def->lines["control.energy"] = Reader::line(*e);
     }
   } else if (design == "limit-cycle") {
-    c.design = ControlDesign::Design::kLimitCycle;
     if (def->ports.size() != 1 || nu != 1) {
       r.fail(line, "control.design = \"limit-cycle\" is the paper's Algorithm 4 for 1 port and 1 "
                    "input; use \"constant\"");
     }
-  } else if (design == "sines" || design == "chirp" || design == "steps") {
+  } else {  // sines, chirp, steps
     read_time_varying_control(r, *ct, line, design, nu, def);
-  } else {
-    const std::string near = closest_name(
-        design, {"constant", "energy-shaping", "limit-cycle", "sines", "chirp", "steps"});
-    r.fail(Reader::line(*design_node), "unknown control.design \"" + design + "\"" +
-                     (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
-                     "; expected one of: constant, energy-shaping, limit-cycle, sines, chirp, steps");
   }
 }
 

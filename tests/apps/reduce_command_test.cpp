@@ -228,7 +228,8 @@ TEST_F(ReduceCommandTest, StatIqmNamesItsStatisticAndIsACheckedSet) {
   ASSERT_EQ(reduce("--format latex --stat iqm", &out), 0) << out;
   EXPECT_THAT(out, HasSubstr("IQM [IQR] (bootstrap 95~\\% interval of the IQM)"));
   EXPECT_EQ(reduce("--stat mean", &out), 2);
-  EXPECT_THAT(out, HasSubstr("--stat: unknown statistic \"mean\"; expected one of: median, iqm"));
+  EXPECT_THAT(out, HasSubstr("--stat: unknown statistic \"mean\" (did you mean \"median\"?); "
+                             "expected one of: median, iqm"));
   EXPECT_EQ(reduce("--comparisons --stat iqm", &out), 2);
   EXPECT_THAT(out, HasSubstr("drop --stat"));
 }

@@ -62,7 +62,8 @@ TEST(TrainCommandTest, RejectsBadOptionsWithStatusTwo) {
     EXPECT_THAT(log, HasSubstr("is outside [")) << bad;
   }
   EXPECT_EQ(run("train --system harmonic --model phnn-jr-rk2 --precision float16 --steps 1", &log), 2);
-  EXPECT_THAT(log, HasSubstr("unknown precision \"float16\"; expected one of: float64, float32"));
+  EXPECT_THAT(log, HasSubstr("unknown precision \"float16\" (did you mean \"float64\"?); "
+                             "expected one of: float64, float32"));
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 3-1", &log), 2);
   EXPECT_THAT(log, HasSubstr("--seeds"));
   EXPECT_EQ(run("train --system harmonic --model phnn-jr --seeds 1,1 --steps 1", &log), 2);

@@ -164,7 +164,7 @@ TEST(CellStatisticTest, ParsesMedianAndIqmAndListsThemOnError) {
   EXPECT_EQ(to_string(CellStatistic::kIqm), "iqm");
   EXPECT_THAT([] { parse_cell_statistic("mean"); },
               testing::ThrowsMessage<std::invalid_argument>(
-                  HasSubstr("\"mean\"; expected one of: median, iqm")));
+                  HasSubstr("\"mean\" (did you mean \"median\"?); expected one of: median, iqm")));
 }
 
 // --stat iqm: NODE-RK2/25 {1..5}e-3 has IQM (2 + 3 + 4) / 3 e-3 = 3e-3;

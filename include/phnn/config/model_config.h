@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 
 /// Model formulation (paper §4.1): NODE baseline, PHNN-S (eq:f_theta-PHS-DAF),
@@ -35,22 +37,28 @@ struct ModelStructure {
   std::vector<double> S, J;
 };
 
-/// "node", "phnn-s", "phnn-jr".
-std::string to_string(ModelKind kind);
-/// "rk2", "dg", "rk4", "dg4".
-std::string to_string(IntegratorKind kind);
-/// "small", "medium", "large".
-std::string to_string(ModelSize size);
-/// "midpoint", "start".
-std::string to_string(DgStructurePoint point);
+inline constexpr EnumNames<ModelKind, 3> kModelNames{
+    "model", {{{ModelKind::kNode, "node"}, {ModelKind::kPhnnS, "phnn-s"}, {ModelKind::kPhnnJr, "phnn-jr"}}}};
+inline constexpr EnumNames<IntegratorKind, 4> kIntegratorNames{
+    "integrator", {{{IntegratorKind::kRk2, "rk2"}, {IntegratorKind::kDg, "dg"},
+                    {IntegratorKind::kRk4, "rk4"}, {IntegratorKind::kDg4, "dg4"}}}};
+inline constexpr EnumNames<ModelSize, 3> kSizeNames{
+    "size", {{{ModelSize::kSmall, "small"}, {ModelSize::kMedium, "medium"}, {ModelSize::kLarge, "large"}}}};
+inline constexpr EnumNames<DgStructurePoint, 2> kDgStructurePointNames{
+    "DG structure point", {{{DgStructurePoint::kMidpoint, "midpoint"}, {DgStructurePoint::kStart, "start"}}}};
+
+inline std::string to_string(ModelKind kind) { return kModelNames.name(kind); }
+inline std::string to_string(IntegratorKind kind) { return kIntegratorNames.name(kind); }
+inline std::string to_string(ModelSize size) { return kSizeNames.name(size); }
+inline std::string to_string(DgStructurePoint point) { return kDgStructurePointNames.name(point); }
 /// Every DgStructurePoint, default first.
-std::vector<DgStructurePoint> all_dg_structure_points();
+inline std::vector<DgStructurePoint> all_dg_structure_points() { return kDgStructurePointNames.all(); }
 
 /// Parsers: throw std::invalid_argument naming the value and listing the
 /// allowed values.
-ModelKind parse_model(const std::string& name);
-IntegratorKind parse_integrator(const std::string& name);
-ModelSize parse_size(const std::string& name);
+inline ModelKind parse_model(const std::string& name) { return kModelNames.parse(name); }
+inline IntegratorKind parse_integrator(const std::string& name) { return kIntegratorNames.parse(name); }
+inline ModelSize parse_size(const std::string& name) { return kSizeNames.parse(name); }
 
 /// Hidden widths of each MLP of a model (docs/METHOD.md §3 table).
 struct NetworkWidths {

@@ -5,13 +5,17 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 
 /// Status of a run: a diverged run is a result, not an error (docs/DECISIONS.md).
 enum class RunStatus { kPending = 0, kDone = 1, kDiverged = 2, kFailed = 3 };
-/// "pending", "done", "diverged", "failed".
-std::string to_string(RunStatus status);
-RunStatus parse_run_status(const std::string& name);
+inline constexpr EnumNames<RunStatus, 4> kRunStatusNames{
+    "run status", {{{RunStatus::kPending, "pending"}, {RunStatus::kDone, "done"},
+                    {RunStatus::kDiverged, "diverged"}, {RunStatus::kFailed, "failed"}}}};
+inline std::string to_string(RunStatus status) { return kRunStatusNames.name(status); }
+inline RunStatus parse_run_status(const std::string& name) { return kRunStatusNames.parse(name); }
 
 /// One validation point of the training log (paper Figures 10 and 12).
 struct TracePoint {

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
 #include "phnn/config/model_config.h"
 
 namespace phnn {
@@ -12,10 +13,13 @@ namespace phnn {
 /// Jacobian regularizer (eq:condition-number-loss, eq:spectral-norm-loss,
 /// eq:stiffness-ratio-loss; docs/METHOD.md §4).
 enum class Regularizer { kNone = 0, kCn = 1, kSn = 2, kSr = 3 };
-/// "none", "cn", "sn", "sr".
-std::string to_string(Regularizer reg);
+inline constexpr EnumNames<Regularizer, 4> kRegularizerNames{
+    "regularizer",
+    {{{Regularizer::kNone, "none"}, {Regularizer::kCn, "cn"}, {Regularizer::kSn, "sn"},
+      {Regularizer::kSr, "sr"}}}};
+inline std::string to_string(Regularizer reg) { return kRegularizerNames.name(reg); }
 /// Throws std::invalid_argument naming the value and the allowed values.
-Regularizer parse_regularizer(const std::string& name);
+inline Regularizer parse_regularizer(const std::string& name) { return kRegularizerNames.parse(name); }
 
 /// Norm of the discrete loss L_d (docs/METHOD.md §4, "Loss"), with e the
 /// error x_{n+1} - x_hat_{n+1} of a pair and h the step:
@@ -24,10 +28,11 @@ Regularizer parse_regularizer(const std::string& name);
 ///           paper's 1-norm of the scaled error;
 ///   kMse:   mean over pairs and both components of e_i^2 / h^2.
 enum class LossNorm { kMeanL1 = 0, kSumL1 = 1, kMse = 2 };
-/// "mean-l1", "sum-l1", "mse".
-std::string to_string(LossNorm norm);
+inline constexpr EnumNames<LossNorm, 3> kLossNormNames{
+    "loss norm", {{{LossNorm::kMeanL1, "mean-l1"}, {LossNorm::kSumL1, "sum-l1"}, {LossNorm::kMse, "mse"}}}};
+inline std::string to_string(LossNorm norm) { return kLossNormNames.name(norm); }
 /// Every LossNorm, default first.
-std::vector<LossNorm> all_loss_norms();
+inline std::vector<LossNorm> all_loss_norms() { return kLossNormNames.all(); }
 
 /// Floating-point type of training (docs/DECISIONS.md, "Ablation knobs"):
 ///   kFloat64 (the default): everything in float64;
@@ -36,12 +41,13 @@ std::vector<LossNorm> all_loss_norms();
 ///             dtype), on the op-by-op reference networks; inference stays
 ///             float64, from the float32 best weights upcast (exactly).
 enum class Precision { kFloat64 = 0, kFloat32 = 1 };
-/// "float64", "float32".
-std::string to_string(Precision precision);
+inline constexpr EnumNames<Precision, 2> kPrecisionNames{
+    "precision", {{{Precision::kFloat64, "float64"}, {Precision::kFloat32, "float32"}}}};
+inline std::string to_string(Precision precision) { return kPrecisionNames.name(precision); }
 /// Every Precision, default first.
-std::vector<Precision> all_precisions();
-/// "float64" or "float32"; throws std::invalid_argument naming both.
-Precision parse_precision(const std::string& name);
+inline std::vector<Precision> all_precisions() { return kPrecisionNames.all(); }
+/// Throws std::invalid_argument naming both.
+inline Precision parse_precision(const std::string& name) { return kPrecisionNames.parse(name); }
 
 /// The weights inference uses (docs/DECISIONS.md, "Ablation knobs"):
 ///   kBestValidation (the default): each member's weights at its lowest
@@ -51,10 +57,12 @@ Precision parse_precision(const std::string& name);
 ///             the last step (or, for a member whose training diverged, at
 ///             the last validation point before).
 enum class InferenceWeights { kBestValidation = 0, kFinal = 1 };
-/// "best-validation", "final".
-std::string to_string(InferenceWeights weights);
+inline constexpr EnumNames<InferenceWeights, 2> kInferenceWeightsNames{
+    "inference weights",
+    {{{InferenceWeights::kBestValidation, "best-validation"}, {InferenceWeights::kFinal, "final"}}}};
+inline std::string to_string(InferenceWeights weights) { return kInferenceWeightsNames.name(weights); }
 /// Every InferenceWeights, default first.
-std::vector<InferenceWeights> all_inference_weights();
+inline std::vector<InferenceWeights> all_inference_weights() { return kInferenceWeightsNames.all(); }
 
 /// Optimizer and schedule of one run (docs/METHOD.md §4). Defaults: docs/METHOD.md.
 struct TrainerOptions {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
 #include "phnn/integrators/step_options.h"
 #include "phnn/systems/builtin_systems.h"
 
@@ -21,10 +22,11 @@ namespace phnn {
 ///                          paper's text asks).
 /// Duffing's Algorithm 2 samples H(x0) in I_E0 by rejection and ignores it.
 enum class EnergySampling { kAlgorithm1 = 0, kDirect = 1 };
-/// "algorithm1", "direct".
-std::string to_string(EnergySampling sampling);
+inline constexpr EnumNames<EnergySampling, 2> kEnergySamplingNames{
+    "energy sampling", {{{EnergySampling::kAlgorithm1, "algorithm1"}, {EnergySampling::kDirect, "direct"}}}};
+inline std::string to_string(EnergySampling sampling) { return kEnergySamplingNames.name(sampling); }
 /// Every EnergySampling, default first.
-std::vector<EnergySampling> all_energy_samplings();
+inline std::vector<EnergySampling> all_energy_samplings() { return kEnergySamplingNames.all(); }
 
 /// Data-set options (paper §5.2, Appendix E; docs/METHOD.md §2). Defaults: docs/METHOD.md.
 struct DatasetOptions {

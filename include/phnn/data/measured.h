@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
 #include "phnn/data/ph_dataset.h"
 #include "phnn/data/ph_rows.h"
 #include "phnn/systems/measurement_map.h"
@@ -93,6 +94,9 @@ enum class ImportSplit {
   /// windows lie inside the inference block: a few long recordings.
   kBlocks,
 };
+/// `phnn import --split`.
+inline constexpr EnumNames<ImportSplit, 2> kImportSplitNames{
+    "split", {{{ImportSplit::kTrajectories, "trajectories"}, {ImportSplit::kBlocks, "blocks"}}}};
 
 /// How recorded trajectories become a data set.
 struct ImportOptions {

@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 
 /// Options of the implicit discrete-gradient step. Defaults are docs/METHOD.md §2.
@@ -24,7 +26,9 @@ struct DiscreteGradientOptions {
 };
 
 enum class StepStatus { kConverged, kMaxIterations, kNonFinite };
-/// "converged", "max-iterations", "non-finite".
-std::string to_string(StepStatus status);
+inline constexpr EnumNames<StepStatus, 3> kStepStatusNames{
+    "step status", {{{StepStatus::kConverged, "converged"}, {StepStatus::kMaxIterations, "max-iterations"},
+                     {StepStatus::kNonFinite, "non-finite"}}}};
+inline std::string to_string(StepStatus status) { return kStepStatusNames.name(status); }
 
 }  // namespace phnn

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
 #include "phnn/config/run_config.h"
 #include "phnn/report/intervals.h"
 #include "phnn/report/statistics.h"
@@ -21,8 +22,11 @@ using SeedResults = std::map<int, double>;
 
 /// The four-way reading of a comparison of A against B at a margin delta.
 enum class ComparisonReading { kABetter, kBBetter, kEquivalent, kUndecided };
-/// "A better", "B better", "equivalent", "undecided".
-std::string to_string(ComparisonReading reading);
+inline constexpr EnumNames<ComparisonReading, 4> kComparisonReadingNames{
+    "reading", {{{ComparisonReading::kABetter, "A better"}, {ComparisonReading::kBBetter, "B better"},
+                 {ComparisonReading::kEquivalent, "equivalent"},
+                 {ComparisonReading::kUndecided, "undecided"}}}};
+inline std::string to_string(ComparisonReading reading) { return kComparisonReadingNames.name(reading); }
 
 /// How the effect's interval is computed.
 enum class EffectInterval {

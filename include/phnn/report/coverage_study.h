@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 
 /// Where the synthetic log10 MSEs come from. "Cell" scenarios draw one
@@ -28,9 +30,17 @@ enum class CoverageScenario {
   kPairsBimodal,
   kPairsBimodalShared,
 };
-std::string to_string(CoverageScenario scenario);
+inline constexpr EnumNames<CoverageScenario, 6> kCoverageScenarioNames{
+    "scenario",
+    {{{CoverageScenario::kCellLogNormal, "cell, log-normal"},
+      {CoverageScenario::kCellBimodal, "cell, bimodal 0.7/0.3"},
+      {CoverageScenario::kPairsLogNormal, "pairs, log-normal"},
+      {CoverageScenario::kPairsLogNormalShared, "pairs, log-normal, shared seed effect"},
+      {CoverageScenario::kPairsBimodal, "pairs, bimodal"},
+      {CoverageScenario::kPairsBimodalShared, "pairs, bimodal, shared mode"}}}};
+inline std::string to_string(CoverageScenario scenario) { return kCoverageScenarioNames.name(scenario); }
 /// Cell scenarios first, then pairs.
-std::vector<CoverageScenario> all_coverage_scenarios();
+inline std::vector<CoverageScenario> all_coverage_scenarios() { return kCoverageScenarioNames.all(); }
 bool is_pairs(CoverageScenario scenario);
 
 /// The interval methods measured. Cell scenarios: the first three on the
@@ -45,7 +55,16 @@ enum class CoverageMethod {
   kPairedOrderStatistic,  // sign-test interval of the median of d
   kUnpairedMoses,         // Moses's interval of the Hodges-Lehmann shift
 };
-std::string to_string(CoverageMethod method);
+inline constexpr EnumNames<CoverageMethod, 7> kCoverageMethodNames{
+    "interval method",
+    {{{CoverageMethod::kPercentileBootstrap, "percentile bootstrap"},
+      {CoverageMethod::kBca, "BCa"},
+      {CoverageMethod::kOrderStatistic, "order statistic (binomial)"},
+      {CoverageMethod::kPairedBootstrap, "paired bootstrap of the log ratio"},
+      {CoverageMethod::kPairedBca, "paired BCa of the log ratio"},
+      {CoverageMethod::kPairedOrderStatistic, "paired order statistic (sign test)"},
+      {CoverageMethod::kUnpairedMoses, "unpaired Hodges-Lehmann (Moses)"}}}};
+inline std::string to_string(CoverageMethod method) { return kCoverageMethodNames.name(method); }
 /// The methods that apply to a scenario, in the order above.
 std::vector<CoverageMethod> coverage_methods(CoverageScenario scenario);
 

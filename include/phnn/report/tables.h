@@ -8,9 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
+#include "phnn/config/run_grid.h"
 #include "phnn/config/run_result.h"
 #include "phnn/report/statistics.h"
-#include "phnn/config/run_grid.h"
 #include "phnn/systems/oscillators.h"
 
 namespace phnn {
@@ -44,19 +45,24 @@ std::vector<TableEntry> make_table_entries(const Grid& grid, const std::vector<R
 
 /// Output format of render_tables().
 enum class TableFormat { kMarkdown, kLatex, kCsv };
-/// "markdown", "latex", "csv"; throws std::invalid_argument listing them.
-TableFormat parse_table_format(const std::string& name);
-/// "markdown", "latex", "csv".
-std::string to_string(TableFormat format);
+inline constexpr EnumNames<TableFormat, 3> kTableFormatNames{
+    "table format",
+    {{{TableFormat::kMarkdown, "markdown"}, {TableFormat::kLatex, "latex"}, {TableFormat::kCsv, "csv"}}}};
+/// Throws std::invalid_argument listing the formats.
+inline TableFormat parse_table_format(const std::string& name) { return kTableFormatNames.parse(name); }
+inline std::string to_string(TableFormat format) { return kTableFormatNames.name(format); }
 
 /// The statistic a table's cells show and rank by (`phnn reduce --stat`):
 /// the median (the paper's), or the interquartile mean (interquartile_mean,
 /// statistics.h) with its bootstrap interval.
 enum class CellStatistic { kMedian, kIqm };
-/// "median", "iqm"; throws std::invalid_argument listing them.
-CellStatistic parse_cell_statistic(const std::string& name);
-/// "median", "iqm".
-std::string to_string(CellStatistic statistic);
+inline constexpr EnumNames<CellStatistic, 2> kCellStatisticNames{
+    "statistic", {{{CellStatistic::kMedian, "median"}, {CellStatistic::kIqm, "iqm"}}}};
+/// Throws std::invalid_argument listing the statistics.
+inline CellStatistic parse_cell_statistic(const std::string& name) {
+  return kCellStatisticNames.parse(name);
+}
+inline std::string to_string(CellStatistic statistic) { return kCellStatisticNames.name(statistic); }
 
 /// Fewest finished seeds for which a table prints a cell's bootstrap
 /// interval; a column marks a best (or a tie) only if every row has as

@@ -6,6 +6,8 @@
 
 #include <string>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 
 /// Dynamic: a shared counter on rank 0 read-and-incremented with MPI-3
@@ -13,7 +15,9 @@ namespace phnn {
 /// sorted largest cost first: longest-processing-time-first). Static: item i
 /// goes to rank i % size, no communication but the stop flag.
 enum class ScheduleMode { kDynamic, kStatic };
-std::string to_string(ScheduleMode mode);
+inline constexpr EnumNames<ScheduleMode, 2> kScheduleModeNames{
+    "schedule mode", {{{ScheduleMode::kDynamic, "dynamic"}, {ScheduleMode::kStatic, "static"}}}};
+inline std::string to_string(ScheduleMode mode) { return kScheduleModeNames.name(mode); }
 
 /// A work queue of items 0..n-1 shared by the ranks of `comm`.
 ///

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
 #include "phnn/config/model_config.h"
 #include "phnn/config/system_file_text.h"
 #include "phnn/config/trainer_options.h"
@@ -119,8 +120,10 @@ enum class AdaptiveRule {
   /// Both cells of every comparison of `comparisons` whose intervals overlap.
   kComparisons,
 };
-std::string to_string(AdaptiveRule rule);
-std::vector<AdaptiveRule> all_adaptive_rules();
+inline constexpr EnumNames<AdaptiveRule, 2> kAdaptiveRuleNames{
+    "rule", {{{AdaptiveRule::kColumnBest, "column-best"}, {AdaptiveRule::kComparisons, "comparisons"}}}};
+inline std::string to_string(AdaptiveRule rule) { return kAdaptiveRuleNames.name(rule); }
+inline std::vector<AdaptiveRule> all_adaptive_rules() { return kAdaptiveRuleNames.all(); }
 
 /// The [adaptive] table: round 0 trains the studies' `seeds`; after each
 /// finished round `rule` names cells, each of which gets the next `batch`

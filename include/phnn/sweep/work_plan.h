@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
 #include "phnn/sweep/grid.h"
 
 namespace phnn {
@@ -34,9 +35,11 @@ struct SplitOptions {
   void validate() const;
 };
 
-/// "auto" / "off", and back (throws std::invalid_argument on other text).
-std::string to_string(SplitOptions::Mode mode);
-SplitOptions::Mode parse_split_mode(const std::string& text);
+inline constexpr EnumNames<SplitOptions::Mode, 2> kSplitModeNames{
+    "split mode", {{{SplitOptions::Mode::kAuto, "auto"}, {SplitOptions::Mode::kOff, "off"}}}};
+inline std::string to_string(SplitOptions::Mode mode) { return kSplitModeNames.name(mode); }
+/// Throws std::invalid_argument listing the modes.
+inline SplitOptions::Mode parse_split_mode(const std::string& text) { return kSplitModeNames.parse(text); }
 
 /// A unit of work handed to one rank: some runs of one cell, trained as one
 /// stack.

@@ -7,19 +7,23 @@
 #include <string>
 #include <vector>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 
 /// The three controlled oscillators of the paper (tab:PHS-examples-and-formulations,
 /// docs/METHOD.md §1).
 enum class SystemKind { kHarmonic = 0, kDuffing = 1, kSelfSustained = 2 };
 
-/// "harmonic", "duffing", "self-sustained".
-std::string to_string(SystemKind kind);
+inline constexpr EnumNames<SystemKind, 3> kSystemNames{
+    "system", {{{SystemKind::kHarmonic, "harmonic"}, {SystemKind::kDuffing, "duffing"},
+                {SystemKind::kSelfSustained, "self-sustained"}}}};
+inline std::string to_string(SystemKind kind) { return kSystemNames.name(kind); }
 /// Parses a system name; throws std::invalid_argument naming the value and
 /// listing the allowed names.
 SystemKind parse_system(const std::string& name);
 /// All systems, in paper order.
-std::vector<SystemKind> all_systems();
+inline std::vector<SystemKind> all_systems() { return kSystemNames.all(); }
 
 /// Physical parameters of one oscillator. Defaults are docs/METHOD.md §1; build them
 /// with OscillatorOptions::defaults(kind).

@@ -13,6 +13,8 @@
 
 #include <Eigen/Core>
 
+#include "phnn/common/enum_names.h"
+
 namespace phnn {
 
 /// The largest n_x + n_w + n_u (the size of S) a system may have. Vectors and
@@ -39,6 +41,10 @@ struct InitialConditionDesign {
     /// p = sqrt(2 E0 / H_pp(0)) cos(theta).
     kAlgorithm1,
   };
+  /// initial.method in a system file.
+  static constexpr EnumNames<Method, 3> kMethodNames{
+      "initial.method",
+      {{{Method::kEnergy, "energy"}, {Method::kBox, "box"}, {Method::kAlgorithm1, "algorithm1"}}}};
   Method method = Method::kEnergy;
   double energy_min = 0.1;
   double energy_max = 1.0;
@@ -71,6 +77,12 @@ struct ControlDesign {
     /// u_i piecewise constant: a new level ~ U(range[i]) every `hold` seconds.
     kSteps,
   };
+  /// control.design in a system file.
+  static constexpr EnumNames<Design, 6> kDesignNames{
+      "control.design",
+      {{{Design::kConstant, "constant"}, {Design::kEnergyShaping, "energy-shaping"},
+        {Design::kLimitCycle, "limit-cycle"}, {Design::kSines, "sines"}, {Design::kChirp, "chirp"},
+        {Design::kSteps, "steps"}}}};
   Design design = Design::kConstant;
   std::vector<std::array<double, 2>> range;  // kConstant, kSteps: one per input; kSines/kChirp offsets
   double equilibrium_energy_min = 0.1;       // kEnergyShaping
