@@ -311,8 +311,9 @@ std::string SweepRun::adaptive_line() const {
          (left == 0 ? std::string(" (every cell at max_seeds)")
                     : "; the other " + std::to_string(left) + " are seeds no round asked for" +
                           (ahead > 0 ? " (" + std::to_string(ahead) +
-                                           " of them trained ahead while a round drained, left "
-                                           "out of every table)"
+                                           " of them finished: trained ahead while a round "
+                                           "drained, or asked for by another rule; left out of "
+                                           "every table)"
                                      : ""));
 }
 

@@ -98,9 +98,10 @@ class ComparisonRule {
     options.delta = adaptive_.delta;
     options.confidence = stop_.confidence;
     const SeedResults sa = seed_results(a), sb = seed_results(b);
-    if (!sa.empty() && !sb.empty() &&
-        compare_cells(sa, sb, paired, options).reading != ComparisonReading::kUndecided) {
-      return;
+    if (!sa.empty() && !sb.empty()) {
+      const Comparison c = compare_cells(sa, sb, paired, options);
+      if (c.reading != ComparisonReading::kUndecided) return;
+      if (adaptive_.futility && four_way_futile(c, options.delta)) return;
     }
     const CellSummary& ca = summary(a);
     const CellSummary& cb = summary(b);
@@ -112,6 +113,26 @@ class ComparisonRule {
     }
     cells->push_back(a);
     cells->push_back(b);
+  }
+
+  // With futility, an undecided four-way comparison stops when max_seeds is
+  // not expected to read it: its effect interval [lo, hi] about the effect
+  // e, narrowed to [e - (e - lo) r, e + (hi - e) r] with r = sqrt(n /
+  // max_seeds) (n its pairs, or its smaller side), would still neither lie
+  // inside (-log10 delta, log10 delta) nor exclude 0 (docs/METHOD.md,
+  // "Adaptive seeds"). An interval with an infinite end (diverged seeds) or
+  // one below min_seeds is never futile.
+  bool four_way_futile(const Comparison& c, double delta) const {
+    const int n = c.paired ? c.n_pairs : std::min(c.n_a, c.n_b);
+    const double lo = c.effect_interval.low, hi = c.effect_interval.high, e = c.effect;
+    if (n < kMinSeedsForInterval || !std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(e)) {
+      return false;
+    }
+    const double r = std::sqrt(static_cast<double>(n) / adaptive_.max_seeds);
+    const double plo = e - (e - lo) * r, phi = e + (hi - e) * r, margin = std::log10(delta);
+    const bool equivalent = -margin < plo && phi < margin;
+    const bool decided = phi < 0.0 || plo > 0.0;
+    return !equivalent && !decided;
   }
 
   // Seed -> MSE of the cell's finished runs among those asked for (a

@@ -174,10 +174,6 @@ void check_rule_keys(const AdaptiveSpec& a, bool has_delta, const Entry& e,
     values.fail(e.line, "delta is the margin of reading = \"four-way\"; set that reading or "
                         "remove delta");
   }
-  if (a.four_way && a.futility) {
-    values.fail(e.line, "futility and reading = \"four-way\" do not combine: the four-way "
-                        "reading stops ties by equivalence within x delta; remove futility");
-  }
   if (a.rule != AdaptiveRule::kComparisons && a.grow_one) {
     values.fail(e.line, "grow = \"one\" applies to rule = \"comparisons\" only; set that rule "
                         "or remove grow");

@@ -131,7 +131,7 @@ echo "ahead items: $(grep -c " ahead [0-9]*/[0-9]*: " "$dir/log") started, $(gre
 per_run "$dir/ahead.h5" "$dir/ahead.csv"
 python3 "$here/compare_runs.py" "$dir/long1.csv" "$dir/ahead.csv" || fail "speculation changed the runs asked for"
 if grep -q "are seeds no round asked for ([1-9]" "$dir/log"; then
-  "$phnn" reduce "$dir/ahead.h5" | grep -q "more runs were trained ahead while a round drained" ||
+  "$phnn" reduce "$dir/ahead.h5" | grep -q "finished runs no round asked for (trained ahead" ||
     fail "reduce does not say that runs trained ahead are left out"
 fi
 long 3 "$dir/noahead.h5" --max-group-size 5 --no-speculation || fail "--no-speculation"

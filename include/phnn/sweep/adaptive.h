@@ -34,8 +34,9 @@ struct AdaptiveState {
   /// as out of the tables).
   int pending = 0, failed = 0;
   /// Finished runs no round asked for: trained ahead by idle ranks
-  /// (runs_to_speculate) and not asked for since. Left out of every
-  /// decision and table.
+  /// (runs_to_speculate) and not asked for since, or asked for by another
+  /// rule (a file grown or replayed under another [adaptive] table). Left
+  /// out of every decision and table.
   int trained_ahead = 0;
 
   /// Runs asked for.

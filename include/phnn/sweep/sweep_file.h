@@ -135,8 +135,10 @@ struct AdaptiveSpec {
   AdaptiveRule rule = AdaptiveRule::kColumnBest;
   std::vector<SeedComparison> comparisons;
   /// rule comparisons only: skip an unresolved comparison that max_seeds is
-  /// not expected to resolve — one cell's median lies inside the other's
-  /// interval narrowed about its median by sqrt(finished / max_seeds)
+  /// not expected to resolve — intervals reading: one cell's median lies
+  /// inside the other's interval narrowed about its median by
+  /// sqrt(finished / max_seeds); four-way reading: the effect's interval so
+  /// narrowed would still be neither inside the margin nor clear of 0
   /// (docs/METHOD.md, "Adaptive seeds").
   bool futility = false;
   /// rule comparisons only: false (grow = "both"): both cells of an
@@ -157,8 +159,8 @@ struct AdaptiveSpec {
   /// true ("four-way"): when compare_cells (phnn/report/comparison.h) reads
   /// it as A better, B better or equivalent within x delta; an undecided
   /// comparison names both cells (a paired one needs both for its pairs;
-  /// grow = "one" still picks one side of an unpaired one). Equivalence
-  /// stops the ties futility stopped, so the two are not combined.
+  /// grow = "one" still picks one side of an unpaired one); with futility,
+  /// also when max_seeds is not expected to read it.
   bool four_way = false;
   /// `delta`: the equivalence margin of the four-way reading, a factor on
   /// the MSE (> 1; ComparisonOptions::delta).
