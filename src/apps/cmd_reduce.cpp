@@ -167,8 +167,10 @@ void print_adaptive_preamble(const SweepSpec& spec, const AdaptiveState& state,
             << "; " << state.active_runs() << " runs asked for; the other pending runs are seeds "
             << "no round asked for, left out of the tables.";
   if (state.trained_ahead > 0) {
-    std::cout << " " << state.trained_ahead << " finished runs no round asked for (trained ahead "
-              << "while a round drained, or asked for by another rule): left out of the tables too.";
+    std::cout << " " << state.trained_ahead << " finished runs no round " << (state.complete ? "" : "so far ")
+              << "asked for (" << (state.complete ? "" : "asked for by a later round, ")
+              << "trained ahead while a round drained, or asked for by another rule): left out of "
+                 "the tables too.";
   }
   if (!state.cells_grown.empty()) {
     std::cout << " Cells given more seeds after round 0, 1, ...:";

@@ -142,9 +142,19 @@ SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const std::strin
   ItemOutcome outcome;
   const std::vector<RunResult> cell_results = train_item(
       cell, &data_, head.system_name(), tick, &checkpoints, prefix_, label, &outcome.stopped);
-  if (outcome.stopped) return outcome;
-  times_.add(ItemTimes::kTrain, cell_start);
-  for (const RunResult& r : cell_results) times_.s[ItemTimes::kRuns] += r.wall_time_s;
+  if (outcome.stopped) {
+    times_.add(ItemTimes::kStopped, item_start);
+    return outcome;
+  }
+  const double trained = std::chrono::duration<double>(SweepClock::now() - cell_start).count();
+  times_.s[ItemTimes::kTrain] += trained;
+  // The runs' wall_time_s of a resumed item includes the time before its
+  // saved state: count this process's time alone, all of it as training.
+  if (checkpoints.resume_step() > 0) {
+    times_.s[ItemTimes::kRuns] += trained;
+  } else {
+    for (const RunResult& r : cell_results) times_.s[ItemTimes::kRuns] += r.wall_time_s;
+  }
   outcome.io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_,
                                  &*results_, &times_);
   if (outcome.io_error.empty()) checkpoints.remove();
@@ -192,6 +202,8 @@ void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue,
       outcome->io_error = done.io_error;
       queue->request_stop();
     }
+    // A signal here stops every rank (the round's items and theirs ahead).
+    if (g_stop_signal != 0 && !queue->stop_requested()) queue->request_stop();
     if (done.stopped || !done.io_error.empty()) return;
   }
 }

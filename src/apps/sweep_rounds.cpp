@@ -74,7 +74,7 @@ SweepRun::Planned SweepRun::plan(const std::vector<int>& status_codes) {
   std::vector<std::vector<int>> resumed;
   if (root_) {
     try {
-      resumed = resumed_groups(grid_, &pending, out_, state_key_);
+      resumed = resumed_groups(grid_, &pending, out_, state_key_, ahead_);
     } catch (const std::exception& e) {  // never leave the others waiting in the broadcast
       std::cerr << "phnn sweep: cannot read the saved training states (" << e.what()
                 << "); their items train from the start\n";
@@ -153,11 +153,12 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
     times_.add(ItemTimes::kQueue, marking);
     report_progress(true);
   }
+  post_stop();  // before any collective call: the others stop at their next step or item
   if (ahead_queue) {
     if (!ended) train_ahead(ahead, &queue, static_cast<int>(work.size()), &*ahead_queue, tick, &outcome);
+    post_stop();
     ahead_queue->close();
   }
-  post_stop();
   outcome.stopped =
       mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>()) != 0;
   queue.close();
@@ -189,7 +190,10 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
     const int round_runs = mpi::all_reduce(world_, round.my_runs, std::plus<int>());
     if (int status = replay_rounds(&status_codes)) return status;
     if (int status = open_results()) return status;
-    if (adaptive_.complete) break;
+    if (adaptive_.complete) {
+      remove_unused_states();
+      break;
+    }
     if (round_runs == 0 && adaptive_.round == round_before) {  // never loop without progress
       round.io_error = prefix_ + "adaptive round " + std::to_string(round_before) +
                        " has pending runs that this sweep did not train; stopping";
@@ -201,6 +205,20 @@ int SweepRun::train_and_close(std::vector<int> status_codes) {
   if (parser_.flag_set("timings")) report_times();
   if (failed) return failed;
   return round.stopped ? kExitStopped : 0;
+}
+
+// Rank 0 at the end of a sweep in rounds: the item states left (items
+// trained ahead of the last round, stopped at its end) belong to runs no
+// round asked for; they go. A [search]'s rung states stay (sweep_search.h).
+void SweepRun::remove_unused_states() const {
+  if (!root_) return;
+  try {
+    std::vector<std::vector<int>> none(grid_.cells.size());
+    resumed_groups(grid_, &none, out_, state_key_);
+  } catch (const std::exception& e) {
+    std::cerr << "phnn sweep: warning: cannot remove the states of items trained ahead (" << e.what()
+              << "); they are removed at the next run\n";
+  }
 }
 
 // --timings: "per item (N items, R ranks, mean): ..." on rank 0.
@@ -225,7 +243,8 @@ void SweepRun::report_times() {
             << ms(all[ItemTimes::kRow]) << ", the rest "
             << ms(all[ItemTimes::kItem] - all[ItemTimes::kTrain] - recorded)
             << " (checkpoint file, log lines); shared queue " << ms(all[ItemTimes::kQueue])
-            << " between items\n";
+            << " between items; " << ms(all[ItemTimes::kStopped])
+            << " in items stopped with their state saved (ahead of a round's end, or a signal)\n";
 }
 
 // Rank 0 replays an adaptive sweep's rounds on the file (closed on every

@@ -40,10 +40,12 @@ using SweepClock = std::chrono::steady_clock;
 
 /// Where this rank's time per item goes (`phnn sweep --timings`) [s]:
 /// kItem an item from its start to its last line, of which kTrain trains its
-/// cell (kRuns of that: the runs' own wall_time_s, the trainer's clock),
-/// kJournal and kRow record it; kQueue the shared counter between items.
+/// cell (kRuns of that: the runs' own wall_time_s, the trainer's clock; a
+/// resumed item's time here counts wholly as the runs'), kJournal and kRow
+/// record it; kQueue the shared counter between items; kStopped items
+/// stopped with their state saved (ahead of a round's end, or a signal).
 struct ItemTimes {
-  enum Part { kItem, kTrain, kRuns, kJournal, kRow, kQueue, kParts };
+  enum Part { kItem, kTrain, kRuns, kJournal, kRow, kQueue, kStopped, kParts };
   std::array<double, kParts> s{};
   int items = 0;  // recorded (stopped ones are not counted)
   void add(Part part, SweepClock::time_point since) {
@@ -99,6 +101,7 @@ class SweepRun {
     });
   }
   int replay_rounds(std::vector<int>* status_codes);
+  void remove_unused_states() const;
   // Trained in rounds decided on the results: [adaptive] or [search].
   bool in_rounds() const { return spec_.adaptive.enabled || spec_.search.enabled; }
   std::string adaptive_dry_run() const;

@@ -48,12 +48,16 @@ std::vector<int> pending_rows_of(const std::string& key, const std::string& swee
 std::vector<std::vector<int>> resumed_groups(const Grid& grid,
                                              std::vector<std::vector<int>>* pending,
                                              const std::string& out,
-                                             const std::string& sweep_hash) {
+                                             const std::string& sweep_hash,
+                                             const std::vector<std::vector<int>>& keep) {
   std::map<std::string, int> row_of;
   for (std::size_t r = 0; r < grid.runs.size(); ++r) row_of[grid.runs[r].id()] = static_cast<int>(r);
-  std::map<int, int> pending_cell;  // row -> cell, for pending rows
+  std::map<int, int> pending_cell, keep_cell;  // row -> cell, for pending (kept) rows
   for (std::size_t c = 0; c < pending->size(); ++c) {
     for (int row : (*pending)[c]) pending_cell[row] = static_cast<int>(c);
+  }
+  for (std::size_t c = 0; c < keep.size(); ++c) {
+    for (int row : keep[c]) keep_cell[row] = static_cast<int>(c);
   }
   std::vector<std::vector<int>> groups;
   for (const std::string& path : list_cell_checkpoints(out)) {
@@ -63,6 +67,9 @@ std::vector<std::vector<int>> resumed_groups(const Grid& grid,
     const bool read = read_cell_checkpoint(path, &saved, &problem);
     const std::vector<int> rows =
         read ? pending_rows_of(saved.key, sweep_hash, row_of, pending_cell) : std::vector<int>();
+    if (rows.empty() && read && !pending_rows_of(saved.key, sweep_hash, row_of, keep_cell).empty()) {
+      continue;  // trained ahead of the round in progress: for a later round
+    }
     if (rows.empty()) {  // finished since, another sweep's, or damaged
       if (!problem.empty()) std::cerr << "phnn sweep: " << problem << "; deleted\n";
       remove_cell_checkpoint(path);

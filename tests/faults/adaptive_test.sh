@@ -134,6 +134,8 @@ if grep -q "are seeds no round asked for ([1-9]" "$dir/log"; then
   "$phnn" reduce "$dir/ahead.h5" | grep -q "finished runs no round asked for (trained ahead" ||
     fail "reduce does not say that runs trained ahead are left out"
 fi
+ls "$dir/ahead.h5.journal"/cell-*.state > /dev/null 2>&1 &&
+  fail "states of items trained ahead of the last round were left behind"
 long 3 "$dir/noahead.h5" --max-group-size 5 --no-speculation || fail "--no-speculation"
 grep -q " ahead [0-9]*/" "$dir/log" && fail "--no-speculation trained ahead"
 

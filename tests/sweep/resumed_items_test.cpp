@@ -113,5 +113,24 @@ TEST_F(ResumedItemsTest, StatesOfPendingRunsBecomeTheirItemsAndStaleOnesGo) {
   EXPECT_EQ(runs, 5u);  // every pending run exactly once
 }
 
+// States of runs trained ahead of the round in progress (not pending, in
+// `keep`) stay for a later round; without `keep` they go like any other.
+TEST_F(ResumedItemsTest, StatesOfRunsTrainedAheadStayUntilNoRoundCanAskForThem) {
+  const SweepSpec spec = two_cells();
+  const Grid grid = expand_grid(spec);
+  const auto& a = grid.cells[0].runs;
+  const auto& b = grid.cells[1].runs;
+  const std::string key = item_key(grid, {b[1], b[2]}, spec.text_hash);
+  write_cell_checkpoint(cell_checkpoint_path(out_, key), CellCheckpoint{key, "s", 1});
+  std::vector<std::vector<int>> pending = {a, {}};
+  const std::vector<std::vector<int>> keep = {{}, {b[1], b[2]}};
+  EXPECT_TRUE(resumed_groups(grid, &pending, out_, spec.text_hash, keep).empty());
+  EXPECT_EQ(list_cell_checkpoints(out_).size(), 1u);  // kept, not resumed
+  EXPECT_EQ(pending[0], a);
+  const std::vector<std::vector<int>> other = {{}, {b[2]}};  // not all of its runs
+  resumed_groups(grid, &pending, out_, spec.text_hash, other);
+  EXPECT_TRUE(list_cell_checkpoints(out_).empty());
+}
+
 }  // namespace
 }  // namespace phnn

@@ -20,13 +20,16 @@ std::string item_key(const Grid& grid, const std::vector<int>& runs,
 
 /// Rank 0 before planning: every saved state whose runs are all still in
 /// `pending` (one cell, this sweep key) becomes an item of exactly those
-/// runs, and its runs leave `pending`; states of finished or foreign runs,
-/// of another build, and scratch files of a save cut short are deleted.
-/// Returns the items' runs (Grid::runs indices), in file order.
+/// runs, and its runs leave `pending`; a state whose runs are all in `keep`
+/// (runs trained ahead of the round in progress, per cell) stays for a later
+/// round; states of finished or foreign runs, of another build, and scratch
+/// files of a save cut short are deleted. Returns the items' runs
+/// (Grid::runs indices), in file order.
 std::vector<std::vector<int>> resumed_groups(const Grid& grid,
                                              std::vector<std::vector<int>>* pending,
                                              const std::string& out,
-                                             const std::string& sweep_hash);
+                                             const std::string& sweep_hash,
+                                             const std::vector<std::vector<int>>& keep = {});
 
 /// The plan's items with the resumed groups first (they are partly done
 /// and go on at once).
