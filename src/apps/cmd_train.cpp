@@ -20,6 +20,7 @@
 #include "phnn/common/counted.h"
 #include "phnn/common/closest_name.h"
 #include "phnn/common/utc_time.h"
+#include "phnn/config/study_defaults.h"
 #include "phnn/config/training_settings.h"
 #include "phnn/report/tables.h"
 #include "phnn/store/ph_dataset_file.h"
@@ -62,10 +63,11 @@ void declare_train_options(cli::Parser* parser) {
                  "", true);
   parser->option("integrator", "old spelling: rk2 | dg | rk4 | dg4 with --model node|phnn-s|phnn-jr",
                  "rk2");
-  parser->option("size", "small | medium | large", "small");
-  parser->option("n-train", "training pairs (1..400)", "25");
-  parser->option("reg", "none | cn | sn | sr", "none");
-  parser->option("seeds", "model seeds, e.g. 0-9 or 0,3,5", "0-9");
+  parser->option("size", "small | medium | large", to_string(kDefaultSize));
+  parser->option("n-train", "training pairs (1..400)", std::to_string(kDefaultNTrain));
+  parser->option("reg", "none | cn | sn | sr", to_string(kDefaultRegularizer));
+  parser->option("seeds", "model seeds, e.g. 0-9 or 0,3,5",
+                 "0-" + std::to_string(kDefaultSeedCount - 1));
   // The training settings with a flag (phnn/config/training_settings.h).
   const TrainerOptions defaults;
   for (const TrainingSetting& s : training_settings()) {

@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 
+#include "phnn/config/study_defaults.h"
 #include "phnn/config/training_settings.h"
 #include "phnn/sweep/output_check.h"
 #include "sweep/sweep_file_adaptive.h"
@@ -247,20 +248,20 @@ class TableWalker {
     study.models = axes.models ? *axes.models : grid_.models ? *grid_.models : all_model_pairs();
     study.sizes = axes.sizes    ? *axes.sizes
                   : grid_.sizes ? *grid_.sizes
-                                : std::vector<ModelSize>{ModelSize::kSmall};
+                                : std::vector<ModelSize>{kDefaultSize};
     study.regularizers = axes.regularizers    ? *axes.regularizers
                          : grid_.regularizers ? *grid_.regularizers
-                                              : std::vector<Regularizer>{Regularizer::kNone};
+                                              : std::vector<Regularizer>{kDefaultRegularizer};
     study.lambdas = axes.lambdas    ? *axes.lambdas
                     : grid_.lambdas ? *grid_.lambdas
                                     : std::vector<double>();
     if (axes.seeds || grid_.seeds) {
       study.seeds = axes.seeds ? *axes.seeds : *grid_.seeds;
     } else {
-      for (int s = 0; s < 10; ++s) study.seeds.push_back(s);
+      for (int s = 0; s < kDefaultSeedCount; ++s) study.seeds.push_back(s);
     }
     const AxisSet* n_train_from = axes.n_train ? &axes : grid_.n_train ? &grid_ : nullptr;
-    study.n_train = n_train_from ? *n_train_from->n_train : std::vector<int>{25};
+    study.n_train = n_train_from ? *n_train_from->n_train : std::vector<int>{kDefaultNTrain};
     check_n_train(study, n_train_from ? n_train_from->n_train_lines : std::vector<int>());
     return study;
   }
