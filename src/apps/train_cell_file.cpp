@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "phnn/common/check.h"
+#include "phnn/common/number_text.h"
 #include "phnn/common/utc_time.h"
 #include "phnn/config/training_settings.h"
 #include "phnn/sweep/grid.h"
@@ -15,12 +16,6 @@
 namespace phnn {
 namespace apps {
 namespace {
-
-std::string g17(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 // The [grid] table of a one-cell sweep on `system` (a name or a system file).
 std::string grid_text(const CellSpec& cell, const std::string& system) {
@@ -58,10 +53,13 @@ std::string physics_text(const OscillatorOptions& physics) {
   const auto& aliases = builtin_aliases(physics.kind);
   std::vector<double> z;
   for (const BuiltinAlias& a : aliases) {
-    if (a.field) s << "\n" << a.physics_key << " = " << g17(physics.*a.field);
+    if (a.field) s << "\n" << a.physics_key << " = " << exact_number(physics.*a.field);
     if (!a.field) z.push_back(physics.z_coefficients[static_cast<std::size_t>(a.z_index)]);
   }
-  if (!z.empty()) s << "\nz_coefficients = [" << g17(z[0]) << ", " << g17(z[1]) << ", " << g17(z[2]) << "]";
+  if (!z.empty()) {
+    s << "\nz_coefficients = [" << exact_number(z[0]) << ", " << exact_number(z[1]) << ", "
+      << exact_number(z[2]) << "]";
+  }
   return s.str();
 }
 

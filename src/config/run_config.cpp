@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "phnn/common/number_text.h"
 #include "phnn/config/training_settings.h"
 
 namespace phnn {
@@ -28,14 +29,6 @@ std::string hex64(std::uint64_t value) {
   return buf;
 }
 
-namespace {
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-}  // namespace
-
 std::string RunConfig::system_name() const {
   return has_system_file() ? system_file : to_string(system);
 }
@@ -47,21 +40,24 @@ void builtin_system_key(const RunConfig& run, std::ostringstream& s) {
   const OscillatorOptions& physics = run.physics;
   const DatasetOptions& data = run.data;
   const SystemKind system = run.system;
-  s << ";mass=" << num(physics.mass) << ";stiffness=" << num(physics.stiffness);
-  if (system == SystemKind::kDuffing) s << ";cubic_stiffness=" << num(physics.cubic_stiffness);
-  if (system == SystemKind::kSelfSustained) {
-    s << ";z=" << num(physics.z_coefficients[0]) << "," << num(physics.z_coefficients[1]) << ","
-      << num(physics.z_coefficients[2]);
-  } else {
-    s << ";damping=" << num(physics.damping);
+  s << ";mass=" << exact_number(physics.mass) << ";stiffness=" << exact_number(physics.stiffness);
+  if (system == SystemKind::kDuffing) {
+    s << ";cubic_stiffness=" << exact_number(physics.cubic_stiffness);
   }
-  s << ";data_seed=" << data.data_seed << ";h_gen=" << num(data.generation_step)
-    << ";period=" << num(data.period) << ";alpha=" << num(data.alpha) << ";beta=" << num(data.beta)
-    << ";sample_rate=" << num(data.sample_rate) << ";e0=" << num(data.energy_min) << ","
-    << num(data.energy_max) << ";eeq=" << num(data.equilibrium_energy_min) << ","
-    << num(data.equilibrium_energy_max) << ";n_traj=" << data.num_trajectories
-    << ";splits=" << data.num_train_max << "," << data.num_validation << ","
-    << data.num_inference << ";gen_tol=" << num(data.newton.newton_tolerance);
+  if (system == SystemKind::kSelfSustained) {
+    s << ";z=" << exact_number(physics.z_coefficients[0]) << ","
+      << exact_number(physics.z_coefficients[1]) << "," << exact_number(physics.z_coefficients[2]);
+  } else {
+    s << ";damping=" << exact_number(physics.damping);
+  }
+  s << ";data_seed=" << data.data_seed << ";h_gen=" << exact_number(data.generation_step)
+    << ";period=" << exact_number(data.period) << ";alpha=" << exact_number(data.alpha)
+    << ";beta=" << exact_number(data.beta) << ";sample_rate=" << exact_number(data.sample_rate)
+    << ";e0=" << exact_number(data.energy_min) << "," << exact_number(data.energy_max)
+    << ";eeq=" << exact_number(data.equilibrium_energy_min) << ","
+    << exact_number(data.equilibrium_energy_max) << ";n_traj=" << data.num_trajectories
+    << ";splits=" << data.num_train_max << "," << data.num_validation << "," << data.num_inference
+    << ";gen_tol=" << exact_number(data.newton.newton_tolerance);
   // Algorithm 1 only (harmonic, self-sustained); only away from the default.
   if (system != SystemKind::kDuffing && data.energy_sampling != EnergySampling::kAlgorithm1) {
     s << ";energy_sampling=" << to_string(data.energy_sampling);
@@ -73,10 +69,10 @@ void builtin_system_key(const RunConfig& run, std::ostringstream& s) {
 void file_system_key(const RunConfig& run, std::ostringstream& s) {
   const DatasetOptions& data = run.data;
   s << ";system_file=" << run.system_file_hash << ";data_seed=" << data.data_seed
-    << ";h_gen=" << num(data.generation_step) << ";period=" << num(data.period)
-    << ";sample_rate=" << num(data.sample_rate) << ";n_traj=" << data.num_trajectories
-    << ";splits=" << data.num_train_max << "," << data.num_validation << ","
-    << data.num_inference << ";gen_tol=" << num(data.newton.newton_tolerance);
+    << ";h_gen=" << exact_number(data.generation_step) << ";period=" << exact_number(data.period)
+    << ";sample_rate=" << exact_number(data.sample_rate) << ";n_traj=" << data.num_trajectories
+    << ";splits=" << data.num_train_max << "," << data.num_validation << "," << data.num_inference
+    << ";gen_tol=" << exact_number(data.newton.newton_tolerance);
   if (data.energy_sampling != EnergySampling::kAlgorithm1) {
     s << ";energy_sampling=" << to_string(data.energy_sampling);
   }

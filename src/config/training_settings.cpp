@@ -3,8 +3,7 @@
 // LibTorch-free; touches no file.
 #include "phnn/config/training_settings.h"
 
-#include <cstdio>
-#include <cstdlib>
+#include "phnn/common/number_text.h"
 
 namespace phnn {
 namespace {
@@ -44,12 +43,6 @@ TrainingSetting choice(const char* key, InKey in_key, const char* flag, const ch
   };
   s.parse_choice = [](TrainerOptions* t, const std::string& text) { t->*Field = Names.parse(text); };
   return s;
-}
-
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
 }
 
 // Whether a setting's part is in the key of a run of this model,
@@ -113,7 +106,7 @@ const std::vector<TrainingSetting>& training_settings() {
 
 std::string TrainingSetting::text(const TrainerOptions& t) const {
   switch (kind) {
-    case Kind::kReal: return num(t.*real);
+    case Kind::kReal: return exact_number(t.*real);
     case Kind::kInteger: return std::to_string(t.*integer);
     case Kind::kChoice: {
       const int i = get_choice(t);
@@ -134,20 +127,6 @@ const TrainingSetting* find_training_setting(const std::string& key) {
   return nullptr;
 }
 
-namespace {
-
-// The shortest %g spelling that reads back as `v` (1e-06, not 9.99...e-07).
-std::string shortest(double v) {
-  char buf[40];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-    if (std::strtod(buf, nullptr) == v) break;
-  }
-  return buf;
-}
-
-}  // namespace
-
 std::string training_settings_markdown() {
   const TrainerOptions defaults;
   std::string out =
@@ -159,7 +138,7 @@ std::string training_settings_markdown() {
       for (const std::string& n : s.choices()) values += (values.empty() ? "" : ", ") + ("`\"" + n + "\"`");
     }
     const std::string value = s.kind == Kind::kChoice ? "`\"" + s.text(defaults) + "\"`"
-                              : s.kind == Kind::kReal  ? "`" + shortest(defaults.*s.real) + "`"
+                              : s.kind == Kind::kReal  ? "`" + shortest_number(defaults.*s.real) + "`"
                                                        : "`" + s.text(defaults) + "`";
     out += "| `" + std::string(s.key) + "` | " + value + " | " + values + " | " +
            (*s.flag ? "`--" + std::string(s.flag) + "`" : "") + " | " + s.doc + " |\n";
@@ -169,21 +148,16 @@ std::string training_settings_markdown() {
 
 std::string training_key(const TrainerOptions& t, ModelKind model, IntegratorKind integrator,
                          Regularizer regularizer) {
-  std::string out, part;
-  const auto& table = training_settings();
-  for (std::size_t i = 0; i < table.size(); ++i) {
-    const TrainingSetting& s = table[i];
+  // Settings of one canonical part are adjacent in the table; of the three
+  // "lambda" ones at most one is in a key.
+  std::string out;
+  std::string part_name;  // the canonical part being written
+  for (const TrainingSetting& s : training_settings()) {
     if (!in_key(s, t, model, integrator, regularizer)) continue;
-    const bool continues = !part.empty() && i > 0 && std::string(table[i - 1].canonical) == s.canonical &&
-                           in_key(table[i - 1], t, model, integrator, regularizer);
-    if (continues) {
-      part += "," + s.text(t);
-    } else {
-      out += part;
-      part = ";" + std::string(s.canonical) + "=" + s.text(t);
-    }
+    out += (s.canonical == part_name ? "," : ";" + std::string(s.canonical) + "=") + s.text(t);
+    part_name = s.canonical;
   }
-  return out + part;
+  return out;
 }
 
 }  // namespace phnn

@@ -1,7 +1,8 @@
-// include/phnn/common/number_text.h — the shortest "%g" spelling of a double
-// that reads back as the same double (0.9, not 0.90000000000000002; 1e-05).
-// Header-only; used where numbers are written for people and read back
-// (column labels, system-file text).
+// include/phnn/common/number_text.h — doubles as text that reads back as the
+// same double: the shortest "%g" spelling (0.9, not 0.90000000000000002;
+// 1e-05) where people read them (column labels, system-file text), and the
+// fixed 17-digit one where the text is an identity (canonical keys, sweep
+// files written for a run). Header-only.
 #pragma once
 
 #include <cstdio>
@@ -18,6 +19,14 @@ inline std::string shortest_number(double value) {
     std::snprintf(buf, sizeof buf, "%.*g", digits, value);
     if (std::strtod(buf, nullptr) == value) break;
   }
+  return buf;
+}
+
+/// "%.17g": 17 significant digits, the same text for the same double
+/// whatever its shortest spelling (the spelling of canonical keys).
+inline std::string exact_number(double value) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", value);
   return buf;
 }
 
