@@ -84,11 +84,6 @@ void announce_item(const std::string& prefix, const std::string& label, const Ru
   }
 }
 
-// "item 3/8", "ahead 2/5" (trained ahead of the round's end).
-std::string item_label(const char* kind, int index, std::size_t items) {
-  return std::string(kind) + " " + std::to_string(index + 1) + "/" + std::to_string(items);
-}
-
 // Journal record first (the source of truth), then the row, each with the
 // item's run times, for each run of the item. A failed journal append (a full disk) does
 // not stop the row: its space was allocated when the file was made, so the
@@ -122,12 +117,15 @@ std::string record_item(const Grid& grid, const WorkItem& item,
 
 }  // namespace
 
-// Trains and records one item (the queue's or one ahead of the round).
+// Trains and records item `index` of `items` of `kind` ("item": the
+// round's; "ahead": trained ahead of its end), logged as "item 3/8".
 // `stop` is asked at every step; `tick` at every validation.
-SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const std::string& label,
-                                          std::function<bool()> stop,
+SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const char* kind, int index,
+                                          std::size_t items, std::function<bool()> stop,
                                           const std::function<void()>& tick) {
   const auto item_start = SweepClock::now();
+  const std::string label =
+      std::string(kind) + " " + std::to_string(index + 1) + "/" + std::to_string(items);
   const RunConfig& head = grid_.runs[static_cast<std::size_t>(item.runs.front())];
   std::vector<int> seeds;
   for (int row : item.runs) seeds.push_back(grid_.runs[static_cast<std::size_t>(row)].seed);
@@ -178,7 +176,8 @@ std::vector<WorkItem> SweepRun::ahead_items() const {
 // While the round's last items train elsewhere, this rank trains `ahead`
 // items from their queue; each stops (its state saved, for the round that
 // asks for it) once every one of the round's `asked` items has finished,
-// or on a stop. Their results are recorded like any other.
+// or on a stop (a signal here is posted to the others by train_round, right
+// after). Their results are recorded like any other.
 void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue, int asked,
                            WorkQueue* ahead_queue, const std::function<void()>& tick,
                            RoundOutcome* outcome) {
@@ -196,14 +195,13 @@ void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue,
     const int i = ahead_queue->next();
     if (i < 0) return;
     const ItemOutcome done =
-        train_one(ahead[static_cast<std::size_t>(i)], item_label("ahead", i, ahead.size()), stop, tick);
+        train_one(ahead[static_cast<std::size_t>(i)], "ahead", i, ahead.size(), stop, tick);
     outcome->ahead_runs += done.runs;
     if (!done.io_error.empty()) {
       outcome->io_error = done.io_error;
       queue->request_stop();
     }
-    // A signal here stops every rank (the round's items and theirs ahead).
-    if (g_stop_signal != 0 && !queue->stop_requested()) queue->request_stop();
+    // A signal is posted by train_round as soon as this returns.
     if (done.stopped || !done.io_error.empty()) return;
   }
 }

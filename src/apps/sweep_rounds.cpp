@@ -140,9 +140,8 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
     const int i = queue.next();
     times_.add(ItemTimes::kQueue, asking);
     if (i < 0) break;
-    const ItemOutcome done = train_one(work[static_cast<std::size_t>(i)],
-                                       "item " + std::to_string(i + 1) + "/" +
-                                           std::to_string(work.size()), signalled, tick);
+    const ItemOutcome done =
+        train_one(work[static_cast<std::size_t>(i)], "item", i, work.size(), signalled, tick);
     outcome.my_runs += done.runs;
     outcome.io_error = done.io_error;
     ended = done.stopped || !done.io_error.empty();

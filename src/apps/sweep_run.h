@@ -88,7 +88,7 @@ class SweepRun {
     bool stopped = false;  // stopped before its end, its state saved
     std::string io_error;
   };
-  ItemOutcome train_one(const WorkItem& item, const std::string& label,
+  ItemOutcome train_one(const WorkItem& item, const char* kind, int index, std::size_t items,
                         std::function<bool()> stop, const std::function<void()>& tick);
   std::vector<WorkItem> ahead_items() const;
   void train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue, int asked,
