@@ -116,22 +116,22 @@ class ComparisonRule {
   }
 
   // With futility, an undecided four-way comparison stops when max_seeds is
-  // not expected to read it: its effect interval [lo, hi] about the effect
-  // e, narrowed to [e - (e - lo) r, e + (hi - e) r] with r = sqrt(n /
-  // max_seeds) (n its pairs, or its smaller side), would still neither lie
+  // not expected to read it: its effect interval narrowed about the effect
+  // (narrowed(), n its pairs, or its smaller side) would still neither lie
   // inside (-log10 delta, log10 delta) nor exclude 0 (docs/METHOD.md,
   // "Adaptive seeds"). An interval with an infinite end (diverged seeds) or
   // one below min_seeds is never futile.
   bool four_way_futile(const Comparison& c, double delta) const {
     const int n = c.paired ? c.n_pairs : std::min(c.n_a, c.n_b);
-    const double lo = c.effect_interval.low, hi = c.effect_interval.high, e = c.effect;
-    if (n < kMinSeedsForInterval || !std::isfinite(lo) || !std::isfinite(hi) || !std::isfinite(e)) {
+    const Interval& i = c.effect_interval;
+    if (n < kMinSeedsForInterval || !std::isfinite(i.low) || !std::isfinite(i.high) ||
+        !std::isfinite(c.effect)) {
       return false;
     }
-    const double r = std::sqrt(static_cast<double>(n) / adaptive_.max_seeds);
-    const double plo = e - (e - lo) * r, phi = e + (hi - e) * r, margin = std::log10(delta);
-    const bool equivalent = -margin < plo && phi < margin;
-    const bool decided = phi < 0.0 || plo > 0.0;
+    const Interval p = narrowed(i, c.effect, n);
+    const double margin = std::log10(delta);
+    const bool equivalent = -margin < p.low && p.high < margin;
+    const bool decided = p.high < 0.0 || p.low > 0.0;
     return !equivalent && !decided;
   }
 
@@ -173,14 +173,20 @@ class ComparisonRule {
   }
 
   // The interval at max_seeds if the median stays and both distances to
-  // it shrink as 1 / sqrt(seeds): [m - (m - lo) r, m + (hi - m) r] with
-  // r = sqrt(finished / max_seeds) (1 once at the cap). Infinite ends stay.
+  // it shrink as 1 / sqrt(seeds).
   Interval projected(const CellSummary& s) const {
-    const double r = std::sqrt(std::min(1.0, static_cast<double>(s.finished()) /
+    return narrowed(s.median_interval, s.median, s.finished());
+  }
+
+  // The interval `i` about `center` of a statistic of n seeds as it would
+  // be at max_seeds if the center stays and both distances to it shrink as
+  // 1 / sqrt(seeds): [c - (c - lo) r, c + (hi - c) r] with r = sqrt(n /
+  // max_seeds) (1 once at the cap). Infinite ends stay.
+  Interval narrowed(const Interval& i, double center, int n) const {
+    const double r = std::sqrt(std::min(1.0, static_cast<double>(n) /
                                                  static_cast<double>(adaptive_.max_seeds)));
-    const Interval& i = s.median_interval;
     const auto toward = [&](double end) {
-      return std::isfinite(end) && std::isfinite(s.median) ? s.median + (end - s.median) * r : end;
+      return std::isfinite(end) && std::isfinite(center) ? center + (end - center) * r : end;
     };
     return Interval{toward(i.low), toward(i.high)};
   }
