@@ -59,16 +59,19 @@ void read_initial(const Reader& r, const toml::table& t, SystemDefinition* def) 
 
 namespace {
 
-// [control] design = "sines" | "chirp" | "steps" (ControlDesign): inputs
-// held over each sample. Every key of the table is checked.
+// [control] design = "sines" | "chirp" | "steps" (ControlDesign, already
+// read into def->control.design; `design` its name): inputs held over each
+// sample. Every key of the table is checked.
 void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
                                const std::string& design, int nu, SystemDefinition* def) {
+  using Design = ControlDesign::Design;
   ControlDesign* c = &def->control;
+  const bool steps = c->design == Design::kSteps, sines = c->design == Design::kSines;
   if (nu == 0) r.fail(line, "control.design = \"" + design + "\" needs at least one input");
   const std::vector<std::string> keys =
-      design == "steps" ? std::vector<std::string>{"design", "range", "hold"}
-      : design == "sines" ? std::vector<std::string>{"design", "range", "frequencies", "amplitude"}
-                          : std::vector<std::string>{"design", "range", "frequency", "amplitude"};
+      steps   ? std::vector<std::string>{"design", "range", "hold"}
+      : sines ? std::vector<std::string>{"design", "range", "frequencies", "amplitude"}
+              : std::vector<std::string>{"design", "range", "frequency", "amplitude"};
   for (const auto& [key, value] : ct) {
     const std::string k(key.str());
     if (std::find(keys.begin(), keys.end(), k) != keys.end()) continue;
@@ -77,12 +80,10 @@ void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
     r.fail(Reader::line(value), "unknown key \"" + k + "\" in [control] for design \"" + design +
                                     "\"; it knows: " + known);
   }
-  const bool need_range = design == "steps";
-  if (const toml::node* range = r.get(ct, "range", need_range, " in [control] (one [lo, hi] per input)", line)) {
+  if (const toml::node* range = r.get(ct, "range", steps, " in [control] (one [lo, hi] per input)", line)) {
     c->range = r.intervals(*range, "control.range", static_cast<std::size_t>(nu), "input");
   }
-  if (design == "steps") {
-    c->design = ControlDesign::Design::kSteps;
+  if (steps) {
     if (const toml::node* h = r.get(ct, "hold", false, "", 0)) {
       def->lines["control.hold"] = Reader::line(*h);
       c->hold = r.number(*h, "control.hold");
@@ -90,13 +91,12 @@ void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
     }
     return;
   }
-  c->design = design == "sines" ? ControlDesign::Design::kSines : ControlDesign::Design::kChirp;
   const toml::node* a = r.get(ct, "amplitude", true, " in [control] (an interval [lo, hi])", line);
   c->amplitude = r.interval(*a, "control.amplitude");
-  const std::string fkey = design == "sines" ? "frequencies" : "frequency";
+  const std::string fkey = sines ? "frequencies" : "frequency";
   const toml::node* f = r.get(ct, fkey, true,
-                              design == "sines" ? " in [control] (a list of frequencies in Hz)"
-                                                : " in [control] (an interval [f0, f1] in Hz)",
+                              sines ? " in [control] (a list of frequencies in Hz)"
+                                    : " in [control] (an interval [f0, f1] in Hz)",
                               line);
   def->lines["control." + fkey] = Reader::line(*f);
   const toml::array* fa = f->as_array();
@@ -106,10 +106,9 @@ void read_time_varying_control(const Reader& r, const toml::table& ct, int line,
                                  " frequencies; at most " + std::to_string(kMaxSines) +
                                  " sines per input are supported");
   }
-  if (fa == nullptr || fa->empty() || (design == "chirp" && fa->size() != 2)) {
+  if (fa == nullptr || fa->empty() || (!sines && fa->size() != 2)) {
     r.fail(Reader::line(*f), "\"control." + fkey + "\" must be " +
-                                 (design == "sines" ? "a non-empty list of frequencies in Hz"
-                                                    : "[f0, f1] in Hz"));
+                                 (sines ? "a non-empty list of frequencies in Hz" : "[f0, f1] in Hz"));
   }
   for (const toml::node& v : *fa) {
     const double hz = r.number(v, "control." + fkey);
@@ -140,10 +139,11 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
   if (!ControlDesign::kDesignNames.find(design, &c.design)) {
     r.fail(Reader::line(*design_node), ControlDesign::kDesignNames.unknown(design));
   }
-  if (design == "constant") {
+  using Design = ControlDesign::Design;
+  if (c.design == Design::kConstant) {
     const toml::node* range = r.get(*ct, "range", nu > 0, " in [control] (one [lo, hi] per input)", line);
     if (range != nullptr) c.range = r.intervals(*range, "control.range", nu, "input");
-  } else if (design == "energy-shaping") {
+  } else if (c.design == Design::kEnergyShaping) {
     if (def->states.size() != 2 || nu != 1) {
       r.fail(line, "control.design = \"energy-shaping\" is the paper's Algorithm 3 for 2 states "
                    "and 1 input; use \"constant\"");
@@ -154,7 +154,7 @@ void read_control(const Reader& r, const toml::table& t, SystemDefinition* def) 
       c.equilibrium_energy_max = v[1];
       def->lines["control.energy"] = Reader::line(*e);
     }
-  } else if (design == "limit-cycle") {
+  } else if (c.design == Design::kLimitCycle) {
     if (def->ports.size() != 1 || nu != 1) {
       r.fail(line, "control.design = \"limit-cycle\" is the paper's Algorithm 4 for 1 port and 1 "
                    "input; use \"constant\"");
