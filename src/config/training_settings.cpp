@@ -120,13 +120,6 @@ bool TrainingSetting::is_default(const TrainerOptions& t) const {
   return text(t) == text(TrainerOptions());
 }
 
-const TrainingSetting* find_training_setting(const std::string& key) {
-  for (const TrainingSetting& s : training_settings()) {
-    if (key == s.key) return &s;
-  }
-  return nullptr;
-}
-
 std::string training_settings_markdown() {
   const TrainerOptions defaults;
   std::string out =

@@ -144,8 +144,15 @@ TEST(TrainingSettingsTest, EveryKeyIsReadFromASweepFileIntoItsField) {
     EXPECT_FALSE(s.is_default(t)) << s.key;
     if (s.kind == TrainingSetting::Kind::kReal) EXPECT_EQ(t.*s.real, 0.125) << s.key;
   }
-  EXPECT_EQ(find_training_setting("learning_rate")->real, &TrainerOptions::learning_rate);
-  EXPECT_EQ(find_training_setting("lr"), nullptr);  // the canonical spelling is not a key
+  const auto with_key = [](const std::string& key) -> const TrainingSetting* {
+    for (const TrainingSetting& s : training_settings()) {
+      if (key == s.key) return &s;
+    }
+    return nullptr;
+  };
+  ASSERT_NE(with_key("learning_rate"), nullptr);
+  EXPECT_EQ(with_key("learning_rate")->real, &TrainerOptions::learning_rate);
+  EXPECT_EQ(with_key("lr"), nullptr);  // the canonical spelling is not a key
 }
 
 }  // namespace

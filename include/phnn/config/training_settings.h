@@ -60,9 +60,6 @@ struct TrainingSetting {
 /// order.
 const std::vector<TrainingSetting>& training_settings();
 
-/// The setting with this sweep-file key, or nullptr.
-const TrainingSetting* find_training_setting(const std::string& key);
-
 /// The table as sweeps/FORMAT.md shows it (Markdown: key, default, values,
 /// `phnn train` flag, what it is); a test keeps FORMAT.md equal to it.
 std::string training_settings_markdown();
