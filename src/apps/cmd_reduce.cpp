@@ -258,7 +258,9 @@ void warn_unfinished_replay(const Inputs& in, const AdaptiveState& state,
 // configuration from the grid).
 std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
   std::vector<RunRecord> rows = read_run_records(file, in.own_grid);
-  for (int row : in.damaged) rows[static_cast<std::size_t>(row)].status = RunStatus::kPending;
+  for (int row : in.damaged) {
+    rows[static_cast<std::size_t>(row)].result.status = RunStatus::kPending;
+  }
   std::vector<RunRecord> records(in.view.row.size());
   for (std::size_t i = 0; i < records.size(); ++i) {
     if (in.view.row[i] >= 0) {
@@ -274,10 +276,13 @@ std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
       r.studies += (r.studies.empty() ? "" : ",") + s;
     }
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    r.mse = r.best_validation_loss = r.wall_time_s = r.initial_validation_loss = nan;
+    for (const ResultColumn& c : result_columns()) {
+      if (c.type == ResultColumn::Type::kDouble) c.set_double(r.result, nan);
+    }
+    r.initial_validation_loss = nan;
     r.final_train_loss = r.final_validation_loss = r.final_kappa = r.final_sigma_max = nan;
     r.final_rho = nan;
-    r.message = "not in " + file.path();
+    r.result.message = "not in " + file.path();
   }
   return records;
 }

@@ -60,16 +60,7 @@ std::vector<RunRecord> read_run_records(const ResultsFile& file, const Grid& gri
   const auto ids = file.read_run_ids();
   const auto studies = file.read_studies();
   const auto canonical = file.read_canonical();
-  const auto statuses = file.read_statuses();
-  const auto messages = file.read_string_column("message");
-  const auto mse = file.read_double_column("mse");
-  const auto best_validation_loss = file.read_double_column("best_validation_loss");
-  const auto wall_time_s = file.read_double_column("wall_time_s");
-  const auto best_step = file.read_int_column("best_step");
-  const auto steps = file.read_int_column("steps");
-  const auto parameter_count = file.read_int_column("parameter_count");
-  const auto diverged_rollouts = file.read_int_column("diverged_rollouts");
-  const auto newton_failures = file.read_int_column("newton_failures");
+  std::vector<RunResult> results = file.read_result_columns();
   std::vector<RunRecord> records(ids.size());
   for (std::size_t i = 0; i < ids.size(); ++i) {
     RunRecord& r = records[i];
@@ -77,16 +68,7 @@ std::vector<RunRecord> read_run_records(const ResultsFile& file, const Grid& gri
     r.studies = studies[i];
     r.model_label = model_label(grid.runs[i].model, grid.runs[i].integrator);
     r.canonical = canonical[i];
-    r.status = statuses[i];
-    r.message = messages[i];
-    r.mse = mse[i];
-    r.best_validation_loss = best_validation_loss[i];
-    r.wall_time_s = wall_time_s[i];
-    r.best_step = best_step[i];
-    r.steps_taken = steps[i];
-    r.parameter_count = parameter_count[i];
-    r.diverged_rollouts = diverged_rollouts[i];
-    r.newton_failures = newton_failures[i];
+    r.result = std::move(results.at(i));
   }
   add_trace_summaries(file, records);
   add_checkpoints(file, records);

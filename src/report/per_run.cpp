@@ -60,9 +60,10 @@ std::string render_per_run_csv(const std::vector<RunRecord>& records) {
   std::ostringstream out;
   out << "run_id,studies,model_label";
   for (const std::string& key : keys) out << "," << csv_field(key);
-  out << ",status,mse,best_step,best_validation_loss,wall_time_s,steps_taken,parameter_count,"
-         "diverged_rollouts,newton_failures,trace_points,initial_validation_loss,final_train_loss,"
-         "final_validation_loss,final_kappa,final_sigma_max,final_rho";
+  out << ",status";
+  for (const ResultColumn& c : result_columns()) out << "," << c.csv_name;
+  out << ",trace_points,initial_validation_loss,final_train_loss,final_validation_loss,"
+         "final_kappa,final_sigma_max,final_rho";
   for (std::int64_t s : budgets) out << ",mse_at_" << s << ",train_s_at_" << s;
   out << ",message\n";
   for (std::size_t i = 0; i < records.size(); ++i) {
@@ -74,10 +75,12 @@ std::string render_per_run_csv(const std::vector<RunRecord>& records) {
         if (kv.first == key) out << csv_field(kv.second);
       }
     }
-    out << "," << to_string(r.status) << "," << csv_double(r.mse) << "," << r.best_step << ","
-        << csv_double(r.best_validation_loss) << "," << csv_double(r.wall_time_s) << ","
-        << r.steps_taken << "," << r.parameter_count << "," << r.diverged_rollouts << ","
-        << r.newton_failures << "," << r.trace_points << ","
+    out << "," << to_string(r.result.status);
+    for (const ResultColumn& c : result_columns()) {
+      out << "," << (c.type == ResultColumn::Type::kInt ? std::to_string(c.get_int(r.result))
+                                                        : csv_double(c.get_double(r.result)));
+    }
+    out << "," << r.trace_points << ","
         << csv_double(r.initial_validation_loss) << "," << csv_double(r.final_train_loss) << ","
         << csv_double(r.final_validation_loss) << "," << csv_double(r.final_kappa) << ","
         << csv_double(r.final_sigma_max) << "," << csv_double(r.final_rho);
@@ -93,7 +96,7 @@ std::string render_per_run_csv(const std::vector<RunRecord>& records) {
         out << ",";
       }
     }
-    out << "," << csv_field(r.message) << "\n";
+    out << "," << csv_field(r.result.message) << "\n";
   }
   return out.str();
 }

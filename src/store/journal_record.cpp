@@ -1,6 +1,7 @@
 // src/store/journal_record.cpp — one journal line: every RunResult field
-// written exactly (hex floats, NaN payloads, percent-escaped strings) and a
-// checksum, and its parser. The files themselves: journal.cpp.
+// written exactly (hex floats, NaN payloads, percent-escaped strings; the
+// scalar ones from config/result_columns.h) and a checksum, and its parser.
+// The files themselves: journal.cpp.
 #include <locale.h>
 
 #include <cerrno>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "phnn/config/result_columns.h"
 #include "phnn/config/run_config.h"  // fnv1a64, hex64
 #include "phnn/store/journal.h"
 
@@ -260,6 +262,43 @@ bool read_checkpoints(std::map<std::string, std::string>& fields, RunResult* r) 
          r->checkpoint_train_seconds.size() == r->checkpoint_steps.size();
 }
 
+// The result columns of one slot (config/result_columns.h), " name=value"
+// each; a column added later is left out while it is NaN (unknown), so a
+// record of before it re-encodes to the same bytes.
+void write_columns(std::ostringstream& s, const RunResult& r, JournalSlot slot) {
+  for (const ResultColumn& c : result_columns()) {
+    if (c.slot != slot) continue;
+    if (c.type == ResultColumn::Type::kInt) {
+      s << " " << c.name << "=" << c.get_int(r);
+      continue;
+    }
+    const double v = c.get_double(r);
+    if (c.added_later && bits_of(v) == kQuietNan) continue;
+    s << " " << c.name << "=" << format_double(v);
+  }
+}
+
+// Every result column from `fields`: integers within 0..highest; a column
+// added later and missing reads NaN; any other missing column fails.
+bool read_columns(std::map<std::string, std::string>& fields, RunResult* r) {
+  for (const ResultColumn& c : result_columns()) {
+    const auto it = fields.find(c.name);
+    if (it == fields.end()) {
+      if (!c.added_later) return false;
+      c.set_double(*r, from_bits(kQuietNan));
+    } else if (c.type == ResultColumn::Type::kInt) {
+      std::int64_t v = 0;
+      if (!parse_int(it->second, &v) || v < 0 || v > c.highest) return false;
+      c.set_int(*r, v);
+    } else {
+      double v = 0;
+      if (!parse_double(it->second, &v)) return false;
+      c.set_double(*r, v);
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 namespace internal {
@@ -269,15 +308,13 @@ std::string encode_journal_record(const std::string& run_id, const RunResult& r,
   const CLocaleScope c_locale;
   std::ostringstream s;
   s << "run " << escape(run_id) << " v=" << kFormatVersion << " time=" << time_ns
-    << " status=" << to_string(r.status) << " message=" << escape(r.message)
-    << " mse=" << format_double(r.mse)
-    << " trajectory_errors=" << format_doubles(r.trajectory_errors)
-    << " diverged_rollouts=" << r.diverged_rollouts << " trace=" << format_trace(r.trace)
-    << " best_step=" << r.best_step
-    << " best_validation_loss=" << format_double(r.best_validation_loss)
-    << " wall_time_s=" << format_double(r.wall_time_s) << " steps=" << r.steps
-    << " parameter_count=" << r.parameter_count << " newton_failures=" << r.newton_failures
-    << " figure_prediction_05=" << format_doubles(r.figure_prediction_05)
+    << " status=" << to_string(r.status) << " message=" << escape(r.message);
+  write_columns(s, r, JournalSlot::kAfterMessage);
+  s << " trajectory_errors=" << format_doubles(r.trajectory_errors);
+  write_columns(s, r, JournalSlot::kAfterTrajectoryErrors);
+  s << " trace=" << format_trace(r.trace);
+  write_columns(s, r, JournalSlot::kAfterTrace);
+  s << " figure_prediction_05=" << format_doubles(r.figure_prediction_05)
     << " figure_prediction_075=" << format_doubles(r.figure_prediction_075)
     << " figure_reference_05=" << format_doubles(r.figure_reference_05)
     << " figure_reference_075=" << format_doubles(r.figure_reference_075);
@@ -287,6 +324,7 @@ std::string encode_journal_record(const std::string& run_id, const RunResult& r,
   // is the row as it was; a record without them reads as unknown times.
   if (!r.started_utc.empty()) s << " started=" << escape(r.started_utc);
   if (!r.finished_utc.empty()) s << " finished=" << escape(r.finished_utc);
+  write_columns(s, r, JournalSlot::kAtEnd);
   const std::string body = s.str();
   return body + kChecksumKey + hex64(fnv1a64(body));
 }
@@ -311,34 +349,25 @@ bool decode_journal_record(const std::string& line_in, std::string* run_id,
     if (eq == std::string::npos) return false;
     fields[tokens[i].substr(0, eq)] = tokens[i].substr(eq + 1);
   }
-  // Every field is required; unknown fields (a later minor version) are
-  // ignored.
-  const char* const kRequired[] = {
-      "v", "time", "status", "message", "mse", "trajectory_errors", "diverged_rollouts",
-      "trace", "best_step", "best_validation_loss", "wall_time_s", "steps",
-      "parameter_count", "newton_failures", "figure_prediction_05", "figure_prediction_075",
-      "figure_reference_05", "figure_reference_075"};
-  for (const char* key : kRequired) {
+  // Every field is required but the optional ones and the columns added
+  // later; unknown fields (a later minor version) are ignored.
+  for (const char* key : {"v", "time", "status", "message", "trajectory_errors", "trace",
+                          "figure_prediction_05", "figure_prediction_075",
+                          "figure_reference_05", "figure_reference_075"}) {
     if (fields.count(key) == 0) return false;
   }
   if (fields["v"] != kFormatVersion) return false;
   const CLocaleScope c_locale;
   RunResult r;
-  std::int64_t diverged = 0, best_step = 0, steps = 0, params = 0;
   try {
     r.status = parse_run_status(fields["status"]);
   } catch (const std::exception&) {
     return false;
   }
   if (!parse_int(fields["time"], time_ns) || !unescape(fields["message"], &r.message) ||
-      !parse_double(fields["mse"], &r.mse) ||
+      !read_columns(fields, &r) ||
       !parse_doubles(fields["trajectory_errors"], &r.trajectory_errors) ||
-      !parse_int(fields["diverged_rollouts"], &diverged) ||
-      !parse_trace(fields["trace"], &r.trace) || !parse_int(fields["best_step"], &best_step) ||
-      !parse_double(fields["best_validation_loss"], &r.best_validation_loss) ||
-      !parse_double(fields["wall_time_s"], &r.wall_time_s) ||
-      !parse_int(fields["steps"], &steps) || !parse_int(fields["parameter_count"], &params) ||
-      !parse_int(fields["newton_failures"], &r.newton_failures) ||
+      !parse_trace(fields["trace"], &r.trace) ||
       !parse_doubles(fields["figure_prediction_05"], &r.figure_prediction_05) ||
       !parse_doubles(fields["figure_prediction_075"], &r.figure_prediction_075) ||
       !parse_doubles(fields["figure_reference_05"], &r.figure_reference_05) ||
@@ -349,10 +378,6 @@ bool decode_journal_record(const std::string& line_in, std::string* run_id,
       (fields.count("finished") != 0 && !unescape(fields["finished"], &r.finished_utc))) {
     return false;
   }
-  r.diverged_rollouts = static_cast<int>(diverged);
-  r.best_step = static_cast<int>(best_step);
-  r.steps = static_cast<int>(steps);
-  r.parameter_count = static_cast<long>(params);
   *result = std::move(r);
   return true;
 }

@@ -1,7 +1,8 @@
 // src/store/results_file_config.cpp — the configuration columns of /runs
 // (id, canonical, system, ..., weights_layout, /runs/config/*): computed from
 // the run list, written by create(), read, compared with a run list and
-// rewritten from it (the repair of damage the file digest finds).
+// rewritten from it (the repair of damage the file digest finds); and the
+// whole-column readers of the reducer (results of every row at once).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -258,6 +259,40 @@ void ResultsFile::rewrite_configuration(const std::vector<RunConfig>& runs,
     return 0;
   });
   impl.read_layout();  // /runs/n_x may have changed
+}
+
+std::vector<RunResult> ResultsFile::read_result_columns() const {
+  const Impl& impl = *impl_;
+  const std::vector<RunStatus> statuses = read_statuses();
+  const std::vector<std::string> messages = impl.strings(kMessage);
+  std::vector<RunResult> rows(statuses.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    rows[i].status = statuses[i];
+    rows[i].message = messages.at(i);
+  }
+  const std::vector<ResultColumn>& columns = result_columns();
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const ResultColumn& c = columns[k];
+    if (!impl.has_result_column[k]) continue;  // added later: stays NaN
+    if (c.type == ResultColumn::Type::kInt) {
+      const std::vector<std::int64_t> values = impl.ints(kRuns + c.name);
+      for (std::size_t i = 0; i < rows.size(); ++i) c.set_int(rows[i], values.at(i));
+    } else {
+      const std::vector<double> values = impl.doubles(kRuns + c.name);
+      for (std::size_t i = 0; i < rows.size(); ++i) c.set_double(rows[i], values.at(i));
+    }
+  }
+  return rows;
+}
+
+std::vector<double> ResultsFile::read_double_column(const std::string& column) const {
+  return impl_->doubles(kRuns + column);
+}
+std::vector<std::int64_t> ResultsFile::read_int_column(const std::string& column) const {
+  return impl_->ints(kRuns + column);
+}
+std::vector<std::string> ResultsFile::read_string_column(const std::string& column) const {
+  return impl_->strings(kRuns + column);
 }
 
 }  // namespace phnn

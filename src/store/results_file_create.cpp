@@ -74,16 +74,16 @@ void create_result_datasets(const DatasetMaker& make, const ResultsLayout& layou
             "then the run's weights; checksum rule 2), written after the status; 0: none yet",
             "");
   make.text(kMessage, kMessageLength, "why a run diverged or failed (truncated)");
-  make.floats(kMse, {R}, kMseUnit, kMseUnits);
-  make.floats(kTrajectoryErrors, {R, I}, kMseUnit, kMseUnits + "; per inference trajectory");
+  make.floats(kTrajectoryErrors, {R, I}, kMseUnit,
+              std::string(kMseUnits) + "; per inference trajectory");
   make.ints(kTrajectoryErrorsLength, {R}, "valid entries of trajectory_errors");
-  make.ints(kDivergedRollouts, {R}, "inference rollouts that diverged");
-  make.ints(kBestStep, {R}, "Adam step of the best validation loss");
-  make.floats(kBestValidationLoss, {R}, kLossUnit, kLossUnits);
-  make.floats(kWallTime, {R}, "s", "wall time of the run's share of its work item");
-  make.ints(kSteps, {R}, "Adam steps");
-  make.ints(kParameterCount, {R}, "trainable parameters");
-  make.ints(kNewtonFailures, {R}, "DG inference steps whose Newton did not converge");
+  for (const ResultColumn& c : result_columns()) {
+    if (c.type == ResultColumn::Type::kInt) {
+      make.ints(kRuns + c.name, {R}, c.description, c.units);
+    } else {
+      make.floats(kRuns + c.name, {R}, c.units, c.description);
+    }
+  }
   make.text(kStartedUtc, kUtcLength,
             "UTC, ISO 8601: when training of the run's work item started; empty if pending "
             "or recovered from a journal");
@@ -95,8 +95,8 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
   const auto T = static_cast<std::uint64_t>(layout.trace_points);
   const auto F = static_cast<std::uint64_t>(layout.figure_points);
   make.floats(kTrace, {R, T, kTraceColumns},
-              "1, s, " + kLossUnit + ", " + kLossUnit + ", 1, 1/s, 1",
-              "per column: step [1], elapsed_s [s], train_loss and validation_loss [" +
+              std::string("1, s, ") + kLossUnit + ", " + kLossUnit + ", 1, 1/s, 1",
+              std::string("per column: step [1], elapsed_s [s], train_loss and validation_loss [") +
                   kLossUnits + "], kappa [1], sigma_max [1/s], rho [1]; NaN after trace_length");
   make.file.set_attribute(kTrace, "columns",
                           std::string("step, elapsed_s, train_loss, validation_loss, kappa, "
@@ -126,7 +126,7 @@ void create_trace_and_figure_datasets(const DatasetMaker& make, const ResultsLay
     make.ints(kCheckpointSteps, {R, K}, "step budgets (TrainerOptions::checkpoints); 0 after the "
                                         "run's own count");
     make.floats(kCheckpointMse, {R, K}, kMseUnit,
-                kMseUnits + "; of the best-validation weights up to each budget");
+                std::string(kMseUnits) + "; of the best-validation weights up to each budget");
     make.floats(kCheckpointTrainSeconds, {R, K}, "s",
                 "training wall time to each budget, this run's share of its stack, inference "
                 "excluded");

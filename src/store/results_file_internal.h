@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "h5/h5file.h"
+#include "phnn/config/result_columns.h"
 #include "phnn/store/results_file.h"
 
 namespace phnn {
@@ -47,16 +48,8 @@ inline const std::string kSettings = "/runs/config";
 inline const std::string kStatus = "/runs/status";
 inline const std::string kChecksum = "/runs/checksum";
 inline const std::string kMessage = "/runs/message";
-inline const std::string kMse = "/runs/mse";
 inline const std::string kTrajectoryErrors = "/runs/trajectory_errors";
 inline const std::string kTrajectoryErrorsLength = "/runs/trajectory_errors_length";
-inline const std::string kDivergedRollouts = "/runs/diverged_rollouts";
-inline const std::string kBestStep = "/runs/best_step";
-inline const std::string kBestValidationLoss = "/runs/best_validation_loss";
-inline const std::string kWallTime = "/runs/wall_time_s";
-inline const std::string kSteps = "/runs/steps";
-inline const std::string kParameterCount = "/runs/parameter_count";
-inline const std::string kNewtonFailures = "/runs/newton_failures";
 inline const std::string kTrace = "/runs/trace";
 inline const std::string kTraceLength = "/runs/trace_length";
 inline const std::string kPrediction05 = "/runs/figure/prediction_05";
@@ -84,14 +77,6 @@ inline const std::string kDigestAttribute = "digest";
 inline constexpr std::size_t kUtcLength = 20;  // "2024-05-01T12:00:00Z"
 
 inline const std::string kStateUnits = "q [m], p [kg m/s]";
-// Units of the MSE and of the loss L_d: states of two units mix.
-inline const std::string kMseUnit = "m^2 and (kg m/s)^2";
-inline const std::string kLossUnit = "m/s and kg m/s^2";
-inline const std::string kMseUnits =
-    "m^2 and (kg m/s)^2 mixed: mean of ||x - x_hat||^2 over the inference "
-    "trajectories and steps (docs/METHOD.md section 5); +inf if a rollout diverged";
-inline const std::string kLossUnits =
-    "m/s and kg m/s^2 mixed: L_d = mean |x_{n+1} - x_hat_{n+1}| / h (+ regularizer)";
 inline const std::string kFileUnits =
     "SI units. States q [m], p [kg m/s]; time [s]; energy [J]; mse in m^2 and "
     "(kg m/s)^2 mixed (mean of ||x - x_hat||^2); losses in m/s and kg m/s^2 mixed "
@@ -168,6 +153,10 @@ struct ResultsFile::Impl {
   std::int64_t checksum_version = 0;
   // Rule 2: every dataset of /runs but the checksum, sorted (a row's bytes).
   std::vector<std::string> row_columns;
+  // Per result column (config/result_columns.h): whether the file has it
+  // (a column added later is missing from files written before it; any
+  // other is required, and its absence an HDF5 error where it is read).
+  std::vector<bool> has_result_column;
   std::string session;         // this process's /provenance/session_<k>
 
   Impl(h5::File f, MPI_Comm c)
@@ -193,6 +182,10 @@ struct ResultsFile::Impl {
     checksum_version = file.has_attribute("/", results_io::kChecksumVersionAttribute) ? 2
                        : has_checksums                                               ? 1
                                                                                      : 0;
+    has_result_column.clear();
+    for (const ResultColumn& c : result_columns()) {
+      has_result_column.push_back(!c.added_later || file.exists(results_io::kRuns + c.name));
+    }
     row_columns.clear();
     if (checksum_version == 2) {
       for (const std::string& name : file.objects_under("/runs")) {

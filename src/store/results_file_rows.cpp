@@ -1,7 +1,7 @@
 // src/store/results_file_rows.cpp — one row of /runs: ResultsFile::write_run
 // (independent raw-data writes, status last) and read_run (every integer
-// checked against its range before it sizes or indexes anything), and the
-// column readers of the reducer. Checksums: results_file_checks.cpp.
+// checked against its range before it sizes or indexes anything). Whole
+// columns: results_file_config.cpp; checksums: results_file_checks.cpp.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -197,17 +197,19 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     auto put_int = [&](const std::string& name, std::int64_t v) {
       f.write_rows(name, at, 1, &v);
     };
-    put_double(kMse, r.mse);
+    const std::vector<ResultColumn>& columns = result_columns();
+    for (std::size_t k = 0; k < columns.size(); ++k) {
+      const ResultColumn& c = columns[k];
+      if (!impl.has_result_column[k]) continue;  // added after the file was written
+      if (c.type == ResultColumn::Type::kInt) {
+        put_int(kRuns + c.name, c.get_int(r));
+      } else {
+        put_double(kRuns + c.name, c.get_double(r));
+      }
+    }
     f.write_rows(kTrajectoryErrors, at, 1,
                  padded(r.trajectory_errors, static_cast<std::size_t>(L.num_inference)).data());
     put_int(kTrajectoryErrorsLength, static_cast<std::int64_t>(r.trajectory_errors.size()));
-    put_int(kDivergedRollouts, r.diverged_rollouts);
-    put_int(kBestStep, r.best_step);
-    put_double(kBestValidationLoss, r.best_validation_loss);
-    put_double(kWallTime, r.wall_time_s);
-    put_int(kSteps, r.steps);
-    put_int(kParameterCount, r.parameter_count);
-    put_int(kNewtonFailures, r.newton_failures);
     f.write_rows(kTrace, at, 1, trace.data());
     put_int(kTraceLength, static_cast<std::int64_t>(r.trace.size()));
     write_figures_and_checkpoints(f, at, r, states, L);
@@ -318,22 +320,22 @@ RunResult ResultsFile::read_run(int row) const {
   auto one_int = [&](const std::string& name, std::int64_t lowest, std::int64_t highest) {
     return checked(impl.ints(name, at, 1).at(0), lowest, highest, name, at, where);
   };
-  auto one_double = [&](const std::string& name) { return impl.doubles(name, at, 1).at(0); };
   RunResult r;
   r.status = status_from_code(impl.ints(kStatus, at, 1).at(0),
                               where + kStatus + "[" + std::to_string(row) + "]");
   r.message = impl.strings_at(kMessage, at);
-  r.mse = one_double(kMse);
+  const std::vector<ResultColumn>& columns = result_columns();
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const ResultColumn& c = columns[k];
+    if (!impl.has_result_column[k]) continue;  // added later: stays NaN
+    if (c.type == ResultColumn::Type::kInt) {
+      c.set_int(r, one_int(kRuns + c.name, 0, c.highest));
+    } else {
+      c.set_double(r, impl.doubles(kRuns + c.name, at, 1).at(0));
+    }
+  }
   r.trajectory_errors = unpadded(impl.doubles(kTrajectoryErrors, at, 1),
                                  one_int(kTrajectoryErrorsLength, 0, L.num_inference));
-  r.diverged_rollouts = static_cast<int>(one_int(kDivergedRollouts, 0, kIntMax));
-  r.best_step = static_cast<int>(one_int(kBestStep, 0, kIntMax));
-  r.best_validation_loss = one_double(kBestValidationLoss);
-  r.wall_time_s = one_double(kWallTime);
-  r.steps = static_cast<int>(one_int(kSteps, 0, kIntMax));
-  r.parameter_count = static_cast<long>(
-      one_int(kParameterCount, 0, std::numeric_limits<std::int64_t>::max()));
-  r.newton_failures = one_int(kNewtonFailures, 0, std::numeric_limits<std::int64_t>::max());
   r.trace = trace_of_row(impl.doubles(kTrace, at, 1), one_int(kTraceLength, 0, L.trace_points),
                          at, where);
   read_figures_and_checkpoints(row, &r);
@@ -369,16 +371,6 @@ void ResultsFile::read_figures_and_checkpoints(int row, RunResult* r) const {
   const auto count = static_cast<std::int64_t>(r->checkpoint_steps.size());
   r->checkpoint_mse = unpadded(impl.doubles(kCheckpointMse, at, 1), count);
   r->checkpoint_train_seconds = unpadded(impl.doubles(kCheckpointTrainSeconds, at, 1), count);
-}
-
-std::vector<double> ResultsFile::read_double_column(const std::string& column) const {
-  return impl_->doubles(kRuns + column);
-}
-std::vector<std::int64_t> ResultsFile::read_int_column(const std::string& column) const {
-  return impl_->ints(kRuns + column);
-}
-std::vector<std::string> ResultsFile::read_string_column(const std::string& column) const {
-  return impl_->strings(kRuns + column);
 }
 
 }  // namespace phnn

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "phnn/config/result_columns.h"
 #include "phnn/store/journal.h"
 
 namespace phnn {
@@ -20,7 +21,7 @@ namespace {
 // The result without its clocks (wall times, run times), which differ
 // between two trainings of the same run.
 RunResult without_clocks(RunResult r) {
-  r.wall_time_s = 0.0;
+  zero_clock_columns(&r);
   r.started_utc.clear();
   r.finished_utc.clear();
   for (TracePoint& p : r.trace) p.elapsed_s = 0.0;

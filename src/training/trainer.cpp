@@ -365,6 +365,7 @@ void CellTrainer::fill_result(int64_t e, const Rollouts* rollouts, double mse, d
   r.parameter_count = model_->parameter_count();
   r.best_validation_loss = best_val_[static_cast<std::size_t>(e)];
   r.wall_time_s = wall / static_cast<double>(E_);
+  r.train_seconds = train_s;
   r.mse = mse;
   if (rollouts) fill_with_rollouts(e, *rollouts, mse, train_s, &r);
   // The weights the rollouts used (float32 training: upcast, exactly).

@@ -138,6 +138,8 @@ TEST_F(ReduceCommandTest, PerRunCsvHasOneRowPerRunWithAxesAndExactValues) {
     }
     EXPECT_EQ(testing_util::bits(std::strtod(fields[column("wall_time_s")].c_str(), nullptr)),
               testing_util::bits(expected.wall_time_s));
+    EXPECT_EQ(testing_util::bits(std::strtod(fields[column("train_seconds")].c_str(), nullptr)),
+              testing_util::bits(expected.train_seconds));
     EXPECT_EQ(fields[column("best_step")], std::to_string(expected.best_step));
     EXPECT_EQ(fields[column("steps_taken")], std::to_string(expected.steps));
     EXPECT_EQ(fields[column("newton_failures")], std::to_string(expected.newton_failures));

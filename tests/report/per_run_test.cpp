@@ -35,15 +35,16 @@ RunRecord record(const std::string& canonical, RunStatus status, double mse) {
   r.studies = "I,II";
   r.model_label = "PHNN-S-DG";
   r.canonical = canonical;
-  r.status = status;
-  r.mse = mse;
-  r.best_validation_loss = 0.1;
-  r.wall_time_s = 12.5;
-  r.best_step = 49000;
-  r.steps_taken = 50000;
-  r.parameter_count = 852;
-  r.diverged_rollouts = 0;
-  r.newton_failures = 3;
+  r.result.status = status;
+  r.result.mse = mse;
+  r.result.best_validation_loss = 0.1;
+  r.result.wall_time_s = 12.5;
+  r.result.best_step = 49000;
+  r.result.steps = 50000;
+  r.result.parameter_count = 852;
+  r.result.diverged_rollouts = 0;
+  r.result.newton_failures = 3;
+  r.result.train_seconds = 11.25;
   r.trace_points = 101;
   r.initial_validation_loss = 0.5;
   r.final_train_loss = 0.25;
@@ -62,13 +63,13 @@ TEST(PerRunCsvTest, OneRowPerRunWithEveryConfigKeyAndFullPrecision) {
   EXPECT_THAT(csv, StartsWith("run_id,studies,model_label,system,model,damping,seed,"
                               "cubic_stiffness,status,mse,best_step,best_validation_loss,"
                               "wall_time_s,steps_taken,parameter_count,diverged_rollouts,"
-                              "newton_failures,trace_points,initial_validation_loss,"
+                              "newton_failures,train_seconds,trace_points,initial_validation_loss,"
                               "final_train_loss,final_validation_loss,final_kappa,"
                               "final_sigma_max,final_rho,message\n"));
   // The shortest text that reads back to the double: 1/3 needs 16 digits,
   // 0.1 one; a key the run lacks is empty.
   EXPECT_THAT(csv, HasSubstr("\n00000000000000ab,\"I,II\",PHNN-S-DG,harmonic,phnn-s,0.5,0,,done,"
-                             "0.3333333333333333,49000,0.1,12.5,50000,852,0,3,"
+                             "0.3333333333333333,49000,0.1,12.5,50000,852,0,3,11.25,"
                              "101,0.5,0.25,0.125,1000,2,0.0625,\n"));
   EXPECT_EQ(std::stod("0.3333333333333333"), 1.0 / 3.0);
   EXPECT_THAT(csv, HasSubstr(",PHNN-S-DG,duffing,phnn-s,0.5,1,1,done,0.002,"));
@@ -110,9 +111,9 @@ TEST(PerRunCsvTest, NamesColumnsAsTheSweepFileAndSplitsMultiNumberKeys) {
 TEST(PerRunCsvTest, SpellsInfinityAndNanForPandasAndQuotesMessages) {
   RunRecord diverged = record("seed=0", RunStatus::kDiverged,
                               std::numeric_limits<double>::infinity());
-  diverged.message = "rollout 1 diverged: ||x|| = 1.2e+06, \"stuck\"\nat step 42";
+  diverged.result.message = "rollout 1 diverged: ||x|| = 1.2e+06, \"stuck\"\nat step 42";
   RunRecord failed = record("seed=1", RunStatus::kFailed, -std::nan(""));
-  failed.best_validation_loss = -std::numeric_limits<double>::infinity();
+  failed.result.best_validation_loss = -std::numeric_limits<double>::infinity();
   const std::string csv = render_per_run_csv({diverged, failed});
   EXPECT_THAT(csv, HasSubstr(",0,diverged,inf,49000,"));
   EXPECT_THAT(csv, HasSubstr(",\"rollout 1 diverged: ||x|| = 1.2e+06, \"\"stuck\"\"\nat step 42\"\n"));
@@ -123,7 +124,8 @@ TEST(PerRunCsvTest, SpellsInfinityAndNanForPandasAndQuotesMessages) {
 TEST(PerRunCsvTest, NoRecordsGiveTheFixedHeaderOnly) {
   EXPECT_EQ(render_per_run_csv({}),
             "run_id,studies,model_label,status,mse,best_step,best_validation_loss,wall_time_s,"
-            "steps_taken,parameter_count,diverged_rollouts,newton_failures,trace_points,"
+            "steps_taken,parameter_count,diverged_rollouts,newton_failures,train_seconds,"
+            "trace_points,"
             "initial_validation_loss,final_train_loss,final_validation_loss,final_kappa,"
             "final_sigma_max,final_rho,message\n");
 }

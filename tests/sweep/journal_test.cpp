@@ -106,6 +106,29 @@ TEST_F(JournalTest, CheckpointsAndWeightsRoundTripAndAreOptional) {
   expect_bit_equal(plain, back);
 }
 
+// The record of a failed run as the journal wrote it before train_seconds
+// (2026-11-28), checksum by an independent FNV-1a 64: it reads with
+// train_seconds unknown (NaN) and re-encodes to the same bytes, so checksum
+// rule 1 (which hashes the re-encoded record) still holds for old files. A
+// known train_seconds goes last.
+TEST_F(JournalTest, ARecordOfBeforeAColumnWasAddedReencodesToTheSameBytes) {
+  const std::string body =
+      "run 00ff v=1 time=42 status=failed message=x mse=0x1.8p+0 trajectory_errors= "
+      "diverged_rollouts=0 trace= best_step=0 best_validation_loss=0x0p+0 wall_time_s=0x0p+0 "
+      "steps=0 parameter_count=0 newton_failures=0 figure_prediction_05= "
+      "figure_prediction_075= figure_reference_05= figure_reference_075=";
+  const std::string line = body + " fnv1a64=c347327e99065108";
+  std::string id;
+  RunResult back;
+  std::int64_t time_ns = 0;
+  ASSERT_TRUE(internal::decode_journal_record(line, &id, &back, &time_ns));
+  EXPECT_TRUE(std::isnan(back.train_seconds));
+  EXPECT_EQ(internal::encode_journal_record(id, back, time_ns), line);
+  back.train_seconds = 3.0;
+  EXPECT_EQ(internal::encode_journal_record(id, back, time_ns),
+            body + " train_seconds=0x1.8p+1 fnv1a64=f0ac0e61e7b2a0d0");
+}
+
 TEST_F(JournalTest, SkipsAndCountsATornLastLine) {
   Journal(results_path_, 0).append(id(0), sample_result(0, sample_layout()));
   Journal(results_path_, 0).append(id(1), sample_result(1, sample_layout()));

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -20,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "h5/h5file.h"
+#include "phnn/config/result_columns.h"
 #include "phnn/store/journal.h"
 #include "sweep/sample_results.h"
 
@@ -271,10 +273,81 @@ TEST(ResultsFileFixtureTest, AFileOfTheEarlierFormatIsRead) {
     const RunResult r = file.read_run(row);
     EXPECT_TRUE(std::isfinite(r.mse)) << row;
     EXPECT_EQ(static_cast<long>(r.weights.size()), r.parameter_count) << row;
+    EXPECT_TRUE(std::isnan(r.train_seconds)) << row;  // a column added after the file
   }
+  for (const RunResult& r : file.read_result_columns()) EXPECT_TRUE(std::isnan(r.train_seconds));
   const h5::File raw = h5::File::open(fixture, h5::Access::kReadOnly);
+  EXPECT_FALSE(raw.exists("/runs/train_seconds"));
   EXPECT_FALSE(raw.exists("/runs/config"));
   EXPECT_FALSE(raw.exists("/runs/weights_layout"));
+}
+
+// Each column of config/result_columns.h, declared once, reaches every
+// place a result goes: its /runs dataset with the declared units and
+// description, the row written and read, the whole-column reader, the
+// row checksum (rule 2 covers the dataset), the journal record and the
+// per-run CSV header (tests/report/per_run_test.cpp, reduce_command_test).
+TEST_F(ResultsFileTest, EveryResultColumnReachesItsDatasetRowChecksumAndJournal) {
+  const ResultsLayout layout = sample_layout();
+  std::set<std::string> names, csv_names;
+  {
+    ResultsFile file = create();
+    for (int row = 0; row < kNumRuns; ++row) file.write_run(row, sample_result(row, layout));
+    file.close();
+  }
+  std::vector<RunResult> columns, rows;
+  {
+    const ResultsFile file = ResultsFile::open_read_only(path_);
+    columns = file.read_result_columns();
+    for (int row = 0; row < kNumRuns; ++row) rows.push_back(file.read_run(row));
+  }
+  ASSERT_EQ(columns.size(), static_cast<std::size_t>(kNumRuns));
+  const std::string record = internal::encode_journal_record("0a", sample_result(0, layout), 1);
+  for (const ResultColumn& c : result_columns()) {
+    SCOPED_TRACE(c.name);
+    EXPECT_TRUE(names.insert(c.name).second);
+    EXPECT_TRUE(csv_names.insert(c.csv_name).second);
+    const std::string dataset = std::string("/runs/") + c.name;
+    {
+      const h5::File raw = h5::File::open(path_, h5::Access::kReadOnly);
+      ASSERT_TRUE(raw.exists(dataset));
+      EXPECT_EQ(raw.string_attribute(dataset, "units"), c.units);
+      EXPECT_EQ(raw.string_attribute(dataset, "description"), c.description);
+    }
+    EXPECT_THAT(record, HasSubstr(std::string(" ") + c.name + "="));
+    for (int row = 0; row < kNumRuns; ++row) {
+      const RunResult expected = sample_result(row, layout);
+      if (c.type == ResultColumn::Type::kInt) {
+        EXPECT_EQ(c.get_int(rows[row]), c.get_int(expected));
+        EXPECT_EQ(c.get_int(columns[row]), c.get_int(expected));
+      } else {
+        EXPECT_EQ(bits(c.get_double(rows[row])), bits(c.get_double(expected)));
+        EXPECT_EQ(bits(c.get_double(columns[row])), bits(c.get_double(expected)));
+      }
+    }
+    // Rule 2: one changed bit of the column damages the row.
+    h5::File damaged = h5::File::open(path_, h5::Access::kReadWrite);
+    if (c.type == ResultColumn::Type::kInt) {
+      std::int64_t v = damaged.read_ints(dataset, 3, 1).at(0) ^ 1;
+      damaged.write_rows(dataset, 3, 1, &v);
+      damaged.close();
+      EXPECT_EQ(ResultsFile::open_read_only(path_).damaged_rows(), std::vector<int>{3});
+      damaged = h5::File::open(path_, h5::Access::kReadWrite);
+      v ^= 1;
+      damaged.write_rows(dataset, 3, 1, &v);
+    } else {
+      double v = damaged.read_doubles(dataset, 3, 1).at(0);
+      const double before = v;
+      v = std::nextafter(v, 1e300);
+      damaged.write_rows(dataset, 3, 1, &v);
+      damaged.close();
+      EXPECT_EQ(ResultsFile::open_read_only(path_).damaged_rows(), std::vector<int>{3});
+      damaged = h5::File::open(path_, h5::Access::kReadWrite);
+      damaged.write_rows(dataset, 3, 1, &before);
+    }
+    damaged.close();
+  }
+  EXPECT_TRUE(ResultsFile::open_read_only(path_).damaged_rows().empty());
 }
 
 TEST_F(ResultsFileTest, StatusesDefaultToPendingUntilWritten) {

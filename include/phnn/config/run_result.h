@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,8 @@ struct TracePoint {
   double rho = 0.0;           // batch-mean stiffness ratio
 };
 
-/// Everything stored for one run (one seed of one cell).
+/// Everything stored for one run (one seed of one cell). The scalar
+/// results are columns of config/result_columns.h.
 struct RunResult {
   RunStatus status = RunStatus::kPending;
   std::string message;
@@ -64,6 +66,10 @@ struct RunResult {
   /// the run started and finished; "" where unknown (a journal record
   /// written before 2026-11-28, or a file without /runs/started_utc).
   std::string started_utc, finished_utc;
+  /// Training wall time of this run's share of its stack, inference and
+  /// checkpoint inference excluded (NaN: unknown, e.g. a file written
+  /// before 2026-11-28).
+  double train_seconds = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace phnn

@@ -8,9 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "phnn/config/result_columns.h"
 #include "phnn/config/setting_columns.h"  // parse_canonical
-
-#include "phnn/config/run_result.h"
 
 namespace phnn {
 
@@ -23,18 +22,9 @@ struct RunRecord {
   /// /runs/canonical: "key=value;..." with every field that determines the
   /// run (RunConfig::canonical()), the seed last.
   std::string canonical;
-  RunStatus status = RunStatus::kPending;
-  std::string message;
-  double mse = 0.0;
-  double best_validation_loss = 0.0;
-  double wall_time_s = 0.0;
-  std::int64_t best_step = 0;
-  /// /runs/steps: Adam steps taken (the configured number is the canonical
-  /// key "steps").
-  std::int64_t steps_taken = 0;
-  std::int64_t parameter_count = 0;
-  std::int64_t diverged_rollouts = 0;
-  std::int64_t newton_failures = 0;
+  /// Status, message and the scalar result columns (config/
+  /// result_columns.h); its arrays stay empty.
+  RunResult result;
   /// From /runs/trace (the validation points, step 0 first): how many there
   /// are, the validation loss at step 0 (how far training got: compare with
   /// best_validation_loss), and train loss, validation loss, kappa,
@@ -52,12 +42,15 @@ struct RunRecord {
 
 /// A tidy CSV, one line per record (in order) after a header:
 ///
-///   run_id,studies,model_label,<config keys>,status,mse,best_step,
-///   best_validation_loss,wall_time_s,steps_taken,parameter_count,
-///   diverged_rollouts,newton_failures,trace_points,initial_validation_loss,
-///   final_train_loss,final_validation_loss,final_kappa,final_sigma_max,
-///   final_rho,message
+///   run_id,studies,model_label,<config keys>,status,<result columns>,
+///   trace_points,initial_validation_loss,final_train_loss,
+///   final_validation_loss,final_kappa,final_sigma_max,final_rho,
+///   [mse_at_<step>,train_s_at_<step>]...,message
 ///
+/// <result columns> are those of config/result_columns.h in its order, by
+/// their CSV names (mse, best_step, best_validation_loss, wall_time_s,
+/// steps_taken, parameter_count, diverged_rollouts, newton_failures,
+/// train_seconds).
 /// <config keys> are the canonical keys of all records in order of first
 /// appearance (system, model, integrator, size, n_train, regularizer, the
 /// physics, data and training keys, ..., seed), so any axis a sweep varies has

@@ -190,6 +190,11 @@ class ResultsFile {
   std::vector<std::string> read_studies() const;  // "I,II"
   std::vector<std::int64_t> read_seeds() const;
 
+  /// Every row's status, message and scalar result columns (config/
+  /// result_columns.h), each read as a whole column; a column added after
+  /// the file was written reads NaN. The arrays stay empty.
+  std::vector<RunResult> read_result_columns() const;
+
   /// Any column of /runs by name ("mse", "wall_time_s", "figure/length",
   /// ...), flattened row-major over all rows.
   std::vector<double> read_double_column(const std::string& column) const;
