@@ -7,7 +7,8 @@
 //
 // Without --system: the paper's three oscillators (their shipped files).
 // With --system FILE or NAME (repeatable): those systems instead. Every
-// system through the steps of include/phnn/integrators/ph_steps.h.
+// system through the steps of include/phnn/integrators/integrator.h (every
+// integrator of its table).
 //   python3 analysis/plot_work_precision.py wp.csv docs/figures/
 //
 // Error: RMS over trajectories and the sample times t_k = k / 12.5 s
@@ -35,7 +36,7 @@
 
 #include "phnn/data/dataset.h"
 #include "phnn/data/ph_dataset.h"
-#include "phnn/integrators/ph_steps.h"
+#include "phnn/integrators/integrator.h"
 #include "phnn/systems/system_file.h"
 
 namespace phnn {
@@ -45,17 +46,6 @@ constexpr double kSampleInterval = 1.0 / 12.5;  // s: the coarsest h
 constexpr int kSamples = 50;                    // 4 s
 constexpr int kLevels = 9;                      // h = 1/12.5 ... 1/3200
 constexpr double kDivergedNorm = 1e6;
-
-enum class Method { kRk2, kDg, kRk4, kDg4 };
-const char* name_of(Method m) {
-  switch (m) {
-    case Method::kRk2: return "rk2";
-    case Method::kDg: return "dg";
-    case Method::kRk4: return "rk4";
-    case Method::kDg4: return "dg4";
-  }
-  return "?";
-}
 
 // Continuous port power p(x) = z(w)^T w + u^T y at the true effort gradH(x).
 double port_power(const PhSystem& sys, const VecX& x, const VecX& u) {
@@ -72,19 +62,17 @@ struct StepResult {
 
 // One step (ph_steps.h); with `diagnostics`, also the balance residual (kept
 // out of the timed passes: for RK it costs two more flow evaluations).
-StepResult<VecX> step(Method m, const PhSystem& sys, const VecX& x, const VecX& u, double h,
-                      bool diagnostics) {
+StepResult<VecX> step(IntegratorKind m, const PhSystem& sys, const VecX& x, const VecX& u,
+                      double h, bool diagnostics) {
   StepResult<VecX> r;
+  const PhImplicitStep s = ph_step(m, sys, x, u, h);
+  r.x_next = s.x_next;
   double power = 0.0;
-  if (m == Method::kDg || m == Method::kDg4) {
-    const PhImplicitStep s = m == Method::kDg ? ph_discrete_gradient_step(sys, x, u, h)
-                                              : ph_discrete_gradient4_step(sys, x, u, h);
-    r.x_next = s.x_next;
+  if (is_discrete_gradient(m)) {
     r.newton_failed = s.status != StepStatus::kConverged;
     power = -h * (s.flows.z.dot(s.flows.w) + u.dot(s.flows.y)) + h * h * h * s.correction_power;
-  } else {
-    r.x_next = m == Method::kRk2 ? ph_rk2_step(sys, x, u, h) : ph_rk4_step(sys, x, u, h);
-    if (diagnostics) power = -0.5 * h * (port_power(sys, x, u) + port_power(sys, r.x_next, u));
+  } else if (diagnostics) {
+    power = -0.5 * h * (port_power(sys, x, u) + port_power(sys, r.x_next, u));
   }
   if (!diagnostics) return r;
   const double H0 = sys.hamiltonian(x);
@@ -102,7 +90,7 @@ struct Run {
 };
 
 template <class System, class Spec>
-auto integrate(Method m, const System& osc, const Spec& spec, int steps_per_sample,
+auto integrate(IntegratorKind m, const System& osc, const Spec& spec, int steps_per_sample,
                bool diagnostics) {
   const double h = kSampleInterval / steps_per_sample;
   Run<std::decay_t<decltype(spec.x0)>> run;
@@ -161,11 +149,12 @@ template <class System, class Spec>
 void run_system(const std::string& name, const System& osc, const std::vector<Spec>& specs,
                 const Options& o) {
   const int ref_steps = (1 << (kLevels - 1)) * 64;
-  std::vector<decltype(integrate(Method::kRk4, osc, specs[0], 1, false))> reference;
+  std::vector<decltype(integrate(IntegratorKind::kRk4, osc, specs[0], 1, false))> reference;
   for (const auto& s : specs) {
-    reference.push_back(integrate(Method::kRk4, osc, s, ref_steps, false));
+    reference.push_back(integrate(IntegratorKind::kRk4, osc, s, ref_steps, false));
   }
-  for (Method m : {Method::kRk2, Method::kDg, Method::kRk4, Method::kDg4}) {
+  for (const Integrator& integrator : all_integrators()) {
+    const IntegratorKind m = integrator.kind;
     for (int level = 0; level < kLevels; ++level) {
       const int per_sample = 1 << level;
       // Timed passes integrate only; one more pass measures errors and balance.
@@ -196,7 +185,7 @@ void run_system(const std::string& name, const System& osc, const std::vector<Sp
         }
       }
       std::printf("%s,%s,%.10g,%d,%.6e,%.6e,%.6e,%.3e,%d,%d\n",
-                  name.c_str(), name_of(m),
+                  name.c_str(), to_string(m).c_str(),
                   kSampleInterval / per_sample, per_sample * kSamples,
                   std::sqrt(sum2 / (runs.size() * kSamples)), worst,
                   median(seconds), balance, failures, diverged);

@@ -42,24 +42,6 @@ inline Vec2 damped_harmonic_solution(const OscillatorOptions& o, const Vec2& x0,
   return Vec2(q, m * v);
 }
 
-/// Max-norm global error of DG (dg = true) or RK2 against the closed form,
-/// damped harmonic oscillator with u = 0.4 from (0.2, -0.1) over [0, t_end].
-inline double global_error(bool dg, double h, double t_end) {
-  const OscillatorOptions o = OscillatorOptions::defaults(SystemKind::kHarmonic);
-  const Oscillator osc(o);
-  const Vec2 x0(0.2, -0.1);
-  const double u = 0.4;
-  Vec2 x = x0;
-  double err = 0.0;
-  const int steps = static_cast<int>(std::lround(t_end / h));
-  for (int n = 1; n <= steps; ++n) {
-    x = dg ? discrete_gradient_step(osc, x, u, h).x_next
-           : explicit_midpoint_step(osc, x, u, h);
-    err = std::max(err, (x - damped_harmonic_solution(o, x0, u, n * h)).norm());
-  }
-  return err;
-}
-
 /// The bytes of the file at `path` ("" if it cannot be read).
 inline std::string read_all(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

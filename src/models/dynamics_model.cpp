@@ -51,6 +51,22 @@ torch::Tensor DynamicsModel::dg4_mean_l1_step(const torch::Tensor&, const torch:
   return {};
 }
 
+torch::Tensor DynamicsModel::mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                                          const torch::Tensor& x_next, const torch::Tensor& u,
+                                          double h, double min_dx_norm,
+                                          const JacobianPenalty& penalty) const {
+  switch (integrator) {
+    case IntegratorKind::kDg:
+      return dg_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty);
+    case IntegratorKind::kDg4:
+      return dg4_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty);
+    case IntegratorKind::kRk2:
+    case IntegratorKind::kRk4:
+      break;
+  }
+  return explicit_mean_l1_step(integrator, x, x_next, u, h, penalty);
+}
+
 torch::Tensor DynamicsModel::hamiltonian(const torch::Tensor&) const {
   PHNN_REQUIRE(false, "hamiltonian: " << to_string(options_.kind) << " has no Hamiltonian");
   return {};

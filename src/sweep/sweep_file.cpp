@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -40,12 +41,19 @@ std::vector<std::pair<ModelKind, IntegratorKind>> all_model_pairs() {
 }
 
 std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs() {
+  // The paper's five, then every other model an integrator of the table
+  // allows (NODE: no discrete gradient), integrator by integrator.
   auto pairs = all_model_pairs();
-  for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnJr, ModelKind::kPhnnS}) {
-    pairs.emplace_back(kind, IntegratorKind::kRk4);
+  for (const Integrator& in : all_integrators()) {
+    for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnJr, ModelKind::kPhnnS}) {
+      const std::pair<ModelKind, IntegratorKind> pair{kind, in.kind};
+      if ((kind == ModelKind::kNode && in.discrete_gradient) ||
+          std::find(pairs.begin(), pairs.end(), pair) != pairs.end()) {
+        continue;
+      }
+      pairs.push_back(pair);
+    }
   }
-  pairs.emplace_back(ModelKind::kPhnnJr, IntegratorKind::kDg4);
-  pairs.emplace_back(ModelKind::kPhnnS, IntegratorKind::kDg4);
   return pairs;
 }
 

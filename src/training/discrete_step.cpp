@@ -47,6 +47,39 @@ torch::Tensor explicit_step(const DynamicsModel& model, IntegratorKind integrato
   return {};
 }
 
+torch::Tensor training_step(const DynamicsModel& model, IntegratorKind integrator,
+                            const torch::Tensor& x, const torch::Tensor& x_next,
+                            const torch::Tensor& u, double h, double min_dx_norm,
+                            const torch::Tensor& k1) {
+  switch (integrator) {
+    case IntegratorKind::kDg:
+      return dg_training_step(model, x, x_next, u, h, min_dx_norm);
+    case IntegratorKind::kDg4:
+      return dg4_training_step(model, x, x_next, u, h, min_dx_norm);
+    case IntegratorKind::kRk2:
+    case IntegratorKind::kRk4:
+      break;
+  }
+  return explicit_step(model, integrator, x, u, h, k1);
+}
+
+DgInferenceStep inference_step(const DynamicsModel& model, IntegratorKind integrator,
+                               const torch::Tensor& x, const torch::Tensor& u, double h,
+                               const DgInferenceOptions& options, DgNewtonJacobian* cache) {
+  switch (integrator) {
+    case IntegratorKind::kDg:
+      return dg_inference_step(model, x, u, h, options, cache);
+    case IntegratorKind::kDg4:
+      return dg4_inference_step(model, x, u, h, options);
+    case IntegratorKind::kRk2:
+    case IntegratorKind::kRk4:
+      break;
+  }
+  DgInferenceStep s;
+  s.x_next = explicit_step(model, integrator, x, u, h);
+  return s;
+}
+
 torch::Tensor dg_training_step(const DynamicsModel& model, const torch::Tensor& x,
                                const torch::Tensor& x_next, const torch::Tensor& u, double h,
                                double min_dx_norm) {

@@ -44,21 +44,22 @@ torch::Tensor step_inputs(const CellData& data, int64_t B_inf, int64_t F, int st
 // too), so chunking changes the memory, not the bits.
 int64_t dg4_rollout_chunk = 0;
 
-// dg4_inference_step on the rows [s, s + chunk) in turn.
-DgInferenceStep dg4_step_in_chunks(const DynamicsModel& model, const torch::Tensor& x,
-                                   const torch::Tensor& u, double h,
-                                   const DgInferenceOptions& options) {
+// inference_step of `integrator`; DG4 on the rows [s, s + chunk) in turn
+// (its jets are what a rollout holds), the others on every row at once.
+DgInferenceStep step_in_chunks(const DynamicsModel& model, IntegratorKind integrator,
+                               const torch::Tensor& x, const torch::Tensor& u, double h,
+                               const DgInferenceOptions& options, DgNewtonJacobian* cache) {
   const int64_t B = x.size(1);
-  const int64_t chunk = dg4_rollout_chunk > 0
-                            ? dg4_rollout_chunk
-                            : dg4_chunk_rows(x.size(0), x.size(2), u.size(2));
-  if (B <= chunk) return dg4_inference_step(model, x, u, h, options);
+  const int64_t chunk = integrator != IntegratorKind::kDg4 ? B
+                        : dg4_rollout_chunk > 0            ? dg4_rollout_chunk
+                                                : dg4_chunk_rows(x.size(0), x.size(2), u.size(2));
+  if (B <= chunk) return inference_step(model, integrator, x, u, h, options, cache);
   std::vector<torch::Tensor> next, converged;
   DgInferenceStep out;
   for (int64_t s = 0; s < B; s += chunk) {
     const int64_t len = std::min(chunk, B - s);
     const DgInferenceStep part =
-        dg4_inference_step(model, x.narrow(1, s, len), u.narrow(1, s, len), h, options);
+        inference_step(model, integrator, x.narrow(1, s, len), u.narrow(1, s, len), h, options);
     next.push_back(part.x_next);
     converged.push_back(part.converged);
     out.iterations = std::max(out.iterations, part.iterations);
@@ -89,7 +90,6 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
   const DynamicsModel* model = &model_ref;
   const TrainerOptions& opt = cell.training;
   const int64_t E = model_ref.members();
-  const bool use_dg = is_discrete_gradient(cell.integrator);
   const int64_t nx = data.n_x, nu = data.n_u;
   const int64_t B_inf = static_cast<int64_t>(data.inference_count);
   const int steps = data.inference_steps;
@@ -129,15 +129,11 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
   for (int n = 1; n <= steps; ++n) {
     const torch::Tensor u =
         u_steps.defined() ? u_steps[n - 1].unsqueeze(0).expand({E, B, nu}).contiguous() : u_constant;
-    torch::Tensor next;
-    if (use_dg) {
-      const auto s = cell.integrator == IntegratorKind::kDg4
-                         ? dg4_step_in_chunks(*model, x, u, h_inf, dg_options)
-                         : dg_inference_step(*model, x, u, h_inf, dg_options, &newton_jacobian);
-      next = s.x_next;
+    const DgInferenceStep s =
+        step_in_chunks(*model, cell.integrator, x, u, h_inf, dg_options, &newton_jacobian);
+    const torch::Tensor& next = s.x_next;
+    if (s.converged.defined()) {
       newton_failures += (s.converged.logical_not() & diverged.logical_not()).sum(-1);
-    } else {
-      next = explicit_step(*model, cell.integrator, x, u, h_inf);
     }
     const auto bad = torch::isfinite(next).all(-1).logical_not() |
                      (internal::ordered_sum(next * next, 1).sqrt() > opt.divergence_norm);

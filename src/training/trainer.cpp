@@ -111,12 +111,7 @@ CellTrainer::Tensors CellTrainer::make_tensors() const {
 torch::Tensor CellTrainer::discrete_step(const torch::Tensor& x, const torch::Tensor& xn,
                                          const torch::Tensor& u,
                                          const torch::Tensor& f_at_x) const {
-  const DynamicsModel& m = *model_;
-  return cell_.integrator == IntegratorKind::kDg
-             ? dg_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
-         : cell_.integrator == IntegratorKind::kDg4
-             ? dg4_training_step(m, x, xn, u, h_, opt_.dg_min_dx_norm)
-             : explicit_step(m, cell_.integrator, x, u, h_, f_at_x);
+  return training_step(*model_, cell_.integrator, x, xn, u, h_, opt_.dg_min_dx_norm, f_at_x);
 }
 
 // Pairs per chunk of a validation pass: the jets of a chunk, not of all
@@ -210,16 +205,8 @@ torch::Tensor CellTrainer::loss_and_gradients(const torch::Tensor& x, const torc
                                               const torch::Tensor& u) {
   const bool regularized = cell_.regularizer != Regularizer::kNone;
   if (opt_.loss_norm == LossNorm::kMeanL1) {
-    torch::Tensor loss;
-    if (cell_.integrator == IntegratorKind::kRk2 || cell_.integrator == IntegratorKind::kRk4) {
-      loss = model_->explicit_mean_l1_step(cell_.integrator, x, xn, u, h_, penalty_);
-    }
-    if (cell_.integrator == IntegratorKind::kDg) {
-      loss = model_->dg_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
-    }
-    if (cell_.integrator == IntegratorKind::kDg4) {
-      loss = model_->dg4_mean_l1_step(x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
-    }
+    const torch::Tensor loss =
+        model_->mean_l1_step(cell_.integrator, x, xn, u, h_, opt_.dg_min_dx_norm, penalty_);
     if (loss.defined()) return loss;
   }
   // A regularizer needs df/dx at the batch; the same evaluation's f is an

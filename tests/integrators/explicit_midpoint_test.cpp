@@ -21,11 +21,5 @@ TEST(ExplicitMidpointTest, MatchesSecondOrderTaylorOnLinearScalarField) {
   EXPECT_NEAR(x1(1), factor * x0(1), 1e-16);
 }
 
-TEST(ExplicitMidpointTest, IsSecondOrderOnDampedHarmonicOscillator) {
-  const double e1 = testing_util::global_error(/*dg=*/false, 1e-2, 2.0);
-  const double e2 = testing_util::global_error(/*dg=*/false, 5e-3, 2.0);
-  EXPECT_NEAR(std::log2(e1 / e2), 2.0, 0.1) << e1 << " " << e2;
-}
-
 }  // namespace
 }  // namespace phnn

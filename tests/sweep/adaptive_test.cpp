@@ -212,7 +212,9 @@ TEST(AdaptiveRoundsTest, SpeculationTakesTheNextBatchOfTheCellsTheRoundGrows) {
   ASSERT_EQ(ahead.size(), grid.cells.size());
   std::vector<int> seeds;
   for (std::size_t c = 0; c < ahead.size(); ++c) {
-    if (static_cast<int>(c) != rk4_cell) EXPECT_TRUE(ahead[c].empty()) << "cell " << c;
+    if (static_cast<int>(c) != rk4_cell) {
+      EXPECT_TRUE(ahead[c].empty()) << "cell " << c;
+    }
   }
   for (int row : ahead[static_cast<std::size_t>(rk4_cell)]) {
     seeds.push_back(grid.runs[static_cast<std::size_t>(row)].seed);

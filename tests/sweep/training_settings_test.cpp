@@ -142,7 +142,9 @@ TEST(TrainingSettingsTest, EveryKeyIsReadFromASweepFileIntoItsField) {
   const TrainerOptions& t = spec.training;
   for (const TrainingSetting& s : training_settings()) {
     EXPECT_FALSE(s.is_default(t)) << s.key;
-    if (s.kind == TrainingSetting::Kind::kReal) EXPECT_EQ(t.*s.real, 0.125) << s.key;
+    if (s.kind == TrainingSetting::Kind::kReal) {
+      EXPECT_EQ(t.*s.real, 0.125) << s.key;
+    }
   }
   const auto with_key = [](const std::string& key) -> const TrainingSetting* {
     for (const TrainingSetting& s : training_settings()) {

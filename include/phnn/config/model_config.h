@@ -5,20 +5,13 @@
 #include <vector>
 
 #include "phnn/common/enum_names.h"
+#include "phnn/integrators/integrator.h"  // IntegratorKind
 
 namespace phnn {
 
 /// Model formulation (paper §4.1): NODE baseline, PHNN-S (eq:f_theta-PHS-DAF),
 /// PHNN-JR (eq:f_theta-PHS-JR).
 enum class ModelKind { kNode = 0, kPhnnS = 1, kPhnnJr = 2 };
-/// Discrete-model integrator (Eqs. 26, 28-30): explicit midpoint or the
-/// Gonzalez discrete gradient. NODE supports RK2 only.
-enum class IntegratorKind { kRk2 = 0, kDg = 1, kRk4 = 2, kDg4 = 3 };
-/// DG and DG4: need a Hamiltonian, are inverse-explicit in training and
-/// implicit (Newton) at inference.
-inline bool is_discrete_gradient(IntegratorKind kind) {
-  return kind == IntegratorKind::kDg || kind == IntegratorKind::kDg4;
-}
 /// Network size (paper Tables 10-12, docs/METHOD.md §3).
 enum class ModelSize { kSmall = 0, kMedium = 1, kLarge = 2 };
 
@@ -39,16 +32,12 @@ struct ModelStructure {
 
 inline constexpr EnumNames<ModelKind, 3> kModelNames{
     "model", {{{ModelKind::kNode, "node"}, {ModelKind::kPhnnS, "phnn-s"}, {ModelKind::kPhnnJr, "phnn-jr"}}}};
-inline constexpr EnumNames<IntegratorKind, 4> kIntegratorNames{
-    "integrator", {{{IntegratorKind::kRk2, "rk2"}, {IntegratorKind::kDg, "dg"},
-                    {IntegratorKind::kRk4, "rk4"}, {IntegratorKind::kDg4, "dg4"}}}};
 inline constexpr EnumNames<ModelSize, 3> kSizeNames{
     "size", {{{ModelSize::kSmall, "small"}, {ModelSize::kMedium, "medium"}, {ModelSize::kLarge, "large"}}}};
 inline constexpr EnumNames<DgStructurePoint, 2> kDgStructurePointNames{
     "DG structure point", {{{DgStructurePoint::kMidpoint, "midpoint"}, {DgStructurePoint::kStart, "start"}}}};
 
 inline std::string to_string(ModelKind kind) { return kModelNames.name(kind); }
-inline std::string to_string(IntegratorKind kind) { return kIntegratorNames.name(kind); }
 inline std::string to_string(ModelSize size) { return kSizeNames.name(size); }
 inline std::string to_string(DgStructurePoint point) { return kDgStructurePointNames.name(point); }
 /// Every DgStructurePoint, default first.
@@ -57,7 +46,6 @@ inline std::vector<DgStructurePoint> all_dg_structure_points() { return kDgStruc
 /// Parsers: throw std::invalid_argument naming the value and listing the
 /// allowed values.
 inline ModelKind parse_model(const std::string& name) { return kModelNames.parse(name); }
-inline IntegratorKind parse_integrator(const std::string& name) { return kIntegratorNames.parse(name); }
 inline ModelSize parse_size(const std::string& name) { return kSizeNames.parse(name); }
 
 /// Hidden widths of each MLP of a model (docs/METHOD.md §3 table).

@@ -105,6 +105,11 @@ class DynamicsModel {
   virtual torch::Tensor dg4_mean_l1_step(const torch::Tensor& x, const torch::Tensor& x_next,
                                          const torch::Tensor& u, double h, double min_dx_norm,
                                          const JacobianPenalty& penalty) const;
+  /// The hand-written training step of `integrator`: one of the three above
+  /// (undefined where the model has none).
+  torch::Tensor mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
+                             const torch::Tensor& x_next, const torch::Tensor& u, double h,
+                             double min_dx_norm, const JacobianPenalty& penalty) const;
   /// H_theta(x) [E, B] and gradH_theta(x) [E, B, n_x] (PH models only).
   virtual torch::Tensor hamiltonian(const torch::Tensor& x) const;
   virtual torch::Tensor grad_hamiltonian(const torch::Tensor& x) const;

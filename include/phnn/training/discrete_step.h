@@ -38,6 +38,14 @@ torch::Tensor dg4_training_step(const DynamicsModel& model, const torch::Tensor&
                                 const torch::Tensor& x_next, const torch::Tensor& u, double h,
                                 double min_dx_norm);
 
+/// The training step of `integrator`, x_hat from the data pair (x, x_next):
+/// explicit_step for RK2/RK4 (x_next unused; `k1` as there), the inverse-
+/// explicit dg_training_step / dg4_training_step for DG/DG4.
+torch::Tensor training_step(const DynamicsModel& model, IntegratorKind integrator,
+                            const torch::Tensor& x, const torch::Tensor& x_next,
+                            const torch::Tensor& u, double h, double min_dx_norm,
+                            const torch::Tensor& k1 = {});
+
 /// The discrete loss L_d per member [E] of predictions x_hat for data x_next
 /// ([E, B, 2] both) at step h, in `norm` (docs/METHOD.md §4, "Loss"); with
 /// e = x_next - x_hat:
@@ -64,8 +72,8 @@ struct DgNewtonJacobian {
 };
 
 struct DgInferenceStep {
-  torch::Tensor x_next;     // [E, B, 2]
-  torch::Tensor converged;  // [E, B] bool
+  torch::Tensor x_next;          // [E, B, n_x]
+  torch::Tensor converged;       // [E, B] bool (undefined for an explicit step)
   int iterations = 0;            // Newton updates of the slowest row
   int jacobian_evaluations = 0;  // batched Jacobian evaluations
 };
@@ -93,5 +101,13 @@ DgInferenceStep dg_inference_step(const DynamicsModel& model, const torch::Tenso
 DgInferenceStep dg4_inference_step(const DynamicsModel& model, const torch::Tensor& x,
                                    const torch::Tensor& u, double h,
                                    const DgInferenceOptions& options = {});
+
+/// One inference (rollout) step of `integrator`: explicit_step for RK2/RK4
+/// (`converged` left undefined: no Newton), dg_inference_step (with `cache`)
+/// or dg4_inference_step for DG/DG4.
+DgInferenceStep inference_step(const DynamicsModel& model, IntegratorKind integrator,
+                               const torch::Tensor& x, const torch::Tensor& u, double h,
+                               const DgInferenceOptions& options = {},
+                               DgNewtonJacobian* cache = nullptr);
 
 }  // namespace phnn
