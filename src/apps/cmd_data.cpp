@@ -8,10 +8,11 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "phnn/common/counted.h"
+#include "phnn/common/number_text.h"
 #include "phnn/data/measured.h"
 #include "phnn/store/output_path.h"
-#include "phnn/store/scratch_file.h"
 #include "phnn/store/ph_dataset_file.h"
+#include "phnn/store/scratch_file.h"
 #include "phnn/store/trajectory_files.h"
 #include "phnn/systems/system_file.h"
 
@@ -105,10 +106,15 @@ int run_data(int argc, char** argv, int first) {
                      "Example: phnn data --system duffing --n-train 100 --out duffing.h5 --csv duffing.csv");
   parser.option("system", "harmonic | duffing | self-sustained | a system file (.toml)", "", true);
   parser.option("out", "output HDF5 file", "", true);
-  parser.option("n-train", "training pairs to generate (<= 400)", "400");
-  parser.option("data-seed", "seed of the counter-based RNG", "0");
-  parser.option("damping", "c of z(w) = c w [N s/m] (harmonic, duffing)", "0.14737");
-  parser.option("mass", "m [kg]", "0.16");
+  const DatasetOptions data_defaults;
+  const OscillatorOptions physics_defaults;
+  parser.option("n-train", "training pairs to generate (<= [data] num_train_max)",
+                std::to_string(data_defaults.num_train_max));
+  parser.option("data-seed", "seed of the counter-based RNG ([data] seed)",
+                std::to_string(data_defaults.data_seed));
+  parser.option("damping", "c of z(w) = c w [N s/m] (harmonic, duffing)",
+                shortest_number(physics_defaults.damping));
+  parser.option("mass", "m [kg]", shortest_number(physics_defaults.mass));
   parser.option("csv", "also write the trajectories behind the splits to this CSV "
                        "(`phnn import`'s format)");
   parser.option("noise", "measurement noise on the training and validation pairs: one level for "

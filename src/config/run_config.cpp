@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "phnn/common/number_text.h"
+#include "phnn/config/data_settings.h"
 #include "phnn/config/training_settings.h"
 
 namespace phnn {
@@ -35,47 +35,16 @@ std::string RunConfig::system_name() const {
 
 namespace {
 
-// A built-in system: only the parameters it uses, then the data options.
+// A built-in system: only the parameters it uses, then the data options
+// (phnn/config/data_settings.h).
 void builtin_system_key(const RunConfig& run, std::ostringstream& s) {
-  const OscillatorOptions& physics = run.physics;
-  const DatasetOptions& data = run.data;
-  const SystemKind system = run.system;
-  s << ";mass=" << exact_number(physics.mass) << ";stiffness=" << exact_number(physics.stiffness);
-  if (system == SystemKind::kDuffing) {
-    s << ";cubic_stiffness=" << exact_number(physics.cubic_stiffness);
-  }
-  if (system == SystemKind::kSelfSustained) {
-    s << ";z=" << exact_number(physics.z_coefficients[0]) << ","
-      << exact_number(physics.z_coefficients[1]) << "," << exact_number(physics.z_coefficients[2]);
-  } else {
-    s << ";damping=" << exact_number(physics.damping);
-  }
-  s << ";data_seed=" << data.data_seed << ";h_gen=" << exact_number(data.generation_step)
-    << ";period=" << exact_number(data.period) << ";alpha=" << exact_number(data.alpha)
-    << ";beta=" << exact_number(data.beta) << ";sample_rate=" << exact_number(data.sample_rate)
-    << ";e0=" << exact_number(data.energy_min) << "," << exact_number(data.energy_max)
-    << ";eeq=" << exact_number(data.equilibrium_energy_min) << ","
-    << exact_number(data.equilibrium_energy_max) << ";n_traj=" << data.num_trajectories
-    << ";splits=" << data.num_train_max << "," << data.num_validation << "," << data.num_inference
-    << ";gen_tol=" << exact_number(data.newton.newton_tolerance);
-  // Algorithm 1 only (harmonic, self-sustained); only away from the default.
-  if (system != SystemKind::kDuffing && data.energy_sampling != EnergySampling::kAlgorithm1) {
-    s << ";energy_sampling=" << to_string(data.energy_sampling);
-  }
+  s << physics_key(run.physics, run.system) << data_key(run.data, /*builtin=*/true, run.system);
 }
 
 // A system file: its text (hash) holds the parameters, the energy intervals
 // and the designs; the data options below are the ones its data use.
 void file_system_key(const RunConfig& run, std::ostringstream& s) {
-  const DatasetOptions& data = run.data;
-  s << ";system_file=" << run.system_file_hash << ";data_seed=" << data.data_seed
-    << ";h_gen=" << exact_number(data.generation_step) << ";period=" << exact_number(data.period)
-    << ";sample_rate=" << exact_number(data.sample_rate) << ";n_traj=" << data.num_trajectories
-    << ";splits=" << data.num_train_max << "," << data.num_validation << "," << data.num_inference
-    << ";gen_tol=" << exact_number(data.newton.newton_tolerance);
-  if (data.energy_sampling != EnergySampling::kAlgorithm1) {
-    s << ";energy_sampling=" << to_string(data.energy_sampling);
-  }
+  s << ";system_file=" << run.system_file_hash << data_key(run.data, /*builtin=*/false, run.system);
 }
 
 }  // namespace

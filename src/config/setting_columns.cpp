@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "phnn/config/data_settings.h"
 #include "phnn/config/training_settings.h"
 
 namespace phnn {
@@ -38,18 +39,15 @@ namespace {
 // name per part. Keys not listed, or with another number of parts, keep their
 // canonical name and value. The training settings' come from their table
 // (phnn/config/training_settings.h; "lambda" stands for one of three and
-// keeps its name); the data and physics ones are these.
+// keeps its name), the data and physics ones from theirs
+// (phnn/config/data_settings.h).
 const std::map<std::string, std::vector<std::string>>& column_names() {
   static const std::map<std::string, std::vector<std::string>> names = [] {
-    std::map<std::string, std::vector<std::string>> m = {
-        {"h_gen", {"generation_step"}},
-        {"e0", {"energy_min", "energy_max"}},
-        {"eeq", {"equilibrium_energy_min", "equilibrium_energy_max"}},
-        {"n_traj", {"num_trajectories"}},
-        {"splits", {"num_train_max", "num_validation", "num_inference"}},
-        {"gen_tol", {"generation_newton_tolerance"}},
-        {"z", {"z1", "z2", "z3"}},
-    };
+    std::map<std::string, std::vector<std::string>> m;
+    for (const PhysicsSetting& s : physics_settings()) {
+      m[s.canonical].assign(s.columns.begin(), s.columns.end());
+    }
+    for (const DataSetting& s : data_settings()) m[s.canonical].push_back(s.column);
     for (const TrainingSetting& s : training_settings()) {
       if (s.in_key != TrainingSetting::InKey::kRegularizer) m[s.canonical].push_back(s.key);
     }

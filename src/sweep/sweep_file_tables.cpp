@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 
+#include "phnn/config/data_settings.h"
 #include "phnn/config/study_defaults.h"
 #include "phnn/config/training_settings.h"
 #include "phnn/sweep/output_check.h"
@@ -409,27 +410,30 @@ class TableWalker {
     return [this, &field, min](const Entry& e) { field = values_.int_at_least(e, min); };
   }
 
+  // Every setting of the table (phnn/config/data_settings.h).
   Handlers data_handlers(DatasetOptions& d) const {
-    return {{"seed",
-             [this, &d](const Entry& e) {
-               d.data_seed = static_cast<std::uint64_t>(
-                   values_.integer(e, *e.value, 0, INT64_MAX, "an integer >= 0"));
-             }},
-            {"generation_step", number(d.generation_step)},
-            {"period", number(d.period)},
-            {"alpha", number(d.alpha)},
-            {"beta", number(d.beta)},
-            {"sample_rate", number(d.sample_rate)},
-            {"energy_min", number(d.energy_min)},
-            {"energy_max", number(d.energy_max)},
-            {"energy_sampling", choice(d.energy_sampling, &all_energy_samplings)},
-            {"equilibrium_energy_min", number(d.equilibrium_energy_min)},
-            {"equilibrium_energy_max", number(d.equilibrium_energy_max)},
-            {"num_trajectories", integer(d.num_trajectories, 1)},
-            {"num_train_max", integer(d.num_train_max, 1)},
-            {"num_validation", integer(d.num_validation, 1)},
-            {"num_inference", integer(d.num_inference, 1)},
-            {"newton_tolerance", number(d.newton.newton_tolerance)}};
+    Handlers h;
+    for (const DataSetting& s : data_settings()) {
+      switch (s.kind) {
+        case DataSetting::Kind::kReal:
+          h.emplace_back(s.key, [this, &d, &s](const Entry& e) {
+            s.set_real(&d, values_.number(e, *e.value));
+          });
+          break;
+        case DataSetting::Kind::kInteger:
+          h.emplace_back(s.key, [this, &d, &s](const Entry& e) {
+            s.set_integer(&d, values_.integer(e, *e.value, s.min_integer, s.max_integer,
+                                              "an integer >= " + std::to_string(s.min_integer)));
+          });
+          break;
+        case DataSetting::Kind::kChoice:
+          h.emplace_back(s.key, [this, &d, &s](const Entry& e) {
+            s.set_choice(&d, static_cast<int>(values_.choice_index(e, s.choices())));
+          });
+          break;
+      }
+    }
+    return h;
   }
 
   // Every setting of the table (phnn/config/training_settings.h), then
@@ -459,15 +463,20 @@ class TableWalker {
   }
 
   // Only the parameters the system uses (RunConfig::cell_key() hashes exactly
-  // these), so a key that would be silently ignored is an error instead.
+  // these; phnn/config/data_settings.h), so a key that would be silently
+  // ignored is an error instead.
   Handlers physics_handlers(SystemKind kind, OscillatorOptions& p) const {
-    Handlers h = {{"mass", number(p.mass)}, {"stiffness", number(p.stiffness)}};
-    if (kind == SystemKind::kDuffing) h.emplace_back("cubic_stiffness", number(p.cubic_stiffness));
-    if (kind != SystemKind::kSelfSustained) {
-      h.emplace_back("damping", number(p.damping));
-    } else {
-      h.emplace_back("z_coefficients",
-                     [this, &p](const Entry& e) { p.z_coefficients = values_.three_numbers(e); });
+    Handlers h;
+    for (const PhysicsSetting& s : physics_settings()) {
+      if (!s.applies_to(kind)) continue;
+      h.emplace_back(s.key, [this, &p, &s](const Entry& e) {
+        if (s.columns.size() == 3) {
+          const std::array<double, 3> v = values_.three_numbers(e);
+          s.set(&p, {v[0], v[1], v[2]});
+        } else {
+          s.set(&p, {values_.number(e, *e.value)});
+        }
+      });
     }
     return h;
   }
