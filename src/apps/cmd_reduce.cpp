@@ -254,12 +254,30 @@ void warn_unfinished_replay(const Inputs& in, const AdaptiveState& state,
             << path << " finished)\n";
 }
 
+// A record's results made unknown: pending, every double NaN, `message`.
+void forget_results(RunRecord* r, const std::string& message) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  r->result = RunResult{};
+  for (const ResultColumn& c : result_columns()) {
+    if (c.type == ResultColumn::Type::kDouble) c.set_double(r->result, nan);
+  }
+  r->result.message = message;
+  r->trace_points = 0;
+  r->initial_validation_loss = r->final_train_loss = r->final_validation_loss = nan;
+  r->final_kappa = r->final_sigma_max = r->final_rho = nan;
+  r->checkpoint_steps.clear();
+  r->checkpoint_mse.clear();
+  r->checkpoint_train_seconds.clear();
+}
+
 // One record per run of the view (a run the file lacks: pending, its
-// configuration from the grid).
+// configuration from the grid). A damaged row reads as pending with
+// unknown results (its stored numbers are not to be trusted).
 std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
   std::vector<RunRecord> rows = read_run_records(file, in.own_grid);
   for (int row : in.damaged) {
-    rows[static_cast<std::size_t>(row)].result.status = RunStatus::kPending;
+    forget_results(&rows[static_cast<std::size_t>(row)],
+                   "damaged row: `phnn verify " + file.path() + "` names the damage");
   }
   std::vector<RunRecord> records(in.view.row.size());
   for (std::size_t i = 0; i < records.size(); ++i) {
@@ -275,14 +293,7 @@ std::vector<RunRecord> view_records(const ResultsFile& file, const Inputs& in) {
     for (const std::string& s : in.view.grid.run_studies[i]) {
       r.studies += (r.studies.empty() ? "" : ",") + s;
     }
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    for (const ResultColumn& c : result_columns()) {
-      if (c.type == ResultColumn::Type::kDouble) c.set_double(r.result, nan);
-    }
-    r.initial_validation_loss = nan;
-    r.final_train_loss = r.final_validation_loss = r.final_kappa = r.final_sigma_max = nan;
-    r.final_rho = nan;
-    r.result.message = "not in " + file.path();
+    forget_results(&r, "not in " + file.path());
   }
   return records;
 }

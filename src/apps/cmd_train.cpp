@@ -19,6 +19,7 @@
 #include "apps/train_cell_file.h"
 #include "phnn/common/counted.h"
 #include "phnn/common/closest_name.h"
+#include "phnn/common/number_text.h"
 #include "phnn/common/utc_time.h"
 #include "phnn/config/study_defaults.h"
 #include "phnn/config/training_settings.h"
@@ -56,15 +57,24 @@ void require_new_output(const cli::Parser& parser) {
 void declare_train_options(cli::Parser* parser) {
   parser->option("system", "harmonic | duffing | self-sustained | a system file (.toml); with "
                            "--data: optional (the data set names its system)");
+  std::string models, integrators;
+  for (const auto& [kind, integrator] : known_model_pairs()) {
+    models += (models.empty() ? "" : ", ") + model_key(kind, integrator);
+  }
+  for (const std::string& name : kIntegratorNames.names()) {
+    integrators += (integrators.empty() ? "" : " | ") + name;
+  }
   parser->option("model",
-                 "formulation-integrator as in sweep files: node-rk2, node-rk4, phnn-s-rk2, "
-                 "phnn-s-dg, phnn-s-rk4, phnn-s-dg4, phnn-jr-rk2, phnn-jr-dg, phnn-jr-rk4, "
-                 "phnn-jr-dg4 (the older `--model phnn-s --integrator dg` still works)",
+                 "formulation-integrator as in sweep files: " + models +
+                     " (the older `--model phnn-s --integrator dg` still works)",
                  "", true);
-  parser->option("integrator", "old spelling: rk2 | dg | rk4 | dg4 with --model node|phnn-s|phnn-jr",
-                 "rk2");
+  parser->option("integrator", "old spelling: " + integrators + " with --model node|phnn-s|phnn-jr",
+                 to_string(IntegratorKind::kRk2));
   parser->option("size", "small | medium | large", to_string(kDefaultSize));
-  parser->option("n-train", "training pairs (1..400)", std::to_string(kDefaultNTrain));
+  parser->option("n-train",
+                 "training pairs (1..[data] num_train_max = " +
+                     std::to_string(DatasetOptions().num_train_max) + ")",
+                 std::to_string(kDefaultNTrain));
   parser->option("reg", "none | cn | sn | sr", to_string(kDefaultRegularizer));
   parser->option("seeds", "model seeds, e.g. 0-9 or 0,3,5",
                  "0-" + std::to_string(kDefaultSeedCount - 1));
@@ -81,8 +91,10 @@ void declare_train_options(cli::Parser* parser) {
     parser->option(s.flag, help, s.text(defaults));
   }
   parser->option("data", "read the data set from this file (`phnn data`) instead of generating it");
-  parser->option("data-seed", "data-set seed when generating", "0");
-  parser->option("damping", "c of z(w) = c w [N s/m] when generating", "0.14737");
+  parser->option("data-seed", "data-set seed when generating ([data] seed)",
+                 std::to_string(DatasetOptions().data_seed));
+  parser->option("damping", "c of z(w) = c w [N s/m] when generating",
+                 shortest_number(OscillatorOptions().damping));
   parser->option("threads", "LibTorch intra-op threads", "1");
   parser->option("out", "also write the runs to this results file (readable by `phnn reduce`)");
   parser->flag("quiet", "no progress line");
@@ -92,8 +104,8 @@ void declare_train_options(cli::Parser* parser) {
 // --model phnn-jr [--integrator rk2], accepted with a note.
 void parse_model_option(const cli::Parser& parser, CellSpec* cell) {
   const std::string name = parser.get("model");
-  for (const char* integrator : {"rk2", "dg", "rk4", "dg4"}) {
-    const std::string suffix = std::string("-") + integrator;
+  for (const std::string& integrator : kIntegratorNames.names()) {
+    const std::string suffix = "-" + integrator;
     if (name.size() <= suffix.size() ||
         name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
       continue;
@@ -110,8 +122,8 @@ void parse_model_option(const cli::Parser& parser, CellSpec* cell) {
     cell->model = parse_model(name);
   } catch (const std::invalid_argument&) {
     std::vector<std::string> labels;
-    for (const char* f : {"node", "phnn-s", "phnn-jr"}) {
-      for (const char* i : {"rk2", "rk4", "dg", "dg4"}) labels.push_back(std::string(f) + "-" + i);
+    for (const auto& [kind, integrator] : known_model_pairs()) {
+      labels.push_back(model_key(kind, integrator));
     }
     const std::string near = closest_name(name, labels);
     throw cli::UsageError{"phnn train: --model \"" + name + "\"" +

@@ -3,7 +3,6 @@
 // write. Touches no file.
 #include "phnn/config/data_settings.h"
 
-#include <charconv>
 #include <cstdint>
 
 #include "phnn/common/number_text.h"
@@ -39,6 +38,7 @@ DataSetting seed() {
       InKey::kAlways, "data seed: keys every random stream with (seed, system, trajectory)"};
   s.get_integer = [](const D& d) { return static_cast<std::int64_t>(d.data_seed); };
   s.set_integer = [](D* d, std::int64_t v) { d->data_seed = static_cast<std::uint64_t>(v); };
+  s.get_text = [](const D& d) { return std::to_string(d.data_seed); };
   s.min_integer = 0;
   s.max_integer = INT64_MAX;
   return s;
@@ -58,7 +58,7 @@ DataSetting energy_sampling() {
                 "energy_sampling",
                 Kind::kChoice,
                 "energy_sampling",
-                InKey::kAwayFromDefault,
+                InKey::kEnergySampling,
                 "initial energy of harmonic and self-sustained trajectories from r ~ U(I_E0): "
                 "`algorithm1` = E0 = √r (the paper's Algorithm 1 as printed, H(x0) ∈ [√E_min, "
                 "√E_max]); `direct` = E0 = r (H(x0) ∈ I_E0). Duffing (Algorithm 2) ignores it; a "
@@ -71,20 +71,13 @@ DataSetting energy_sampling() {
   return s;
 }
 
-// A default as the docs show it: the shortest text that reads back to the
-// same double (100, not %g's 1e+02).
-std::string doc_number(double value) {
-  char buf[32];
-  return std::string(buf, std::to_chars(buf, buf + sizeof buf, value).ptr);
-}
-
 bool in_key(const DataSetting& s, const D& d, bool builtin, SystemKind system) {
   switch (s.in_key) {
     case InKey::kAlways:
       return true;
     case InKey::kBuiltin:
       return builtin;
-    case InKey::kAwayFromDefault:
+    case InKey::kEnergySampling:
       return s.text(d) != s.text(D()) && !(builtin && system == SystemKind::kDuffing);
   }
   return false;
@@ -132,6 +125,7 @@ const std::vector<DataSetting>& data_settings() {
 }
 
 std::string DataSetting::text(const DatasetOptions& d) const {
+  if (get_text) return get_text(d);
   switch (kind) {
     case Kind::kReal:
       return exact_number(get_real(d));
@@ -228,7 +222,7 @@ std::string data_settings_markdown() {
     switch (s.kind) {
       case Kind::kReal:
         values = "number";
-        value = "`" + doc_number(s.get_real(defaults)) + "`";
+        value = "`" + roundtrip_number(s.get_real(defaults)) + "`";
         break;
       case Kind::kInteger:
         values = "integer >= " + std::to_string(s.min_integer);
@@ -251,7 +245,7 @@ std::string physics_settings_markdown() {
     const std::vector<double> values = s.get(OscillatorOptions::defaults(s.systems.front()));
     std::string value, systems, columns;
     for (std::size_t i = 0; i < values.size(); ++i)
-      value += (i ? ", " : "") + doc_number(values[i]);
+      value += (i ? ", " : "") + roundtrip_number(values[i]);
     if (values.size() > 1) value = "[" + value + "]";
     for (SystemKind k : s.systems) systems += (systems.empty() ? "" : ", ") + to_string(k);
     for (const char* c : s.columns)

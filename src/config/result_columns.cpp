@@ -2,6 +2,8 @@
 // (include/phnn/config/result_columns.h) and its accessors.
 #include "phnn/config/result_columns.h"
 
+#include <stdexcept>
+
 namespace phnn {
 
 namespace {
@@ -75,10 +77,22 @@ std::vector<ResultColumn> make_columns() {
   };
 }
 
+// A column added later reads NaN where it is missing: a double.
+std::vector<ResultColumn> checked_columns() {
+  std::vector<ResultColumn> columns = make_columns();
+  for (const ResultColumn& c : columns) {
+    if (c.added_later && c.type != Type::kDouble) {
+      throw std::logic_error(std::string("result column ") + c.name +
+                             ": only a double can be added later (NaN where it is missing)");
+    }
+  }
+  return columns;
+}
+
 }  // namespace
 
 const std::vector<ResultColumn>& result_columns() {
-  static const std::vector<ResultColumn> columns = make_columns();
+  static const std::vector<ResultColumn> columns = checked_columns();
   return columns;
 }
 

@@ -4,6 +4,7 @@
 #include "phnn/config/training_settings.h"
 
 #include "phnn/common/number_text.h"
+#include "phnn/integrators/integrator.h"
 
 namespace phnn {
 namespace {

@@ -51,20 +51,22 @@ torch::Tensor DynamicsModel::dg4_mean_l1_step(const torch::Tensor&, const torch:
   return {};
 }
 
+// An integrator without a case has no hand-written step: undefined, and the
+// trainer runs autograd on training_step.
 torch::Tensor DynamicsModel::mean_l1_step(IntegratorKind integrator, const torch::Tensor& x,
                                           const torch::Tensor& x_next, const torch::Tensor& u,
                                           double h, double min_dx_norm,
                                           const JacobianPenalty& penalty) const {
   switch (integrator) {
+    case IntegratorKind::kRk2:
+    case IntegratorKind::kRk4:
+      return explicit_mean_l1_step(integrator, x, x_next, u, h, penalty);
     case IntegratorKind::kDg:
       return dg_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty);
     case IntegratorKind::kDg4:
       return dg4_mean_l1_step(x, x_next, u, h, min_dx_norm, penalty);
-    case IntegratorKind::kRk2:
-    case IntegratorKind::kRk4:
-      break;
   }
-  return explicit_mean_l1_step(integrator, x, x_next, u, h, penalty);
+  return {};
 }
 
 torch::Tensor DynamicsModel::hamiltonian(const torch::Tensor&) const {

@@ -2,7 +2,6 @@
 #include "phnn/report/per_run.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -10,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "phnn/common/number_text.h"
 #include "phnn/config/setting_columns.h"
 #include "report/csv.h"
 
@@ -25,9 +25,7 @@ using internal::csv_field;
 std::string csv_double(double value) {
   if (std::isnan(value)) return "nan";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char buf[40];
-  const auto end = std::to_chars(buf, buf + sizeof buf, value).ptr;
-  return std::string(buf, end);
+  return roundtrip_number(value);
 }
 
 // A configuration value as the canonical key spells it (%.17g numbers): a

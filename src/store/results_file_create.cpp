@@ -48,15 +48,24 @@ struct DatasetMaker {
   }
 };
 
+// "a, b or c".
+std::string one_of(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  }
+  return out;
+}
+
 void create_config_datasets(const DatasetMaker& make) {
   const std::uint64_t R = make.rows;
   make.text(kId, kIdLength, "RunConfig::id(): FNV-1a 64 of canonical, 16 hex digits");
   make.text(kCanonical, kCanonicalLength, "RunConfig::canonical()");
   make.text(kSystem, kNameLength, "harmonic, duffing or self-sustained");
-  make.text(kModel, kNameLength, "node, phnn-s or phnn-jr");
-  make.text(kIntegrator, kNameLength, "rk2, dg, rk4 or dg4");
-  make.text(kSize, kNameLength, "small, medium or large");
-  make.text(kRegularizer, kNameLength, "none, cn, sn or sr");
+  make.text(kModel, kNameLength, one_of(kModelNames.names()));
+  make.text(kIntegrator, kNameLength, one_of(kIntegratorNames.names()));
+  make.text(kSize, kNameLength, one_of(kSizeNames.names()));
+  make.text(kRegularizer, kNameLength, one_of(kRegularizerNames.names()));
   make.ints(kNTrain, {R}, "training pairs");
   make.ints(kSeed, {R}, "model initialization seed");
   make.ints(kStates, {R}, "states of the run's system (n_x): the valid columns of /runs/figure/*");

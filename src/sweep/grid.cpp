@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "phnn/common/number_text.h"
+#include "phnn/integrators/integrator.h"
 
 namespace phnn {
 

@@ -14,6 +14,7 @@
 #include <cstring>
 
 #include "phnn/config/run_config.h"
+#include "phnn/integrators/integrator.h"
 #include "phnn/store/ph_dataset_file.h"
 #include "phnn/systems/system_file.h"
 #include "sweep/sweep_file_source.h"

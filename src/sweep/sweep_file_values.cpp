@@ -11,6 +11,7 @@
 #include <set>
 
 #include "phnn/common/closest_name.h"
+#include "phnn/integrators/integrator.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/systems/ph_system.h"
 
@@ -315,22 +316,30 @@ std::pair<ModelKind, IntegratorKind> ValueReader::model(const toml::node& v) con
     allowed.push_back(model_key(kind, integrator));
   }
   const std::string expected = "; expected one of: " + join(allowed);
-  if (s == "node-dg" || s == "node-dg4") {
-    fail(line_of(v), "models value " + raw +
-                         ": NODE has no discrete-gradient variant (it has no Hamiltonian; rk2 "
-                         "or rk4 only)" +
-                         expected);
-  }
+  const auto is_name = [](const std::vector<std::string>& names, const std::string& n) {
+    return std::find(names.begin(), names.end(), n) != names.end();
+  };
   const std::size_t dash = s.rfind('-');
+  const std::string suffix = dash == std::string::npos ? "" : s.substr(dash + 1);
+  if (dash != std::string::npos && s.substr(0, dash) == to_string(ModelKind::kNode) &&
+      is_name(kIntegratorNames.names(), suffix) && is_discrete_gradient(parse_integrator(suffix))) {
+    std::string explicit_names;
+    for (const Integrator& in : all_integrators()) {
+      if (in.discrete_gradient) continue;
+      explicit_names += (explicit_names.empty() ? "" : " or ") + to_string(in.kind);
+    }
+    fail(line_of(v), "models value " + raw +
+                         ": NODE has no discrete-gradient variant (it has no "
+                         "Hamiltonian; " +
+                         explicit_names + " only)" + expected);
+  }
   if (dash == std::string::npos) {
     fail(line_of(v), "models value " + raw + " is not FORMULATION-INTEGRATOR" +
                          did_you_mean(s, allowed) + expected);
   }
   const std::string formulation = s.substr(0, dash), integrator = s.substr(dash + 1);
-  const bool formulation_ok =
-      formulation == "node" || formulation == "phnn-jr" || formulation == "phnn-s";
-  const bool integrator_ok =
-      integrator == "rk2" || integrator == "dg" || integrator == "rk4" || integrator == "dg4";
+  const bool formulation_ok = is_name(kModelNames.names(), formulation);
+  const bool integrator_ok = is_name(kIntegratorNames.names(), integrator);
   if (formulation_ok && !integrator_ok) {
     fail(line_of(v),
          "unknown integrator " + quoted(integrator) + " in models value " + raw + expected);

@@ -6,6 +6,7 @@
 #include "phnn/common/check.h"
 #include <sstream>
 
+#include "phnn/integrators/integrator.h"
 #include "phnn/training/trainer.h"
 #include "training/cell_data.h"
 

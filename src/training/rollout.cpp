@@ -45,7 +45,9 @@ torch::Tensor step_inputs(const CellData& data, int64_t B_inf, int64_t F, int st
 int64_t dg4_rollout_chunk = 0;
 
 // inference_step of `integrator`; DG4 on the rows [s, s + chunk) in turn
-// (its jets are what a rollout holds), the others on every row at once.
+// (its jets are what a rollout holds), the others on every row at once. Only
+// DG4 is ever chunked: it keeps no Newton cache and always reports
+// `converged`, which the chunks' concatenation needs.
 DgInferenceStep step_in_chunks(const DynamicsModel& model, IntegratorKind integrator,
                                const torch::Tensor& x, const torch::Tensor& u, double h,
                                const DgInferenceOptions& options, DgNewtonJacobian* cache) {

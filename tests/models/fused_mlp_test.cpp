@@ -15,6 +15,7 @@
 #include "models/fused_heads_common.h"
 #include "kernels/kernel_isa.h"
 #include "kernels/vector_math.h"
+#include "phnn/integrators/integrator.h"
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/discrete_step.h"
 #include "phnn/training/regularizers.h"
@@ -112,18 +113,15 @@ TEST(FusedMlpTest, TrainingLossAndGradientsMatchReferenceForEveryModel) {
   TrainerOptions options;
   options.lambda_cn = options.lambda_sn = options.lambda_sr = 1.0;  // make the penalty count
   for (ModelKind kind : {ModelKind::kNode, ModelKind::kPhnnS, ModelKind::kPhnnJr}) {
-    for (IntegratorKind integrator : {IntegratorKind::kRk2, IntegratorKind::kDg, IntegratorKind::kRk4,
-                                      IntegratorKind::kDg4}) {
-      if (kind == ModelKind::kNode && is_discrete_gradient(integrator)) continue;
+    for (const Integrator& in : all_integrators()) {
+      const IntegratorKind integrator = in.kind;
+      if (kind == ModelKind::kNode && in.discrete_gradient) continue;
       for (Regularizer reg : {Regularizer::kNone, Regularizer::kCn, Regularizer::kSn, Regularizer::kSr}) {
         std::vector<torch::Tensor> losses, grads[2];
         for (bool fused : {true, false}) {
           const auto model = DynamicsModel::create(
               ModelOptions{kind, ModelSize::kSmall, SystemKind::kDuffing, fused}, seeds());
-          const auto x_hat =
-              integrator == IntegratorKind::kDg    ? dg_training_step(*model, x, x_next, u, h, 6e-6)
-              : integrator == IntegratorKind::kDg4 ? dg4_training_step(*model, x, x_next, u, h, 6e-6)
-                                                   : explicit_step(*model, integrator, x, u, h);
+          const auto x_hat = training_step(*model, integrator, x, x_next, u, h, 6e-6);
           auto loss = ((x_next - x_hat).abs() / h).mean({1, 2});
           if (reg != Regularizer::kNone) {
             loss = loss + regularizer_penalty(

@@ -41,11 +41,7 @@ inline torch::Tensor autograd_loss_of(const DynamicsModel& model, IntegratorKind
                                       const TrainerOptions& options) {
   const bool regularized = regularizer != Regularizer::kNone;
   const FieldEval at_x = regularized ? model.field(x, u, true) : FieldEval{};
-  const auto x_hat = integrator == IntegratorKind::kDg
-                         ? dg_training_step(model, x, x_next, u, h, min_dx_norm)
-                     : integrator == IntegratorKind::kDg4
-                         ? dg4_training_step(model, x, x_next, u, h, min_dx_norm)
-                         : explicit_step(model, integrator, x, u, h, at_x.f);
+  const auto x_hat = training_step(model, integrator, x, x_next, u, h, min_dx_norm, at_x.f);
   const auto loss = discrete_loss(x_next, x_hat, h, LossNorm::kMeanL1);
   if (!regularized) return loss;
   return loss + regularizer_penalty(regularizer, jacobian_stats(at_x.dfdx, options.jacobian_eps),

@@ -282,6 +282,41 @@ TEST(ResultsFileFixtureTest, AFileOfTheEarlierFormatIsRead) {
   EXPECT_FALSE(raw.exists("/runs/weights_layout"));
 }
 
+// A row written into a file of before train_seconds (checksum rule 1, no
+// /runs/train_seconds): the column is skipped, the rest stored, and the row
+// verifies (rule 1 hashes the journal encoding, which leaves NaN out).
+TEST(ResultsFileFixtureTest, ARowWrittenIntoAFileOfBeforeAColumnVerifies) {
+  const std::string fixture =
+      std::string(PHNN_SOURCE_DIR) + "/tests/fixtures/results-2026-11-25.h5";
+  const std::string path =
+      ::testing::TempDir() + "phnn_fixture_copy_" + std::to_string(::getpid()) + ".h5";
+  {
+    std::ifstream in(fixture, std::ios::binary);
+    std::ofstream(path, std::ios::binary) << in.rdbuf();
+  }
+  RunResult r;
+  std::string hash;
+  {
+    const ResultsFile old = ResultsFile::open_read_only(path);
+    r = old.read_run(1);
+    hash = old.sweep_hash();
+  }
+  r.train_seconds = 3.0;
+  r.mse = 0.25;
+  {
+    ResultsFile file = ResultsFile::open(path, MPI_COMM_NULL, hash);
+    file.write_run(1, r);
+    file.close();
+  }
+  const ResultsFile file = ResultsFile::open_read_only(path);
+  const RunResult back = file.read_run(1);
+  EXPECT_EQ(back.mse, 0.25);
+  EXPECT_TRUE(std::isnan(back.train_seconds));
+  EXPECT_TRUE(file.damaged_rows().empty());
+  std::remove(path.c_str());
+  remove_journals(path);
+}
+
 // Each column of config/result_columns.h, declared once, reaches every
 // place a result goes: its /runs dataset with the declared units and
 // description, the row written and read, the whole-column reader, the

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include "phnn/integrators/integrator.h"
 #include "phnn/models/general_ph.h"
 #include "phnn/models/port_hamiltonian.h"
 #include "phnn/training/trainer.h"

@@ -5,6 +5,7 @@
 // files written for a run). Header-only.
 #pragma once
 
+#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -20,6 +21,14 @@ inline std::string shortest_number(double value) {
     if (std::strtod(buf, nullptr) == value) break;
   }
   return buf;
+}
+
+/// std::to_chars' shortest round-trip text: 100 and 0.0025 (not %g's 1e+02
+/// or %.17g's 0.0025000000000000001); "inf", "-inf", "nan" as the C++
+/// library spells them. For tables and CSV, never for identities.
+inline std::string roundtrip_number(double value) {
+  char buf[32];
+  return std::string(buf, std::to_chars(buf, buf + sizeof buf, value).ptr);
 }
 
 /// "%.17g": 17 significant digits, the same text for the same double

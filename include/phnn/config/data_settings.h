@@ -7,6 +7,7 @@
 // member initializers (physics: OscillatorOptions::defaults).
 #pragma once
 
+#include <climits>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -22,9 +23,10 @@ struct DataSetting {
   /// Which runs' canonical keys hold it.
   enum class InKey {
     kAlways,
-    kBuiltin,          // built-in systems only (a system file sets its own)
-    kAwayFromDefault,  // energy_sampling: only away from Algorithm 1, and of a
-                       // built-in system only where it applies (not Duffing)
+    kBuiltin,         // built-in systems only (a system file sets its own)
+    kEnergySampling,  // energy_sampling's rule: only away from its default,
+                      // and of a built-in system only where it applies (not
+                      // Duffing, whose Algorithm 2 ignores it)
   };
   /// Sweep-file key in [data].
   const char* key;
@@ -44,7 +46,9 @@ struct DataSetting {
   /// kInteger: smallest value allowed (largest: INT64_MAX for the seed,
   /// INT_MAX otherwise).
   std::int64_t min_integer = 1;
-  std::int64_t max_integer = 2147483647;
+  std::int64_t max_integer = INT_MAX;
+  /// Where the value has a spelling of its own (the unsigned seed).
+  std::string (*get_text)(const DatasetOptions&) = nullptr;
   /// kChoice: its names (default first) and the value's index among them.
   std::vector<std::string> (*choices)() = nullptr;
   int (*get_choice)(const DatasetOptions&) = nullptr;

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "phnn/common/enum_names.h"
-#include "phnn/integrators/integrator.h"  // IntegratorKind
+#include "phnn/integrators/integrator_kind.h"
 
 namespace phnn {
 

@@ -6,27 +6,12 @@
 // an integrator". No state, no files.
 #pragma once
 
-#include <string>
 #include <vector>
 
-#include "phnn/common/enum_names.h"
+#include "phnn/integrators/integrator_kind.h"
 #include "phnn/integrators/ph_steps.h"
 
 namespace phnn {
-
-/// Discrete-model integrator (Eqs. 26, 28-30): explicit midpoint, the
-/// Gonzalez discrete gradient, classical RK4, the fourth-order DG.
-enum class IntegratorKind { kRk2 = 0, kDg = 1, kRk4 = 2, kDg4 = 3 };
-inline constexpr EnumNames<IntegratorKind, 4> kIntegratorNames{"integrator",
-                                                               {{{IntegratorKind::kRk2, "rk2"},
-                                                                 {IntegratorKind::kDg, "dg"},
-                                                                 {IntegratorKind::kRk4, "rk4"},
-                                                                 {IntegratorKind::kDg4, "dg4"}}}};
-inline std::string to_string(IntegratorKind kind) { return kIntegratorNames.name(kind); }
-/// Throws std::invalid_argument naming the value and listing the allowed ones.
-inline IntegratorKind parse_integrator(const std::string& name) {
-  return kIntegratorNames.parse(name);
-}
 
 /// One integrator's contract.
 struct Integrator {
