@@ -80,7 +80,10 @@ class CellTrainer {
   void report_progress(int step, std::vector<double> live_best) const;
   // Rollouts of the best weights so far, in float64: in the training model (the caller
   // restores its weights if training goes on) or, after float32 training, inference_model_.
-  Rollouts roll_out_best();
+  Rollouts roll_out_best(const std::function<bool()>& stop = {});
+  // Throws CellInterrupted at the last trained step after saving `state`
+  // (taken before the rollouts replaced the weights by the best ones).
+  [[noreturn]] void interrupt_before_inference(const std::string& state);
   void checkpoint(int step);
   // The training state after `step` as bytes, and back (cell_trainer_state.cpp).
   std::string save_state(int step) const;
@@ -123,6 +126,7 @@ class CellTrainer {
   const CellCheckpointing* checkpointing_ = nullptr;
   std::unique_ptr<BatchSampler> sampler_;
   int first_step_ = 1;
+  int last_step_ = 0;  // the last step train() took (or restored)
   std::size_t next_checkpoint_ = 0;
   double elapsed_before_ = 0.0;
   double last_save_ = 0.0;

@@ -85,7 +85,8 @@ int64_t dg4_chunk_rows(int64_t members, int64_t n_x, int64_t n_u) {
   return std::max<int64_t>(16, (int64_t{1} << 21) / std::max<int64_t>(per_row, 1));
 }
 
-Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const CellData& data) {
+Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const CellData& data,
+                  const std::function<bool()>& stop) {
   PHNN_CHECK(model_ref.options().dtype == torch::kFloat64,
              "roll_out: inference is float64; got a " << model_ref.options().dtype << " model");
   torch::NoGradGuard no_grad;
@@ -129,6 +130,7 @@ Rollouts roll_out(const DynamicsModel& model_ref, const CellSpec& cell, const Ce
   dg_options.min_dx_norm = opt.dg_min_dx_norm;
   DgNewtonJacobian newton_jacobian;  // carried along the rollout
   for (int n = 1; n <= steps; ++n) {
+    if (stop && n % kRolloutStopEvery == 0 && stop()) throw RolloutStopped{};
     const torch::Tensor u =
         u_steps.defined() ? u_steps[n - 1].unsqueeze(0).expand({E, B, nu}).contiguous() : u_constant;
     const DgInferenceStep s =

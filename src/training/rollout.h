@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <torch/torch.h>
@@ -34,7 +35,13 @@ struct Rollouts {
                                   // without figure trajectories
   int steps = 0;
 };
-Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const CellData& data);
+// `stop`, when set, is asked every kRolloutStopEvery steps; true throws
+// RolloutStopped (the rollouts are dropped: the caller saves what it needs
+// to do them again).
+struct RolloutStopped {};
+inline constexpr int kRolloutStopEvery = 32;
+Rollouts roll_out(const DynamicsModel& model, const CellSpec& cell, const CellData& data,
+                  const std::function<bool()>& stop = {});
 
 // Rows per chunk of a DG4 rollout step, or 0 (the default): dg4_chunk_rows.
 // The bits do not depend on it (tests/training/rollout_test.cpp sets others).

@@ -170,6 +170,7 @@ void CellTrainer::train() {
     if (!any_alive()) break;
     save_if_due(s);
   }
+  last_step_ = last;
   if (checkpointing_ && checkpointing_->save_final) checkpointing_->save_final(save_state(last), last);
 }
 
@@ -297,12 +298,17 @@ void CellTrainer::report_progress(int step, std::vector<double> live_best) const
   progress_(p);
 }
 
-Rollouts CellTrainer::roll_out_best() {
+Rollouts CellTrainer::roll_out_best(const std::function<bool()>& stop) {
   torch::NoGradGuard no_grad;
   const std::vector<torch::Tensor> target =
       inference_model_ ? inference_model_->parameters() : params_;
   for (std::size_t k = 0; k < target.size(); ++k) target[k].copy_(best_[k]);
-  return roll_out(inference_model_ ? *inference_model_ : *model_, cell_, data_);
+  return roll_out(inference_model_ ? *inference_model_ : *model_, cell_, data_, stop);
+}
+
+void CellTrainer::interrupt_before_inference(const std::string& state) {
+  checkpointing_->save(state, last_step_);
+  throw CellInterrupted(last_step_, opt_.steps);
 }
 
 // Inference of the best weights so far at a step budget; the training
@@ -335,7 +341,18 @@ std::vector<RunResult> CellTrainer::finish() {
     for (int64_t e = 0; e < E_; ++e) fill_result(e, nullptr, kNoMse, train_s, elapsed());
     return std::move(results_);
   }
-  const Rollouts rollouts = roll_out_best();
+  // A stop asked before or during the rollouts (a signal; an ahead item at
+  // its round's end) saves the state of the last step: the cell goes on
+  // from it straight to inference, bitwise as if never stopped.
+  const std::function<bool()> stop = checkpointing_ ? checkpointing_->stop_requested : nullptr;
+  const std::string state = stop ? save_state(last_step_) : std::string();
+  if (stop && stop()) interrupt_before_inference(state);
+  Rollouts rollouts;
+  try {
+    rollouts = roll_out_best(stop);
+  } catch (const RolloutStopped&) {
+    interrupt_before_inference(state);
+  }
   const double wall = elapsed();
   const std::vector<double> mse = member_mse(rollouts);
   for (int64_t e = 0; e < E_; ++e) {

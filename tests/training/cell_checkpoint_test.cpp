@@ -100,6 +100,51 @@ TEST(CellCheckpointTest, StoppedTwiceEndsBitwiseAsUninterrupted) {
   expect_same_results(resumed, plain);
 }
 
+// A stop asked once training is over — before the inference rollouts (poll
+// steps + 1) or during them (polls steps + 2, + 4: every 32 rollout steps) —
+// saves the state of the last step; the cell goes on from it straight to
+// inference and ends bitwise as uninterrupted. PHNN-S-DG: its Newton
+// rollouts are the long ones.
+TEST(CellCheckpointTest, AStopDuringInferenceGoesOnStraightToInference) {
+  CellSpec cell;
+  cell.model = ModelKind::kPhnnS;
+  cell.integrator = IntegratorKind::kDg;
+  cell.n_train = 25;
+  cell.training.steps = 30;
+  cell.training.eval_every = 10;
+  cell.seeds = {1, 2};
+  const Train train = [&](const CellCheckpointing* c) {
+    return train_cell(cell, duffing(), {}, nullptr, c);
+  };
+  const auto plain = train(nullptr);
+  for (int stop_at : {31, 32, 34}) {
+    SCOPED_TRACE("stop at poll " + std::to_string(stop_at));
+    std::string state;
+    std::vector<int> saved_at;
+    int polls = 0;
+    CellCheckpointing c;
+    c.save = [&](const std::string& s, int step) {
+      state = s;
+      saved_at.push_back(step);
+    };
+    c.stop_requested = [&] { return ++polls == stop_at; };
+    try {
+      train(&c);
+      ADD_FAILURE() << "not stopped";
+    } catch (const CellInterrupted& e) {
+      EXPECT_EQ(e.step, 30);
+    }
+    EXPECT_EQ(polls, stop_at);
+    EXPECT_EQ(saved_at, std::vector<int>{30});
+    CellCheckpointing r;
+    r.resume_from = state;
+    r.save = [&](const std::string&, int step) { saved_at.push_back(step); };
+    r.stop_requested = [] { return false; };
+    expect_same_results(train(&r), plain);
+    EXPECT_EQ(saved_at, std::vector<int>{30});  // nothing more to save
+  }
+}
+
 // Float32 training with a member that diverges (frozen) before the stop:
 // the frozen weights and the divergence step survive the restart.
 TEST(CellCheckpointTest, FrozenMembersAndFloat32Survive) {

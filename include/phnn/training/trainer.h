@@ -82,8 +82,10 @@ struct CellCheckpointing {
   std::string resume_from;
   /// Receives each state and the step it ends; required.
   std::function<void(const std::string& state, int step)> save;
-  /// Polled after every step (keep it cheap); true: save the state and
-  /// throw CellInterrupted.
+  /// Polled after every step and, once training is over, before and every
+  /// 32 steps during the final inference rollouts (keep it cheap); true:
+  /// save the state (of the last step: a cell stopped in its inference goes
+  /// on from there straight to inference) and throw CellInterrupted.
   std::function<bool()> stop_requested;
   /// When set, receives the state after the last step (before inference):
   /// what a cell of the same runs at a larger step budget goes on from.
