@@ -83,11 +83,18 @@ std::vector<std::uint64_t> File::dims(const std::string& path) const {
 }
 
 namespace {
-void rows_io(hid_t file, const std::string& fname, const std::string& path,
-             std::uint64_t row, std::uint64_t count, hid_t memtype, void* data,
-             bool write, std::uint64_t* count_out = nullptr) {
+// Dataset `path` of `file`, open (throws naming the file if it is not there).
+Handle open_dataset(hid_t file, const std::string& fname, const std::string& path) {
   Handle dset(H5Dopen2(file, path.c_str(), H5P_DEFAULT), H5Dclose);
   if (!dset.ok()) fail(fname, "no dataset " + path);
+  return dset;
+}
+
+// Rows [row, row + count) of the open dataset `dset` (named `path`): read
+// or written; count 0 on a read: to the end. *count_out gets the count.
+void dataset_rows_io(const Handle& dset, const std::string& fname, const std::string& path,
+                     std::uint64_t row, std::uint64_t count, hid_t memtype, void* data,
+                     bool write, std::uint64_t* count_out = nullptr) {
   std::vector<hsize_t> dims = dataset_dims(dset.get());
   if (dims.empty()) dims = {1};
   if (count == 0 && !write) count = dims[0] - std::min<hsize_t>(row, dims[0]);
@@ -107,7 +114,6 @@ void rows_io(hid_t file, const std::string& fname, const std::string& path,
                       extent.data(), nullptr);
   Handle mspace(H5Screate_simple(static_cast<int>(extent.size()), extent.data(), nullptr),
                 H5Sclose);
-  Handle dxpl(H5Pcreate(H5P_DATASET_XFER), H5Pclose);
   // An enum of 64-bit integers (create_enum_dataset) moves as int64: HDF5
   // converts no integers to enums, so the memory type is the enum itself
   // (same bytes as int64_t).
@@ -120,14 +126,21 @@ void rows_io(hid_t file, const std::string& fname, const std::string& path,
   }
   const Handle native_enum(enum_type, H5Tclose);  // closed on return (if opened)
   const herr_t status =
-      write ? H5Dwrite(dset.get(), memtype, mspace.get(), fspace.get(), dxpl.get(), data)
-            : H5Dread(dset.get(), memtype, mspace.get(), fspace.get(), dxpl.get(), data);
+      write ? H5Dwrite(dset.get(), memtype, mspace.get(), fspace.get(), H5P_DEFAULT, data)
+            : H5Dread(dset.get(), memtype, mspace.get(), fspace.get(), H5P_DEFAULT, data);
   if (status < 0) {
     std::ostringstream msg;
     msg << (write ? "H5Dwrite" : "H5Dread") << " failed for " << path << " rows ["
         << row << ", " << row + count << ")";
     fail(fname, msg.str());
   }
+}
+
+void rows_io(hid_t file, const std::string& fname, const std::string& path,
+             std::uint64_t row, std::uint64_t count, hid_t memtype, void* data,
+             bool write, std::uint64_t* count_out = nullptr) {
+  dataset_rows_io(open_dataset(file, fname, path), fname, path, row, count, memtype, data, write,
+                  count_out);
 }
 }  // namespace
 
@@ -144,8 +157,7 @@ void File::write_rows(const std::string& path, std::uint64_t row,
 
 void File::write_string_rows(const std::string& path, std::uint64_t row,
                              const std::vector<std::string>& values) {
-  Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
-  if (!dset.ok()) fail(path_, "no dataset " + path);
+  const Handle dset = open_dataset(id_, path_, path);
   Handle type(H5Dget_type(dset.get()), H5Tclose);
   const std::size_t length = H5Tget_size(type.get());
   std::vector<char> buffer(values.size() * length, '\0');
@@ -153,7 +165,7 @@ void File::write_string_rows(const std::string& path, std::uint64_t row,
     std::memcpy(buffer.data() + i * length, values[i].data(),
                 std::min(length, values[i].size()));
   }
-  rows_io(id_, path_, path, row, values.size(), type.get(), buffer.data(), true);
+  dataset_rows_io(dset, path_, path, row, values.size(), type.get(), buffer.data(), true);
 }
 
 void File::write(const std::string& path, const std::vector<std::uint64_t>& dims,
@@ -172,38 +184,40 @@ void File::write(const std::string& path, const std::vector<std::uint64_t>& dims
   if (rank == 0) write_rows(path, 0, dims.empty() ? 1 : dims[0], data.data());
 }
 
+namespace {
+// Rows [row, row + count) of dataset `path` (count 0: to the end), of
+// element type T (memtype), the dataset opened once.
+template <class T>
+std::vector<T> read_rows(hid_t file, const std::string& fname, const std::string& path,
+                         std::uint64_t row, std::uint64_t count, hid_t memtype) {
+  const Handle dset = open_dataset(file, fname, path);
+  std::uint64_t n = 0;
+  dataset_rows_io(dset, fname, path, row, count, memtype, nullptr, false, &n);
+  std::vector<T> out(n * row_size(dataset_dims(dset.get())));
+  dataset_rows_io(dset, fname, path, row, n, memtype, out.data(), false);
+  return out;
+}
+}  // namespace
+
 std::vector<double> File::read_doubles(const std::string& path, std::uint64_t row,
                                        std::uint64_t count) const {
-  std::uint64_t n = 0;
-  rows_io(id_, path_, path, row, count, H5T_NATIVE_DOUBLE, nullptr, false, &n);
-  const auto d = dims(path);
-  std::vector<hsize_t> hd(d.begin(), d.end());
-  std::vector<double> out(n * row_size(hd));
-  rows_io(id_, path_, path, row, n, H5T_NATIVE_DOUBLE, out.data(), false);
-  return out;
+  return read_rows<double>(id_, path_, path, row, count, H5T_NATIVE_DOUBLE);
 }
 
 std::vector<std::int64_t> File::read_ints(const std::string& path, std::uint64_t row,
                                           std::uint64_t count) const {
-  std::uint64_t n = 0;
-  rows_io(id_, path_, path, row, count, H5T_NATIVE_INT64, nullptr, false, &n);
-  const auto d = dims(path);
-  std::vector<hsize_t> hd(d.begin(), d.end());
-  std::vector<std::int64_t> out(n * row_size(hd));
-  rows_io(id_, path_, path, row, n, H5T_NATIVE_INT64, out.data(), false);
-  return out;
+  return read_rows<std::int64_t>(id_, path_, path, row, count, H5T_NATIVE_INT64);
 }
 
 std::string File::read_row_bytes(const std::string& path, std::uint64_t row,
                                  std::uint64_t count) const {
-  Handle dset(H5Dopen2(id_, path.c_str(), H5P_DEFAULT), H5Dclose);
-  if (!dset.ok()) fail(path_, "no dataset " + path);
+  const Handle dset = open_dataset(id_, path_, path);
   Handle type(H5Dget_type(dset.get()), H5Tclose);
   std::vector<hsize_t> d = dataset_dims(dset.get());
   std::uint64_t rows = 0;
-  rows_io(id_, path_, path, row, count, type.get(), nullptr, false, &rows);
+  dataset_rows_io(dset, path_, path, row, count, type.get(), nullptr, false, &rows);
   std::string out(rows * row_size(d) * H5Tget_size(type.get()), '\0');
-  rows_io(id_, path_, path, row, rows, type.get(), out.data(), false);
+  dataset_rows_io(dset, path_, path, row, rows, type.get(), out.data(), false);
   return out;
 }
 
@@ -232,10 +246,10 @@ std::vector<std::string> File::read_strings(const std::string& path, std::uint64
     }
   } else {
     std::uint64_t rows = 0;
-    rows_io(id_, path_, path, row, count, type.get(), nullptr, false, &rows);
+    dataset_rows_io(dset, path_, path, row, count, type.get(), nullptr, false, &rows);
     n = rows;
     buffer.assign(n * length, '\0');
-    rows_io(id_, path_, path, row, n, type.get(), buffer.data(), false);
+    dataset_rows_io(dset, path_, path, row, n, type.get(), buffer.data(), false);
   }
   std::vector<std::string> out(n);
   for (std::size_t i = 0; i < n; ++i) {
