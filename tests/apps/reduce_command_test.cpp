@@ -13,9 +13,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "h5/h5file.h"
 #include "sweep/sample_results.h"
 #include "test_util.h"
-
 #include "phnn/store/journal.h"
 #include "phnn/sweep/grid.h"
 
@@ -164,6 +164,37 @@ TEST_F(ReduceCommandTest, PerRunCsvHasOneRowPerRunWithAxesAndExactValues) {
     }
   }
   EXPECT_THAT(csv, HasSubstr(",diverged,inf,"));
+}
+
+// A damaged row (here: one bit of its best_step, so its checksum fails)
+// reads as pending with unknown results: none of its stored numbers, which
+// are not to be trusted, reaches the per-run CSV.
+TEST_F(ReduceCommandTest, ADamagedRowShowsNoneOfItsNumbers) {
+  {
+    h5::File raw = h5::File::open(path_, h5::Access::kReadWrite);
+    std::int64_t step = raw.read_ints("/runs/best_step", 3, 1).at(0) ^ (std::int64_t{1} << 40);
+    raw.write_rows("/runs/best_step", 3, 1, &step);
+    raw.close();
+  }
+  std::string out;
+  ASSERT_EQ(reduce("--per-run", &out), 0) << out;
+  // stderr first (the damage is named there), then the CSV.
+  ASSERT_NE(out.find("run_id,"), std::string::npos) << out;
+  EXPECT_THAT(out.substr(0, out.find("run_id,")), HasSubstr("damaged"));
+  const auto rows = parse_csv(out.substr(out.find("run_id,")));
+  const std::vector<std::string>& header = rows.at(0);
+  const auto column = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const std::vector<std::string>& damaged = rows.at(4);  // row 3
+  EXPECT_EQ(damaged.at(column("run_id")), grid_.runs[3].id());
+  EXPECT_EQ(damaged.at(column("status")), "pending");
+  EXPECT_EQ(damaged.at(column("mse")), "nan");
+  EXPECT_EQ(damaged.at(column("best_step")), "0");
+  EXPECT_EQ(damaged.at(column("trace_points")), "0");
+  EXPECT_THAT(damaged.at(column("message")), HasSubstr("damaged row"));
+  EXPECT_EQ(rows.at(5).at(column("status")),
+            to_string(testing_util::sample_result(4, testing_util::sample_layout()).status));
 }
 
 TEST_F(ReduceCommandTest, TablesShowIntervalsAndNeverNan) {

@@ -4,6 +4,8 @@
 // twice, one trajectory at a time, give the data set of reading them all.
 #include "phnn/store/trajectory_files.h"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -43,7 +45,9 @@ const TrajectoryColumns kPendulum{{"q", "p"}, {"u"}};
 
 std::string csv_file(const std::string& text) {
   static int counter = 0;
-  const std::string path = ::testing::TempDir() + "phnn_bad_" + std::to_string(counter++) + ".csv";
+  // The process id too: ctest runs each test in a process of its own, in parallel.
+  const std::string path = ::testing::TempDir() + "phnn_bad_" + std::to_string(::getpid()) + "_" +
+                           std::to_string(counter++) + ".csv";
   std::ofstream(path) << text;
   return path;
 }
@@ -274,7 +278,8 @@ TEST(MeasuredDataTest, TwoPassesOverTheFilesGiveTheDataSetOfReadingThemAll) {
     EXPECT_EQ(got.options.beta, want.options.beta);
     EXPECT_EQ(got.options.num_train_max, want.options.num_train_max);
     // The file written from the rows is the file of the data set.
-    const std::string path = ::testing::TempDir() + "phnn_streamed.h5";
+    const std::string path =
+        ::testing::TempDir() + "phnn_streamed_" + std::to_string(::getpid()) + ".h5";
     write_ph_dataset_file(path, rows.data, rows.train, rows.validation, rows.inference);
     EXPECT_EQ(data_set_checksum(read_ph_dataset_file(path)), checksum);
     std::remove(path.c_str());
@@ -297,7 +302,8 @@ TEST(MeasuredDataTest, TwoPassesOverTheFilesGiveTheDataSetOfReadingThemAll) {
 // HDF5 trajectory files: the documented layout reads like the CSV.
 std::string h5_file(const std::function<void(h5::File&)>& fill) {
   static int counter = 0;
-  const std::string path = ::testing::TempDir() + "phnn_traj_" + std::to_string(counter++) + ".h5";
+  const std::string path = ::testing::TempDir() + "phnn_traj_" + std::to_string(::getpid()) + "_" +
+                           std::to_string(counter++) + ".h5";
   h5::File f = h5::File::create(path);
   fill(f);
   f.close();
