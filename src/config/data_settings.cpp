@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "config/key_parts.h"
 #include "phnn/common/number_text.h"
 
 namespace phnn {
@@ -138,15 +139,9 @@ std::string DataSetting::text(const DatasetOptions& d) const {
 }
 
 std::string data_key(const DatasetOptions& d, bool builtin, SystemKind system) {
-  // Settings of one canonical part are adjacent in the table.
-  std::string out;
-  std::string part_name;  // the canonical part being written
-  for (const DataSetting& s : data_settings()) {
-    if (!in_key(s, d, builtin, system)) continue;
-    out += (s.canonical == part_name ? "," : ";" + std::string(s.canonical) + "=") + s.text(d);
-    part_name = s.canonical;
-  }
-  return out;
+  return internal::key_parts(
+      data_settings(), [&](const DataSetting& s) { return in_key(s, d, builtin, system); },
+      [&](const DataSetting& s) { return s.text(d); });
 }
 
 const std::vector<PhysicsSetting>& physics_settings() {

@@ -3,6 +3,7 @@
 // LibTorch-free; touches no file.
 #include "phnn/config/training_settings.h"
 
+#include "config/key_parts.h"
 #include "phnn/common/number_text.h"
 #include "phnn/integrators/integrator.h"
 
@@ -142,16 +143,11 @@ std::string training_settings_markdown() {
 
 std::string training_key(const TrainerOptions& t, ModelKind model, IntegratorKind integrator,
                          Regularizer regularizer) {
-  // Settings of one canonical part are adjacent in the table; of the three
-  // "lambda" ones at most one is in a key.
-  std::string out;
-  std::string part_name;  // the canonical part being written
-  for (const TrainingSetting& s : training_settings()) {
-    if (!in_key(s, t, model, integrator, regularizer)) continue;
-    out += (s.canonical == part_name ? "," : ";" + std::string(s.canonical) + "=") + s.text(t);
-    part_name = s.canonical;
-  }
-  return out;
+  // Of the three "lambda" settings at most one is in a key.
+  return internal::key_parts(
+      training_settings(),
+      [&](const TrainingSetting& s) { return in_key(s, t, model, integrator, regularizer); },
+      [&](const TrainingSetting& s) { return s.text(t); });
 }
 
 }  // namespace phnn
