@@ -2,7 +2,8 @@
 // in file order and maps each key onto the defaults of docs/METHOD.md
 // (OscillatorOptions, DatasetOptions, TrainerOptions, the grid axes): unknown
 // tables and keys, whole-struct validation at the key a message names, and the
-// studies' inheritance from [grid] (split from the values: this file knows keys).
+// studies' inheritance from [grid] (split from the values: this file knows keys;
+// the settings tables' handlers: sweep_file_settings.cpp).
 // Size: one handler per key of the format; the keys and their cross-checks stay together.
 #include "sweep/sweep_file_tables.h"
 
@@ -11,12 +12,11 @@
 #include <map>
 #include <optional>
 
-#include "phnn/config/data_settings.h"
 #include "phnn/config/study_defaults.h"
-#include "phnn/config/training_settings.h"
 #include "phnn/sweep/output_check.h"
 #include "sweep/sweep_file_adaptive.h"
 #include "sweep/sweep_file_search.h"
+#include "sweep/sweep_file_settings.h"
 #include "sweep/sweep_file_systems.h"
 #include "sweep/sweep_file_values.h"
 
@@ -39,9 +39,6 @@ struct AxisSet {
   std::optional<std::vector<int>> seeds;
 };
 
-// A key's handler: reads the entry and stores the value.
-using Handler = std::function<void(const Entry&)>;
-using Handlers = std::vector<std::pair<std::string, Handler>>;
 // key -> line of the keys a table set.
 using KeyLines = std::map<std::string, int>;
 
@@ -87,11 +84,11 @@ class TableWalker {
       has_output_ = true;
     } else if (e.key == "data") {
       data_header_ = e.line;
-      data_lines_ = apply(values_.table(e, "[data]"), "[data]", data_handlers(spec_.data));
+      data_lines_ = apply(values_.table(e, "[data]"), "[data]", data_handlers(values_, spec_.data));
     } else if (e.key == "training") {
       training_header_ = e.line;
-      training_lines_ =
-          apply(values_.table(e, "[training]"), "[training]", training_handlers(spec_.training));
+      training_lines_ = apply(values_.table(e, "[training]"), "[training]",
+                              training_handlers(values_, spec_.training));
     } else if (e.key == "grid") {
       apply(values_.table(e, "[grid]"), "[grid]", axis_handlers(grid_, /*allow_title=*/false));
     } else if (e.key == "physics") {
@@ -120,7 +117,7 @@ class TableWalker {
   // [search], once [training] and the studies are final.
   void read_search() {
     const TrainingKeySetter set = [this](TrainerOptions& t, const Entry& e) {
-      for (auto& [key, handler] : training_handlers(t)) {
+      for (auto& [key, handler] : training_handlers(values_, t)) {
         if (key == e.key) {
           handler(e);
           return true;
@@ -147,8 +144,8 @@ class TableWalker {
                          "[physics.self-sustained]");
       }
       physics_header_[*kind] = e.line;
-      physics_lines_[*kind] =
-          apply(values_.table(e, label), label, physics_handlers(*kind, spec_.physics[*kind]));
+      physics_lines_[*kind] = apply(values_.table(e, label), label,
+                                    physics_handlers(values_, *kind, spec_.physics[*kind]));
     }
   }
 
@@ -395,89 +392,6 @@ class TableWalker {
       axes.lambdas_line = e.line;
     });
     h.emplace_back("seeds", [this, &axes](const Entry& e) { axes.seeds = values_.seeds(e); });
-    return h;
-  }
-
-  // A fixed-choice key: `all` lists its values, default first.
-  template <typename T>
-  Handler choice(T& field, std::vector<T> (*all)()) const {
-    return [this, &field, all](const Entry& e) { field = values_.choice(e, all()); };
-  }
-  Handler number(double& field) const {
-    return [this, &field](const Entry& e) { field = values_.number(e, *e.value); };
-  }
-  Handler integer(int& field, int min) const {
-    return [this, &field, min](const Entry& e) { field = values_.int_at_least(e, min); };
-  }
-
-  // Every setting of the table (phnn/config/data_settings.h).
-  Handlers data_handlers(DatasetOptions& d) const {
-    Handlers h;
-    for (const DataSetting& s : data_settings()) {
-      switch (s.kind) {
-        case DataSetting::Kind::kReal:
-          h.emplace_back(s.key, [this, &d, &s](const Entry& e) {
-            s.set_real(&d, values_.number(e, *e.value));
-          });
-          break;
-        case DataSetting::Kind::kInteger:
-          h.emplace_back(s.key, [this, &d, &s](const Entry& e) {
-            s.set_integer(&d, values_.integer(e, *e.value, s.min_integer, s.max_integer,
-                                              "an integer >= " + std::to_string(s.min_integer)));
-          });
-          break;
-        case DataSetting::Kind::kChoice:
-          h.emplace_back(s.key, [this, &d, &s](const Entry& e) {
-            s.set_choice(&d, static_cast<int>(values_.choice_index(e, s.choices())));
-          });
-          break;
-      }
-    }
-    return h;
-  }
-
-  // Every setting of the table (phnn/config/training_settings.h), then
-  // checkpoints (a list).
-  Handlers training_handlers(TrainerOptions& t) const {
-    Handlers h;
-    for (const TrainingSetting& s : training_settings()) {
-      switch (s.kind) {
-        case TrainingSetting::Kind::kReal:
-          h.emplace_back(s.key, number(t.*s.real));
-          break;
-        case TrainingSetting::Kind::kInteger:
-          h.emplace_back(s.key, integer(t.*s.integer, s.min_integer));
-          break;
-        case TrainingSetting::Kind::kChoice:
-          h.emplace_back(s.key, [this, &t, &s](const Entry& e) {
-            s.set_choice(&t, static_cast<int>(values_.choice_index(e, s.choices())));
-          });
-          break;
-      }
-    }
-    h.emplace_back("checkpoints", [this, &t](const Entry& e) {
-      t.checkpoints = values_.int_axis(e, 1, nullptr);
-      std::sort(t.checkpoints.begin(), t.checkpoints.end());
-    });
-    return h;
-  }
-
-  // Only the parameters the system uses (RunConfig::cell_key() hashes exactly
-  // these; phnn/config/data_settings.h), so a key that would be silently
-  // ignored is an error instead.
-  Handlers physics_handlers(SystemKind kind, OscillatorOptions& p) const {
-    Handlers h;
-    for (const PhysicsSetting& s : physics_settings()) {
-      if (!s.applies_to(kind)) continue;
-      h.emplace_back(s.key, [this, &p, &s](const Entry& e) {
-        if (s.columns.size() == 3) {
-          const std::array<double, 3> v = values_.three_numbers(e);
-          s.set(&p, {v[0], v[1], v[2]});
-        } else {
-          s.set(&p, {values_.number(e, *e.value)});
-        }
-      });
-    }
     return h;
   }
 
