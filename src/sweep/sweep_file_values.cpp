@@ -316,13 +316,18 @@ std::pair<ModelKind, IntegratorKind> ValueReader::model(const toml::node& v) con
     allowed.push_back(model_key(kind, integrator));
   }
   const std::string expected = "; expected one of: " + join(allowed);
-  const auto is_name = [](const std::vector<std::string>& names, const std::string& n) {
-    return std::find(names.begin(), names.end(), n) != names.end();
-  };
   const std::size_t dash = s.rfind('-');
-  const std::string suffix = dash == std::string::npos ? "" : s.substr(dash + 1);
-  if (dash != std::string::npos && s.substr(0, dash) == to_string(ModelKind::kNode) &&
-      is_name(kIntegratorNames.names(), suffix) && is_discrete_gradient(parse_integrator(suffix))) {
+  if (dash == std::string::npos) {
+    fail(line_of(v), "models value " + raw + " is not FORMULATION-INTEGRATOR" +
+                         did_you_mean(s, allowed) + expected);
+  }
+  const std::string formulation = s.substr(0, dash), integrator = s.substr(dash + 1);
+  ModelKind model_kind{};
+  IntegratorKind integrator_kind{};
+  const bool formulation_ok = kModelNames.find(formulation, &model_kind);
+  const bool integrator_ok = kIntegratorNames.find(integrator, &integrator_kind);
+  if (formulation_ok && integrator_ok && model_kind == ModelKind::kNode &&
+      is_discrete_gradient(integrator_kind)) {
     std::string explicit_names;
     for (const Integrator& in : all_integrators()) {
       if (in.discrete_gradient) continue;
@@ -333,13 +338,6 @@ std::pair<ModelKind, IntegratorKind> ValueReader::model(const toml::node& v) con
                          "Hamiltonian; " +
                          explicit_names + " only)" + expected);
   }
-  if (dash == std::string::npos) {
-    fail(line_of(v), "models value " + raw + " is not FORMULATION-INTEGRATOR" +
-                         did_you_mean(s, allowed) + expected);
-  }
-  const std::string formulation = s.substr(0, dash), integrator = s.substr(dash + 1);
-  const bool formulation_ok = is_name(kModelNames.names(), formulation);
-  const bool integrator_ok = is_name(kIntegratorNames.names(), integrator);
   if (formulation_ok && !integrator_ok) {
     fail(line_of(v),
          "unknown integrator " + quoted(integrator) + " in models value " + raw + expected);
