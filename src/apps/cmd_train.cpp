@@ -58,9 +58,7 @@ void declare_train_options(cli::Parser* parser) {
   parser->option("system", "harmonic | duffing | self-sustained | a system file (.toml); with "
                            "--data: optional (the data set names its system)");
   std::string models, integrators;
-  for (const auto& [kind, integrator] : known_model_pairs()) {
-    models += (models.empty() ? "" : ", ") + model_key(kind, integrator);
-  }
+  for (const std::string& key : known_model_keys()) models += (models.empty() ? "" : ", ") + key;
   for (const std::string& name : kIntegratorNames.names()) {
     integrators += (integrators.empty() ? "" : " | ") + name;
   }
@@ -121,11 +119,7 @@ void parse_model_option(const cli::Parser& parser, CellSpec* cell) {
   try {
     cell->model = parse_model(name);
   } catch (const std::invalid_argument&) {
-    std::vector<std::string> labels;
-    for (const auto& [kind, integrator] : known_model_pairs()) {
-      labels.push_back(model_key(kind, integrator));
-    }
-    const std::string near = closest_name(name, labels);
+    const std::string near = closest_name(name, known_model_keys());
     throw cli::UsageError{"phnn train: --model \"" + name + "\"" +
                           (near.empty() ? "" : " (did you mean \"" + near + "\"?)") +
                           ": expected formulation-integrator as in sweep files, e.g. phnn-jr-rk2 "

@@ -58,6 +58,14 @@ std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs() {
   return pairs;
 }
 
+std::vector<std::string> known_model_keys() {
+  std::vector<std::string> keys;
+  for (const auto& [kind, integrator] : known_model_pairs()) {
+    keys.push_back(model_key(kind, integrator));
+  }
+  return keys;
+}
+
 const SweepSystemFile* SweepSpec::system_file(const std::string& system_name) const {
   for (const SweepSystemFile& f : system_files) {
     if (f.name == system_name) return &f;

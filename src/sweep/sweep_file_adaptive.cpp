@@ -51,10 +51,7 @@ CellSelector parse_selector(const std::string& text, int line, const ValueReader
   CellSelector s;
   s.text = text;
   s.system = parts[0];
-  std::vector<std::string> model_names;
-  for (const auto& [kind, integrator] : known_model_pairs()) {
-    model_names.push_back(model_key(kind, integrator));
-  }
+  const std::vector<std::string> model_names = known_model_keys();
   if (parts[1].empty()) {
     reader.fail(line, "comparison cell " + quoted(text) + " names no model; write " +
                           kSelectorForm);

@@ -264,9 +264,12 @@ std::string model_key(ModelKind kind, IntegratorKind integrator);
 /// The five valid pairs in the order node-rk2, phnn-jr-dg, phnn-jr-rk2,
 /// phnn-s-dg, phnn-s-rk2 (NODE has RK2 only, docs/METHOD.md §3).
 std::vector<std::pair<ModelKind, IntegratorKind>> all_model_pairs();
-/// Every pair a sweep file may name: the paper's five and the RK4 variants
-/// of the three formulations (node-rk4, phnn-jr-rk4, phnn-s-rk4), then the
-/// fourth-order discrete gradient of the PHNNs (phnn-jr-dg4, phnn-s-dg4).
+/// Every pair a sweep file may name: the paper's five, then every other
+/// model each integrator of the table allows (all_integrators(); NODE: no
+/// discrete gradient), today node-rk4, phnn-jr-rk4, phnn-s-rk4, phnn-jr-dg4,
+/// phnn-s-dg4.
 std::vector<std::pair<ModelKind, IntegratorKind>> known_model_pairs();
+/// model_key of each of known_model_pairs(), in its order.
+std::vector<std::string> known_model_keys();
 
 }  // namespace phnn
