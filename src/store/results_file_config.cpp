@@ -270,16 +270,13 @@ std::vector<RunResult> ResultsFile::read_result_columns() const {
     rows[i].status = statuses[i];
     rows[i].message = messages.at(i);
   }
-  const std::vector<ResultColumn>& columns = result_columns();
-  for (std::size_t k = 0; k < columns.size(); ++k) {
-    const ResultColumn& c = columns[k];
-    if (!impl.has_result_column[k]) continue;  // added later: stays NaN
-    if (c.type == ResultColumn::Type::kInt) {
-      const std::vector<std::int64_t> values = impl.ints(kRuns + c.name);
-      for (std::size_t i = 0; i < rows.size(); ++i) c.set_int(rows[i], values.at(i));
+  for (const ResultColumn* c : impl.result_columns) {  // one the file lacks stays NaN
+    if (c->type == ResultColumn::Type::kInt) {
+      const std::vector<std::int64_t> values = impl.ints(kRuns + c->name);
+      for (std::size_t i = 0; i < rows.size(); ++i) c->set_int(rows[i], values.at(i));
     } else {
-      const std::vector<double> values = impl.doubles(kRuns + c.name);
-      for (std::size_t i = 0; i < rows.size(); ++i) c.set_double(rows[i], values.at(i));
+      const std::vector<double> values = impl.doubles(kRuns + c->name);
+      for (std::size_t i = 0; i < rows.size(); ++i) c->set_double(rows[i], values.at(i));
     }
   }
   return rows;

@@ -153,10 +153,10 @@ struct ResultsFile::Impl {
   std::int64_t checksum_version = 0;
   // Rule 2: every dataset of /runs but the checksum, sorted (a row's bytes).
   std::vector<std::string> row_columns;
-  // Per result column (config/result_columns.h): whether the file has it
-  // (a column added later is missing from files written before it; any
-  // other is required, and its absence an HDF5 error where it is read).
-  std::vector<bool> has_result_column;
+  // The result columns (config/result_columns.h) the file has: a column
+  // added later is missing from files written before it; any other is
+  // required, and its absence an HDF5 error where it is read.
+  std::vector<const ResultColumn*> result_columns;
   std::string session;         // this process's /provenance/session_<k>
 
   Impl(h5::File f, MPI_Comm c)
@@ -182,9 +182,9 @@ struct ResultsFile::Impl {
     checksum_version = file.has_attribute("/", results_io::kChecksumVersionAttribute) ? 2
                        : has_checksums                                               ? 1
                                                                                      : 0;
-    has_result_column.clear();
-    for (const ResultColumn& c : result_columns()) {
-      has_result_column.push_back(!c.added_later || file.exists(results_io::kRuns + c.name));
+    result_columns.clear();
+    for (const ResultColumn& c : phnn::result_columns()) {
+      if (!c.added_later || file.exists(results_io::kRuns + c.name)) result_columns.push_back(&c);
     }
     row_columns.clear();
     if (checksum_version == 2) {

@@ -197,14 +197,11 @@ void ResultsFile::write_run(int row, const RunResult& r) {
     auto put_int = [&](const std::string& name, std::int64_t v) {
       f.write_rows(name, at, 1, &v);
     };
-    const std::vector<ResultColumn>& columns = result_columns();
-    for (std::size_t k = 0; k < columns.size(); ++k) {
-      const ResultColumn& c = columns[k];
-      if (!impl.has_result_column[k]) continue;  // added after the file was written
-      if (c.type == ResultColumn::Type::kInt) {
-        put_int(kRuns + c.name, c.get_int(r));
+    for (const ResultColumn* c : impl.result_columns) {  // not one added after the file
+      if (c->type == ResultColumn::Type::kInt) {
+        put_int(kRuns + c->name, c->get_int(r));
       } else {
-        put_double(kRuns + c.name, c.get_double(r));
+        put_double(kRuns + c->name, c->get_double(r));
       }
     }
     f.write_rows(kTrajectoryErrors, at, 1,
@@ -324,14 +321,11 @@ RunResult ResultsFile::read_run(int row) const {
   r.status = status_from_code(impl.ints(kStatus, at, 1).at(0),
                               where + kStatus + "[" + std::to_string(row) + "]");
   r.message = impl.strings_at(kMessage, at);
-  const std::vector<ResultColumn>& columns = result_columns();
-  for (std::size_t k = 0; k < columns.size(); ++k) {
-    const ResultColumn& c = columns[k];
-    if (!impl.has_result_column[k]) continue;  // added later: stays NaN
-    if (c.type == ResultColumn::Type::kInt) {
-      c.set_int(r, one_int(kRuns + c.name, 0, c.highest));
+  for (const ResultColumn* c : impl.result_columns) {  // one the file lacks stays NaN
+    if (c->type == ResultColumn::Type::kInt) {
+      c->set_int(r, one_int(kRuns + c->name, 0, c->highest));
     } else {
-      c.set_double(r, impl.doubles(kRuns + c.name, at, 1).at(0));
+      c->set_double(r, impl.doubles(kRuns + c->name, at, 1).at(0));
     }
   }
   r.trajectory_errors = unpadded(impl.doubles(kTrajectoryErrors, at, 1),
