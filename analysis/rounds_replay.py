@@ -165,12 +165,13 @@ def speculative_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, spli
     cost); a cell that stops growing loses the work ahead of it. An ahead item costs what it
     costs in the round that asks for it (that round's scale), else in this one. window > 1: the
     cells grown in any of the last `window` rounds (`phnn sweep`: 1).
-    Returns (makespan, work spent ahead, of it never asked for)."""
+    Returns (makespan, work spent ahead, of it never asked for, work spent on the runs asked
+    for)."""
     model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
     seeds = {}    # cell -> seeds asked so far
     grown = {}    # cell -> the last round that gave it seeds
     started = {}  # cell -> {first seed: ahead item} trained ahead, not yet asked for
-    makespan = spent = lost = 0.0
+    makespan = spent = lost = trained = 0.0
 
     def scale_of(c, k):  # of the first later round that asks for cell c, else its last round's
         for later in cells_of_rounds[k + 1:]:
@@ -209,12 +210,115 @@ def speculative_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, spli
                 ahead.append({"cell": c, "first": firsts[c], "runs": m, "cost": cost, "left": cost})
                 firsts[c] += m
         makespan += ahead_schedule(costs, ahead, ranks)[0]
+        trained += sum(costs)
         for item in ahead:
             spent += item["cost"] - item["left"]
             if item["left"] < item["cost"]:
                 started.setdefault(item["cell"], {})[item["first"]] = item
     lost += sum(i["cost"] - i["left"] for items in started.values() for i in items.values())
-    return makespan, spent, lost
+    return makespan, spent, lost, trained + spent - lost
+
+
+def comparison_cells(comparisons, cost_rows):
+    """Per comparison of an [adaptive] table, the set of cells its two selectors cover."""
+    cell_of = {"/".join((c["system"], c["model"].lower(), c["n_train"], c["size"],
+                         c["regularizer"])): int(c["cell"]) for c in cost_rows}
+    out = []
+    for pair in comparisons:
+        cells = set()
+        for side in pair:
+            system, models, rest = side.split("/", 2)
+            cells.update(cell_of[f"{system}/{m}/{rest}"] for m in models.split("+")
+                         if f"{system}/{m}/{rest}" in cell_of)
+        out.append(cells)
+    return out
+
+
+def named_by_round(results, rounds, cost_rows):
+    """Per round k but the last, {cell: [comparison index, ...]}: the comparisons that named the
+    cell after round k (`phnn reduce --round k --named`)."""
+    cell_of = {"/".join((c["system"], c["model"].lower(), c["n_train"], c["size"],
+                         c["regularizer"])): int(c["cell"]) for c in cost_rows}
+    out = []
+    for k in range(len(rounds) - 1):
+        named = {}
+        for row in run_csv("reduce", results, "--round", str(k), "--named"):
+            named.setdefault(cell_of[row["cell"]], []).append(int(row["comparison"]) - 1)
+        out.append(named)
+    return out
+
+
+def early_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, cells_of_comparison,
+                 named, split=True):
+    """The rounds as `phnn sweep` runs a comparisons rule (docs/METHOD.md "Speculation"): a
+    comparison names its cells for the next round as soon as every cell it covers has finished
+    the round's items, and ranks left idle train those cells' next seeds (items of the plan of
+    every comparison cell's next batch), in the order they became known; an item stops at the
+    round's end and goes on from where it stopped when the next round asks for it (always: only
+    named cells are trained). Returns (makespan, work spent ahead, of it never asked for, work spent
+    on the runs asked for)."""
+    model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
+    candidates = sorted(set().union(*cells_of_comparison)) if cells_of_comparison else []
+    seeds, started = {}, {}
+    makespan = spent = lost = trained = 0.0
+    for k, cells in enumerate(cells_of_rounds):
+        items, to_plan = [], []
+        for c, (n, _) in cells.items():
+            first = seeds.get(c, 0)
+            for start in [s0 for s0 in started.get(c, {}) if s0 < first + n]:
+                item = started[c].pop(start)
+                n -= item["runs"]
+                if item["left"] > 0:
+                    items.append((c, item["left"]))
+            if n > 0:
+                to_plan.append(PlanCell(c, *model[c], n))
+            seeds[c] = first + cells[c][0]
+        for c in [c for c in started if c not in cells]:  # never asked for
+            lost += sum(i["cost"] - i["left"] for i in started.pop(c).values())
+        items += [(c, cells[c][1] * (model[c][0] + m * model[c][1]))
+                  for c, m in plan_work(to_plan, ranks, split)]
+        loads, finish = [0.0] * ranks, {}
+        trained += sum(cost for _, cost in items)
+        for c, cost in items:
+            t = heapq.heappop(loads) + cost
+            finish[c] = max(finish.get(c, 0.0), t)
+            heapq.heappush(loads, t)
+        end = max(loads)
+        makespan += end
+        if k + 1 >= len(cells_of_rounds):
+            break
+        nxt, known = cells_of_rounds[k + 1], named[k]
+        ahead, firsts = [], {}
+        plan = [PlanCell(c, *model[c], min(batch, max_seeds - seeds.get(c, 0))) for c in candidates
+                if seeds.get(c, 0) < max_seeds and seeds.get(c, 0) not in started.get(c, {})]
+        for c, m in plan_work(plan, ranks, split):
+            if c not in known:
+                continue
+            ready = min(max(finish.get(d, 0.0) for d in cells_of_comparison[j]) for j in known[c])
+            scale = nxt[c][1] if c in nxt else 1.0
+            cost = scale * (model[c][0] + m * model[c][1])
+            first = firsts.get(c, seeds.get(c, 0))
+            ahead.append({"cell": c, "first": first, "runs": m, "cost": cost, "left": cost,
+                          "ready": ready})
+            firsts[c] = first + m
+        ahead.sort(key=lambda i: i["ready"])  # stable: plan order among equal times
+        while ahead:
+            free = heapq.heappop(loads)
+            if free >= end:
+                break
+            ready = [i for i in ahead if i["ready"] <= free]
+            if not ready:
+                heapq.heappush(loads, min(i["ready"] for i in ahead))
+                continue
+            item = ready[0]
+            ahead.remove(item)
+            done = min(item["left"], end - free)
+            item["left"] -= done
+            spent += done
+            heapq.heappush(loads, free + done)
+            started.setdefault(item["cell"], {})[item["first"]] = item
+    lost += sum(i["cost"] - i["left"] for items in started.values() for i in items.values())
+    return makespan, spent, lost, trained + spent - lost
 
 
 def replay(rounds, ranks):
@@ -241,11 +345,11 @@ def table(rows):
              "with speculation | efficiency | core-hours ahead (never asked for) | "
              "without barriers | efficiency |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        spec, ahead, lost = r["speculative"]
+        spec, ahead, lost, asked = r["speculative"]
         lines.append(f"| {r['ranks']} | {len(r['items'])} | {sum(r['items'])} | "
                      f"{r['work'] / 3600:.3g} | {duration(r['barrier'])} | "
                      f"{100 * r['efficiency']:.1f} % | {duration(spec)} | "
-                     f"{100 * r['work'] / (r['ranks'] * spec):.1f} % | "
+                     f"{100 * asked / (r['ranks'] * spec):.1f} % | "
                      f"{ahead / 3600:.2f} ({lost / 3600:.2f}) | {duration(r['free'])} | "
                      f"{100 * r['free_efficiency']:.1f} % |")
     lines.append("")
@@ -278,11 +382,18 @@ def main(argv=None):
           + ", ".join(str(len(c)) for c in cells))
     with open(args.sweep, "rb") as f:
         adaptive = tomllib.load(f)["adaptive"]
+    early = adaptive.get("rule") == "comparisons"
+    if early:
+        named = named_by_round(args.results, rounds, cost_rows)
+        covered = comparison_cells(adaptive["comparisons"], cost_rows)
     rows = []
     for n in (int(r) for r in args.ranks.split(",")):
         row = replay(round_item_costs(cells, cost_rows, n, args.split == "auto"), n)
-        row["speculative"] = speculative_replay(cells, cost_rows, n, adaptive["batch"],
-                                                adaptive["max_seeds"], args.split == "auto")
+        row["speculative"] = (
+            early_replay(cells, cost_rows, n, adaptive["batch"], adaptive["max_seeds"], covered,
+                         named, args.split == "auto") if early else
+            speculative_replay(cells, cost_rows, n, adaptive["batch"], adaptive["max_seeds"],
+                               args.split == "auto"))
         rows.append(row)
     print(table(rows))
     print(f"critical path of the rounds (each round's costliest single run, summed): "

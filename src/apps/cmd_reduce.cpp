@@ -316,6 +316,10 @@ void declare_options(cli::Parser* p) {
   parser.option("round",
                  "adaptive sweeps: the tables as they stood after round K (0: every cell at its "
                  "first seeds)");
+  parser.flag("named",
+              "adaptive sweeps of the comparisons rule: instead of the tables, the cells each "
+              "comparison names after round K (--round; else the last) as CSV: comparison, line, "
+              "cell");
   parser.option("rule",
                 "adaptive sweeps: replay the [adaptive] table of sweep file SWEEP (same grid, "
                 "another rule, batch or max_seeds) on FILE's runs instead of FILE's own; the "
@@ -429,6 +433,11 @@ int run_reduce(int argc, char** argv, int first) {
       search ? std::optional<AdaptiveState>(search->state)
              : adaptive_rounds(spec, grid, statuses, in.mse, parser, path);
   if (adaptive) warn_unfinished_replay(in, *adaptive, parser, path);
+  if (parser.flag_set("named")) {
+    std::cout << named_cells_csv(spec, grid, search || !adaptive ? nullptr : &*adaptive, statuses,
+                                 in.mse, path);
+    return 0;
+  }
   if (per_run) {
     print_per_run(file, in, adaptive ? &*adaptive : nullptr);
     return 0;

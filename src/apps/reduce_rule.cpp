@@ -4,6 +4,7 @@
 #include "apps/reduce_rule.h"
 
 #include <algorithm>
+#include <sstream>
 #include <unordered_map>
 
 #include "apps/cli.h"
@@ -36,6 +37,28 @@ RuleView rule_view(const ResultsFile& file, const std::string& rule_path) {
                           "file — only its [adaptive] table may differ"};
   }
   return view;
+}
+
+std::string named_cells_csv(const SweepSpec& spec, const Grid& grid, const AdaptiveState* state,
+                            const std::vector<RunStatus>& status, const std::vector<double>& mse,
+                            const std::string& path) {
+  if (state == nullptr || spec.adaptive.rule != AdaptiveRule::kComparisons) {
+    throw cli::UsageError{"phnn reduce: --named: " + path +
+                          " is not an adaptive sweep of the comparisons rule; drop --named"};
+  }
+  const auto named = comparison_named_cells(spec, grid, state->active, status, mse);
+  std::ostringstream out;
+  out << "comparison,line,cell\n";
+  for (std::size_t j = 0; j < named.size(); ++j) {
+    for (int c : named[j]) {
+      const RunConfig& run =
+          grid.runs[static_cast<std::size_t>(grid.cells[static_cast<std::size_t>(c)].runs.front())];
+      out << j + 1 << "," << spec.adaptive.comparisons[j].line << "," << run.system_name() << "/"
+          << model_key(run.model, run.integrator) << "/" << run.n_train << "/"
+          << to_string(run.size) << "/" << to_string(run.regularizer) << "\n";
+    }
+  }
+  return out.str();
 }
 
 }  // namespace apps

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "phnn/store/results_file.h"
+#include "phnn/sweep/adaptive.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/sweep_file.h"
 
@@ -37,6 +38,18 @@ std::vector<T> through_view(const RuleView& view, const std::vector<T>& values, 
   }
   return out;
 }
+
+/// `phnn reduce FILE --round K --named`: what each comparison of the
+/// [adaptive] table names after round K (state: the replay up to K), one
+/// CSV row per named cell: its 1-based index, its line in the sweep file,
+/// the cell as a selector ("system/model/n_train/size/regularizer"). For
+/// analysis/rounds_replay.py, which replays when each cell of the next round
+/// became known as the round drained. Throws cli::UsageError naming `path`
+/// for a file that is not an adaptive sweep (state null) or whose rule is
+/// not comparisons.
+std::string named_cells_csv(const SweepSpec& spec, const Grid& grid, const AdaptiveState* state,
+                            const std::vector<RunStatus>& status, const std::vector<double>& mse,
+                            const std::string& path);
 
 }  // namespace apps
 }  // namespace phnn

@@ -1,9 +1,11 @@
 // src/apps/sweep_items.cpp — SweepRun's work items (sweep_run.h): one
 // item trained (from its saved state if it has one), journaled and written
 // as rows; and the items idle ranks train ahead of a round's end.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <thread>
 
 #include "apps/sweep_checkpoints.h"
 #include "apps/sweep_report.h"
@@ -156,6 +158,16 @@ SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const char* kind
   outcome.io_error = record_item(grid_, item, cell_results, started, utc_now(), &*journal_,
                                  &*results_, &times_);
   if (outcome.io_error.empty()) checkpoints.remove();
+  // For the decisions taken while the round drains (ahead_ready).
+  if (outcome.io_error.empty() && board_ != nullptr) {
+    std::vector<RunStatus> status;
+    std::vector<double> mse;
+    for (const RunResult& r : cell_results) {
+      status.push_back(r.status);
+      mse.push_back(r.mse);
+    }
+    board_->post(item.runs, status, mse);
+  }
   outcome.runs = static_cast<int>(item.runs.size());
   if (!quiet && outcome.io_error.empty()) {
     print_item(prefix_, label + " done in " + format_duration(std::chrono::duration<double>(
@@ -173,27 +185,84 @@ std::vector<WorkItem> SweepRun::ahead_items() const {
   return plan_work(grid_, ahead_, size_, split_).items;
 }
 
-// While the round's last items train elsewhere, this rank trains `ahead`
-// items from their queue; each stops (its state saved, for the round that
-// asks for it) once every one of the round's `asked` items has finished,
-// or on a stop (a signal here is posted to the others by train_round, right
-// after). Their results are recorded like any other.
-void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue, int asked,
-                           WorkQueue* ahead_queue, const std::function<void()>& tick,
-                           RoundOutcome* outcome) {
+// The ahead items this rank may take now that were not ready before: with
+// the comparisons rule, those of the cells the next round is certain to
+// grow (cells_named_early on the outcomes posted so far; every run of the
+// round's items not posted yet counts as pending, a retried failed one too);
+// with column-best, all of them at the first call (the guess of
+// runs_to_speculate). *decided: the comparisons read so far, empty at first;
+// all set when nothing more can become ready.
+std::vector<int> SweepRun::ahead_ready(const std::vector<WorkItem>& ahead,
+                                       const std::vector<WorkItem>& work,
+                                       const std::vector<int>& status_codes,
+                                       std::vector<char>* decided) {
+  std::vector<int> ready;
+  if (spec_.adaptive.rule != AdaptiveRule::kComparisons) {
+    if (decided->empty()) {
+      decided->push_back(1);
+      for (std::size_t i = 0; i < ahead.size(); ++i) ready.push_back(static_cast<int>(i));
+    }
+    return ready;
+  }
+  std::vector<RunStatus> status;
+  for (int code : status_codes) status.push_back(static_cast<RunStatus>(code));
+  for (const WorkItem& item : work) {
+    for (int r : item.runs) status[static_cast<std::size_t>(r)] = RunStatus::kPending;
+  }
+  std::vector<double> mse = round_mse_;
+  board_->read(&status, &mse);
+  const std::vector<int> cells =
+      cells_named_early(spec_, grid_, adaptive_.active, status, mse, decided);
+  for (std::size_t i = 0; i < ahead.size(); ++i) {
+    if (std::binary_search(cells.begin(), cells.end(), ahead[i].cell))
+      ready.push_back(static_cast<int>(i));
+  }
+  return ready;
+}
+
+// While the round's last items train elsewhere, this rank trains ahead
+// items as they become ready (ahead_ready, read at most twice a second; in
+// the order they became ready), each claimed on the board by one rank; each
+// stops (its state saved, for the round that asks for it) once every one of
+// the round's `work` items has finished, or on a stop (a signal here is
+// posted to the others by train_round, right after). Their results are
+// recorded like any other.
+void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, const std::vector<WorkItem>& work,
+                           WorkQueue* queue, const std::vector<int>& status_codes,
+                           const std::function<void()>& tick, RoundOutcome* outcome) {
   bool round_over = false;
-  SweepClock::time_point last_poll{};
+  SweepClock::time_point last_poll{}, last_read{};
   const auto stop = [&] {  // asked at every step: the shared count read at most 10 times a second
     if (g_stop_signal != 0 || round_over) return true;
     if (SweepClock::now() - last_poll < std::chrono::milliseconds(100)) return false;
     last_poll = SweepClock::now();
     queue->progress();
-    round_over = queue->done() >= asked || queue->stop_requested();
+    round_over = queue->done() >= static_cast<int>(work.size()) || queue->stop_requested();
     return round_over;
   };
+  std::vector<char> decided, listed(ahead.size(), 0);
+  std::vector<int> ready;  // in the order they became ready
+  std::size_t next = 0;    // the first of `ready` not tried here
   while (!stop()) {
-    const int i = ahead_queue->next();
-    if (i < 0) return;
+    if (next == ready.size()) {
+      const bool all_read = !decided.empty() && std::all_of(decided.begin(), decided.end(),
+                                                            [](char d) { return d != 0; });
+      if (all_read) return;
+      if (SweepClock::now() - last_read < std::chrono::milliseconds(500)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        continue;
+      }
+      last_read = SweepClock::now();
+      for (int i : ahead_ready(ahead, work, status_codes, &decided)) {
+        if (!listed[static_cast<std::size_t>(i)]) {
+          listed[static_cast<std::size_t>(i)] = 1;
+          ready.push_back(i);
+        }
+      }
+      continue;
+    }
+    const int i = ready[next++];
+    if (!board_->claim(i)) continue;
     const ItemOutcome done =
         train_one(ahead[static_cast<std::size_t>(i)], "ahead", i, ahead.size(), stop, tick);
     outcome->ahead_runs += done.runs;

@@ -99,9 +99,11 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
   // static mode lacks.
   const std::vector<WorkItem> ahead =
       queue.mode() == ScheduleMode::kDynamic ? ahead_items() : std::vector<WorkItem>();
-  std::optional<WorkQueue> ahead_queue;
+  std::optional<RoundBoard> board;
   if (!ahead.empty()) {
-    ahead_queue.emplace(MPI_COMM_WORLD, static_cast<int>(ahead.size()), ScheduleMode::kDynamic);
+    board.emplace(MPI_COMM_WORLD, static_cast<int>(grid_.runs.size()),
+                  static_cast<int>(ahead.size()));
+    board_ = &*board;
   }
   if (root_) {
     print_plan(spec_, grid_, shard_, planned.runs_done_before, planned.runs_to_do, planned.plan,
@@ -153,10 +155,11 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
     report_progress(true);
   }
   post_stop();  // before any collective call: the others stop at their next step or item
-  if (ahead_queue) {
-    if (!ended) train_ahead(ahead, &queue, static_cast<int>(work.size()), &*ahead_queue, tick, &outcome);
+  if (board) {
+    if (!ended) train_ahead(ahead, work, &queue, status_codes, tick, &outcome);
     post_stop();
-    ahead_queue->close();
+    board_ = nullptr;
+    board->close();
   }
   outcome.stopped =
       mpi::all_reduce(world_, queue.stop_requested() ? 1 : 0, mpi::maximum<int>()) != 0;
@@ -254,12 +257,13 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
   if (int status = agreed(world_, root_, [&] {
         const ResultsFile file = ResultsFile::open_read_only(out_);
         const std::vector<RunStatus> statuses = file.read_statuses();
+        round_mse_ = file.read_double_column("mse");
         adaptive_ = spec_.search.enabled
                         ? replay_search(spec_, grid_, statuses,
                                         file.read_double_column("best_validation_loss"),
                                         file.read_double_column("mse"))
                               .state
-                        : replay_adaptive_rounds(spec_, grid_, statuses, file.read_double_column("mse"));
+                        : replay_adaptive_rounds(spec_, grid_, statuses, round_mse_);
         for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
         ahead_ = spec_.adaptive.enabled && !spec_.search.enabled
                      ? runs_to_speculate(spec_, grid_, adaptive_, statuses)
@@ -276,6 +280,7 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
   mpi::broadcast(world_, adaptive_.complete, 0);
   mpi::broadcast(world_, adaptive_.trained_ahead, 0);
   mpi::broadcast(world_, ahead_, 0);
+  mpi::broadcast(world_, round_mse_, 0);
   for (std::size_t i = 0; i < codes.size(); ++i) {
     if (!adaptive_.active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
   }

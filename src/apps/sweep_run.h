@@ -22,6 +22,7 @@
 #include "phnn/sweep/adaptive.h"
 #include "phnn/sweep/grid.h"
 #include "phnn/sweep/merge.h"
+#include "phnn/sweep/round_board.h"
 #include "phnn/sweep/scheduler.h"
 #include "phnn/sweep/sweep_file.h"
 #include "phnn/sweep/work_plan.h"
@@ -91,9 +92,12 @@ class SweepRun {
   ItemOutcome train_one(const WorkItem& item, const char* kind, int index, std::size_t items,
                         std::function<bool()> stop, const std::function<void()>& tick);
   std::vector<WorkItem> ahead_items() const;
-  void train_ahead(const std::vector<WorkItem>& ahead, WorkQueue* queue, int asked,
-                   WorkQueue* ahead_queue, const std::function<void()>& tick,
-                   RoundOutcome* outcome);
+  void train_ahead(const std::vector<WorkItem>& ahead, const std::vector<WorkItem>& work,
+                   WorkQueue* queue, const std::vector<int>& status_codes,
+                   const std::function<void()>& tick, RoundOutcome* outcome);
+  std::vector<int> ahead_ready(const std::vector<WorkItem>& ahead,
+                               const std::vector<WorkItem>& work,
+                               const std::vector<int>& status_codes, std::vector<char>* decided);
   int train_and_close(std::vector<int> status_codes);
   int open_results() {
     return agreed(world_, true, [&] {
@@ -147,6 +151,12 @@ class SweepRun {
   // The runs idle ranks train ahead of the round in progress, per cell
   // (runs_to_speculate; the same on every rank).
   std::vector<std::vector<int>> ahead_;
+  // The MSE of every run at the round's start (replay_rounds; every rank),
+  // for the decisions taken while the round drains (cells_named_early).
+  std::vector<double> round_mse_;
+  // The round's shared outcomes and claims while it has items to train
+  // ahead (train_round); train_one posts every recorded item there.
+  RoundBoard* board_ = nullptr;
   bool planned_once_ = false;
   SweepClock::time_point start_ = SweepClock::now();
 };

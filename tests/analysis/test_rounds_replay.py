@@ -72,18 +72,38 @@ class Speculation(unittest.TestCase):
         # against 2 + 2 with barriers alone.
         rounds = [{0: (2, 1.0), 1: (1, 1.0)}, {0: (2, 1.0)}]
         self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 2, 2, 10, split=False),
-                         (3.0, 2.0, 1.0))
+                         (3.0, 2.0, 1.0, 5.0))
         self.assertEqual(rr.barrier_makespan(rr.round_item_costs(rounds, self.COSTS, 2, False), 2),
                          4.0)
         # One rank never idles: the makespan is the work, nothing is trained ahead.
         self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 1, 2, 10, split=False),
-                         (5.0, 0.0, 0.0))
+                         (5.0, 0.0, 0.0, 5.0))
         # Critical path: round 0's costliest run 1 s, round 1's 1 s.
         self.assertEqual(rr.critical_path(rounds, self.COSTS), 2.0)
         # max_seeds 2: cell 0 is at the cap after round 0, so only cell 1's second seed (1 s,
         # never asked for) is trained ahead.
         self.assertEqual(rr.speculative_replay(rounds, self.COSTS, 2, 2, 2, split=False)[1:],
-                         (1.0, 1.0))
+                         (1.0, 1.0, 5.0))
+
+    def test_cells_known_early_by_hand(self):
+        # The comparisons rule: round 0 on 2 ranks is cell 2 (3 s) | cell 0 (1 s), cell 1 (1 s):
+        # cells 0, 1, 2 finish at 1, 2, 3. Comparison 0 covers cells 0 and 1, comparison 1
+        # cells 1 and 2. Comparison 0 names cell 0 (2 more seeds): known at 2, when cell 1 is
+        # done; rank 1 trains it from 2 to the round's end at 3 (1 s of 2). Round 1 resumes it:
+        # 1 s. Makespan 3 + 1 against 3 + 2 with barriers; the work asked for is 7 s, all of it
+        # trained once; nothing is lost.
+        costs = self.COSTS + [{"cell": "2", "fixed_s": "0", "member_s": "1"}]
+        rounds = [{0: (1, 1.0), 1: (1, 1.0), 2: (3, 1.0)}, {0: (2, 1.0)}]
+        covered = [{0, 1}, {1, 2}]
+        self.assertEqual(rr.early_replay(rounds, costs, 2, 2, 10, covered, [{0: [0]}],
+                                         split=False), (4.0, 1.0, 0.0, 7.0))
+        # Named by comparison 1 instead, cell 0 is known only when cell 2 is done, at the
+        # round's end: nothing ahead, 3 + 2.
+        self.assertEqual(rr.early_replay(rounds, costs, 2, 2, 10, covered, [{0: [1]}],
+                                         split=False), (5.0, 0.0, 0.0, 7.0))
+        # Either comparison: the earlier one counts.
+        self.assertEqual(rr.early_replay(rounds, costs, 2, 2, 10, covered, [{0: [1, 0]}],
+                                         split=False)[0], 4.0)
 
 
 class WorkPlanPort(unittest.TestCase):

@@ -139,6 +139,38 @@ ls "$dir/ahead.h5.journal"/cell-*.state > /dev/null 2>&1 &&
 long 3 "$dir/noahead.h5" --max-group-size 5 --no-speculation || fail "--no-speculation"
 grep -q " ahead [0-9]*/" "$dir/log" && fail "--no-speculation trained ahead"
 
+# Speculation under the comparisons rule: two independent pairs (RK2 against
+# RK4 at N_train 25 and at 100) grow every round, NODE's pair is resolved.
+# An idle rank trains only seeds the next round is certain to ask for (a
+# pair whose cells have all finished the round names them already), so on
+# 3 ranks items run ahead, the runs equal 1 rank's bitwise, and no finished
+# run trained ahead is left unasked.
+sed '/^\[adaptive\]/,$d' "$dir/long.toml" > "$dir/pairs.toml"
+cat >> "$dir/pairs.toml" <<'TOML'
+[study.I]
+n_train = [25, 100]
+[adaptive]
+max_seeds = 12
+batch = 3
+rule = "comparisons"
+comparisons = [["harmonic/phnn-jr-rk2/25/small/none", "harmonic/phnn-jr-rk4/25/small/none"],
+               ["harmonic/phnn-jr-rk2/100/small/none", "harmonic/phnn-jr-rk4/100/small/none"],
+               ["harmonic/node-rk2/25/small/none", "harmonic/node-rk2/100/small/none"]]
+TOML
+pairs() {  # NP OUT
+  timeout -k 5 400 "$mpiexec" "$np_flag" "$1" "${preflags[@]}" "$phnn" sweep "$dir/pairs.toml" \
+    --out "$2" --max-group-size 5 > "$dir/log" 2>&1
+}
+pairs 1 "$dir/pairs1.h5" || fail "the 1-rank comparisons sweep failed"
+per_run "$dir/pairs1.h5" "$dir/pairs1.csv"
+pairs 3 "$dir/pairs3.h5" || fail "the 3-rank comparisons sweep with ahead items failed"
+grep -q "^\[rank [0-9]/3\] ahead [0-9]*/[0-9]*: " "$dir/log" || fail "no rank trained ahead under the comparisons rule"
+grep -q "trained ahead while a round drained" "$dir/log" &&
+  fail "a run trained ahead under the comparisons rule was never asked for"
+per_run "$dir/pairs3.h5" "$dir/pairs3.csv"
+python3 "$here/compare_runs.py" "$dir/pairs1.csv" "$dir/pairs3.csv" ||
+  fail "speculation under the comparisons rule changed the runs asked for"
+
 # kill -9 of every rank once round 1 has finished runs of its own (round 0
 # is 9 items of at most 2 seeds).
 sweep 2 "$dir/k.h5" & job=$!
@@ -153,4 +185,4 @@ grep -q "adaptive sweep complete" "$dir/log" && fail "the sweep ended before the
 sweep 2 "$dir/k.h5" || fail "the resumed sweep failed"
 per_run "$dir/k.h5" "$dir/k.csv"
 python3 "$here/compare_runs.py" "$dir/np1.csv" "$dir/k.csv" || fail "the killed and resumed sweep differs"
-echo "PASSED: 1, 2, 3 ranks, runs trained ahead and a kill -9 mid-round give the same 29 runs bitwise"
+echo "PASSED: 1, 2, 3 ranks, runs trained ahead (column-best and comparisons) and a kill -9 mid-round give the same runs bitwise"

@@ -81,17 +81,48 @@ std::vector<int> adaptive_rule_cells(const SweepSpec& spec, const Grid& grid,
                                      const std::vector<double>& mse,
                                      const BootstrapOptions& bootstrap = {});
 
-/// What idle ranks train ahead while a round drains (docs/METHOD.md,
-/// "Speculation"): the runs the next round asks for if it names again every
-/// cell the round in progress grows (a cell with a pending run asked for) —
-/// per such cell below max_seeds, its next `batch` seeds (fewer at the cap)
-/// that are still pending: element c lists cell c's (ascending; empty for
-/// most), the form plan_work() takes. Empty (no elements) when none is left
-/// or `state` is complete. A run's result depends only on its configuration and seed, so
-/// training a run early changes neither what the rule asks for nor a number.
+/// What idle ranks may train ahead while a round drains (docs/METHOD.md,
+/// "Speculation"): per candidate cell below max_seeds, its next `batch`
+/// seeds (fewer at the cap) that are still pending: element c lists cell c's
+/// (ascending; empty for most), the form plan_work() takes. Candidates: with
+/// the comparisons rule every cell a comparison selects from — the ones the
+/// next round grows become known while the round drains (cells_named_early);
+/// with column-best the cells the round in progress grows (a cell with a
+/// pending run asked for), on the guess that they stay undecided. Empty (no
+/// elements) when none is left or `state` is complete. A run's result
+/// depends only on its configuration and seed, so training a run early
+/// changes neither what the rule asks for nor a number.
 std::vector<std::vector<int>> runs_to_speculate(const SweepSpec& spec, const Grid& grid,
                                                 const AdaptiveState& state,
                                                 const std::vector<RunStatus>& status);
+
+/// The comparisons rule: per comparison of spec.adaptive.comparisons, the
+/// cells below max_seeds it names when the runs with active[i] != 0 are the
+/// results (their union is adaptive_rule_cells()'s, less the cells at the
+/// cap); only those with read[j] != 0 unless `read` is empty, the others
+/// left empty. All empty for the column-best rule.
+std::vector<std::vector<int>> comparison_named_cells(const SweepSpec& spec, const Grid& grid,
+                                                     const std::vector<char>& active,
+                                                     const std::vector<RunStatus>& status,
+                                                     const std::vector<double>& mse,
+                                                     const std::vector<char>& read = {},
+                                                     const BootstrapOptions& bootstrap = {});
+
+/// The comparisons rule while a round drains: the cells its next round is
+/// certain to grow, from the runs finished so far. A comparison names cells
+/// from the runs of the cells its two sides select from alone, so once none
+/// of those has a pending run asked for (`active`, `status`), what it names
+/// is what adaptive_rule_cells() names for it at the round's end; a cell any
+/// comparison names grows. Evaluates each comparison that is newly complete
+/// (marks it in `decided`, resized to the comparisons and kept by the caller
+/// for the round) and returns the cells below max_seeds they name,
+/// ascending. Empty for the column-best rule, whose columns are not known
+/// before the round ends.
+std::vector<int> cells_named_early(const SweepSpec& spec, const Grid& grid,
+                                   const std::vector<char>& active,
+                                   const std::vector<RunStatus>& status,
+                                   const std::vector<double>& mse, std::vector<char>* decided,
+                                   const BootstrapOptions& bootstrap = {});
 
 /// The sweep of round 0 alone: `spec` without [adaptive], every study's
 /// seeds its initial ones (for --dry-run's round-0 cost).

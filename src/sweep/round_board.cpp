@@ -1,0 +1,94 @@
+// src/sweep/round_board.cpp — RoundBoard (phnn/sweep/round_board.h): run
+// outcomes and claim flags in one MPI-3 window on rank 0.
+#include "phnn/sweep/round_board.h"
+
+#include <cstring>
+
+namespace phnn {
+
+RoundBoard::RoundBoard(MPI_Comm comm, int num_runs, int num_items)
+    : comm_(comm), num_runs_(num_runs), num_items_(num_items) {
+  int rank = 0;
+  MPI_Comm_rank(comm_, &rank);
+  const MPI_Aint slots = static_cast<MPI_Aint>(num_items) + 2 * static_cast<MPI_Aint>(num_runs);
+  MPI_Errhandler previous;
+  MPI_Comm_get_errhandler(comm_, &previous);
+  MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
+  const MPI_Aint bytes = rank == 0 ? slots * static_cast<MPI_Aint>(sizeof(long)) : 0;
+  const int rc = MPI_Win_allocate(bytes, sizeof(long), MPI_INFO_NULL, comm_, &slots_, &window_);
+  MPI_Comm_set_errhandler(comm_, previous);
+  MPI_Errhandler_free(&previous);
+  int ok = rc == MPI_SUCCESS ? 1 : 0, all_ok = 0;
+  MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm_);
+  if (!all_ok) {
+    if (rc == MPI_SUCCESS) MPI_Win_free(&window_);
+    window_ = MPI_WIN_NULL;
+    return;
+  }
+  if (rank == 0) {
+    MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window_);
+    std::memset(slots_, 0, static_cast<std::size_t>(slots) * sizeof(long));
+    MPI_Win_unlock(0, window_);
+  }
+  MPI_Barrier(comm_);
+  MPI_Win_lock_all(0, window_);
+}
+
+// close() is collective; a destructor during stack unwinding on one rank
+// must not block, so it frees nothing.
+RoundBoard::~RoundBoard() = default;
+
+void RoundBoard::post(const std::vector<int>& runs, const std::vector<RunStatus>& status,
+                      const std::vector<double>& mse) {
+  if (!ok()) return;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    long bits = 0;
+    std::memcpy(&bits, &mse[k], sizeof bits);
+    MPI_Accumulate(&bits, 1, MPI_LONG, 0, mse_at(runs[k]), 1, MPI_LONG, MPI_REPLACE, window_);
+  }
+  MPI_Win_flush(0, window_);
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const long code = static_cast<long>(status[k]) + 1;
+    MPI_Accumulate(&code, 1, MPI_LONG, 0, status_at(runs[k]), 1, MPI_LONG, MPI_REPLACE, window_);
+  }
+  MPI_Win_flush(0, window_);
+}
+
+void RoundBoard::read(std::vector<RunStatus>* status, std::vector<double>* mse) const {
+  if (!ok() || num_runs_ == 0) return;
+  std::vector<long> codes(static_cast<std::size_t>(num_runs_)), bits(codes.size());
+  // Statuses first: an MSE is complete at rank 0 before its status is posted.
+  MPI_Get_accumulate(nullptr, 0, MPI_LONG, codes.data(), num_runs_, MPI_LONG, 0, status_at(0),
+                     num_runs_, MPI_LONG, MPI_NO_OP, window_);
+  MPI_Win_flush(0, window_);
+  MPI_Get_accumulate(nullptr, 0, MPI_LONG, bits.data(), num_runs_, MPI_LONG, 0, mse_at(0),
+                     num_runs_, MPI_LONG, MPI_NO_OP, window_);
+  MPI_Win_flush(0, window_);
+  for (std::size_t r = 0; r < codes.size(); ++r) {
+    if (codes[r] == 0) continue;
+    (*status)[r] = static_cast<RunStatus>(codes[r] - 1);
+    std::memcpy(&(*mse)[r], &bits[r], sizeof(double));
+  }
+}
+
+// A fetch-and-add, not MPI_Compare_and_swap: Open MPI 4.1's shared-memory
+// transport crashes in its compare-and-swap emulation (osc/rdma over vader,
+// seen here); the first rank to add finds 0.
+bool RoundBoard::claim(int item) {
+  if (!ok()) return false;
+  const long one = 1;
+  long previous = 1;
+  MPI_Fetch_and_op(&one, &previous, MPI_LONG, 0, item, MPI_SUM, window_);
+  MPI_Win_flush(0, window_);
+  return previous == 0;
+}
+
+void RoundBoard::close() {
+  if (window_ != MPI_WIN_NULL) {
+    MPI_Win_unlock_all(window_);
+    MPI_Win_free(&window_);
+    window_ = MPI_WIN_NULL;
+  }
+}
+
+}  // namespace phnn
