@@ -116,6 +116,14 @@ def round_item_costs(cells_of_rounds, cost_rows, ranks, split=True):
     return out
 
 
+def unsplit_work(cells_of_rounds, cost_rows):
+    """The runs asked for as one stack per cell and round (fixed + runs x member, at the round's
+    measured scale) [s]: the least work any schedule spends on them."""
+    model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
+    return sum(scale * (model[c][0] + n * model[c][1])
+               for cells in cells_of_rounds for c, (n, scale) in cells.items())
+
+
 def critical_path(cells_of_rounds, cost_rows):
     """Sum over rounds of the round's costliest single run (fixed + one member, at its measured
     scale) [s]: no schedule that waits for each round's decision is shorter, at any rank count
@@ -155,13 +163,36 @@ def ahead_schedule(costs, ahead, ranks):
     return end, spent
 
 
+def take_ahead(cells, seeds, started, model):
+    """Round start: the items of the round's cells ({cell: (runs, scale)}) trained ahead before
+    (`started`, {cell: {first seed: item}}) are taken, and `seeds` advanced. Returns
+    ([(cell, cost left)] of the resumed ones, [PlanCell] of the runs still to plan)."""
+    resumed, to_plan = [], []
+    for c, (n, _) in cells.items():
+        first = seeds.get(c, 0)
+        for start in [s0 for s0 in started.get(c, {}) if s0 < first + n]:
+            item = started[c].pop(start)
+            n -= item["runs"]
+            if item["left"] > 0:
+                resumed.append((c, item["left"]))
+        if n > 0:
+            to_plan.append(PlanCell(c, *model[c], n))
+        seeds[c] = first + cells[c][0]
+    return resumed, to_plan
+
+
+# As `phnn sweep` plans the items idle ranks may train ahead under the comparisons rule
+# (sweep_items.cpp, kAheadSplit): for this many times the ranks, so that they fit the end of a
+# round.
+AHEAD_SPLIT = 8
+
+
 def speculative_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, split=True,
                        depth=1, window=1):
-    """The rounds with speculation as `phnn sweep` does it (docs/METHOD.md "Speculation"): while
-    round k drains, idle ranks train the next `depth` batches of `batch` seeds (fewer at
-    max_seeds) of each cell round k grows, nearer batches first, largest items first within
-    one; an ahead item stops at the round's end. A round that asks for an ahead item's runs
-    takes them as they are (finished, or a resumed item first in the plan, what is left of its
+    """The rounds with speculation as `phnn sweep` does it for the column-best rule (docs/METHOD.md
+    "Speculation"): while round k drains, idle ranks train the next `depth` batches of `batch`
+    seeds (fewer at max_seeds) of each cell round k grows, nearer batches first, largest items
+    first within one; an ahead item stops at the round's end. A round that asks for an ahead item's runs takes them as they are (finished, or a resumed item first in the plan, what is left of its
     cost); a cell that stops growing loses the work ahead of it. An ahead item costs what it
     costs in the round that asks for it (that round's scale), else in this one. window > 1: the
     cells grown in any of the last `window` rounds (`phnn sweep`: 1).
@@ -180,17 +211,9 @@ def speculative_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, spli
         return cells_of_rounds[grown[c]][c][1]
 
     for k, cells in enumerate(cells_of_rounds):
-        resumed, to_plan = [], []
-        for c, (n, _) in cells.items():
-            first = seeds.get(c, 0)
-            for start in [s0 for s0 in started.get(c, {}) if s0 < first + n]:
-                item = started[c].pop(start)
-                n -= item["runs"]
-                if item["left"] > 0:
-                    resumed.append(item["left"])
-            if n > 0:
-                to_plan.append(PlanCell(c, *model[c], n))
-            seeds[c] = first + cells[c][0]
+        resumed, to_plan = take_ahead(cells, seeds, started, model)
+        resumed = [left for _, left in resumed]
+        for c in cells:
             grown[c] = k
         growing = [c for c in sorted(grown) if k - grown[c] < window]
         for c in [c for c in started if c not in growing]:  # stopped growing
@@ -248,6 +271,27 @@ def named_by_round(results, rounds, cost_rows):
     return out
 
 
+def comparison_chain(cells_of_rounds, cost_rows, cells_of_comparison, named):
+    """The longest chain of one comparison's decisions [s]: the costliest single run of its cells
+    in round 0, plus for each round after which it named cells the costliest single run of those
+    (at the next round's measured scale). A comparison decides again only once the runs it named
+    have finished, and they cannot start before it named them: a schedule that trains only runs
+    a decision has asked for is never shorter, however many ranks and however finely split."""
+    model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
+
+    def single(c, k):
+        return cells_of_rounds[k][c][1] * (model[c][0] + model[c][1])
+
+    longest = 0.0
+    for j, cells in enumerate(cells_of_comparison):
+        chain = max((single(c, 0) for c in cells if c in cells_of_rounds[0]), default=0.0)
+        for k, known in enumerate(named):
+            mine = [c for c, by in known.items() if j in by and c in cells_of_rounds[k + 1]]
+            chain += max((single(c, k + 1) for c in mine), default=0.0)
+        longest = max(longest, chain)
+    return longest
+
+
 def early_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, cells_of_comparison,
                  named, split=True):
     """The rounds as `phnn sweep` runs a comparisons rule (docs/METHOD.md "Speculation"): a
@@ -255,24 +299,15 @@ def early_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, cells_of_c
     the round's items, and ranks left idle train those cells' next seeds (items of the plan of
     every comparison cell's next batch), in the order they became known; an item stops at the
     round's end and goes on from where it stopped when the next round asks for it (always: only
-    named cells are trained). Returns (makespan, work spent ahead, of it never asked for, work spent
+    named cells are trained; the plan is made for AHEAD_SPLIT times the ranks, as the sweep's).
+    Returns (makespan, work spent ahead, of it never asked for, work spent
     on the runs asked for)."""
     model = {int(c["cell"]): (float(c["fixed_s"]), float(c["member_s"])) for c in cost_rows}
     candidates = sorted(set().union(*cells_of_comparison)) if cells_of_comparison else []
     seeds, started = {}, {}
     makespan = spent = lost = trained = 0.0
     for k, cells in enumerate(cells_of_rounds):
-        items, to_plan = [], []
-        for c, (n, _) in cells.items():
-            first = seeds.get(c, 0)
-            for start in [s0 for s0 in started.get(c, {}) if s0 < first + n]:
-                item = started[c].pop(start)
-                n -= item["runs"]
-                if item["left"] > 0:
-                    items.append((c, item["left"]))
-            if n > 0:
-                to_plan.append(PlanCell(c, *model[c], n))
-            seeds[c] = first + cells[c][0]
+        items, to_plan = take_ahead(cells, seeds, started, model)
         for c in [c for c in started if c not in cells]:  # never asked for
             lost += sum(i["cost"] - i["left"] for i in started.pop(c).values())
         items += [(c, cells[c][1] * (model[c][0] + m * model[c][1]))
@@ -291,7 +326,7 @@ def early_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, cells_of_c
         ahead, firsts = [], {}
         plan = [PlanCell(c, *model[c], min(batch, max_seeds - seeds.get(c, 0))) for c in candidates
                 if seeds.get(c, 0) < max_seeds and seeds.get(c, 0) not in started.get(c, {})]
-        for c, m in plan_work(plan, ranks, split):
+        for c, m in plan_work(plan, ranks * AHEAD_SPLIT, split):
             if c not in known:
                 continue
             ready = min(max(finish.get(d, 0.0) for d in cells_of_comparison[j]) for j in known[c])
@@ -345,11 +380,11 @@ def table(rows):
              "with speculation | efficiency | core-hours ahead (never asked for) | "
              "without barriers | efficiency |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        spec, ahead, lost, asked = r["speculative"]
+        spec, ahead, lost, _ = r["speculative"]
         lines.append(f"| {r['ranks']} | {len(r['items'])} | {sum(r['items'])} | "
                      f"{r['work'] / 3600:.3g} | {duration(r['barrier'])} | "
                      f"{100 * r['efficiency']:.1f} % | {duration(spec)} | "
-                     f"{100 * asked / (r['ranks'] * spec):.1f} % | "
+                     f"{100 * r['work'] / (r['ranks'] * spec):.1f} % | "
                      f"{ahead / 3600:.2f} ({lost / 3600:.2f}) | {duration(r['free'])} | "
                      f"{100 * r['free_efficiency']:.1f} % |")
     lines.append("")
@@ -396,8 +431,13 @@ def main(argv=None):
                                args.split == "auto"))
         rows.append(row)
     print(table(rows))
+    print(f"the runs asked for as one stack per cell and round: "
+          f"{unsplit_work(cells, cost_rows) / 3600:.2f} core-hours")
     print(f"critical path of the rounds (each round's costliest single run, summed): "
           f"{duration(critical_path(cells, cost_rows))}")
+    if early:
+        print(f"longest chain of one comparison's decisions (its named cells' costliest single "
+              f"run per round, summed): {duration(comparison_chain(cells, cost_rows, covered, named))}")
     return 0
 
 

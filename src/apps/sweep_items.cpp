@@ -178,11 +178,19 @@ SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const char* kind
   return outcome;
 }
 
-// The runs to train ahead (runs_to_speculate, on every rank) as items of
-// this rank count's plan, largest first; none with --no-speculation.
+// The runs to train ahead (runs_to_speculate, on every rank) as items,
+// largest first; none with --no-speculation. Under the comparisons rule
+// they are planned for kAheadSplit times the ranks: they have only the end
+// of a round, so they are split as finely as a plan for many ranks would
+// (the lean paper grid replayed at 16 ranks: 24.3 min planned for the
+// ranks, 21.6 for 4x, 21.1 for 8x and the same beyond; docs/BENCHMARKS.md).
+// The column-best guess keeps the plan for the ranks (25.4 min against 23.1
+// for its guesses on that grid at 8x: more of them are lost).
 std::vector<WorkItem> SweepRun::ahead_items() const {
+  constexpr int kAheadSplit = 8;
   if (ahead_.empty() || parser_.flag_set("no-speculation")) return {};
-  return plan_work(grid_, ahead_, size_, split_).items;
+  const bool known = spec_.adaptive.rule == AdaptiveRule::kComparisons;
+  return plan_work(grid_, ahead_, known ? size_ * kAheadSplit : size_, split_).items;
 }
 
 // The ahead items this rank may take now that were not ready before: with

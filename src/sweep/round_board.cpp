@@ -4,34 +4,16 @@
 
 #include <cstring>
 
+#include "sweep/rank0_window.h"
+
 namespace phnn {
+
+static_assert(sizeof(long) == sizeof(double), "an MSE's bits travel in one long");
 
 RoundBoard::RoundBoard(MPI_Comm comm, int num_runs, int num_items)
     : comm_(comm), num_runs_(num_runs), num_items_(num_items) {
-  int rank = 0;
-  MPI_Comm_rank(comm_, &rank);
-  const MPI_Aint slots = static_cast<MPI_Aint>(num_items) + 2 * static_cast<MPI_Aint>(num_runs);
-  MPI_Errhandler previous;
-  MPI_Comm_get_errhandler(comm_, &previous);
-  MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
-  const MPI_Aint bytes = rank == 0 ? slots * static_cast<MPI_Aint>(sizeof(long)) : 0;
-  const int rc = MPI_Win_allocate(bytes, sizeof(long), MPI_INFO_NULL, comm_, &slots_, &window_);
-  MPI_Comm_set_errhandler(comm_, previous);
-  MPI_Errhandler_free(&previous);
-  int ok = rc == MPI_SUCCESS ? 1 : 0, all_ok = 0;
-  MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm_);
-  if (!all_ok) {
-    if (rc == MPI_SUCCESS) MPI_Win_free(&window_);
-    window_ = MPI_WIN_NULL;
-    return;
-  }
-  if (rank == 0) {
-    MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window_);
-    std::memset(slots_, 0, static_cast<std::size_t>(slots) * sizeof(long));
-    MPI_Win_unlock(0, window_);
-  }
-  MPI_Barrier(comm_);
-  MPI_Win_lock_all(0, window_);
+  window_ = allocate_rank0_window(
+      comm_, static_cast<MPI_Aint>(num_items) + 2 * static_cast<MPI_Aint>(num_runs), &slots_);
 }
 
 // close() is collective; a destructor during stack unwinding on one rank

@@ -2,6 +2,8 @@
 // shared counter that hands out work items, with the stop flag.
 #include "phnn/sweep/scheduler.h"
 
+#include "sweep/rank0_window.h"
+
 namespace phnn {
 
 WorkQueue::WorkQueue(MPI_Comm comm, int num_items, ScheduleMode mode)
@@ -14,27 +16,9 @@ WorkQueue::WorkQueue(MPI_Comm comm, int num_items, ScheduleMode mode)
   int want_dynamic = mode == ScheduleMode::kDynamic ? 1 : 0;
   MPI_Bcast(&want_dynamic, 1, MPI_INT, 0, comm_);
   mode_ = ScheduleMode::kStatic;
-  MPI_Errhandler previous;
-  MPI_Comm_get_errhandler(comm_, &previous);
-  MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN);
-  const MPI_Aint bytes = rank_ == 0 ? static_cast<MPI_Aint>(3 * sizeof(long)) : 0;
-  const int rc = MPI_Win_allocate(bytes, sizeof(long), MPI_INFO_NULL, comm_, &counters_, &window_);
-  MPI_Comm_set_errhandler(comm_, previous);
-  MPI_Errhandler_free(&previous);
-  int ok = rc == MPI_SUCCESS ? 1 : 0, all_ok = 0;
-  MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, comm_);
-  if (!all_ok) {
-    if (rc == MPI_SUCCESS) MPI_Win_free(&window_);
-    window_ = MPI_WIN_NULL;
-    return;
-  }
-  if (rank_ == 0) {
-    MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, window_);
-    counters_[0] = counters_[1] = counters_[2] = 0;
-    MPI_Win_unlock(0, window_);
-  }
-  MPI_Barrier(comm_);
-  MPI_Win_lock_all(0, window_);
+  // Rank 0's window: [0] = next item, [1] = items done, [2] = stop flag.
+  window_ = allocate_rank0_window(comm_, 3, &counters_);
+  if (window_ == MPI_WIN_NULL) return;
   if (want_dynamic) mode_ = ScheduleMode::kDynamic;
 }
 

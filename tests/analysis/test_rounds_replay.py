@@ -104,6 +104,10 @@ class Speculation(unittest.TestCase):
         # Either comparison: the earlier one counts.
         self.assertEqual(rr.early_replay(rounds, costs, 2, 2, 10, covered, [{0: [1, 0]}],
                                          split=False)[0], 4.0)
+        # The longest chain: comparison 0's round 0 (its costliest single run, 1 s) and the run
+        # of cell 0 it named (1 s); comparison 1 named nothing: 1 s.
+        self.assertEqual(rr.comparison_chain(rounds, costs, covered, [{0: [0]}]), 2.0)
+        self.assertEqual(rr.comparison_chain(rounds, costs, covered, [{}]), 1.0)
 
 
 class WorkPlanPort(unittest.TestCase):
