@@ -163,6 +163,12 @@ pairs() {  # NP OUT
 }
 pairs 1 "$dir/pairs1.h5" || fail "the 1-rank comparisons sweep failed"
 per_run "$dir/pairs1.h5" "$dir/pairs1.csv"
+# reduce --named: the cells the comparisons named after round 0 are the cells round 1 grew.
+grew=$(sed -n 's/.*adaptive round 1: .*(\([0-9]*\) cells\{0,1\} got.*/\1/p' "$dir/log")
+named=$("$phnn" reduce "$dir/pairs1.h5" --round 0 --named | tail -n +2 | cut -d, -f3 | sort -u | wc -l)
+[[ -n $grew && $named -eq $grew ]] || fail "reduce --named lists $named cells after round 0, round 1 grew '$grew'"
+"$phnn" reduce "$dir/np1.h5" --named > /dev/null 2> "$dir/err" && fail "reduce --named accepted a column-best sweep"
+grep -q "not an adaptive sweep of the comparisons rule" "$dir/err" || fail "no clear error for --named: $(cat "$dir/err")"
 pairs 3 "$dir/pairs3.h5" || fail "the 3-rank comparisons sweep with ahead items failed"
 grep -q "^\[rank [0-9]/3\] ahead [0-9]*/[0-9]*: " "$dir/log" || fail "no rank trained ahead under the comparisons rule"
 grep -q "trained ahead while a round drained" "$dir/log" &&
