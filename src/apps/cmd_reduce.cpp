@@ -319,7 +319,7 @@ void declare_options(cli::Parser* p) {
   parser.flag("named",
               "adaptive sweeps of the comparisons rule: instead of the tables, the cells each "
               "comparison names after round K (--round; else the last) as CSV: comparison, line, "
-              "cell");
+              "cell (of a round in progress: what its finished runs name)");
   parser.option("rule",
                 "adaptive sweeps: replay the [adaptive] table of sweep file SWEEP (same grid, "
                 "another rule, batch or max_seeds) on FILE's runs instead of FILE's own; the "

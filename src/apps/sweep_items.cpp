@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <functional>
+#include <iostream>
 #include <thread>
 
 #include "apps/sweep_checkpoints.h"
@@ -183,7 +184,7 @@ SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const char* kind
 // they are planned for kAheadSplit times the ranks: they have only the end
 // of a round, so they are split as finely as a plan for many ranks would
 // (the lean paper grid replayed at 16 ranks: 24.3 min planned for the
-// ranks, 21.6 for 4x, 21.1 for 8x and the same beyond; docs/BENCHMARKS.md).
+// ranks, 21.6 for 4x, 21.1 for 8x, 21.2 for 16x and 64x; docs/BENCHMARKS.md).
 // The column-best guess keeps the plan for the ranks (25.4 min against 23.1
 // for its guesses on that grid at 8x: more of them are lost).
 std::vector<WorkItem> SweepRun::ahead_items() const {
@@ -196,10 +197,12 @@ std::vector<WorkItem> SweepRun::ahead_items() const {
 // The ahead items this rank may take now that were not ready before: with
 // the comparisons rule, those of the cells the next round is certain to
 // grow (cells_named_early on the outcomes posted so far; every run of the
-// round's items not posted yet counts as pending, a retried failed one too);
-// with column-best, all of them at the first call (the guess of
-// runs_to_speculate). *decided: the comparisons read so far, empty at first;
-// all set when nothing more can become ready.
+// round's items not posted yet counts as pending); with column-best, all of
+// them at the first call (the guess of runs_to_speculate). None in a round
+// that retries failed runs (--retry-failed): a retried run of an earlier
+// round can change that round's decision, so nothing is certain. *decided:
+// the comparisons read so far, empty at first; all set when nothing more
+// can become ready.
 std::vector<int> SweepRun::ahead_ready(const std::vector<WorkItem>& ahead,
                                        const std::vector<WorkItem>& work,
                                        const std::vector<int>& status_codes,
@@ -215,7 +218,13 @@ std::vector<int> SweepRun::ahead_ready(const std::vector<WorkItem>& ahead,
   std::vector<RunStatus> status;
   for (int code : status_codes) status.push_back(static_cast<RunStatus>(code));
   for (const WorkItem& item : work) {
-    for (int r : item.runs) status[static_cast<std::size_t>(r)] = RunStatus::kPending;
+    for (int r : item.runs) {
+      if (status[static_cast<std::size_t>(r)] == RunStatus::kFailed) {  // retried
+        decided->assign(spec_.adaptive.comparisons.size() + 1, 1);
+        return ready;
+      }
+      status[static_cast<std::size_t>(r)] = RunStatus::kPending;
+    }
   }
   std::vector<double> mse = round_mse_;
   board_->read(&status, &mse);
@@ -261,7 +270,14 @@ void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, const std::vector
         continue;
       }
       last_read = SweepClock::now();
-      for (int i : ahead_ready(ahead, work, status_codes, &decided)) {
+      std::vector<int> now;
+      try {  // never leave this rank before the collective close: nothing ready instead
+        now = ahead_ready(ahead, work, status_codes, &decided);
+      } catch (const std::exception& e) {
+        std::cerr << prefix_ << "warning: no items trained ahead this round (" << e.what() << ")\n";
+        decided.assign(1, 1);
+      }
+      for (int i : now) {
         if (!listed[static_cast<std::size_t>(i)]) {
           listed[static_cast<std::size_t>(i)] = 1;
           ready.push_back(i);

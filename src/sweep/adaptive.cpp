@@ -221,7 +221,8 @@ std::vector<std::vector<int>> runs_to_speculate(const SweepSpec& spec, const Gri
     const bool growing = std::any_of(runs.begin(), runs.begin() + static_cast<long>(asked), [&](int r) {
       return status[static_cast<std::size_t>(r)] == RunStatus::kPending;
     });
-    if (!growing && !candidate[c]) continue;
+    const bool comparisons = spec.adaptive.rule == AdaptiveRule::kComparisons;
+    if (comparisons ? !candidate[c] : !growing) continue;
     const std::size_t next = std::min<std::size_t>(
         {runs.size(), asked + static_cast<std::size_t>(spec.adaptive.batch),
          static_cast<std::size_t>(spec.adaptive.max_seeds)});

@@ -83,7 +83,10 @@ int check_rounds(const SweepSpec& spec, const Grid& grid, const Results& r, unsi
     std::vector<char> decided;
     std::set<int> named;
     for (std::size_t j = 0; j <= order.size(); ++j) {
-      if (j > 0) status[static_cast<std::size_t>(order[j - 1])] = RunStatus::kDone;
+      if (j > 0) {  // run order[j - 1] finishes as it did
+        const auto i = static_cast<std::size_t>(order[j - 1]);
+        status[i] = r.status[i];
+      }
       for (int c : cells_named_early(spec, grid, s.active, status, r.mse, &decided, fast)) {
         EXPECT_TRUE(std::find(decision.begin(), decision.end(), c) != decision.end())
             << "round " << k << ": cell " << c << " named early, not at the round's end";
@@ -97,17 +100,56 @@ int check_rounds(const SweepSpec& spec, const Grid& grid, const Results& r, unsi
   return early;
 }
 
+// Every option of the comparisons rule (the four-way reading pairs the
+// PHNN-JR cells: same architecture and seeds), with a failed and a
+// diverged run among the results.
 TEST(AdaptiveEarlyTest, CellsNamedEarlyAreTheRoundsDecision) {
   for (const std::string& options :
        {std::string(), std::string("futility = true\n"), std::string("grow = \"one\"\n"),
-        std::string("grow = \"one\"\nfutility = true\n")}) {
+        std::string("grow = \"one\"\nfutility = true\n"), std::string("stop_confidence = 0.99\n"),
+        std::string("reading = \"four-way\"\n"),
+        std::string("reading = \"four-way\"\nfutility = true\ngrow = \"one\"\n")}) {
     SCOPED_TRACE(options);
     const SweepSpec spec = parse_sweep_text(sweep_text(kModels, kComparisons + options), "x.toml");
     const Grid grid = expand_grid(spec);
-    const Results r = results_of(grid, mse_of);
+    Results r = results_of(grid, mse_of);
+    for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+      const RunConfig& run = grid.runs[i];
+      if (run.seed == 3 && run.model == ModelKind::kNode) r.status[i] = RunStatus::kFailed;
+      if (run.seed == 7 && run.integrator == IntegratorKind::kRk4)
+        r.status[i] = RunStatus::kDiverged;
+    }
     int early = 0;
     for (unsigned seed = 1; seed <= 3; ++seed) early += check_rounds(spec, grid, r, seed);
     EXPECT_GT(early, 0) << "no cell was ever known before its round ended";
+  }
+}
+
+// Under the comparisons rule idle ranks may take the next batch of every
+// cell a comparison covers (which ones become certain is known as the round
+// drains), and of no other cell, in round 0 too.
+TEST(AdaptiveEarlyTest, SpeculationCandidatesAreTheComparisonsCells) {
+  const std::string one =
+      "max_seeds = 25\nbatch = 5\nrule = \"comparisons\"\n"
+      "comparisons = [[\"harmonic/phnn-jr-rk2/25/small/none\", "
+      "\"harmonic/phnn-jr-rk4/25/small/none\"]]\n";
+  const SweepSpec spec = parse_sweep_text(sweep_text(kModels, one), "x.toml");
+  const Grid grid = expand_grid(spec);
+  Results r = results_of(grid, mse_of);
+  for (std::size_t i = 0; i < grid.runs.size(); ++i) {
+    if (grid.runs[i].seed >= 3) r.status[i] = RunStatus::kPending;  // round 0 in progress
+  }
+  const AdaptiveState s = replay_adaptive_rounds(spec, grid, r.status, r.mse);
+  ASSERT_EQ(s.round, 0);
+  const std::vector<std::vector<int>> ahead = runs_to_speculate(spec, grid, s, r.status);
+  ASSERT_EQ(ahead.size(), grid.cells.size());
+  for (std::size_t c = 0; c < grid.cells.size(); ++c) {
+    const RunConfig& run = grid.runs[static_cast<std::size_t>(grid.cells[c].runs[0])];
+    std::vector<int> seeds;
+    for (int i : ahead[c]) seeds.push_back(grid.runs[static_cast<std::size_t>(i)].seed);
+    const bool covered = run.model == ModelKind::kPhnnJr;
+    EXPECT_EQ(seeds, covered ? std::vector<int>({5, 6, 7, 8, 9}) : std::vector<int>())
+        << "cell " << c;
   }
 }
 
