@@ -114,8 +114,10 @@ void declare_options(cli::Parser* parser) {
                  "at most K runs per work item (forces splitting, with --split auto); 0 = no cap",
                  "0");
   parser->flag("static", "static round-robin scheduling instead of the MPI-3 shared counter");
-  parser->flag("no-speculation", "[adaptive]: ranks left idle while a round drains wait instead of "
-               "training the runs the next round is likely to ask for");
+  parser->flag("no-speculation",
+               "[adaptive] and [search]: ranks left idle while a round drains "
+               "wait instead of training runs of the next round (the certain ones, or under "
+               "rule = \"column-best\" the likely ones)");
   parser->flag("retry-failed", "re-run runs whose status is failed (done/diverged are kept)");
   parser->flag("mix-kernels", "resume a results file whose runs another kernel set computed, "
                               "or whose stored data sets this binary does not regenerate bit for "

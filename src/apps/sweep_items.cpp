@@ -13,6 +13,7 @@
 #include "apps/sweep_run.h"
 #include "apps/sweep_search.h"
 #include "phnn/sweep/resumed_items.h"
+#include "phnn/sweep/search.h"
 #include "phnn/training/trainer.h"
 
 namespace phnn {
@@ -160,15 +161,7 @@ SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const char* kind
                                  &*results_, &times_);
   if (outcome.io_error.empty()) checkpoints.remove();
   // For the decisions taken while the round drains (ahead_ready).
-  if (outcome.io_error.empty() && board_ != nullptr) {
-    std::vector<RunStatus> status;
-    std::vector<double> mse;
-    for (const RunResult& r : cell_results) {
-      status.push_back(r.status);
-      mse.push_back(r.mse);
-    }
-    board_->post(item.runs, status, mse);
-  }
+  if (outcome.io_error.empty() && board_ != nullptr) board_->post(item.runs, cell_results);
   outcome.runs = static_cast<int>(item.runs.size());
   if (!quiet && outcome.io_error.empty()) {
     print_item(prefix_, label + " done in " + format_duration(std::chrono::duration<double>(
@@ -179,60 +172,66 @@ SweepRun::ItemOutcome SweepRun::train_one(const WorkItem& item, const char* kind
   return outcome;
 }
 
-// The runs to train ahead (runs_to_speculate, on every rank) as items,
-// largest first; none with --no-speculation. Under the comparisons rule
-// they are planned for kAheadSplit times the ranks: they have only the end
-// of a round, so they are split as finely as a plan for many ranks would
-// (the lean paper grid replayed at 16 ranks: 24.3 min planned for the
-// ranks, 21.6 for 4x, 21.1 for 8x, 21.2 for 16x and 64x; docs/BENCHMARKS.md).
-// The column-best guess keeps the plan for the ranks (25.4 min against 23.1
-// for its guesses on that grid at 8x: more of them are lost).
+// The runs to train ahead (runs_to_speculate, search_runs_ahead; on every
+// rank) as items, largest first; none with --no-speculation. Under the
+// comparisons rule they are planned for kAheadSplit times the ranks: they
+// have only the end of a round, so they are split as finely as a plan for
+// many ranks would (the lean paper grid replayed at 16 ranks: 24.3 min
+// planned for the ranks, 21.6 for 4x, 21.1 for 8x, 21.2 for 16x and 64x;
+// docs/BENCHMARKS.md). The column-best guess keeps the plan for the ranks
+// (25.4 min against 23.1 for its guesses on that grid at 8x: more of them
+// are lost), and so does a search, whose next rung goes on from the saved
+// state of the same configuration and seeds as the rung's items grouped them.
 std::vector<WorkItem> SweepRun::ahead_items() const {
   constexpr int kAheadSplit = 8;
   if (ahead_.empty() || parser_.flag_set("no-speculation")) return {};
-  const bool known = spec_.adaptive.rule == AdaptiveRule::kComparisons;
-  return plan_work(grid_, ahead_, known ? size_ * kAheadSplit : size_, split_).items;
+  const bool finer = !spec_.search.enabled && spec_.adaptive.rule == AdaptiveRule::kComparisons;
+  return plan_work(grid_, ahead_, finer ? size_ * kAheadSplit : size_, split_).items;
 }
 
 // The ahead items this rank may take now that were not ready before: with
 // the comparisons rule, those of the cells the next round is certain to
-// grow (cells_named_early on the outcomes posted so far; every run of the
-// round's items not posted yet counts as pending); with column-best, all of
-// them at the first call (the guess of runs_to_speculate). None in a round
-// that retries failed runs (--retry-failed): a retried run of an earlier
-// round can change that round's decision, so nothing is certain. *decided:
-// the comparisons read so far, empty at first; all set when nothing more
-// can become ready.
+// grow (cells_named_early), with a search those of the configurations the
+// groups already complete keep (search_cells_known_early) — both on the
+// outcomes posted so far, every run of the round's items not posted yet
+// counting as pending; with column-best, all of them at the first call (the
+// guess of runs_to_speculate). None in a round that retries failed runs
+// (--retry-failed): a retried run of an earlier round can change that
+// round's decision, so nothing is certain. *decided: the comparisons or
+// groups read so far, empty at first; all set when nothing more can become
+// ready.
 std::vector<int> SweepRun::ahead_ready(const std::vector<WorkItem>& ahead,
                                        const std::vector<WorkItem>& work,
-                                       const std::vector<int>& status_codes,
                                        std::vector<char>* decided) {
   std::vector<int> ready;
-  if (spec_.adaptive.rule != AdaptiveRule::kComparisons) {
+  const bool known = spec_.search.enabled || spec_.adaptive.rule == AdaptiveRule::kComparisons;
+  if (!known) {
     if (decided->empty()) {
       decided->push_back(1);
       for (std::size_t i = 0; i < ahead.size(); ++i) ready.push_back(static_cast<int>(i));
     }
     return ready;
   }
-  std::vector<RunStatus> status;
-  for (int code : status_codes) status.push_back(static_cast<RunStatus>(code));
+  std::vector<RunStatus> status = round_status_;
   for (const WorkItem& item : work) {
     for (int r : item.runs) {
       if (status[static_cast<std::size_t>(r)] == RunStatus::kFailed) {  // retried
-        decided->assign(spec_.adaptive.comparisons.size() + 1, 1);
+        decided->assign(1, 1);
         return ready;
       }
       status[static_cast<std::size_t>(r)] = RunStatus::kPending;
     }
   }
-  std::vector<double> mse = round_mse_;
-  board_->read(&status, &mse);
+  std::vector<double> mse = round_mse_, criterion = round_criterion_;
+  board_->read(&status, &mse, &criterion);
   const std::vector<int> cells =
-      cells_named_early(spec_, grid_, adaptive_.active, status, mse, decided);
+      spec_.search.enabled
+          ? search_cells_known_early(spec_, grid_, adaptive_.round, status, criterion, mse, decided)
+          : cells_named_early(spec_, grid_, adaptive_.active, status, mse, decided);
   for (std::size_t i = 0; i < ahead.size(); ++i) {
-    if (std::binary_search(cells.begin(), cells.end(), ahead[i].cell))
+    if (std::binary_search(cells.begin(), cells.end(), ahead[i].cell)) {
       ready.push_back(static_cast<int>(i));
+    }
   }
   return ready;
 }
@@ -245,8 +244,8 @@ std::vector<int> SweepRun::ahead_ready(const std::vector<WorkItem>& ahead,
 // posted to the others by train_round, right after). Their results are
 // recorded like any other.
 void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, const std::vector<WorkItem>& work,
-                           WorkQueue* queue, const std::vector<int>& status_codes,
-                           const std::function<void()>& tick, RoundOutcome* outcome) {
+                           WorkQueue* queue, const std::function<void()>& tick,
+                           RoundOutcome* outcome) {
   bool round_over = false;
   SweepClock::time_point last_poll{}, last_read{};
   const auto stop = [&] {  // asked at every step: the shared count read at most 10 times a second
@@ -272,7 +271,7 @@ void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, const std::vector
       last_read = SweepClock::now();
       std::vector<int> now;
       try {  // never leave this rank before the collective close: nothing ready instead
-        now = ahead_ready(ahead, work, status_codes, &decided);
+        now = ahead_ready(ahead, work, &decided);
       } catch (const std::exception& e) {
         std::cerr << prefix_ << "warning: no items trained ahead this round (" << e.what() << ")\n";
         decided.assign(1, 1);

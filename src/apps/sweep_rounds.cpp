@@ -156,7 +156,7 @@ SweepRun::RoundOutcome SweepRun::train_round(const std::vector<int>& status_code
   }
   post_stop();  // before any collective call: the others stop at their next step or item
   if (board) {
-    if (!ended) train_ahead(ahead, work, &queue, status_codes, tick, &outcome);
+    if (!ended) train_ahead(ahead, work, &queue, tick, &outcome);
     post_stop();
     board_ = nullptr;
     board->close();
@@ -258,16 +258,15 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
         const ResultsFile file = ResultsFile::open_read_only(out_);
         const std::vector<RunStatus> statuses = file.read_statuses();
         round_mse_ = file.read_double_column("mse");
+        round_criterion_ = file.read_double_column("best_validation_loss");
         adaptive_ = spec_.search.enabled
-                        ? replay_search(spec_, grid_, statuses,
-                                        file.read_double_column("best_validation_loss"),
-                                        file.read_double_column("mse"))
-                              .state
+                        ? replay_search(spec_, grid_, statuses, round_criterion_, round_mse_).state
                         : replay_adaptive_rounds(spec_, grid_, statuses, round_mse_);
         for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
-        ahead_ = spec_.adaptive.enabled && !spec_.search.enabled
-                     ? runs_to_speculate(spec_, grid_, adaptive_, statuses)
-                     : std::vector<std::vector<int>>();
+        ahead_ = !spec_.search.enabled ? runs_to_speculate(spec_, grid_, adaptive_, statuses)
+                 : adaptive_.complete  ? std::vector<std::vector<int>>()
+                                       : search_runs_ahead(spec_, grid_, adaptive_.round, statuses,
+                                                           round_criterion_, round_mse_);
       })) {
     return status;
   }
@@ -281,6 +280,9 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
   mpi::broadcast(world_, adaptive_.trained_ahead, 0);
   mpi::broadcast(world_, ahead_, 0);
   mpi::broadcast(world_, round_mse_, 0);
+  mpi::broadcast(world_, round_criterion_, 0);
+  round_status_.clear();
+  for (int code : codes) round_status_.push_back(static_cast<RunStatus>(code));
   for (std::size_t i = 0; i < codes.size(); ++i) {
     if (!adaptive_.active[i]) codes[i] = static_cast<int>(RunStatus::kDone);
   }

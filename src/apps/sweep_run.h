@@ -93,11 +93,9 @@ class SweepRun {
                         std::function<bool()> stop, const std::function<void()>& tick);
   std::vector<WorkItem> ahead_items() const;
   void train_ahead(const std::vector<WorkItem>& ahead, const std::vector<WorkItem>& work,
-                   WorkQueue* queue, const std::vector<int>& status_codes,
-                   const std::function<void()>& tick, RoundOutcome* outcome);
+                   WorkQueue* queue, const std::function<void()>& tick, RoundOutcome* outcome);
   std::vector<int> ahead_ready(const std::vector<WorkItem>& ahead,
-                               const std::vector<WorkItem>& work,
-                               const std::vector<int>& status_codes, std::vector<char>* decided);
+                               const std::vector<WorkItem>& work, std::vector<char>* decided);
   int train_and_close(std::vector<int> status_codes);
   int open_results() {
     return agreed(world_, true, [&] {
@@ -148,12 +146,14 @@ class SweepRun {
   ItemTimes times_;
   // Rank 0 prints every rank's ItemTimes, summed (collective).
   void report_times();
-  // The runs idle ranks train ahead of the round in progress, per cell
-  // (runs_to_speculate; the same on every rank).
+  // The runs idle ranks may train ahead of the round in progress, per cell
+  // (runs_to_speculate, search_runs_ahead; the same on every rank).
   std::vector<std::vector<int>> ahead_;
-  // The MSE of every run at the round's start (replay_rounds; every rank),
-  // for the decisions taken while the round drains (cells_named_early).
-  std::vector<double> round_mse_;
+  // Every run's status, MSE and best validation loss at the round's start
+  // (replay_rounds; every rank), for the decisions taken while the round
+  // drains (cells_named_early, search_cells_known_early).
+  std::vector<RunStatus> round_status_;
+  std::vector<double> round_mse_, round_criterion_;
   // The round's shared outcomes and claims while it has items to train
   // ahead (train_round); train_one posts every recorded item there.
   RoundBoard* board_ = nullptr;

@@ -107,6 +107,49 @@ double trained_before_s(const Grid& grid, const Cell& cell, int steps) {
   return estimate_group_cost_s(run, static_cast<int>(cell.runs.size()));
 }
 
+// Positions of `entries` best criterion first (ties by position: grid
+// order), and how many of n a rung keeps: ceil(n / eta).
+std::vector<std::size_t> by_criterion(const std::vector<SearchEntry>& entries) {
+  std::vector<std::size_t> order(entries.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return entries[a].criterion < entries[b].criterion;
+  });
+  return order;
+}
+std::size_t kept_count(std::size_t n, int eta) {
+  return (n + static_cast<std::size_t>(eta) - 1) / static_cast<std::size_t>(eta);
+}
+
+// Per group, which configurations train at rung `rung` (all at rung 0;
+// then those rung - 1 kept, as replay_search decided it).
+struct RungConfigurations {
+  std::vector<Group> groups;
+  std::vector<std::vector<char>> alive;
+};
+RungConfigurations at_rung(const SweepSpec& spec, const Grid& grid, int rung,
+                           const std::vector<RunStatus>& status,
+                           const std::vector<double>& criterion, const std::vector<double>& mse) {
+  RungConfigurations out;
+  out.groups = groups_of(spec, grid);
+  const SearchReplay replay =
+      rung > 0 ? replay_search(spec, grid, status, criterion, mse, rung) : SearchReplay{};
+  for (std::size_t g = 0; g < out.groups.size(); ++g) {
+    const auto& configurations = out.groups[g].configurations;
+    std::vector<char> alive(configurations.size(), rung == 0 ? 1 : 0);
+    const auto before = static_cast<std::size_t>(rung) - 1;
+    if (rung > 0 && replay.groups[g].rungs.size() > before) {  // kept at the rung before
+      for (const SearchEntry& e : replay.groups[g].rungs[before]) {
+        for (std::size_t k = 0; k < alive.size(); ++k) {
+          if (e.kept && configurations[k].cells[before] == e.cell) alive[k] = 1;
+        }
+      }
+    }
+    out.alive.push_back(std::move(alive));
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string configuration_key(const RunConfig& run) {
@@ -164,13 +207,8 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
         entries.push_back(entry_of(grid, conf.cells[r], conf.label, status, criterion, mse));
         which.push_back(k);
       }
-      std::vector<std::size_t> order(entries.size());
-      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-        return entries[a].criterion < entries[b].criterion;
-      });
-      const std::size_t keep = (entries.size() + static_cast<std::size_t>(spec.search.eta) - 1) /
-                               static_cast<std::size_t>(spec.search.eta);
+      const std::vector<std::size_t> order = by_criterion(entries);
+      const std::size_t keep = kept_count(entries.size(), spec.search.eta);
       std::vector<SearchEntry> sorted;
       std::vector<char> next(alive[g].size(), 0);
       for (std::size_t i = 0; i < order.size(); ++i) {
@@ -189,6 +227,66 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
     }
     state.cells_grown.push_back(kept_total);
   }
+  return out;
+}
+
+std::vector<std::vector<int>> search_runs_ahead(const SweepSpec& spec, const Grid& grid, int rung,
+                                                const std::vector<RunStatus>& status,
+                                                const std::vector<double>& criterion,
+                                                const std::vector<double>& mse) {
+  const auto next = static_cast<std::size_t>(rung + 1);
+  if (rung < 0 || next >= spec.search.rungs.size()) return {};
+  const RungConfigurations now = at_rung(spec, grid, rung, status, criterion, mse);
+  std::vector<std::vector<int>> ahead(grid.cells.size());
+  bool any = false;
+  for (std::size_t g = 0; g < now.groups.size(); ++g) {
+    for (std::size_t k = 0; k < now.alive[g].size(); ++k) {
+      const int cell = now.groups[g].configurations[k].cells[next];
+      if (!now.alive[g][k] || cell < 0) continue;
+      for (int r : grid.cells[static_cast<std::size_t>(cell)].runs) {
+        if (status[static_cast<std::size_t>(r)] != RunStatus::kPending) continue;
+        ahead[static_cast<std::size_t>(cell)].push_back(r);
+        any = true;
+      }
+    }
+  }
+  return any ? ahead : std::vector<std::vector<int>>();
+}
+
+std::vector<int> search_cells_known_early(const SweepSpec& spec, const Grid& grid, int rung_index,
+                                          const std::vector<RunStatus>& status,
+                                          const std::vector<double>& criterion,
+                                          const std::vector<double>& mse,
+                                          std::vector<char>* decided) {
+  const auto rung = static_cast<std::size_t>(rung_index);
+  if (rung_index < 0 || rung + 1 >= spec.search.rungs.size()) return {};
+  const RungConfigurations now = at_rung(spec, grid, rung_index, status, criterion, mse);
+  decided->resize(now.groups.size(), 0);
+  std::vector<int> out;
+  for (std::size_t g = 0; g < now.groups.size(); ++g) {
+    if ((*decided)[g]) continue;
+    std::vector<SearchEntry> entries;
+    std::vector<std::size_t> which;
+    bool pending = false;
+    for (std::size_t k = 0; k < now.alive[g].size(); ++k) {
+      const Configuration& conf = now.groups[g].configurations[k];
+      if (!now.alive[g][k] || conf.cells[rung] < 0) continue;
+      for (int r : grid.cells[static_cast<std::size_t>(conf.cells[rung])].runs) {
+        pending = pending || status[static_cast<std::size_t>(r)] == RunStatus::kPending;
+      }
+      entries.push_back(entry_of(grid, conf.cells[rung], conf.label, status, criterion, mse));
+      which.push_back(k);
+    }
+    if (pending) continue;
+    (*decided)[g] = 1;
+    const std::vector<std::size_t> order = by_criterion(entries);
+    const std::size_t keep = kept_count(entries.size(), spec.search.eta);
+    for (std::size_t i = 0; i < keep && i < order.size(); ++i) {
+      const int next = now.groups[g].configurations[which[order[i]]].cells[rung + 1];
+      if (next >= 0) out.push_back(next);
+    }
+  }
+  std::sort(out.begin(), out.end());
   return out;
 }
 

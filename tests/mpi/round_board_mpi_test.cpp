@@ -40,27 +40,31 @@ TEST(RoundBoardMpiTest, EveryRankReadsWhatEveryRankPosted) {
   RoundBoard board(MPI_COMM_WORLD, runs, 4);
   ASSERT_TRUE(board.ok());
   std::vector<int> mine;  // runs 0..9; 10 and 11 are never posted
-  std::vector<RunStatus> status;
-  std::vector<double> mse;
+  std::vector<RunResult> results;
   for (int r = rank; r < 10; r += size) {
     mine.push_back(r);
-    status.push_back(status_of(r));
-    mse.push_back(mse_of(r));
+    RunResult result;
+    result.status = status_of(r);
+    result.mse = mse_of(r);
+    result.best_validation_loss = -mse_of(r);
+    results.push_back(result);
   }
-  board.post(mine, status, mse);
+  board.post(mine, results);
   MPI_Barrier(MPI_COMM_WORLD);
   std::vector<RunStatus> seen(runs, RunStatus::kPending);
-  std::vector<double> seen_mse(runs, -1.0);
-  board.read(&seen, &seen_mse);
+  std::vector<double> seen_mse(runs, -1.0), seen_criterion(runs, -2.0);
+  board.read(&seen, &seen_mse, &seen_criterion);
   for (int r = 0; r < runs; ++r) {
     if (r >= 10) {
       EXPECT_EQ(seen[r], RunStatus::kPending) << "run " << r;
       EXPECT_EQ(seen_mse[r], -1.0) << "run " << r;
+      EXPECT_EQ(seen_criterion[r], -2.0) << "run " << r;
       continue;
     }
     EXPECT_EQ(seen[r], status_of(r)) << "run " << r;
-    const double want = mse_of(r);
+    const double want = mse_of(r), criterion = -mse_of(r);
     EXPECT_EQ(std::memcmp(&seen_mse[r], &want, sizeof want), 0) << "run " << r;
+    EXPECT_EQ(std::memcmp(&seen_criterion[r], &criterion, sizeof criterion), 0) << "run " << r;
   }
   MPI_Barrier(MPI_COMM_WORLD);
   board.close();

@@ -56,6 +56,29 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
                            const std::vector<double>& criterion, const std::vector<double>& mse,
                            int last_round = -1);
 
+/// What idle ranks may train ahead while rung `rung` (the one in progress,
+/// SearchReplay::state.round) drains (docs/METHOD.md, "Speculation"): per
+/// cell, the pending runs of the next rung of every configuration that
+/// trains at `rung` (the form plan_work() takes); empty (no elements) at the
+/// last rung.
+std::vector<std::vector<int>> search_runs_ahead(const SweepSpec& spec, const Grid& grid, int rung,
+                                                const std::vector<RunStatus>& status,
+                                                const std::vector<double>& criterion,
+                                                const std::vector<double>& mse);
+
+/// While rung `rung` drains: the next-rung cells of the configurations that
+/// the groups already complete keep. A group ranks only its own
+/// configurations, so once none of its runs of the rung is pending its
+/// survivors are those replay_search() keeps at the rung's end. Reads each
+/// group newly complete (marks it in `decided`, resized to the groups and
+/// kept by the caller for the rung); returns their survivors' next-rung
+/// cells, ascending. Empty at the last rung.
+std::vector<int> search_cells_known_early(const SweepSpec& spec, const Grid& grid, int rung,
+                                          const std::vector<RunStatus>& status,
+                                          const std::vector<double>& criterion,
+                                          const std::vector<double>& mse,
+                                          std::vector<char>* decided);
+
 /// The cost model's estimate of a search: per rung the configurations that
 /// train (summed over groups, each keeping ceil(n / eta)), the core-seconds
 /// of halving (a configuration at rung r > 0 pays its steps and validations
