@@ -297,7 +297,7 @@ def early_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, cells_of_c
     """The rounds as `phnn sweep` runs a comparisons rule (docs/METHOD.md "Speculation"): a
     comparison names its cells for the next round as soon as every cell it covers has finished
     the round's items, and ranks left idle train those cells' next seeds (items of the plan of
-    every comparison cell's next batch), in the order they became known; an item stops at the
+    every comparison cell's next batch), the first ready one in plan order; an item stops at the
     round's end and goes on from where it stopped when the next round asks for it (always: only
     named cells are trained; the plan is made for AHEAD_SPLIT times the ranks, as the sweep's).
     Returns (makespan, work spent ahead, of it never asked for, work spent
@@ -336,7 +336,6 @@ def early_replay(cells_of_rounds, cost_rows, ranks, batch, max_seeds, cells_of_c
             ahead.append({"cell": c, "first": first, "runs": m, "cost": cost, "left": cost,
                           "ready": ready})
             firsts[c] = first + m
-        ahead.sort(key=lambda i: i["ready"])  # stable: plan order among equal times
         while ahead:
             free = heapq.heappop(loads)
             if free >= end:

@@ -169,16 +169,22 @@ named=$("$phnn" reduce "$dir/pairs1.h5" --round 0 --named | tail -n +2 | cut -d,
 [[ -n $grew && $named -eq $grew ]] || fail "reduce --named lists $named cells after round 0, round 1 grew '$grew'"
 "$phnn" reduce "$dir/np1.h5" --named > /dev/null 2> "$dir/err" && fail "reduce --named accepted a column-best sweep"
 grep -q "not an adaptive sweep of the comparisons rule" "$dir/err" || fail "no clear error for --named: $(cat "$dir/err")"
-pairs 3 "$dir/pairs3.h5" || fail "the 3-rank comparisons sweep with ahead items failed"
-grep -q "^\[rank [0-9]/3\] ahead [0-9]*/[0-9]*: " "$dir/log" || fail "no rank trained ahead under the comparisons rule"
-grep -q "trained ahead while a round drained" "$dir/log" &&
-  fail "a run trained ahead under the comparisons rule was never asked for"
-per_run "$dir/pairs3.h5" "$dir/pairs3.csv"
-python3 "$here/compare_runs.py" "$dir/pairs1.csv" "$dir/pairs3.csv" ||
-  fail "speculation under the comparisons rule changed the runs asked for"
+ahead=0  # whether a pair finishes first is timing: up to 3 tries, every one checked
+for try in 1 2 3; do
+  rm -rf "$dir/pairs3.h5" "$dir/pairs3.h5.journal"
+  pairs 3 "$dir/pairs3.h5" || fail "the 3-rank comparisons sweep with ahead items failed"
+  grep -q "trained ahead while a round drained" "$dir/log" &&
+    fail "a run trained ahead under the comparisons rule was never asked for"
+  per_run "$dir/pairs3.h5" "$dir/pairs3.csv"
+  python3 "$here/compare_runs.py" "$dir/pairs1.csv" "$dir/pairs3.csv" ||
+    fail "speculation under the comparisons rule changed the runs asked for"
+  grep -q "^\[rank [0-9]/3\] ahead [0-9]*/[0-9]*: " "$dir/log" && { ahead=1; break; }
+done
+[[ $ahead -eq 1 ]] || fail "no rank trained ahead under the comparisons rule in 3 tries"
 
 # kill -9 of every rank once round 1 has finished runs of its own (round 0
 # is 9 items of at most 2 seeds).
+: > "$dir/log"  # no line of the run before may be read as this one's
 sweep 2 "$dir/k.h5" & job=$!
 for _ in $(seq 1 1200); do
   grep -q "adaptive round 1:" "$dir/log" 2>/dev/null && [[ $(grep -c "done in" "$dir/log") -ge 10 ]] && break

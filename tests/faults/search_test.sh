@@ -93,12 +93,18 @@ groups() {  # NP OUT
 }
 groups 1 "$dir/g1.h5" || fail "the 1-rank two-group search failed"
 per_run "$dir/g1.h5" "$dir/g1.csv"
-groups 3 "$dir/g3.h5" || fail "the 3-rank two-group search failed"
-grep -q "^\[rank [0-9]/3\] ahead [0-9]*/[0-9]*: " "$dir/log" || fail "no rank trained a rung ahead"
-per_run "$dir/g3.h5" "$dir/g3.csv"
-python3 "$here/compare_runs.py" "$dir/g1.csv" "$dir/g3.csv" || fail "training rungs ahead changed the runs"
+ahead=0  # whether a group finishes first is timing: up to 3 tries, every one bitwise equal
+for try in 1 2 3; do
+  rm -rf "$dir/g3.h5" "$dir/g3.h5.journal"
+  groups 3 "$dir/g3.h5" || fail "the 3-rank two-group search failed"
+  per_run "$dir/g3.h5" "$dir/g3.csv"
+  python3 "$here/compare_runs.py" "$dir/g1.csv" "$dir/g3.csv" || fail "training rungs ahead changed the runs"
+  grep -q "^\[rank [0-9]/3\] ahead [0-9]*/[0-9]*: " "$dir/log" && { ahead=1; break; }
+done
+[[ $ahead -eq 1 ]] || fail "no rank trained a rung ahead in 3 tries"
 
 # kill -9 of every rank once rung 1 has started.
+: > "$dir/log"  # no line of the run before may be read as this one's
 sweep 2 "$dir/k.h5" & job=$!
 for _ in $(seq 1 1200); do
   grep -q "search rung 1 " "$dir/log" 2>/dev/null && break
