@@ -271,8 +271,10 @@ void SweepRun::train_ahead(const std::vector<WorkItem>& ahead, const std::vector
         std::cerr << prefix_ << "warning: no items trained ahead this round (" << e.what() << ")\n";
         decided.assign(1, 1);
       }
-      for (int k : now)
-        state[static_cast<std::size_t>(k)] = std::max<char>(state[static_cast<std::size_t>(k)], 1);
+      for (int k : now) {
+        char& item = state[static_cast<std::size_t>(k)];
+        item = std::max<char>(item, 1);  // tried stays tried
+      }
       first = std::find(state.begin(), state.end(), 1);
     }
     if (first == state.end()) {  // nothing ready now: done if nothing can become ready
