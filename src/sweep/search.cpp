@@ -107,18 +107,39 @@ double trained_before_s(const Grid& grid, const Cell& cell, int steps) {
   return estimate_group_cost_s(run, static_cast<int>(cell.runs.size()));
 }
 
-// Positions of `entries` best criterion first (ties by position: grid
-// order), and how many of n a rung keeps: ceil(n / eta).
-std::vector<std::size_t> by_criterion(const std::vector<SearchEntry>& entries) {
+// Rung r of `group` decided: the entries of its configurations that train
+// there (alive), best criterion first (ties by grid order), each kept unless
+// `last` while among the best ceil(n / eta); *next: which configurations go
+// on to rung r + 1.
+std::vector<SearchEntry> decide_rung(const SweepSpec& spec, const Grid& grid, const Group& group,
+                                     const std::vector<char>& alive, std::size_t r, bool last,
+                                     const std::vector<RunStatus>& status,
+                                     const std::vector<double>& criterion,
+                                     const std::vector<double>& mse, std::vector<char>* next) {
+  std::vector<SearchEntry> entries;
+  std::vector<std::size_t> which;
+  for (std::size_t k = 0; k < alive.size(); ++k) {
+    const Configuration& conf = group.configurations[k];
+    if (!alive[k] || conf.cells[r] < 0) continue;
+    entries.push_back(entry_of(grid, conf.cells[r], conf.label, status, criterion, mse));
+    which.push_back(k);
+  }
   std::vector<std::size_t> order(entries.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return entries[a].criterion < entries[b].criterion;
   });
-  return order;
-}
-std::size_t kept_count(std::size_t n, int eta) {
-  return (n + static_cast<std::size_t>(eta) - 1) / static_cast<std::size_t>(eta);
+  const std::size_t keep = (entries.size() + static_cast<std::size_t>(spec.search.eta) - 1) /
+                           static_cast<std::size_t>(spec.search.eta);
+  std::vector<SearchEntry> sorted;
+  next->assign(alive.size(), 0);
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    SearchEntry e = entries[order[i]];
+    e.kept = !last && i < keep;
+    if (e.kept) (*next)[which[order[i]]] = 1;
+    sorted.push_back(e);
+  }
+  return sorted;
 }
 
 // Per group, which configurations train at rung `rung` (all at rung 0;
@@ -199,26 +220,10 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
     const bool last = r + 1 == R || static_cast<int>(r) == last_round;
     int kept_total = 0;
     for (std::size_t g = 0; g < groups.size(); ++g) {
-      std::vector<SearchEntry> entries;
-      std::vector<std::size_t> which;
-      for (std::size_t k = 0; k < alive[g].size(); ++k) {
-        const Configuration& conf = groups[g].configurations[k];
-        if (!alive[g][k] || conf.cells[r] < 0) continue;
-        entries.push_back(entry_of(grid, conf.cells[r], conf.label, status, criterion, mse));
-        which.push_back(k);
-      }
-      const std::vector<std::size_t> order = by_criterion(entries);
-      const std::size_t keep = kept_count(entries.size(), spec.search.eta);
-      std::vector<SearchEntry> sorted;
-      std::vector<char> next(alive[g].size(), 0);
-      for (std::size_t i = 0; i < order.size(); ++i) {
-        SearchEntry e = entries[order[i]];
-        e.kept = !last && i < keep;
-        if (e.kept) next[which[order[i]]] = 1;
-        kept_total += e.kept ? 1 : 0;
-        sorted.push_back(e);
-      }
-      out.groups[g].rungs.push_back(std::move(sorted));
+      std::vector<char> next;
+      out.groups[g].rungs.push_back(
+          decide_rung(spec, grid, groups[g], alive[g], r, last, status, criterion, mse, &next));
+      kept_total += static_cast<int>(std::count(next.begin(), next.end(), 1));
       alive[g] = std::move(next);
     }
     if (last) {
@@ -264,26 +269,22 @@ std::vector<int> search_cells_known_early(const SweepSpec& spec, const Grid& gri
   decided->resize(now.groups.size(), 0);
   std::vector<int> out;
   for (std::size_t g = 0; g < now.groups.size(); ++g) {
-    if ((*decided)[g]) continue;
-    std::vector<SearchEntry> entries;
-    std::vector<std::size_t> which;
+    const Group& group = now.groups[g];
     bool pending = false;
     for (std::size_t k = 0; k < now.alive[g].size(); ++k) {
-      const Configuration& conf = now.groups[g].configurations[k];
-      if (!now.alive[g][k] || conf.cells[rung] < 0) continue;
-      for (int r : grid.cells[static_cast<std::size_t>(conf.cells[rung])].runs) {
+      const int cell = group.configurations[k].cells[rung];
+      if (!now.alive[g][k] || cell < 0) continue;
+      for (int r : grid.cells[static_cast<std::size_t>(cell)].runs) {
         pending = pending || status[static_cast<std::size_t>(r)] == RunStatus::kPending;
       }
-      entries.push_back(entry_of(grid, conf.cells[rung], conf.label, status, criterion, mse));
-      which.push_back(k);
     }
-    if (pending) continue;
+    if ((*decided)[g] || pending) continue;
     (*decided)[g] = 1;
-    const std::vector<std::size_t> order = by_criterion(entries);
-    const std::size_t keep = kept_count(entries.size(), spec.search.eta);
-    for (std::size_t i = 0; i < keep && i < order.size(); ++i) {
-      const int next = now.groups[g].configurations[which[order[i]]].cells[rung + 1];
-      if (next >= 0) out.push_back(next);
+    std::vector<char> next;
+    decide_rung(spec, grid, group, now.alive[g], rung, false, status, criterion, mse, &next);
+    for (std::size_t k = 0; k < next.size(); ++k) {
+      const int cell = group.configurations[k].cells[rung + 1];
+      if (next[k] && cell >= 0) out.push_back(cell);
     }
   }
   std::sort(out.begin(), out.end());
