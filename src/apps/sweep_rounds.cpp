@@ -263,10 +263,9 @@ int SweepRun::replay_rounds(std::vector<int>* status_codes) {
                         ? replay_search(spec_, grid_, statuses, round_criterion_, round_mse_).state
                         : replay_adaptive_rounds(spec_, grid_, statuses, round_mse_);
         for (RunStatus st : statuses) codes.push_back(static_cast<int>(st));
-        ahead_ = !spec_.search.enabled ? runs_to_speculate(spec_, grid_, adaptive_, statuses)
-                 : adaptive_.complete  ? std::vector<std::vector<int>>()
-                                       : search_runs_ahead(spec_, grid_, adaptive_.round, statuses,
-                                                           round_criterion_, round_mse_);
+        ahead_ = spec_.search.enabled ? search_runs_ahead(spec_, grid_, adaptive_.round, statuses,
+                                                          round_criterion_, round_mse_)
+                                      : runs_to_speculate(spec_, grid_, adaptive_, statuses);
       })) {
     return status;
   }

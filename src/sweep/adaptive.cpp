@@ -207,8 +207,9 @@ std::vector<std::vector<int>> runs_to_speculate(const SweepSpec& spec, const Gri
   // The candidates: comparisons, every cell a comparison selects from (which
   // of them the next round grows is known as the round drains:
   // cells_named_early); column-best, the cells the round in progress grows.
+  const bool comparisons = spec.adaptive.rule == AdaptiveRule::kComparisons;
   std::vector<char> candidate(grid.cells.size(), 0);
-  if (spec.adaptive.rule == AdaptiveRule::kComparisons) {
+  if (comparisons) {
     const std::map<std::string, int> cell_by_key = cells_by_key(grid);
     for (const SeedComparison& c : spec.adaptive.comparisons) {
       for (int cell : selector_cells(cell_by_key, c)) candidate[static_cast<std::size_t>(cell)] = 1;
@@ -218,10 +219,9 @@ std::vector<std::vector<int>> runs_to_speculate(const SweepSpec& spec, const Gri
   for (std::size_t c = 0; c < grid.cells.size(); ++c) {
     const auto& runs = grid.cells[c].runs;
     const auto asked = std::min<std::size_t>(runs.size(), static_cast<std::size_t>(state.cell_seeds[c]));
-    const bool growing = std::any_of(runs.begin(), runs.begin() + static_cast<long>(asked), [&](int r) {
-      return status[static_cast<std::size_t>(r)] == RunStatus::kPending;
-    });
-    const bool comparisons = spec.adaptive.rule == AdaptiveRule::kComparisons;
+    const bool growing = std::any_of(
+        runs.begin(), runs.begin() + static_cast<long>(asked),
+        [&](int r) { return status[static_cast<std::size_t>(r)] == RunStatus::kPending; });
     if (comparisons ? !candidate[c] : !growing) continue;
     const std::size_t next = std::min<std::size_t>(
         {runs.size(), asked + static_cast<std::size_t>(spec.adaptive.batch),

@@ -60,7 +60,8 @@ SearchReplay replay_search(const SweepSpec& spec, const Grid& grid,
 /// SearchReplay::state.round) drains (docs/METHOD.md, "Speculation"): per
 /// cell, the pending runs of the next rung of every configuration that
 /// trains at `rung` (the form plan_work() takes); empty (no elements) at the
-/// last rung.
+/// last rung, so also when the search is complete (its state's round is the
+/// last rung).
 std::vector<std::vector<int>> search_runs_ahead(const SweepSpec& spec, const Grid& grid, int rung,
                                                 const std::vector<RunStatus>& status,
                                                 const std::vector<double>& criterion,
