@@ -1,4 +1,5 @@
-// src/sweep/rank0_window.cpp — allocate_rank0_window (sweep/rank0_window.h).
+// src/sweep/rank0_window.cpp — allocate_rank0_window and free_rank0_window
+// (sweep/rank0_window.h).
 #include "sweep/rank0_window.h"
 
 #include <cstring>
@@ -30,6 +31,12 @@ MPI_Win allocate_rank0_window(MPI_Comm comm, MPI_Aint longs, long** base) {
   MPI_Barrier(comm);
   MPI_Win_lock_all(0, window);
   return window;
+}
+
+void free_rank0_window(MPI_Win* window) {
+  if (*window == MPI_WIN_NULL) return;
+  MPI_Win_unlock_all(*window);
+  MPI_Win_free(window);  // sets MPI_WIN_NULL
 }
 
 }  // namespace phnn

@@ -81,12 +81,6 @@ bool RoundBoard::claim(int item) {
   return previous == 0;
 }
 
-void RoundBoard::close() {
-  if (window_ != MPI_WIN_NULL) {
-    MPI_Win_unlock_all(window_);
-    MPI_Win_free(&window_);
-    window_ = MPI_WIN_NULL;
-  }
-}
+void RoundBoard::close() { free_rank0_window(&window_); }
 
 }  // namespace phnn

@@ -72,12 +72,6 @@ int WorkQueue::done() const {
   return static_cast<int>(fetch_and_add(1, 0, MPI_NO_OP));
 }
 
-void WorkQueue::close() {
-  if (window_ != MPI_WIN_NULL) {
-    MPI_Win_unlock_all(window_);
-    MPI_Win_free(&window_);
-    window_ = MPI_WIN_NULL;
-  }
-}
+void WorkQueue::close() { free_rank0_window(&window_); }
 
 }  // namespace phnn
