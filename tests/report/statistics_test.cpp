@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "phnn/data/counter_rng.h"
+
 namespace phnn {
 namespace {
 
@@ -150,6 +152,70 @@ TEST(BootstrapTest, IsReproducibleAndDependsOnTheSeedOnly) {
   std::reverse(shuffled.begin(), shuffled.end());
   EXPECT_EQ(a, bootstrap_medians(shuffled));  // the run order does not matter
   EXPECT_NE(a, bootstrap_medians(values, other_seed));
+}
+
+// The resamples as the header defines them, computed the plain way: the n
+// draws of each from one CounterRng stream, the drawn values sorted. The
+// library sorts by counting the draws per index; the medians must be the
+// same doubles, ties, repeats and +inf included.
+std::vector<double> plain_bootstrap_medians(std::vector<double> values,
+                                            const BootstrapOptions& options) {
+  std::sort(values.begin(), values.end());
+  CounterRng rng(options.seed);
+  std::vector<double> medians, sample(values.size());
+  for (int b = 0; b < options.resamples; ++b) {
+    for (double& x : sample) x = values[rng.below(values.size())];
+    medians.push_back(quantile_linear(sample, 0.5));
+  }
+  return medians;
+}
+
+TEST(BootstrapTest, CountingTheDrawsGivesTheSortedResamplesMedians) {
+  const std::vector<std::vector<double>> samples = {
+      {0.05, 0.07, 12.0, 0.04, 800.0, 0.06, 35.0, 0.05, 2600.0},
+      {3.0, 1.0, 3.0, 2.0, kInf, 1.0, 1e-300, 7.5, 7.5, 0.0},
+      {42.0},
+  };
+  for (const auto& values : samples) {
+    const BootstrapOptions options = options_with(3000, 0.95);
+    EXPECT_EQ(bootstrap_medians(values, options), plain_bootstrap_medians(values, options));
+  }
+}
+
+// The intervals are memoized per process: a repeated call, a reordered
+// sample, a sample one ulp away and other options must each give what a
+// fresh computation gives.
+TEST(BootstrapTest, RepeatedIntervalsEqualAFreshComputation) {
+  const std::vector<double> values = {0.05, 0.07, 12.0, 0.04, 800.0, 0.06, 35.0, 0.05, 2600.0};
+  auto fresh = [](const std::vector<double>& v, const BootstrapOptions& o) {
+    return percentile_interval(bootstrap_medians(v, o), o.confidence);
+  };
+  auto same = [](const Interval& a, const Interval& b) {
+    return a.low == b.low && a.high == b.high;
+  };
+  std::vector<double> reversed(values.rbegin(), values.rend());
+  std::vector<double> nudged = values;
+  nudged[4] = std::nextafter(800.0, 0.0);
+  const BootstrapOptions base = options_with(2000, 0.95);
+  for (const auto& options : {base, options_with(2000, 0.5), options_with(4000, 0.95)}) {
+    for (const auto& v : {values, reversed, values, nudged}) {
+      EXPECT_TRUE(same(bootstrap_median_interval(v, options), fresh(v, options)));
+    }
+  }
+  // A one-ulp change of the value the 50 % interval ends on reaches the
+  // interval (B = 2001: the 25 % and 75 % points are draws 500 and 1500
+  // exactly, each a median of 9 values, so a value of the sample).
+  const Interval half = bootstrap_median_interval(values, options_with(2001, 0.5));
+  std::vector<double> moved = values;
+  for (double& v : moved) {
+    if (v == half.high) v = std::nextafter(v, kInf);
+  }
+  const Interval half_moved = bootstrap_median_interval(moved, options_with(2001, 0.5));
+  EXPECT_EQ(half_moved.high, std::nextafter(half.high, kInf));
+  // The IQM's interval is kept apart from the median's.
+  EXPECT_TRUE(same(
+      bootstrap_iqm_interval(values, base),
+      percentile_interval(bootstrap_statistics(values, base, interquartile_mean_sorted), 0.95)));
 }
 
 TEST(BootstrapTest, RejectsFewResamplesBadConfidenceAndNan) {

@@ -104,6 +104,9 @@ Interval percentile_interval(std::vector<double> draws, double confidence);
 /// A constant sample gives [v, v]; n = 1 gives [v, v]; n = 3 with
 /// a < b < c gives [a, c] at 95 % (each of a and c is the bootstrap median
 /// with probability 7/27). Same errors as bootstrap_medians.
+/// Memoized per process (the values' bits and the options are the key): a
+/// reducer replaying adaptive rounds asks for each cell's interval once per
+/// round and table. Thread-safe.
 Interval bootstrap_median_interval(const std::vector<double>& values,
                                    const BootstrapOptions& options = {});
 
