@@ -1,12 +1,13 @@
 // tests/apps/data_command_test.cpp — `phnn data --system FILE`: a system
 // file's data set written with its names and text; a bad file refused with
 // FILE:LINE and the fix, and no output file left behind.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <fstream>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "phnn/store/ph_dataset_file.h"
 #include "test_util.h"
@@ -22,7 +23,8 @@ int phnn(const std::string& args, std::string* output) {
 }
 
 TEST(DataCommandTest, WritesASystemFilesDataSet) {
-  const std::string out = ::testing::TempDir() + "phnn_data_pendulum.h5";
+  const std::string out =
+      ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_data_pendulum.h5";
   std::remove(out.c_str());
   std::string log;
   ASSERT_EQ(phnn("data --system " + std::string(PHNN_SOURCE_DIR) +
@@ -49,7 +51,8 @@ TEST(DataCommandTest, WritesASystemFilesDataSet) {
 TEST(DataCommandTest, SystemFileDataAreTheSameBitsInEveryProcess) {
   std::vector<PhSystemData> runs;
   for (int k = 0; k < 2; ++k) {
-    const std::string out = ::testing::TempDir() + "phnn_data_bits_" + std::to_string(k) + ".h5";
+    const std::string out = ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_data_bits_" +
+                            std::to_string(k) + ".h5";
     std::remove(out.c_str());
     std::string log;
     ASSERT_EQ(phnn("data --system " + std::string(PHNN_SOURCE_DIR) +
@@ -75,8 +78,9 @@ TEST(DataCommandTest, SystemFileDataAreTheSameBitsInEveryProcess) {
 }
 
 TEST(DataCommandTest, RefusesAMalformedSystemFileWithItsLine) {
-  const std::string sys = ::testing::TempDir() + "phnn_bad_system.toml";
-  const std::string out = ::testing::TempDir() + "phnn_bad_system.h5";
+  const std::string sys =
+      ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_bad_system.toml";
+  const std::string out = ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_bad_system.h5";
   std::remove(out.c_str());
   std::ofstream(sys) << "name = \"bad\"\nstates = [\"q\", \"p\"]\nH = \"q^2 + p^2 + mass\"\n"
                         "S = [[0, 1], [-1, 0]]\n[initial]\nmethod = \"energy\"\nenergy = [0.1, 1]\n";
@@ -102,7 +106,8 @@ TEST(TrainCommandTest, TrainsOnASystemFileAndWritesItsResults) {
       << log;
   EXPECT_THAT(log, HasSubstr("coupled-duffing (4 states, 2 ports, 1 input) PHNN-S-RK2"));
   EXPECT_THAT(log, HasSubstr("median [IQR]"));
-  const std::string out = ::testing::TempDir() + "phnn_train_file_out.h5";
+  const std::string out =
+      ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_train_file_out.h5";
   std::remove(out.c_str());
   ASSERT_EQ(phnn("train --system " + sys + " --model phnn-jr-dg --seeds 0,1 --steps 5 --quiet --out " +
                      out,

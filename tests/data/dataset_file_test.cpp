@@ -1,5 +1,7 @@
 // tests/data/dataset_file_test.cpp
-#include "phnn/store/ph_dataset_file.h"
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -7,13 +9,10 @@
 #include <fstream>
 #include <string>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-
-#include "test_util.h"
-
 #include "h5/h5file.h"
+#include "phnn/store/ph_dataset_file.h"
 #include "phnn/store/results_file.h"
+#include "test_util.h"
 
 namespace phnn {
 namespace {
@@ -21,7 +20,7 @@ namespace {
 using ::testing::HasSubstr;
 
 std::string temp_path(const std::string& name) {
-  return ::testing::TempDir() + "phnn_" + name;
+  return ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_" + name;
 }
 
 // A built-in system's data set is its shipped file's, with the physics of

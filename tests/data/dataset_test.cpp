@@ -3,20 +3,21 @@
 // closed forms of the Oscillator class, and the built-in alias table.
 #include "phnn/data/dataset.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <cmath>
 #include <set>
 #include <stdexcept>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-
 #include "phnn/data/ph_dataset.h"
-#include "reference/oscillator.h"
 #include "phnn/systems/system_file.h"
+#include "reference/oscillator.h"
 
 namespace phnn {
 namespace {
@@ -236,7 +237,8 @@ TEST(BuiltinSystemsTest, AliasTableWritesAndReadsEveryParameter) {
 // A shipped file that no longer defines the paper's system is refused,
 // naming the file and the fix; the user's copy under another name is fine.
 TEST(BuiltinSystemsTest, AChangedShippedFileIsRefused) {
-  const std::string dir = ::testing::TempDir() + "phnn_shipped_changed";
+  const std::string dir =
+      ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_shipped_changed";
   std::filesystem::create_directories(dir);
   std::string text = read_system_file_text(shipped_systems_dir() + "/duffing.toml");
   text.replace(text.find("k3*q^4/4"), 8, "k3*q^6/6");

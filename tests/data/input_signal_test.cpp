@@ -3,15 +3,16 @@
 // RNG (a trajectory alone gives the same signal), the discrete power balance
 // exact with u held over a step, pairs carrying u_n, the data-set file
 // round trip, and the [control] table's errors.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "phnn/config/run_config.h"
 #include "phnn/data/ph_dataset.h"
@@ -127,7 +128,8 @@ TEST(InputSignalTest, PairsCarryTheirSamplesInputAndFilesKeepTheSignals) {
   }
   ASSERT_EQ(data.inference.inputs.size(), data.inference.size());
   EXPECT_EQ(data.inference.inputs[0].size(), data.inference.states[0].size());
-  const std::string path = testing::TempDir() + "input_signal_roundtrip.h5";
+  const std::string path =
+      testing::TempDir() + std::to_string(::getpid()) + "_input_signal_roundtrip.h5";
   write_ph_dataset_file(path, data);
   const PhSystemData back = read_ph_dataset_file(path);
   EXPECT_EQ(back.inference.inputs, data.inference.inputs);

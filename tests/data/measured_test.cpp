@@ -5,13 +5,14 @@
 // tests/data/trajectory_files_test.cpp.
 #include "phnn/data/measured.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <set>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "phnn/store/ph_dataset_file.h"
 #include "phnn/store/trajectory_files.h"
@@ -51,7 +52,8 @@ TEST(MeasuredDataTest, AGeneratedSetWrittenAsCsvAndImportedIsTheSameSet) {
   for (const char* name : {"pendulum", "pendulum-forced"}) {
   const auto system = testing_util::shipped_system(name);
   const PhSystemData data = make_ph_system_data(*system, small_options(), 4);
-  const std::string csv = ::testing::TempDir() + "phnn_measured_roundtrip.csv";
+  const std::string csv =
+      ::testing::TempDir() + std::to_string(::getpid()) + "_phnn_measured_roundtrip.csv";
   const TrajectoryColumns columns{system->state_names(), system->input_names()};
   write_trajectory_csv(csv, columns, generated_trajectories(*system, data), "test");
   EXPECT_TRUE(is_phnn_trajectory_csv(csv));

@@ -4,20 +4,21 @@
 // the discrete power balance, and the version-2 data-set file round-trips.
 #include "phnn/data/ph_dataset.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-
 #include "h5/h5file.h"
-#include "reference/discrete_gradient.h"
 #include "phnn/integrators/ph_steps.h"
 #include "phnn/store/dataset_file.h"
 #include "phnn/store/ph_dataset_file.h"
 #include "phnn/systems/system_file.h"
+#include "reference/discrete_gradient.h"
 
 namespace phnn {
 namespace {
@@ -171,7 +172,8 @@ TEST(PhDatasetTest, VersionTwoFileRoundTripsWithNamesAndTheSystemText) {
   options.num_inference = 2;
   const auto system = load_system_file(shipped("coupled-duffing"));
   const PhSystemData data = make_ph_system_data(*system, options, 3);
-  const std::string path = ::testing::TempDir() + "ph_dataset_roundtrip.h5";
+  const std::string path =
+      ::testing::TempDir() + std::to_string(::getpid()) + "_ph_dataset_roundtrip.h5";
   write_ph_dataset_file(path, data);
   const PhSystemData back = read_ph_dataset_file(path);
   EXPECT_EQ(back.system_name, "coupled-duffing");
@@ -202,7 +204,8 @@ TEST(PhDatasetTest, DamagedFilesAreRefusedBeforeAnythingIsIndexed) {
   options.num_validation = 5;
   options.num_inference = 2;
   const auto system = load_system_file(shipped("pendulum"));
-  const std::string path = ::testing::TempDir() + "ph_dataset_damaged.h5";
+  const std::string path =
+      ::testing::TempDir() + std::to_string(::getpid()) + "_ph_dataset_damaged.h5";
   std::string names = "q0";
   for (int i = 1; i < 40; ++i) names += ",q" + std::to_string(i);
   write_ph_dataset_file(path, make_ph_system_data(*system, options, 3));
