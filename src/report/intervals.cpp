@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 namespace phnn {
 namespace {
@@ -155,7 +158,20 @@ RankInterval shift_rank_interval(int m, int n, double confidence) {
     throw std::invalid_argument("shift_rank_interval: m = " + std::to_string(m) +
                                 ", n = " + std::to_string(n) + "; both must be >= 1");
   }
-  return widest_symmetric(m * n, confidence, mann_whitney_cdf(m, n));
+  // A function of (m, n, confidence) alone whose exact recursion costs
+  // O(m^2 n^2): memoized, since a reading of many comparisons (200 seed
+  // resamples of a grid's) asks for the same few sizes again and again.
+  static std::mutex mutex;
+  static std::map<std::tuple<int, int, double>, RankInterval> memo;
+  const auto key = std::make_tuple(m, n, confidence);
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    const auto hit = memo.find(key);
+    if (hit != memo.end()) return hit->second;
+  }
+  const RankInterval r = widest_symmetric(m * n, confidence, mann_whitney_cdf(m, n));
+  const std::lock_guard<std::mutex> lock(mutex);
+  return memo.emplace(key, r).first->second;
 }
 
 double hodges_lehmann_shift(const std::vector<double>& x, const std::vector<double>& y) {

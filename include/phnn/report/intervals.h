@@ -48,6 +48,7 @@ Interval order_statistic_median_interval(const std::vector<double>& values, doub
 ///   p_{i,j}(u) = i/(i+j) p_{i-1,j}(u - j) + j/(i+j) p_{i,j-1}(u)
 /// while m n <= 10 000, else the normal approximation with continuity
 /// correction), k the largest with coverage >= confidence, or k = 1.
+/// Memoized per process (thread-safe).
 RankInterval shift_rank_interval(int m, int n, double confidence);
 
 /// The Hodges-Lehmann shift of x against y: median of the differences
