@@ -3,9 +3,9 @@
 # (tests/analysis/make_fixture.py), plot it, and check that each kind of figure was written;
 # first the unit tests of the scripts' choices (tests/analysis/test_plot_results.py,
 # test_paper_claims.py, test_cost_model_check.py, test_schedule_replay.py,
-# test_compare_ablation.py, test_adaptive_cost.py, test_plot_eval_errors.py, test_arx_baseline.py,
-# test_rounds_replay.py: with the phnn binary given, else $PHNN or build/phnn, it also trains a small
-# adaptive sweep, ~3 s; without one that part is skipped).
+# test_compare_ablation.py, test_adaptive_cost.py, test_rule_variants.py, test_plot_eval_errors.py,
+# test_arx_baseline.py, test_rounds_replay.py: with the phnn binary given, else $PHNN or
+# build/phnn, it also trains a small adaptive sweep, ~3 s; without one that part is skipped).
 # ctest: add_test(NAME plot_results_smoke COMMAND sh ${CMAKE_SOURCE_DIR}/tests/analysis/plot_results_smoke.sh)
 #        set_tests_properties(plot_results_smoke PROPERTIES SKIP_RETURN_CODE 77)
 # Then, with a phnn binary, a real results file with stored weights: the energy figure (phnn eval).
@@ -24,6 +24,7 @@ trap 'rm -rf "$out"' EXIT
 "$py" "$here/test_schedule_replay.py"
 "$py" "$here/test_compare_ablation.py"
 "$py" "$here/test_adaptive_cost.py"
+"$py" "$here/test_rule_variants.py"
 "$py" "$here/test_plot_eval_errors.py"
 "$py" "$here/test_arx_baseline.py"
 PHNN="${2:-${PHNN:-$root/build/phnn}}" "$py" "$here/test_rounds_replay.py"
