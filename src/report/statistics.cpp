@@ -103,18 +103,26 @@ void BootstrapOptions::validate() const {
   }
 }
 
-std::vector<double> bootstrap_statistics(const std::vector<double>& values,
-                                         const BootstrapOptions& options,
-                                         double (*statistic)(const std::vector<double>& sorted)) {
+namespace {
+// The checks every bootstrap makes, then the values sorted: the draws
+// depend on the multiset of values only, not on the order the runs were
+// stored in.
+std::vector<double> checked_sorted(const std::vector<double>& values,
+                                   const BootstrapOptions& options) {
   options.validate();
   if (values.empty()) throw std::invalid_argument("bootstrap: no values");
   for (double v : values) {
     if (std::isnan(v)) throw std::invalid_argument("bootstrap: values contain NaN");
   }
-  // Sorted first, so the draws depend on the multiset of values only, not
-  // on the order the runs were stored in.
   std::vector<double> sorted = values;
   std::sort(sorted.begin(), sorted.end());
+  return sorted;
+}
+
+// bootstrap_statistics on values already checked and sorted.
+std::vector<double> statistics_of_sorted(const std::vector<double>& sorted,
+                                         const BootstrapOptions& options,
+                                         double (*statistic)(const std::vector<double>& sorted)) {
   const std::uint64_t n = sorted.size();
   CounterRng rng(options.seed);
   // Each resample is sorted by counting how often each index of `sorted` is
@@ -133,6 +141,13 @@ std::vector<double> bootstrap_statistics(const std::vector<double>& values,
     draws.push_back(statistic(sample));
   }
   return draws;
+}
+}  // namespace
+
+std::vector<double> bootstrap_statistics(const std::vector<double>& values,
+                                         const BootstrapOptions& options,
+                                         double (*statistic)(const std::vector<double>& sorted)) {
+  return statistics_of_sorted(checked_sorted(values, options), options, statistic);
 }
 
 namespace {
@@ -185,20 +200,16 @@ Interval memoized_interval(Statistic statistic, const std::vector<double>& value
   constexpr std::size_t kMaxEntries = 1 << 14;  // a coverage study's samples never repeat
   static std::mutex mutex;
   static std::unordered_map<IntervalKey, Interval, IntervalKeyHash> memo;
-  options.validate();
-  IntervalKey key{statistic, options.resamples, options.seed, options.confidence, values};
-  if (std::any_of(values.begin(), values.end(), [](double v) { return std::isnan(v); })) {
-    throw std::invalid_argument("bootstrap: values contain NaN");
-  }
-  std::sort(key.sorted.begin(), key.sorted.end());
+  IntervalKey key{statistic, options.resamples, options.seed, options.confidence,
+                  checked_sorted(values, options)};
   {
     const std::lock_guard<std::mutex> lock(mutex);
     const auto hit = memo.find(key);
     if (hit != memo.end()) return hit->second;
   }
   const Interval interval = percentile_interval(
-      bootstrap_statistics(
-          values, options,
+      statistics_of_sorted(
+          key.sorted, options,
           statistic == Statistic::kMedian ? median_sorted : interquartile_mean_sorted),
       options.confidence);
   const std::lock_guard<std::mutex> lock(mutex);
