@@ -65,6 +65,26 @@ def report(s, max_seeds):
     return "\n".join(lines)
 
 
+def summarize_sweep(results, sweep, rule=False):
+    """(summarize() of RESULTS' runs with SWEEP's cost model, the runs asked for that RESULTS
+    lacks, SWEEP's max_seeds); with rule, SWEEP's [adaptive] table replayed on RESULTS' runs
+    (`phnn reduce --rule`)."""
+    import tomllib
+    with open(sweep, "rb") as f:
+        adaptive = tomllib.load(f).get("adaptive")
+    if not adaptive:
+        raise ValueError(f"{sweep}: no [adaptive] table")
+    replay = ("--rule", sweep) if rule else ()
+    runs = run_csv("reduce", results, "--per-run", *replay)
+    missing = [r for r in runs if r["status"] == "pending"]
+    costs = run_csv("sweep", sweep, "--dry-run", "--cell-costs")
+    # Round 0's seeds: the fewest any cell has (every cell trains them).
+    seeds_by_cell = Counter(cell_key(r, "model_label") for r in runs)
+    initial = min(seeds_by_cell.values()) if seeds_by_cell else 0
+    max_seeds = adaptive["max_seeds"]
+    return summarize(runs, costs, initial, adaptive["batch"], max_seeds), missing, max_seeds
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("results", help="results file of an adaptive sweep")
@@ -73,25 +93,16 @@ def main(argv=None):
                         help="replay SWEEP's [adaptive] table on the file's runs instead of the "
                         "file's own (same grid, another rule)")
     args = parser.parse_args(argv)
-    import tomllib
-    with open(args.sweep, "rb") as f:
-        adaptive = tomllib.load(f).get("adaptive")
-    if not adaptive:
-        parser.error(f"{args.sweep}: no [adaptive] table")
-    replay = ("--rule", args.sweep) if args.rule else ()
-    runs = run_csv("reduce", args.results, "--per-run", *replay)
-    missing = [r for r in runs if r["status"] == "pending"]
+    try:
+        s, missing, max_seeds = summarize_sweep(args.results, args.sweep, args.rule)
+    except ValueError as e:
+        parser.error(str(e))
     if missing:
         print(f"adaptive_cost.py: warning: {len(missing)} runs asked for are not finished in "
               f"{args.results}: they count as trained runs (and in the cost model's figures) but "
               f"their seconds are unknown, left out of 'measured', e.g. {missing[0]['run_id']}",
               file=sys.stderr)
-    costs = run_csv("sweep", args.sweep, "--dry-run", "--cell-costs")
-    # Round 0's seeds: the fewest any cell has (every cell trains them).
-    seeds_by_cell = Counter(cell_key(r, "model_label") for r in runs)
-    initial = min(seeds_by_cell.values()) if seeds_by_cell else 0
-    s = summarize(runs, costs, initial, adaptive["batch"], adaptive["max_seeds"])
-    print(report(s, adaptive["max_seeds"]))
+    print(report(s, max_seeds))
     return 0
 
 

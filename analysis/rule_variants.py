@@ -22,12 +22,9 @@ import os
 import re
 import sys
 import tempfile
-import tomllib
-from collections import Counter
 
 import adaptive_cost
 import paper_claims
-from phnn_tool import run_csv
 
 STABLE = 0.9
 
@@ -72,19 +69,13 @@ def verdicts(path, extra, resamples):
     run_rows = paper_claims.reduce_csv(path, "--per-run", *extra)
     stat_rows = paper_claims.reduce_csv(path, *extra)
     stable = paper_claims.read_four_way(path, stat_rows, run_rows, resamples, extra) or {}
-    claims = paper_claims.all_claims(paper_claims.Results(stat_rows, run_rows))
-    return {tag: (paper_claims.verdict_name(comps), stable.get(tag, float("nan")))
-            for tag, _, comps in claims if comps}
+    named = paper_claims.four_way_verdicts(stat_rows, run_rows, paper_claims.FOUR_WAY)
+    return {tag: (v, stable.get(tag, float("nan"))) for tag, v in named.items() if v != "no data"}
 
 
 def rule_cost(path, sweep):
     """(runs asked for, cost-model share of every cell at max_seeds) of SWEEP's rule on PATH."""
-    with open(sweep, "rb") as f:
-        adaptive = tomllib.load(f)["adaptive"]
-    runs = run_csv("reduce", path, "--per-run", "--rule", sweep)
-    costs = run_csv("sweep", sweep, "--dry-run", "--cell-costs")
-    initial = min(Counter(adaptive_cost.cell_key(r, "model_label") for r in runs).values())
-    s = adaptive_cost.summarize(runs, costs, initial, adaptive["batch"], adaptive["max_seeds"])
+    s, _, _ = adaptive_cost.summarize_sweep(path, sweep, rule=True)
     return s["runs"], s["model_trained"] / s["model_full"]
 
 
